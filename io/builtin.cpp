@@ -1,0 +1,32 @@
+#include "scoleid/io/builtin.h"
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::io {
+
+namespace {
+std::vector<BuiltinScenario> all_builtins() {
+  auto all = beam_builtin_scenarios();
+  for (auto& s : scole_builtin_scenarios()) all.push_back(std::move(s));
+  return all;
+}
+}  // namespace
+
+std::vector<std::string> builtin_scenario_names() {
+  std::vector<std::string> names;
+  for (const auto& s : all_builtins()) names.push_back(s.name);
+  return names;
+}
+
+std::string builtin_scenario_yaml(const std::string& name) {
+  for (const auto& s : all_builtins())
+    if (s.name == name) return s.yaml;
+  return {};
+}
+
+std::string builtin_scenario_description(const std::string& name) {
+  for (const auto& s : all_builtins())
+    if (s.name == name) return s.description;
+  return {};
+}
+
+}  // namespace scoleid::io

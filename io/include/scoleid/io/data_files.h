@@ -1,0 +1,70 @@
+#pragma once
+// The data files that are the only bridge between the truth generator and the identifier:
+//   truth.csv   header "t,<columns>", one row per sample; t strictly increasing; all finite.
+//   truth.json  {"scenario", "structure", "columns":[{"name","unit","kind":"input"|"output",
+//                "quantity","at","location","direction","noise_std"}], "true_parameters":{...},
+//                "generator":{...}, "settings":{scenario echo}}
+//   identify.json  see identify/; written through write_json_atomic.
+// Every write goes to a temporary file in the same directory and is renamed into place, so a
+// failed run never leaves a half-written output.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace scoleid::io {
+
+struct DataTable {
+  std::vector<std::string> names;             // column names, without "t"
+  std::vector<double> t;                      // sample times
+  std::vector<std::vector<double>> columns;   // columns[j][i] = value of names[j] at t[i]
+  std::string source;                         // path read from, for messages
+
+  // Index of a column, or -1.
+  int find(const std::string& name) const;
+  // Linear interpolation of column j at time tt (clamped to the ends).
+  double interpolate(int j, double tt) const;
+};
+
+// Throws InputError naming the file, line, column and value for: missing file, empty file,
+// header not starting with t, duplicate names, wrong field count, non-numeric or non-finite
+// values, time not strictly increasing.
+DataTable read_csv(const std::string& path);
+// 17 significant digits; atomic.
+void write_csv(const std::string& path, const DataTable& table);
+
+struct ColumnMeta {
+  std::string name;
+  std::string unit;
+  std::string kind;        // input | output
+  std::string quantity;    // force | moment | displacement | rotation | velocity | acceleration | line_of_sight
+  std::string at;          // beam | mast | shuttle | reflector | actuator1 | actuator2
+  double location = 0.0;   // arc length s, where meaningful
+  std::vector<double> direction = {0.0, 0.0, 0.0};
+  double noise_std = 0.0;
+};
+
+struct TruthMeta {
+  std::string scenario;
+  std::string structure;
+  std::vector<ColumnMeta> columns;
+  std::map<std::string, double> true_parameters;
+  nlohmann::json generator = nlohmann::json::object();
+  nlohmann::json settings = nlohmann::json::object();
+};
+
+nlohmann::json to_json(const TruthMeta& m);
+TruthMeta truth_meta_from_json(const nlohmann::json& j, const std::string& source);
+TruthMeta read_truth_meta(const std::string& path);
+
+// Reads a JSON file; InputError on a missing file or a parse error (with position).
+nlohmann::json read_json(const std::string& path);
+// Pretty-printed, atomic.
+void write_json_atomic(const std::string& path, const nlohmann::json& j);
+// Writes `text` to path atomically (temp file in the same directory + rename).
+void write_text_atomic(const std::string& path, const std::string& text);
+// Creates a directory (and parents); InputError if it cannot.
+void ensure_directory(const std::string& dir);
+
+}  // namespace scoleid::io

@@ -1,0 +1,155 @@
+#pragma once
+// The scenario: one YAML document that both the Simbody truth (model/) and the finite-element
+// identifier (identify/) read. Each struct maps one-to-one onto a YAML section; every field has
+// its default written here, and parse errors name the source, the field path and the value.
+//
+// Units are whatever consistent system the scenario uses (SI for the beam cases, slug-ft-s for
+// SCOLE); no conversion happens anywhere in the code.
+//
+//   name, description
+//   structure: beam | scole
+//   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, tip_mass, tip_inertia }
+//   scole:     see ScoleSpec
+//   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
+//   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
+//   simulation:{ duration, sample_interval, seed }
+//   identification: { parameterization, estimate, initial, elements, data_elements, method, ... }
+//   truth:     { segments, integrator, accuracy, ... }   (the Simbody generator's settings)
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "scoleid/io/signal.h"
+
+namespace scoleid::io {
+
+enum class EndCondition { Pinned, Clamped, Free };
+const char* to_string(EndCondition e);
+
+// Euler–Bernoulli beam on s in [0, length]:
+//   rho_A w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = loads,  c = 2 zeta sqrt(rho_A EI)
+// EI holds one value (uniform) or N values on N equal-length sections.
+struct BeamSpec {
+  double length = 10.0;
+  EndCondition left = EndCondition::Pinned;
+  EndCondition right = EndCondition::Pinned;
+  double rho_A = 67.0;
+  std::vector<double> EI = {23000.0};
+  double zeta = 0.0;
+  double tip_mass = 0.0;     // rigid mass at s = length
+  double tip_inertia = 0.0;  // its rotary inertia about the bending axis
+};
+
+struct RigidBodySpec {
+  double mass = 0.0;
+  double Ixx = 0.0, Iyy = 0.0, Izz = 0.0, Ixy = 0.0, Ixz = 0.0, Iyz = 0.0;  // about its CM
+};
+
+// SCOLE (Taylor & Balakrishnan 1984), slug-ft-s. Shuttle body frame: x roll, y pitch, z yaw;
+// the mast leaves the shuttle at `mast_root` (shuttle frame, relative to the shuttle CM) along
+// body -z; s measured from the root. Roll bending is displacement along y, pitch along x.
+struct ScoleSpec {
+  double length = 130.0;
+  double rho_A = 0.0956;
+  double EI_roll = 4.0e7;
+  double EI_pitch = 4.0e7;
+  double GJ = 4.0e7;
+  double rho_I_psi = 0.9089;
+  double zeta = 0.003;
+  RigidBodySpec shuttle{6366.0, 905443.0, 6789100.0, 7086601.0, 0.0, 0.0, 0.0};
+  RigidBodySpec reflector{12.42, 4969.0, 4969.0, 9938.0, 0.0, 0.0, 0.0};
+  double reflector_rx = 18.75;   // reflector CM offset from the mast tip, shuttle x
+  double reflector_ry = -32.5;   // shuttle y
+  std::vector<double> mast_root = {0.0, 0.0, 0.0};
+  std::vector<double> actuator_locations = {130.0 / 3.0, 260.0 / 3.0};
+  double actuator_mass = 0.2;
+};
+
+// A point input. `at` names the body it acts on: "beam" or "mast" (then `location` is s),
+// "shuttle", "reflector", or "actuatorK" (K = 1, 2: the proof mass's commanded force along its
+// slider). `direction` is a unit axis in the shuttle frame ([0,1,0] etc.); beam inputs act
+// transversally and ignore it.
+struct InputSpec {
+  std::string name;
+  std::string at = "beam";
+  std::string kind = "force";  // force | moment
+  double location = 0.0;
+  std::vector<double> direction = {0.0, 0.0, 0.0};
+  std::string unit;
+  Signal signal;
+};
+
+// A sensor. kind: displacement | rotation | velocity | acceleration | line_of_sight.
+// For beams: transverse displacement w(s) or slope w_s(s) at `location`. For SCOLE: the mast
+// station at `location` (or the reflector), measured in the shuttle frame along `direction`.
+struct SensorSpec {
+  std::string name;
+  std::string at = "beam";
+  std::string kind = "displacement";
+  double location = 0.0;
+  std::vector<double> direction = {0.0, 0.0, 0.0};
+  std::string unit;
+  double noise_std = 0.0;
+};
+
+struct SimulationSpec {
+  double duration = 10.0;
+  double sample_interval = 0.01;
+  unsigned seed = 1;
+};
+
+struct IdentificationSpec {
+  // "physical": parameters are rho_A, EI, zeta, EI_k (k = 1..N), c (damping coefficient).
+  // "paper":    the beam equation divided by rho_A: q1 = EI/rho_A, q2 = 1/rho_A,
+  //             q3 = 2 zeta sqrt(EI/rho_A) (then q1_k on sections).
+  std::string parameterization = "physical";
+  std::vector<std::string> estimate;
+  // Starting point: physical values (rho_A, EI, zeta, EI_k) and/or parameter values by name.
+  std::map<std::string, double> initial;
+  int elements = 10;          // identifier mesh
+  int data_elements = 0;      // mesh that synthesises data; 0 = 2 x elements (at least 2x)
+  std::string method = "auto";  // auto | gauss-newton | lbfgs | steepest-descent
+  int max_iterations = 50;
+  double gradient_tolerance = 1e-9;  // on the scaled gradient
+  double step_tolerance = 1e-10;     // relative parameter change
+  std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
+  double rtol = 1e-9;                 // time-integration tolerances
+  double atol = 0.0;                  // 0 = scaled automatically from the response
+};
+
+struct TruthModelSpec {
+  int segments = 40;
+  std::string integrator = "auto";
+  double accuracy = 1e-8;
+  double output_interval = 0.0;   // 0 = simulation.sample_interval
+};
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  std::string source;       // file path or "built-in scenario 'NAME'", used in messages
+  std::string structure = "beam";  // beam | scole
+  BeamSpec beam;
+  ScoleSpec scole;
+  std::vector<InputSpec> inputs;
+  std::vector<SensorSpec> sensors;
+  SimulationSpec simulation;
+  IdentificationSpec identification;
+  TruthModelSpec truth;
+};
+
+// NAME (a built-in) or a path to a YAML file. Throws InputError.
+Scenario load_scenario(const std::string& name_or_file);
+// Parses YAML text; `source` names it in error messages. Throws InputError.
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source);
+
+std::vector<std::string> builtin_scenario_names();
+std::string builtin_scenario_yaml(const std::string& name);  // "" if unknown
+std::string builtin_scenario_description(const std::string& name);
+
+// Every field, defaults included: the settings a run actually used, echoed into its outputs.
+nlohmann::json to_json(const Scenario& s);
+
+}  // namespace scoleid::io

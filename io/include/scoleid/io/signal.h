@@ -1,0 +1,56 @@
+#pragma once
+// Scalar time functions f(t) that drive the structures: step, pulse, bang-bang, sine, chirp,
+// tabulated (piecewise linear), and sums of these. Shared by the truth generator and the
+// identifier so that both apply bit-identical inputs.
+//
+// Conventions (consistent units, time in seconds):
+//   step      f = A                      for t >= t0, else 0           (a step "at t0+")
+//   pulse     f = A                      for t0 <= t < t0 + width
+//   bangbang  f = +A on [t0, t0+w/2), -A on [t0+w/2, t0+w), 0 elsewhere (rest-to-rest slew)
+//   sine      f = A sin(2π f0 (t - t0) + φ)  on [t0, t0+duration)   (duration <= 0: forever)
+//   chirp     f = A sin(2π (f0 τ + (f1 - f0) τ² / (2 D))), τ = t - t0 in [0, D)  (linear sweep)
+//   haversine f = A (1 - cos(2π (t - t0)/w)) / 2 on [t0, t0+w)   (smooth pulse)
+//   table     piecewise linear through (t_k, f_k), constant beyond the ends
+// Discontinuities (in f or its derivative) are exposed by breakpoints() so integrators can stop
+// there instead of stepping across them.
+#include <string>
+#include <vector>
+
+
+namespace scoleid::io {
+
+struct SignalTerm {
+  enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table };
+  Type type = Type::Step;
+  double amplitude = 0.0;
+  double t0 = 0.0;
+  double width = 0.0;      // pulse, bangbang, haversine
+  double f0 = 0.0;         // sine frequency, chirp start frequency [Hz]
+  double f1 = 0.0;         // chirp end frequency [Hz]
+  double duration = 0.0;   // sine, chirp
+  double phase = 0.0;      // sine [rad]
+  std::vector<double> times, values;  // table
+};
+
+class Signal {
+public:
+  Signal() = default;
+  explicit Signal(std::vector<SignalTerm> terms);
+  static Signal step(double amplitude, double t0 = 0.0);
+  static Signal table(std::vector<double> times, std::vector<double> values);
+
+  double operator()(double t) const;
+  // Sorted, unique times where f or f' jumps.
+  std::vector<double> breakpoints() const;
+  bool is_zero() const { return terms_.empty(); }
+  const std::vector<SignalTerm>& terms() const { return terms_; }
+  // One-line human description, e.g. "step 10 at 0".
+  std::string describe() const;
+
+private:
+  std::vector<SignalTerm> terms_;
+};
+
+const char* to_string(SignalTerm::Type t);
+
+}  // namespace scoleid::io

@@ -1,0 +1,509 @@
+#include "scoleid/io/scenario.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "scoleid/io/error.h"
+
+namespace scoleid::io {
+
+const char* to_string(EndCondition e) {
+  switch (e) {
+    case EndCondition::Pinned: return "pinned";
+    case EndCondition::Clamped: return "clamped";
+    case EndCondition::Free: return "free";
+  }
+  return "?";
+}
+
+namespace {
+
+// Reads typed fields from a YAML map, naming `source` and the dotted field path on any error,
+// and rejects keys the schema does not know (a typo must not silently fall back to a default).
+class Reader {
+public:
+  Reader(const YAML::Node& node, std::string source, std::string path)
+      : node_(node), source_(std::move(source)), path_(std::move(path)) {
+    if (node_ && !node_.IsNull() && !node_.IsMap())
+      fail_field(source_, path_.empty() ? "document" : path_, "must be a map", "a " + kind(node_));
+  }
+  ~Reader() noexcept(false) {
+    if (std::uncaught_exceptions() == 0) check_unknown();
+  }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  bool has(const std::string& key) {
+    seen_.insert(key);
+    return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
+  }
+  YAML::Node child(const std::string& key) {
+    seen_.insert(key);
+    return node_ && node_.IsMap() ? node_[key] : YAML::Node();
+  }
+  std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const std::string& source() const { return source_; }
+
+  double num(const std::string& key, double dflt) {
+    if (!has(key)) return dflt;
+    return as_number(node_[key], field(key));
+  }
+  double positive(const std::string& key, double dflt) {
+    const double v = num(key, dflt);
+    if (!(v > 0.0)) fail_field(source_, field(key), "must be > 0", format_value(v));
+    return v;
+  }
+  double nonneg(const std::string& key, double dflt) {
+    const double v = num(key, dflt);
+    if (!(v >= 0.0)) fail_field(source_, field(key), "must be >= 0", format_value(v));
+    return v;
+  }
+  int integer(const std::string& key, int dflt, int lo, int hi) {
+    if (!has(key)) return dflt;
+    const double v = as_number(node_[key], field(key));
+    if (v != std::floor(v) || v < lo || v > hi)
+      fail_field(source_, field(key),
+                 "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]",
+                 format_value(v));
+    return static_cast<int>(v);
+  }
+  std::string str(const std::string& key, const std::string& dflt) {
+    if (!has(key)) return dflt;
+    const YAML::Node n = node_[key];
+    if (!n.IsScalar()) fail_field(source_, field(key), "must be a string", "a " + kind(n));
+    return n.as<std::string>();
+  }
+  std::string choice(const std::string& key, const std::string& dflt,
+                     const std::vector<std::string>& allowed) {
+    const std::string v = str(key, dflt);
+    for (const auto& a : allowed)
+      if (a == v) return v;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
+    fail_field(source_, field(key), "must be one of " + list, "'" + v + "'");
+  }
+  std::vector<double> numbers(const std::string& key, const std::vector<double>& dflt) {
+    if (!has(key)) return dflt;
+    const YAML::Node n = node_[key];
+    std::vector<double> out;
+    if (n.IsScalar()) {
+      out.push_back(as_number(n, field(key)));
+    } else if (n.IsSequence()) {
+      for (std::size_t i = 0; i < n.size(); ++i)
+        out.push_back(as_number(n[i], field(key) + "[" + std::to_string(i) + "]"));
+    } else {
+      fail_field(source_, field(key), "must be a number or a list of numbers", "a " + kind(n));
+    }
+    return out;
+  }
+  std::vector<std::string> strings(const std::string& key) {
+    std::vector<std::string> out;
+    if (!has(key)) return out;
+    const YAML::Node n = node_[key];
+    if (n.IsScalar()) {
+      out.push_back(n.as<std::string>());
+    } else if (n.IsSequence()) {
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        if (!n[i].IsScalar())
+          fail_field(source_, field(key) + "[" + std::to_string(i) + "]", "must be a string",
+                     "a " + kind(n[i]));
+        out.push_back(n[i].as<std::string>());
+      }
+    } else {
+      fail_field(source_, field(key), "must be a string or a list of strings", "a " + kind(n));
+    }
+    return out;
+  }
+
+  double as_number(const YAML::Node& n, const std::string& f) const {
+    if (!n.IsScalar()) fail_field(source_, f, "must be a number", "a " + kind(n));
+    const std::string text = n.Scalar();
+    const std::string low = lower(text);
+    if (low == "nan" || low == ".nan" || low == "inf" || low == ".inf" || low == "-.inf" ||
+        low == "-inf" || low == "+inf")
+      fail_field(source_, f, "must be a finite number", "'" + text + "'");
+    double v = 0.0;
+    try {
+      std::size_t used = 0;
+      v = std::stod(text, &used);
+      if (used != text.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      fail_field(source_, f, "must be a number", "'" + text + "'");
+    }
+    if (!std::isfinite(v)) fail_field(source_, f, "must be a finite number", "'" + text + "'");
+    return v;
+  }
+
+  static std::string kind(const YAML::Node& n) {
+    if (n.IsSequence()) return std::string("list");
+    if (n.IsMap()) return std::string("map");
+    if (n.IsNull()) return std::string("null");
+    return "'" + n.Scalar() + "'";
+  }
+
+private:
+  static std::string lower(std::string s) {
+    for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  }
+  void check_unknown() const {
+    if (!node_ || !node_.IsMap()) return;
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (!seen_.count(key)) fail_field(source_, field(key), "is not a known field", "'" + key + "'");
+    }
+  }
+
+  YAML::Node node_;
+  std::string source_, path_;
+  std::set<std::string> seen_;
+};
+
+EndCondition parse_end(Reader& r, const std::string& key, EndCondition dflt) {
+  const std::string v = r.choice(key, to_string(dflt), {"pinned", "clamped", "free"});
+  if (v == "pinned") return EndCondition::Pinned;
+  if (v == "clamped") return EndCondition::Clamped;
+  return EndCondition::Free;
+}
+
+SignalTerm parse_signal_term(const YAML::Node& n, const std::string& source, const std::string& path) {
+  Reader r(n, source, path);
+  SignalTerm s;
+  const std::string type = r.choice("type", "step",
+                                    {"step", "pulse", "bangbang", "sine", "chirp", "haversine", "table"});
+  s.amplitude = r.num("amplitude", 0.0);
+  s.t0 = r.num("t0", 0.0);
+  if (type == "step") {
+    s.type = SignalTerm::Type::Step;
+  } else if (type == "pulse" || type == "bangbang" || type == "haversine") {
+    s.type = type == "pulse" ? SignalTerm::Type::Pulse
+             : type == "bangbang" ? SignalTerm::Type::BangBang : SignalTerm::Type::Haversine;
+    s.width = r.positive("width", 0.0);
+  } else if (type == "sine") {
+    s.type = SignalTerm::Type::Sine;
+    s.f0 = r.positive("frequency", 0.0);
+    s.phase = r.num("phase", 0.0);
+    s.duration = r.nonneg("duration", 0.0);
+  } else if (type == "chirp") {
+    s.type = SignalTerm::Type::Chirp;
+    s.f0 = r.nonneg("f0", 0.0);
+    s.f1 = r.nonneg("f1", 0.0);
+    s.duration = r.positive("duration", 0.0);
+  } else {
+    s.type = SignalTerm::Type::Table;
+    s.times = r.numbers("times", {});
+    s.values = r.numbers("values", {});
+    if (s.times.empty() || s.times.size() != s.values.size())
+      fail_field(source, r.field("values"), "must have one value per entry of times (" +
+                                                std::to_string(s.times.size()) + ")",
+                 std::to_string(s.values.size()) + " values");
+    for (std::size_t i = 1; i < s.times.size(); ++i)
+      if (!(s.times[i] > s.times[i - 1]))
+        fail_field(source, r.field("times") + "[" + std::to_string(i) + "]",
+                   "must be increasing", format_value(s.times[i]));
+  }
+  return s;
+}
+
+Signal parse_signal(const YAML::Node& n, const std::string& source, const std::string& path) {
+  std::vector<SignalTerm> terms;
+  if (!n || n.IsNull()) return Signal();
+  if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i)
+      terms.push_back(parse_signal_term(n[i], source, path + "[" + std::to_string(i) + "]"));
+  } else {
+    terms.push_back(parse_signal_term(n, source, path));
+  }
+  return Signal(std::move(terms));
+}
+
+std::vector<double> parse_direction(Reader& r, const std::string& key) {
+  if (!r.has(key)) return {0.0, 0.0, 0.0};
+  const YAML::Node n = r.child(key);
+  if (n.IsScalar()) {
+    const std::string a = n.Scalar();
+    if (a == "x") return {1, 0, 0};
+    if (a == "y") return {0, 1, 0};
+    if (a == "z") return {0, 0, 1};
+  }
+  std::vector<double> d = r.numbers(key, {});
+  if (d.size() != 3) fail_field(r.source(), r.field(key), "must be x, y, z or a 3-vector", Reader::kind(n));
+  const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(norm > 0)) fail_field(r.source(), r.field(key), "must be non-zero", "[0, 0, 0]");
+  for (auto& x : d) x /= norm;
+  return d;
+}
+
+void parse_rigid(const YAML::Node& n, const std::string& source, const std::string& path, RigidBodySpec& b) {
+  Reader r(n, source, path);
+  b.mass = r.positive("mass", b.mass);
+  b.Ixx = r.positive("Ixx", b.Ixx);
+  b.Iyy = r.positive("Iyy", b.Iyy);
+  b.Izz = r.positive("Izz", b.Izz);
+  b.Ixy = r.num("Ixy", b.Ixy);
+  b.Ixz = r.num("Ixz", b.Ixz);
+  b.Iyz = r.num("Iyz", b.Iyz);
+}
+
+void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b) {
+  Reader r(n, source, "beam");
+  b.length = r.positive("length", b.length);
+  b.left = parse_end(r, "left", b.left);
+  b.right = parse_end(r, "right", b.right);
+  b.rho_A = r.positive("rho_A", b.rho_A);
+  b.EI = r.numbers("EI", b.EI);
+  if (b.EI.empty() || b.EI.size() > 4096)
+    fail_field(source, "beam.EI", "must hold 1 to 4096 section values", std::to_string(b.EI.size()));
+  for (std::size_t i = 0; i < b.EI.size(); ++i)
+    if (!(b.EI[i] > 0.0))
+      fail_field(source, b.EI.size() == 1 ? "beam.EI" : "beam.EI[" + std::to_string(i) + "]",
+                 "must be > 0", format_value(b.EI[i]));
+  b.zeta = r.nonneg("zeta", b.zeta);
+  b.tip_mass = r.nonneg("tip_mass", b.tip_mass);
+  b.tip_inertia = r.nonneg("tip_inertia", b.tip_inertia);
+  if (b.left == EndCondition::Free && b.right == EndCondition::Free) {
+    // free-free is allowed (rigid modes), nothing to check here
+  }
+}
+
+void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s) {
+  Reader r(n, source, "scole");
+  s.length = r.positive("length", s.length);
+  s.rho_A = r.positive("rho_A", s.rho_A);
+  if (r.has("EI")) s.EI_roll = s.EI_pitch = r.positive("EI", s.EI_roll);
+  s.EI_roll = r.positive("EI_roll", s.EI_roll);
+  s.EI_pitch = r.positive("EI_pitch", s.EI_pitch);
+  s.GJ = r.positive("GJ", s.GJ);
+  s.rho_I_psi = r.positive("rho_I_psi", s.rho_I_psi);
+  s.zeta = r.nonneg("zeta", s.zeta);
+  if (r.has("shuttle")) parse_rigid(r.child("shuttle"), source, "scole.shuttle", s.shuttle);
+  if (r.has("reflector")) parse_rigid(r.child("reflector"), source, "scole.reflector", s.reflector);
+  s.reflector_rx = r.num("reflector_rx", s.reflector_rx);
+  s.reflector_ry = r.num("reflector_ry", s.reflector_ry);
+  s.mast_root = r.numbers("mast_root", s.mast_root);
+  if (s.mast_root.size() != 3)
+    fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(s.mast_root.size()) + " values");
+  // Actuators default to L/3 and 2L/3 of the length actually configured.
+  s.actuator_locations = r.numbers("actuator_locations", {s.length / 3.0, 2.0 * s.length / 3.0});
+  for (std::size_t i = 0; i < s.actuator_locations.size(); ++i) {
+    const double a = s.actuator_locations[i];
+    if (!(a > 0.0 && a < s.length))
+      fail_field(source, "scole.actuator_locations[" + std::to_string(i) + "]",
+                 "must lie inside the mast (0, " + format_value(s.length) + ")", format_value(a));
+  }
+  s.actuator_mass = r.positive("actuator_mass", s.actuator_mass);
+}
+
+double structure_length(const Scenario& sc) {
+  return sc.structure == "scole" ? sc.scole.length : sc.beam.length;
+}
+
+void check_location(const Scenario& sc, const std::string& field, const std::string& at, double loc) {
+  if (at != "beam" && at != "mast") return;
+  const double L = structure_length(sc);
+  if (!(loc >= 0.0 && loc <= L))
+    fail_field(sc.source, field, "must lie on the " + at + " [0, " + format_value(L) + "]", format_value(loc));
+}
+
+void parse_inputs(const YAML::Node& n, Scenario& sc) {
+  if (!n || n.IsNull()) return;
+  if (!n.IsSequence()) fail_field(sc.source, "inputs", "must be a list", Reader::kind(n));
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string path = "inputs[" + std::to_string(i) + "]";
+    Reader r(n[i], sc.source, path);
+    InputSpec in;
+    in.name = r.str("name", "u" + std::to_string(i + 1));
+    if (!names.insert(in.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + in.name + "'");
+    in.at = r.choice("at", sc.structure == "scole" ? "reflector" : "beam",
+                     {"beam", "mast", "shuttle", "reflector", "actuator1", "actuator2"});
+    in.kind = r.choice("kind", "force", {"force", "moment"});
+    in.location = r.num("location", 0.0);
+    check_location(sc, r.field("location"), in.at, in.location);
+    in.direction = parse_direction(r, "direction");
+    in.unit = r.str("unit", "");
+    in.signal = parse_signal(r.child("signal"), sc.source, r.field("signal"));
+    sc.inputs.push_back(std::move(in));
+  }
+}
+
+void parse_sensors(const YAML::Node& n, Scenario& sc) {
+  if (!n || n.IsNull()) return;
+  if (!n.IsSequence()) fail_field(sc.source, "sensors", "must be a list", Reader::kind(n));
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string path = "sensors[" + std::to_string(i) + "]";
+    Reader r(n[i], sc.source, path);
+    SensorSpec s;
+    s.name = r.str("name", "y" + std::to_string(i + 1));
+    if (!names.insert(s.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + s.name + "'");
+    s.at = r.choice("at", sc.structure == "scole" ? "mast" : "beam", {"beam", "mast", "reflector", "shuttle"});
+    s.kind = r.choice("kind", "displacement",
+                      {"displacement", "rotation", "velocity", "acceleration", "line_of_sight"});
+    s.location = r.num("location", 0.0);
+    check_location(sc, r.field("location"), s.at, s.location);
+    s.direction = parse_direction(r, "direction");
+    s.unit = r.str("unit", "");
+    s.noise_std = r.nonneg("noise_std", 0.0);
+    sc.sensors.push_back(std::move(s));
+  }
+}
+
+void parse_identification(const YAML::Node& n, const std::string& source, IdentificationSpec& id) {
+  Reader r(n, source, "identification");
+  id.parameterization = r.choice("parameterization", id.parameterization, {"physical", "paper"});
+  id.estimate = r.strings("estimate");
+  if (r.has("initial")) {
+    const YAML::Node m = r.child("initial");
+    if (!m.IsMap()) fail_field(source, "identification.initial", "must be a map name: value", Reader::kind(m));
+    for (const auto& kv : m) {
+      const std::string key = kv.first.as<std::string>();
+      const double v = r.as_number(kv.second, "identification.initial." + key);
+      if (!(v > 0.0)) fail_field(source, "identification.initial." + key, "must be > 0", format_value(v));
+      id.initial[key] = v;
+    }
+  }
+  id.elements = r.integer("elements", id.elements, 1, 4096);
+  id.data_elements = r.integer("data_elements", id.data_elements, 0, 16384);
+  id.method = r.choice("method", id.method, {"auto", "gauss-newton", "lbfgs", "steepest-descent"});
+  id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
+  id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
+  id.step_tolerance = r.positive("step_tolerance", id.step_tolerance);
+  id.steepest_weights = r.numbers("steepest_weights", {});
+  for (std::size_t i = 0; i < id.steepest_weights.size(); ++i)
+    if (!(id.steepest_weights[i] > 0))
+      fail_field(source, "identification.steepest_weights[" + std::to_string(i) + "]", "must be > 0",
+                 format_value(id.steepest_weights[i]));
+  id.rtol = r.positive("rtol", id.rtol);
+  id.atol = r.nonneg("atol", id.atol);
+}
+
+void parse_truth(const YAML::Node& n, const std::string& source, TruthModelSpec& t) {
+  Reader r(n, source, "truth");
+  t.segments = r.integer("segments", t.segments, 2, 100000);
+  t.integrator = r.str("integrator", t.integrator);
+  t.accuracy = r.positive("accuracy", t.accuracy);
+  t.output_interval = r.nonneg("output_interval", t.output_interval);
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
+                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (!root || root.IsNull()) throw InputError(source + ": empty scenario document");
+  Scenario sc;
+  sc.source = source;
+  try {
+    Reader r(root, source, "");
+    sc.name = r.str("name", "unnamed");
+    sc.description = r.str("description", "");
+    sc.structure = r.choice("structure", "beam", {"beam", "scole"});
+    if (r.has("beam")) parse_beam(r.child("beam"), source, sc.beam);
+    if (r.has("scole")) parse_scole(r.child("scole"), source, sc.scole);
+    {
+      Reader s(r.child("simulation"), source, "simulation");
+      sc.simulation.duration = s.positive("duration", sc.simulation.duration);
+      sc.simulation.sample_interval = s.positive("sample_interval", sc.simulation.sample_interval);
+      sc.simulation.seed = static_cast<unsigned>(s.integer("seed", 1, 0, 2147483647));
+      if (sc.simulation.sample_interval > sc.simulation.duration)
+        fail_field(source, "simulation.sample_interval", "must not exceed simulation.duration (" +
+                                                             format_value(sc.simulation.duration) + ")",
+                   format_value(sc.simulation.sample_interval));
+    }
+    parse_inputs(r.child("inputs"), sc);
+    parse_sensors(r.child("sensors"), sc);
+    if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
+    if (r.has("truth")) parse_truth(r.child("truth"), source, sc.truth);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  return sc;
+}
+
+Scenario load_scenario(const std::string& name_or_file) {
+  const std::string builtin = builtin_scenario_yaml(name_or_file);
+  if (!builtin.empty()) return parse_scenario(builtin, "built-in scenario '" + name_or_file + "'");
+  std::ifstream in(name_or_file);
+  if (!in) {
+    const bool looks_like_file = name_or_file.find('/') != std::string::npos ||
+                                 name_or_file.find(".yaml") != std::string::npos ||
+                                 name_or_file.find(".yml") != std::string::npos;
+    if (looks_like_file) throw InputError("scenario file '" + name_or_file + "': cannot be opened");
+    std::string names;
+    for (const auto& n : builtin_scenario_names()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError("scenario '" + name_or_file + "': not a built-in scenario (" + names +
+                     ") nor a readable file");
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_scenario(ss.str(), "scenario '" + name_or_file + "'");
+}
+
+nlohmann::json to_json(const Scenario& s) {
+  using nlohmann::json;
+  auto rigid = [](const RigidBodySpec& b) {
+    return json{{"mass", b.mass}, {"Ixx", b.Ixx}, {"Iyy", b.Iyy}, {"Izz", b.Izz},
+                {"Ixy", b.Ixy}, {"Ixz", b.Ixz}, {"Iyz", b.Iyz}};
+  };
+  auto signal = [](const Signal& sig) {
+    json terms = json::array();
+    for (const auto& t : sig.terms()) {
+      json j{{"type", to_string(t.type)}, {"amplitude", t.amplitude}, {"t0", t.t0}};
+      if (t.width > 0) j["width"] = t.width;
+      if (t.type == SignalTerm::Type::Sine) { j["frequency"] = t.f0; j["phase"] = t.phase; j["duration"] = t.duration; }
+      if (t.type == SignalTerm::Type::Chirp) { j["f0"] = t.f0; j["f1"] = t.f1; j["duration"] = t.duration; }
+      if (t.type == SignalTerm::Type::Table) { j["times"] = t.times; j["values"] = t.values; }
+      terms.push_back(j);
+    }
+    return terms;
+  };
+  json j;
+  j["name"] = s.name;
+  j["description"] = s.description;
+  j["source"] = s.source;
+  j["structure"] = s.structure;
+  if (s.structure == "beam") {
+    j["beam"] = {{"length", s.beam.length}, {"left", to_string(s.beam.left)}, {"right", to_string(s.beam.right)},
+                 {"rho_A", s.beam.rho_A}, {"EI", s.beam.EI}, {"zeta", s.beam.zeta},
+                 {"tip_mass", s.beam.tip_mass}, {"tip_inertia", s.beam.tip_inertia}};
+  } else {
+    const auto& c = s.scole;
+    j["scole"] = {{"length", c.length}, {"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch},
+                  {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}, {"shuttle", rigid(c.shuttle)},
+                  {"reflector", rigid(c.reflector)}, {"reflector_rx", c.reflector_rx},
+                  {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
+                  {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass}};
+  }
+  j["inputs"] = json::array();
+  for (const auto& in : s.inputs)
+    j["inputs"].push_back({{"name", in.name}, {"at", in.at}, {"kind", in.kind}, {"location", in.location},
+                           {"direction", in.direction}, {"unit", in.unit}, {"signal", signal(in.signal)}});
+  j["sensors"] = json::array();
+  for (const auto& se : s.sensors)
+    j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", se.kind}, {"location", se.location},
+                            {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
+  j["simulation"] = {{"duration", s.simulation.duration}, {"sample_interval", s.simulation.sample_interval},
+                     {"seed", s.simulation.seed}};
+  const auto& id = s.identification;
+  j["identification"] = {{"parameterization", id.parameterization}, {"estimate", id.estimate},
+                         {"initial", id.initial}, {"elements", id.elements}, {"data_elements", id.data_elements},
+                         {"method", id.method}, {"max_iterations", id.max_iterations},
+                         {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
+                         {"steepest_weights", id.steepest_weights}, {"rtol", id.rtol}, {"atol", id.atol}};
+  j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
+                {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval}};
+  return j;
+}
+
+}  // namespace scoleid::io

@@ -1,0 +1,125 @@
+#include "scoleid/io/signal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace scoleid::io {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+double table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
+  if (ts.empty()) return 0.0;
+  if (t <= ts.front()) return vs.front();
+  if (t >= ts.back()) return vs.back();
+  const auto it = std::upper_bound(ts.begin(), ts.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - ts.begin());
+  const double a = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+  return (1.0 - a) * vs[k - 1] + a * vs[k];
+}
+
+double term_value(const SignalTerm& s, double t) {
+  using T = SignalTerm::Type;
+  const double tau = t - s.t0;
+  switch (s.type) {
+    case T::Step: return tau >= 0.0 ? s.amplitude : 0.0;
+    case T::Pulse: return (tau >= 0.0 && tau < s.width) ? s.amplitude : 0.0;
+    case T::BangBang:
+      if (tau < 0.0 || tau >= s.width) return 0.0;
+      return tau < 0.5 * s.width ? s.amplitude : -s.amplitude;
+    case T::Sine:
+      if (tau < 0.0 || (s.duration > 0.0 && tau >= s.duration)) return 0.0;
+      return s.amplitude * std::sin(2.0 * kPi * s.f0 * tau + s.phase);
+    case T::Chirp:
+      if (tau < 0.0 || tau >= s.duration) return 0.0;
+      return s.amplitude *
+             std::sin(2.0 * kPi * (s.f0 * tau + (s.f1 - s.f0) * tau * tau / (2.0 * s.duration)));
+    case T::Haversine:
+      if (tau < 0.0 || tau >= s.width) return 0.0;
+      return s.amplitude * 0.5 * (1.0 - std::cos(2.0 * kPi * tau / s.width));
+    case T::Table: return table_value(s.times, s.values, t);
+  }
+  return 0.0;
+}
+}  // namespace
+
+Signal::Signal(std::vector<SignalTerm> terms) : terms_(std::move(terms)) {}
+
+Signal Signal::step(double amplitude, double t0) {
+  SignalTerm s;
+  s.type = SignalTerm::Type::Step;
+  s.amplitude = amplitude;
+  s.t0 = t0;
+  return Signal({s});
+}
+
+Signal Signal::table(std::vector<double> times, std::vector<double> values) {
+  SignalTerm s;
+  s.type = SignalTerm::Type::Table;
+  s.times = std::move(times);
+  s.values = std::move(values);
+  return Signal({s});
+}
+
+double Signal::operator()(double t) const {
+  double f = 0.0;
+  for (const auto& s : terms_) f += term_value(s, t);
+  return f;
+}
+
+std::vector<double> Signal::breakpoints() const {
+  using T = SignalTerm::Type;
+  std::vector<double> b;
+  for (const auto& s : terms_) {
+    switch (s.type) {
+      case T::Step: b.push_back(s.t0); break;
+      case T::Pulse:
+      case T::Haversine: b.push_back(s.t0); b.push_back(s.t0 + s.width); break;
+      case T::BangBang:
+        b.push_back(s.t0); b.push_back(s.t0 + 0.5 * s.width); b.push_back(s.t0 + s.width);
+        break;
+      case T::Sine:
+        b.push_back(s.t0);
+        if (s.duration > 0.0) b.push_back(s.t0 + s.duration);
+        break;
+      case T::Chirp: b.push_back(s.t0); b.push_back(s.t0 + s.duration); break;
+      case T::Table: b.insert(b.end(), s.times.begin(), s.times.end()); break;
+    }
+  }
+  std::sort(b.begin(), b.end());
+  b.erase(std::unique(b.begin(), b.end()), b.end());
+  return b;
+}
+
+const char* to_string(SignalTerm::Type t) {
+  using T = SignalTerm::Type;
+  switch (t) {
+    case T::Step: return "step";
+    case T::Pulse: return "pulse";
+    case T::BangBang: return "bangbang";
+    case T::Sine: return "sine";
+    case T::Chirp: return "chirp";
+    case T::Haversine: return "haversine";
+    case T::Table: return "table";
+  }
+  return "?";
+}
+
+std::string Signal::describe() const {
+  if (terms_.empty()) return "zero";
+  std::ostringstream os;
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const auto& s = terms_[i];
+    if (i) os << " + ";
+    os << to_string(s.type);
+    if (s.type == SignalTerm::Type::Table) {
+      os << " (" << s.times.size() << " points)";
+    } else {
+      os << ' ' << s.amplitude << " at " << s.t0;
+    }
+  }
+  return os.str();
+}
+
+}  // namespace scoleid::io

@@ -1,0 +1,102 @@
+#include "scoleid/io/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "scoleid/io/error.h"
+
+using namespace scoleid::io;
+
+namespace {
+std::string error_of(const std::string& yaml) {
+  try {
+    parse_scenario(yaml, "scenario 'x.yaml'");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Scenario, EveryBuiltinParsesAndHasInputsAndSensors) {
+  ASSERT_FALSE(builtin_scenario_names().empty());
+  for (const auto& name : builtin_scenario_names()) {
+    const Scenario s = load_scenario(name);
+    EXPECT_EQ(s.name, name);
+    EXPECT_FALSE(s.inputs.empty()) << name;
+    EXPECT_FALSE(s.sensors.empty()) << name;
+    EXPECT_FALSE(builtin_scenario_description(name).empty()) << name;
+  }
+}
+
+TEST(Scenario, PaperBeamOneHoldsThePaperValues) {
+  const Scenario s = load_scenario("paper-beam-1");
+  EXPECT_EQ(s.beam.left, EndCondition::Pinned);
+  EXPECT_DOUBLE_EQ(s.beam.rho_A, 67.0);
+  EXPECT_DOUBLE_EQ(s.beam.EI.at(0), 23000.0);
+  EXPECT_DOUBLE_EQ(s.identification.initial.at("rho_A"), 63.0);
+  EXPECT_DOUBLE_EQ(s.inputs.at(0).signal(0.1), 10.0);
+}
+
+TEST(Scenario, JsonEchoRoundTripsKeyFields) {
+  const Scenario s = load_scenario("paper-beam-3");
+  const auto j = to_json(s);
+  EXPECT_EQ(j["beam"]["EI"].size(), 2u);
+  EXPECT_EQ(j["sensors"][1]["location"].get<double>(), 7.5);
+}
+
+TEST(Scenario, UnknownBuiltinNamesTheChoices) {
+  try {
+    load_scenario("paper-beam-9");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("paper-beam-9"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("paper-beam-1"), std::string::npos);
+  }
+}
+
+TEST(Scenario, MissingFileIsNamed) {
+  try {
+    load_scenario("/nonexistent/s.yaml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/s.yaml"), std::string::npos);
+  }
+}
+
+TEST(Scenario, MalformedYamlGivesLine) {
+  const std::string e = error_of("beam: {length: 10\ninputs: [");
+  EXPECT_NE(e.find("malformed YAML at line"), std::string::npos) << e;
+}
+
+TEST(Scenario, NegativeStiffnessNamesFieldAndValue) {
+  EXPECT_EQ(error_of("beam: {EI: -3}"), "scenario 'x.yaml': beam.EI must be > 0, got -3");
+  EXPECT_EQ(error_of("beam: {EI: [1, 0]}"), "scenario 'x.yaml': beam.EI[1] must be > 0, got 0");
+  EXPECT_EQ(error_of("beam: {rho_A: -1}"), "scenario 'x.yaml': beam.rho_A must be > 0, got -1");
+}
+
+TEST(Scenario, NanAndTextAreRejected) {
+  EXPECT_EQ(error_of("beam: {EI: .nan}"), "scenario 'x.yaml': beam.EI must be a finite number, got '.nan'");
+  EXPECT_EQ(error_of("beam: {length: ten}"), "scenario 'x.yaml': beam.length must be a number, got 'ten'");
+}
+
+TEST(Scenario, UnknownFieldIsRejected) {
+  EXPECT_EQ(error_of("beam: {lenght: 3}"), "scenario 'x.yaml': beam.lenght is not a known field, got 'lenght'");
+}
+
+TEST(Scenario, SensorOutsideBeamIsRejected) {
+  EXPECT_EQ(error_of("beam: {length: 10}\nsensors: [{name: a, location: 12}]"),
+            "scenario 'x.yaml': sensors[0].location must lie on the beam [0, 10], got 12");
+}
+
+TEST(Scenario, BadEndConditionListsChoices) {
+  EXPECT_EQ(error_of("beam: {left: hinged}"),
+            "scenario 'x.yaml': beam.left must be one of pinned|clamped|free, got 'hinged'");
+}
+
+TEST(Scenario, TableSignalNeedsIncreasingTimes) {
+  const std::string e = error_of(
+      "inputs: [{name: f, location: 1, signal: {type: table, times: [0, 2, 1], values: [0, 1, 2]}}]");
+  EXPECT_EQ(e, "scenario 'x.yaml': inputs[0].signal.times[2] must be increasing, got 1");
+}
