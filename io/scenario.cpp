@@ -369,6 +369,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     }
   }
   id.elements = r.integer("elements", id.elements, 1, 4096);
+  id.sections = r.integer("sections", id.sections, 0, 4096);
   id.data_elements = r.integer("data_elements", id.data_elements, 0, 16384);
   id.method = r.choice("method", id.method, {"auto", "gauss-newton", "lbfgs", "steepest-descent"});
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
@@ -497,7 +498,7 @@ nlohmann::json to_json(const Scenario& s) {
                      {"seed", s.simulation.seed}};
   const auto& id = s.identification;
   j["identification"] = {{"parameterization", id.parameterization}, {"estimate", id.estimate},
-                         {"initial", id.initial}, {"elements", id.elements}, {"data_elements", id.data_elements},
+                         {"initial", id.initial}, {"elements", id.elements}, {"sections", id.sections}, {"data_elements", id.data_elements},
                          {"method", id.method}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"steepest_weights", id.steepest_weights}, {"rtol", id.rtol}, {"atol", id.atol}};

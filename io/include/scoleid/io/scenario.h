@@ -109,6 +109,7 @@ struct IdentificationSpec {
   // Starting point: physical values (rho_A, EI, zeta, EI_k) and/or parameter values by name.
   std::map<std::string, double> initial;
   int elements = 10;          // identifier mesh
+  int sections = 0;           // equal sections carrying EI_k in the identifier (0 = the beam's own)
   int data_elements = 0;      // mesh that synthesises data; 0 = 2 x elements (at least 2x)
   std::string method = "auto";  // auto | gauss-newton | lbfgs | steepest-descent
   int max_iterations = 50;

@@ -1,0 +1,37 @@
+#pragma once
+// Closed-form Euler–Bernoulli results used as references (uniform beam, length L, EI, ρA).
+//
+// Frequencies ω_k = (β_k L)² sqrt(EI / (ρA L⁴)), with β_k L the k-th positive root of
+//   pinned–pinned    sin βL = 0                                  (β_k L = kπ)
+//   clamped–free     1 + cos βL cosh βL = 0
+//   free–free        1 − cos βL cosh βL = 0                       (flexible modes)
+//   clamped–clamped  1 − cos βL cosh βL = 0
+//   clamped, tip mass m_t and rotary inertia J_t at the free end (μ = m_t/(ρA L), j = J_t/(ρA L³)):
+//     1 + c ch + μ λ (c sh − s ch) − j λ³ (s ch + c sh) + μ j λ⁴ (1 − c ch) = 0,  λ = βL
+//     (Blevins, Formulas for Natural Frequency and Mode Shape, Table 8-1; c = cos, ch = cosh …)
+// Roots are found by bracketing sign changes and bisection to machine precision.
+//
+// Static deflections: pinned–pinned with a point load P at a:
+//   w(x) = P b x (L² − b² − x²) / (6 EI L),  x <= a,  b = L − a     (symmetric expression beyond a)
+// clamped–free with a tip load P: w(x) = P x² (3L − x) / (6 EI).
+//
+// Step response of the pinned–pinned beam to a point step load P at a (zero initial state),
+// modal series: w(x,t) = Σ_k (2P / (ρA L ω_k²)) sin(kπa/L) sin(kπx/L) (1 − cos ω_k t).
+#include <vector>
+
+namespace scoleid::identify::analytic {
+
+enum class Support { PinnedPinned, ClampedFree, FreeFree, ClampedClamped };
+
+std::vector<double> beta_L(Support s, int count);
+std::vector<double> beta_L_tip_mass(double mu, double j, int count);
+// ω_k from β_k L
+double omega(double betaL, double L, double EI, double rhoA);
+
+double ss_static_point_load(double x, double a, double P, double L, double EI);
+double cantilever_static_tip_load(double x, double P, double L, double EI);
+// Modal series with `terms` modes (the neglected tail is bounded by Σ k⁻⁴, below 1e-11 relative at 4000).
+double ss_step_response(double x, double t, double a, double P, double L, double EI, double rhoA,
+                        int terms = 4000);
+
+}  // namespace scoleid::identify::analytic

@@ -1,0 +1,67 @@
+#pragma once
+// A linear structural model whose operators are affine in a coefficient vector c:
+//
+//   M(c) ü + D(c) u̇ + K(c) u = Σ_i γ_i(c) b_i f_i(t),     y = C u
+//
+//   M(c) = Σ_terms c_j M_j,  D(c) = Σ c_j D_j,  K(c) = Σ c_j K_j   (coefficient index -1 = constant 1)
+//
+// Every physical parameter enters through the coefficients (mass per length, sectional EI,
+// Kelvin–Voigt coefficients, ...), so the first variation needed by the costate gradient is
+//   ∂J/∂c_j = ∫₀ᵀ pᵀ (M_j ü + D_j u̇ + K_j u − b_j f) dt
+// a sum over the terms that carry c_j; its cost is that of one pass over all terms, whatever
+// the number of coefficients (DESIGN §2, Eq. 25).
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <string>
+#include <vector>
+
+namespace scoleid::identify {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+struct OperatorTerm {
+  SparseMatrix matrix;
+  int coefficient = -1;  // index into c, or -1 for a constant term
+};
+
+struct ModelInput {
+  std::string name;
+  VectorXd vector;        // b_i (generalised load for a unit input)
+  int coefficient = -1;   // γ_i = c[coefficient], or 1
+};
+
+struct ModelSensor {
+  std::string name;
+  std::string kind;       // displacement | rotation (rows act on u)
+  Eigen::RowVectorXd row; // C_k
+};
+
+struct StructuralModel {
+  int ndof = 0;
+  int ncoef = 0;
+  std::vector<std::string> coefficient_names;
+  std::vector<int> dof_group;             // for error weights: DOFs of like units share a group
+  std::vector<OperatorTerm> mass, damping, stiffness;
+  std::vector<ModelInput> inputs;
+  std::vector<ModelSensor> sensors;
+
+  SparseMatrix assemble(const std::vector<OperatorTerm>& terms, const VectorXd& c) const;
+  double input_scale(int i, const VectorXd& c) const {
+    const int k = inputs[static_cast<std::size_t>(i)].coefficient;
+    return k < 0 ? 1.0 : c[k];
+  }
+  // Output matrix C (sensors × ndof).
+  MatrixXd output_matrix() const;
+};
+
+// Assembled operators at one coefficient vector.
+struct AssembledModel {
+  SparseMatrix M, D, K;
+  std::vector<VectorXd> loads;  // γ_i b_i
+};
+
+AssembledModel assemble(const StructuralModel& model, const VectorXd& c);
+
+}  // namespace scoleid::identify

@@ -1,0 +1,339 @@
+#include "scoleid/identify/second_order_solver.h"
+
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace scoleid::identify {
+
+bool SolverOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(rtol > 0 && rtol < 1)) return bad("rtol must be in (0, 1)");
+  if (!(atol_floor > 0)) return bad("atol_floor must be > 0");
+  if (max_steps < 1) return bad("max_steps must be >= 1");
+  if (!(max_step >= 0)) return bad("max_step must be >= 0");
+  if (max_order < 1 || max_order > 5) return bad("max_order must be in [1, 5]");
+  return true;
+}
+
+std::string SolverSummary::BriefReport() const {
+  std::ostringstream os;
+  os << (ok ? "ok" : "FAILED") << ": steps " << steps << ", rhs " << rhs_evaluations << ", factorizations "
+     << factorizations << ", error-test failures " << error_test_failures << ", " << wall_seconds << " s";
+  if (!ok) os << " (" << message << ")";
+  return os.str();
+}
+
+void SolverSummary::Accumulate(const SolverSummary& o) {
+  steps += o.steps;
+  rhs_evaluations += o.rhs_evaluations;
+  factorizations += o.factorizations;
+  linear_solves += o.linear_solves;
+  error_test_failures += o.error_test_failures;
+  nonlinear_iterations += o.nonlinear_iterations;
+  wall_seconds += o.wall_seconds;
+}
+
+namespace {
+
+using LDLT = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>>;
+
+// RAII owners for the SUNDIALS objects of one solve.
+struct Context {
+  SUNContext ctx = nullptr;
+  Context() {
+    if (SUNContext_Create(nullptr, &ctx) != 0) throw std::runtime_error("SUNContext_Create failed");
+  }
+  ~Context() { SUNContext_Free(&ctx); }
+};
+struct Vector {
+  N_Vector v = nullptr;
+  Vector(sunindextype n, SUNContext ctx) : v(N_VNew_Serial(n, ctx)) {
+    if (!v) throw std::runtime_error("N_VNew_Serial failed");
+  }
+  ~Vector() { N_VDestroy(v); }
+  double* data() const { return N_VGetArrayPointer(v); }
+};
+struct CvodeMem {
+  void* mem = nullptr;
+  explicit CvodeMem(SUNContext ctx) : mem(CVodeCreate(CV_BDF, ctx)) {
+    if (!mem) throw std::runtime_error("CVodeCreate failed");
+  }
+  ~CvodeMem() { CVodeFree(&mem); }
+};
+
+void check(int retval, const char* what) {
+  if (retval < 0) throw std::runtime_error(std::string(what) + " failed with flag " + std::to_string(retval));
+}
+
+}  // namespace
+
+struct SecondOrderSolver::Impl {
+  int n = 0;
+  SparseMatrix M, D, K;   // on the common pattern of M, D, K
+  std::vector<int> group;
+  int ngroups = 1;
+  SolverOptions opt;
+  LDLT mass_ldlt;
+
+  // Per-solve state (solve() is const but single-threaded per object).
+  mutable LDLT newton_ldlt;
+  mutable SparseMatrix S;
+  mutable double gamma_factored = std::numeric_limits<double>::quiet_NaN();
+  mutable long factorizations = 0;
+  mutable long linear_solves = 0;
+  mutable std::vector<double> group_max;
+  mutable const Forcing* forcing = nullptr;
+  mutable Eigen::VectorXd F, tmp;
+  mutable void* cvode = nullptr;
+  mutable std::string callback_error;
+
+  void rhs(double t, const double* y, double* ydot) const {
+    const double* x = y;
+    const double* v = y + n;
+    std::copy_n(v, n, ydot);
+    F.setZero();
+    (*forcing)(t, F.data());
+    acceleration(F.data(), x, v, ydot + n);
+  }
+  void acceleration(const double* Fp, const double* x, const double* v, double* a) const {
+    Eigen::Map<const Eigen::VectorXd> X(x, n), V(v, n), Fm(Fp, n);
+    tmp = Fm - D * V - K * X;
+    Eigen::Map<Eigen::VectorXd>(a, n) = mass_ldlt.solve(tmp);
+  }
+  void factor(double gamma) const {
+    // S = M + γD + γ²K on the shared pattern: values only, the symbolic analysis is reused.
+    const int nnz = static_cast<int>(M.nonZeros());
+    double* s = S.valuePtr();
+    const double* m = M.valuePtr();
+    const double* d = D.valuePtr();
+    const double* k = K.valuePtr();
+    const double g2 = gamma * gamma;
+    for (int i = 0; i < nnz; ++i) s[i] = m[i] + gamma * d[i] + g2 * k[i];
+    newton_ldlt.factorize(S);
+    if (newton_ldlt.info() != Eigen::Success) throw std::runtime_error("Newton matrix factorization failed");
+    gamma_factored = gamma;
+    ++factorizations;
+  }
+  void newton_solve(double gamma, const double* r, double* sol) const {
+    if (gamma != gamma_factored) factor(gamma);
+    ++linear_solves;
+    Eigen::Map<const Eigen::VectorXd> r1(r, n), r2(r + n, n);
+    tmp = M * r2 - gamma * (K * r1);
+    Eigen::Map<Eigen::VectorXd> a(sol, n), b(sol + n, n);
+    b = newton_ldlt.solve(tmp);
+    a = r1 + gamma * b;
+  }
+  void weights(const double* y, double* w) const {
+    const double rtol = opt.rtol;
+    for (int i = 0; i < 2 * n; ++i) {
+      const int g = (i < n ? group[static_cast<std::size_t>(i)] : ngroups + group[static_cast<std::size_t>(i - n)]);
+      group_max[static_cast<std::size_t>(g)] = std::max(group_max[static_cast<std::size_t>(g)], std::abs(y[i]));
+    }
+    for (int i = 0; i < 2 * n; ++i) {
+      const int g = (i < n ? group[static_cast<std::size_t>(i)] : ngroups + group[static_cast<std::size_t>(i - n)]);
+      const double atol = rtol * std::max(group_max[static_cast<std::size_t>(g)], opt.atol_floor);
+      w[i] = 1.0 / (rtol * std::abs(y[i]) + atol);
+    }
+  }
+};
+
+namespace {
+SecondOrderSolver::Impl* impl_of(void* user) { return static_cast<SecondOrderSolver::Impl*>(user); }
+
+int cv_rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
+  auto* s = impl_of(user);
+  try {
+    s->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+    return 0;
+  } catch (const std::exception& e) {
+    s->callback_error = e.what();
+    return -1;
+  }
+}
+
+int cv_ewt(N_Vector y, N_Vector ewt, void* user) {
+  impl_of(user)->weights(N_VGetArrayPointer(y), N_VGetArrayPointer(ewt));
+  return 0;
+}
+
+// Matrix-embedded linear solver: the integrator hands us b; we read γ from CVODES.
+SUNLinearSolver_Type ls_type(SUNLinearSolver) { return SUNLINEARSOLVER_MATRIX_EMBEDDED; }
+SUNLinearSolver_ID ls_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+int ls_setup(SUNLinearSolver, SUNMatrix) { return 0; }
+int ls_solve(SUNLinearSolver LS, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+  auto* s = impl_of(LS->content);
+  try {
+    double gamma = 0.0;
+    CVodeGetCurrentGamma(s->cvode, &gamma);
+    s->newton_solve(gamma, N_VGetArrayPointer(b), N_VGetArrayPointer(x));
+    return 0;
+  } catch (const std::exception& e) {
+    s->callback_error = e.what();
+    return -1;
+  }
+}
+int ls_free(SUNLinearSolver LS) {
+  LS->content = nullptr;
+  SUNLinSolFreeEmpty(LS);
+  return 0;
+}
+
+SparseMatrix on_pattern(const SparseMatrix& A, const SparseMatrix& pattern) {
+  // A re-expressed on `pattern` (which contains A's pattern), explicit zeros kept.
+  SparseMatrix out = pattern;
+  for (int k = 0; k < out.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(out, k); it; ++it) it.valueRef() = 0.0;
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(A, k); it; ++it) out.coeffRef(it.row(), it.col()) += it.value();
+  return out;
+}
+}  // namespace
+
+SecondOrderSolver::SecondOrderSolver(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K,
+                                     std::vector<int> dof_group, SolverOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("SolverOptions: " + why);
+  Impl& s = *impl_;
+  s.n = static_cast<int>(M.rows());
+  s.opt = options;
+  // Common pattern: |M| + |D| + |K| with structural ones so that no entry cancels.
+  SparseMatrix pattern = M.cwiseAbs() + D.cwiseAbs() + K.cwiseAbs();
+  for (int k = 0; k < pattern.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(pattern, k); it; ++it) it.valueRef() = 1.0;
+  pattern.makeCompressed();
+  s.M = on_pattern(M, pattern);
+  s.D = on_pattern(D, pattern);
+  s.K = on_pattern(K, pattern);
+  s.S = pattern;
+  s.group = dof_group.empty() ? std::vector<int>(static_cast<std::size_t>(s.n), 0) : std::move(dof_group);
+  s.ngroups = 1 + *std::max_element(s.group.begin(), s.group.end());
+  s.mass_ldlt.compute(M);
+  if (s.mass_ldlt.info() != Eigen::Success) throw std::runtime_error("mass matrix is not positive definite");
+  s.newton_ldlt.analyzePattern(s.S);
+  s.F.resize(s.n);
+  s.tmp.resize(s.n);
+}
+
+SecondOrderSolver::~SecondOrderSolver() = default;
+
+int SecondOrderSolver::dim() const { return impl_->n; }
+
+void SecondOrderSolver::acceleration(const double* F, const double* x, const double* v, double* a) const {
+  impl_->acceleration(F, x, v, a);
+}
+
+Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
+                                    SolverSummary* summary) const {
+  const auto wall0 = std::chrono::steady_clock::now();
+  Impl& s = *impl_;
+  const int n = s.n;
+  s.forcing = &forcing;
+  s.gamma_factored = std::numeric_limits<double>::quiet_NaN();
+  s.factorizations = 0;
+  s.linear_solves = 0;
+  s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);
+  s.callback_error.clear();
+
+  std::vector<double> stops;
+  for (double b : breakpoints)
+    if (b > t0 && b < t1) stops.push_back(b);
+  std::sort(stops.begin(), stops.end());
+  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
+  stops.push_back(t1);
+
+  Context ctx;
+  Vector y(2 * n, ctx.ctx);
+  N_VConst(0.0, y.v);
+  CvodeMem cv(ctx.ctx);
+  s.cvode = cv.mem;
+  check(CVodeInit(cv.mem, cv_rhs, t0, y.v), "CVodeInit");
+  check(CVodeSetUserData(cv.mem, &s), "CVodeSetUserData");
+  check(CVodeWFtolerances(cv.mem, cv_ewt), "CVodeWFtolerances");
+  check(CVodeSetMaxNumSteps(cv.mem, s.opt.max_steps), "CVodeSetMaxNumSteps");
+  check(CVodeSetMaxOrd(cv.mem, s.opt.max_order), "CVodeSetMaxOrd");
+  if (s.opt.max_step > 0) check(CVodeSetMaxStep(cv.mem, s.opt.max_step), "CVodeSetMaxStep");
+  SUNLinearSolver LS = SUNLinSolNewEmpty(ctx.ctx);
+  if (!LS) throw std::runtime_error("SUNLinSolNewEmpty failed");
+  LS->content = &s;
+  LS->ops->gettype = ls_type;
+  LS->ops->getid = ls_id;
+  LS->ops->setup = ls_setup;
+  LS->ops->solve = ls_solve;
+  LS->ops->free = ls_free;
+  struct LSOwner {
+    SUNLinearSolver ls;
+    ~LSOwner() { SUNLinSolFree(ls); }
+  } ls_owner{LS};
+  check(CVodeSetLinearSolver(cv.mem, LS, nullptr), "CVodeSetLinearSolver");
+
+  Trajectory traj(n);
+  std::vector<double> a(static_cast<std::size_t>(n));
+  auto record = [&](double t, const double* yy, bool left_limit) {
+    s.F.setZero();
+    forcing(left_limit ? std::nextafter(t, -std::numeric_limits<double>::infinity()) : t, s.F.data());
+    s.acceleration(s.F.data(), yy, yy + n, a.data());
+    traj.push(t, yy, yy + n, a.data());
+  };
+  record(t0, y.data(), false);
+
+  long steps = 0, rhs = 0, etf = 0, nni = 0;
+  double t = t0;
+  for (std::size_t seg = 0; seg < stops.size(); ++seg) {
+    const double stop = stops[seg];
+    check(CVodeSetStopTime(cv.mem, stop), "CVodeSetStopTime");
+    while (t < stop) {
+      const int flag = CVode(cv.mem, stop, y.v, &t, CV_ONE_STEP);
+      if (flag < 0) {
+        std::string msg = "CVODES failed at t = " + std::to_string(t) + " with flag " + std::to_string(flag);
+        if (!s.callback_error.empty()) msg += ": " + s.callback_error;
+        throw std::runtime_error(msg);
+      }
+      const bool at_break = (t >= stop) && seg + 1 < stops.size();
+      record(t, y.data(), at_break);
+    }
+    if (seg + 1 < stops.size()) {
+      // Restart past the discontinuity: right limit recorded at the same time.
+      long st = 0, fe = 0, ef = 0, ni = 0;
+      CVodeGetNumSteps(cv.mem, &st);
+      CVodeGetNumRhsEvals(cv.mem, &fe);
+      CVodeGetNumErrTestFails(cv.mem, &ef);
+      CVodeGetNumNonlinSolvIters(cv.mem, &ni);
+      steps += st; rhs += fe; etf += ef; nni += ni;
+      record(t, y.data(), false);
+      check(CVodeReInit(cv.mem, t, y.v), "CVodeReInit");
+    }
+  }
+  long st = 0, fe = 0, ef = 0, ni = 0;
+  CVodeGetNumSteps(cv.mem, &st);
+  CVodeGetNumRhsEvals(cv.mem, &fe);
+  CVodeGetNumErrTestFails(cv.mem, &ef);
+  CVodeGetNumNonlinSolvIters(cv.mem, &ni);
+  if (summary) {
+    summary->ok = true;
+    summary->steps = steps + st;
+    summary->rhs_evaluations = rhs + fe;
+    summary->error_test_failures = etf + ef;
+    summary->nonlinear_iterations = nni + ni;
+    summary->factorizations = s.factorizations;
+    summary->linear_solves = s.linear_solves;
+    summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  }
+  s.forcing = nullptr;
+  return traj;
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,66 @@
+#include "scoleid/model/beam_chain.h"
+
+#include <cmath>
+
+#include "scoleid/model/joint_forces.h"
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
+  length_ = beam.length;
+  root_R_ = Vec3(0);
+  axis_B_ = axis_R_ = Vec3(1, 0, 0);
+
+  PiecewiseField EI{beam.length, beam.EI};
+  PiecewiseField c{beam.length, beam.EI};
+  for (auto& v : c.values) v = 2.0 * beam.zeta * std::sqrt(beam.rho_A * v);
+  lumping_ = hencky_lumping(n, EI, c);
+  const double h = lumping_.h;
+
+  // Thin rigid bar along its x axis: no inertia about its own axis.
+  const double m = beam.rho_A * h;
+  const double J = m * h * h / 12.0;
+  const MassProperties bar(m, Vec3(h / 2, 0, 0), Inertia(Vec3(0, J, J)).shiftFromMassCenter(Vec3(-h / 2, 0, 0), m));
+
+  std::vector<JointSpring> joints;
+  std::vector<AnchorSpring> anchors;
+  MobilizedBody parent = matter_.Ground();
+  for (int i = 0; i < n; ++i) {
+    MassProperties mp = bar;
+    if (i == n - 1 && (beam.tip_mass > 0.0 || beam.tip_inertia > 0.0)) {
+      // Bar + tip body, combined about the segment origin.
+      const double M = m + beam.tip_mass;
+      const Vec3 com = (m * Vec3(h / 2, 0, 0) + beam.tip_mass * Vec3(h, 0, 0)) / M;
+      const Inertia I_tip = Inertia(Vec3(0, beam.tip_inertia, beam.tip_inertia)) +
+                            Inertia(Vec3(h, 0, 0), beam.tip_mass);
+      mp = MassProperties(M, com, bar.getInertia() + I_tip);
+    }
+    const Body::Rigid body(mp);
+    const Transform X_PF = i == 0 ? Transform() : Transform(Vec3(h, 0, 0));
+    MobilizedBody seg;
+    if (i == 0 && beam.left == io::EndCondition::Free) {
+      seg = MobilizedBody::Planar(parent, X_PF, body, Transform());
+    } else {
+      seg = MobilizedBody::Pin(parent, X_PF, body, Transform());
+    }
+    const auto j = static_cast<std::size_t>(i);
+    if (i > 0) joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
+    if (i == 0 && beam.left == io::EndCondition::Clamped)
+      joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[0], lumping_.damping[0]});
+    segment_bodies_.push_back(seg.getMobilizedBodyIndex());
+    parent = seg;
+  }
+  if (beam.right != io::EndCondition::Free) {
+    Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));
+    if (beam.right == io::EndCondition::Clamped) {
+      const auto j = static_cast<std::size_t>(n);
+      anchors.push_back({parent.getMobilizedBodyIndex(), lumping_.stiffness[j], lumping_.damping[j]});
+    }
+  }
+  joint_springs_ = joints;
+  Force::Custom(forces_, new JointForces(matter_, std::move(joints), std::move(anchors)));
+}
+
+}  // namespace scoleid::model

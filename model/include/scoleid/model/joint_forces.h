@@ -1,0 +1,39 @@
+#pragma once
+// Joint spring-dampers of a lumped chain, as one Simbody force element.
+//
+// Each JointSpring acts on one mobility (a joint rotation q with speed u = qdot, as for Pin and
+// Gimbal mobilizers): generalized force f = -k q - c u, potential energy 1/2 k q^2. Mobility
+// forces are internal: they act equally and oppositely on the two bodies of the joint, so they
+// conserve the system's linear and angular momentum. An AnchorSpring ties a planar body's
+// absolute rotation about ground z to zero (a clamped end that is not the chain's root):
+// torque -k theta - c omega_z on the body.
+#include <vector>
+
+#include <Simbody.h>
+
+#include "scoleid/model/structure.h"
+
+namespace scoleid::model {
+
+struct AnchorSpring {
+  SimTK::MobilizedBodyIndex body;
+  double k = 0.0;
+  double c = 0.0;
+};
+
+class JointForces : public SimTK::Force::Custom::Implementation {
+public:
+  JointForces(const SimTK::SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
+              std::vector<AnchorSpring> anchors);
+  void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
+                 SimTK::Vector_<SimTK::Vec3>& particle_forces,
+                 SimTK::Vector& mobility_forces) const override;
+  SimTK::Real calcPotentialEnergy(const SimTK::State& state) const override;
+
+private:
+  const SimTK::SimbodyMatterSubsystem& matter_;
+  std::vector<JointSpring> joints_;
+  std::vector<AnchorSpring> anchors_;
+};
+
+}  // namespace scoleid::model

@@ -1,0 +1,42 @@
+#pragma once
+// Sensor read-outs of a Structure (DESIGN §5), all measured in the reference body R (ground for
+// a beam, the shuttle for SCOLE) along the sensor's unit direction d_R:
+//   displacement   (p_RP - p_RP0) . d          P the station, p_RP0 its undeformed position
+//                  (beam: w(s) along +y)
+//   rotation       theta_RB . d                theta the rotation vector (angle * axis) of the
+//                  body B carrying P relative to R (beam: the slope w_s, about +z)
+//   velocity       (d/dt in R of p_RP) . d     (beam: w_t)
+//   acceleration   a_GP expressed in R, . d    inertial, as an accelerometer reads it (no
+//                  gravity in orbit; beam: w_tt)
+//   line_of_sight  the angle, about d, through which the line from the mast root to the point
+//                  (the feed-to-reflector line) has turned in R: (u0 x u) . d, u unit vectors.
+// Shuttle sensors ("at: shuttle") measure the shuttle itself in ground: CM displacement and the
+// attitude rotation vector relative to its initial orientation.
+// Every read-out needs the state realized to Stage::Acceleration (for acceleration) or Velocity.
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "scoleid/io/scenario.h"
+#include "scoleid/model/structure.h"
+
+namespace scoleid::model {
+
+struct ResolvedSensor {
+  enum class Kind { Displacement, Rotation, Velocity, Acceleration, LineOfSight };
+  Kind kind = Kind::Displacement;
+  Station station;
+  SimTK::Vec3 d_R{0.0};
+  SimTK::MobilizedBodyIndex reference;   // R
+  SimTK::Vec3 root_R{0.0};               // for line_of_sight
+};
+
+std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& scenario, const Structure& structure);
+
+// Sensor value in the given state (realized to Acceleration when any sensor is an
+// accelerometer, else Velocity).
+double read_sensor(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::State& state,
+                   const ResolvedSensor& sensor);
+
+}  // namespace scoleid::model

@@ -1,0 +1,73 @@
+#pragma once
+// A structure built in Simbody: the multibody system plus the map from the scenario's
+// vocabulary (arc position s, "shuttle", "reflector", "actuatorK") to bodies and stations.
+//
+// Frames (monogram notation): G ground (inertial), R the reference body in which displacements
+// are measured (ground for a beam, the shuttle for SCOLE), B a segment body. A station is a
+// point fixed on a body, p_BS; p_RS0 is where it sits in R in the undeformed configuration.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "scoleid/model/hencky.h"
+
+namespace scoleid::model {
+
+struct Station {
+  SimTK::MobilizedBodyIndex body;
+  SimTK::Vec3 p_BS{0.0};   // station on its body
+  SimTK::Vec3 p_RS0{0.0};  // undeformed position in the reference body R
+};
+
+// One spring-damper on one mobility (a joint rotation): f = -k q - c u.
+struct JointSpring {
+  SimTK::MobilizedBodyIndex body;
+  int which = 0;
+  double k = 0.0;
+  double c = 0.0;
+};
+
+class Structure {
+public:
+  Structure() : matter_(system_), forces_(system_) {}
+  virtual ~Structure() = default;
+  Structure(const Structure&) = delete;
+  Structure& operator=(const Structure&) = delete;
+
+  SimTK::MultibodySystem& system() { return system_; }
+  const SimTK::MultibodySystem& system() const { return system_; }
+  SimTK::SimbodyMatterSubsystem& matter() { return matter_; }
+  const SimTK::SimbodyMatterSubsystem& matter() const { return matter_; }
+  SimTK::GeneralForceSubsystem& forces() { return forces_; }
+
+  // "beam" or "scole".
+  virtual std::string kind() const = 0;
+  // The body in which displacements are measured (ground or shuttle).
+  virtual SimTK::MobilizedBodyIndex reference_body() const = 0;
+  // The point at arc position s on the rigid segment that contains it.
+  Station station_at(double s) const;
+  // Named rigid bodies: "shuttle", "reflector"; an invalid index if absent.
+  virtual Station named_station(const std::string& at) const;
+  // Slider mobilizers of actuator K (1-based) along reference x and y, or invalid.
+  virtual SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const;
+
+  int segments() const { return static_cast<int>(segment_bodies_.size()); }
+  double length() const { return length_; }
+  const std::vector<SimTK::MobilizedBodyIndex>& segment_bodies() const { return segment_bodies_; }
+  const std::vector<JointSpring>& joint_springs() const { return joint_springs_; }
+
+protected:
+  SimTK::MultibodySystem system_;
+  SimTK::SimbodyMatterSubsystem matter_;
+  SimTK::GeneralForceSubsystem forces_;
+  double length_ = 0.0;
+  SimTK::Vec3 root_R_{0.0};        // s = 0 in R, undeformed
+  SimTK::Vec3 axis_B_{1, 0, 0};    // unit tangent of the chain in every segment frame
+  SimTK::Vec3 axis_R_{1, 0, 0};    // the same tangent in R, undeformed
+  std::vector<SimTK::MobilizedBodyIndex> segment_bodies_;  // segment i spans [i h, (i+1) h]
+  std::vector<JointSpring> joint_springs_;
+};
+
+}  // namespace scoleid::model

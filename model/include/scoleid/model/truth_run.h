@@ -1,0 +1,90 @@
+#pragma once
+// Scenario -> Simbody structure -> trajectory table + metadata (the truth.csv / truth.json of
+// DESIGN §6, written through scoleid::io).
+//
+// The equations integrated are the structure's multibody equations of motion (beam_chain.h,
+// scole_system.h) under the scenario's inputs, from rest in the undeformed configuration.
+// Integration stops at every input breakpoint (io::Signal::breakpoints) and restarts there,
+// so no step straddles a jump in f or f'. Samples are taken at k * dt, k = 0..floor(T/dt),
+// dt = truth.output_interval or simulation.sample_interval, by the integrator's interpolant.
+// Sensor noise: N(0, noise_std^2), one std::mt19937_64 seeded with simulation.seed, drawn
+// column by column (sensors in scenario order, samples in time order) for sensors with
+// noise_std > 0; inputs are never noisy.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/scenario.h"
+#include "scoleid/model/structure.h"
+
+namespace scoleid::model {
+
+// Integrators by name: rk-merson, rk-feldberg, rk3, cpodes, verlet, semi-explicit-euler2, and
+// "auto" (= kDefaultIntegrator, chosen from the benchmark in model/bench.cpp).
+extern const char* const kDefaultIntegrator;
+std::vector<std::string> integrator_names();
+std::unique_ptr<SimTK::Integrator> make_integrator(const std::string& name, const SimTK::System& system,
+                                                   double accuracy);
+
+// Builds the beam chain or the SCOLE system of the scenario with `segments` segments.
+std::unique_ptr<Structure> build_structure(const io::Scenario& scenario, int segments);
+
+struct SimulateOptions {
+  std::string integrator = "auto";
+  double accuracy = 1e-8;
+  double final_time = 1.0;
+  double sample_interval = 0.01;
+  std::vector<double> breakpoints;   // times where the inputs jump
+  bool progress = false;             // percent and real-time factor on stderr
+  bool IsValid(std::string* why) const;
+};
+
+struct SimulateSummary {
+  enum class Termination { Completed, Failed };
+  Termination termination = Termination::Completed;
+  std::string message;
+  std::string integrator;
+  int samples = 0;
+  int steps_taken = 0;
+  int steps_attempted = 0;
+  int realizations = 0;
+  double simulated_seconds = 0.0;
+  double wall_seconds = 0.0;
+  double real_time_factor() const { return wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0; }
+  std::string BriefReport() const;
+};
+
+// Integrates `system` from `initial` (realized or not) and calls on_sample(state) at every
+// sample time with the state realized to Acceleration. Throws std::runtime_error on failure.
+SimulateSummary simulate(const SimTK::MultibodySystem& system, const SimTK::State& initial,
+                         const SimulateOptions& options,
+                         const std::function<void(const SimTK::State&)>& on_sample);
+
+struct TruthOptions {
+  int segments = 0;            // 0 = scenario truth.segments
+  std::string integrator;      // "" = scenario truth.integrator
+  double accuracy = 0.0;       // 0 = scenario truth.accuracy
+  bool progress = false;
+  bool IsValid(std::string* why) const;
+};
+
+struct TruthResult {
+  io::DataTable table;
+  io::TruthMeta meta;
+  SimulateSummary summary;
+};
+
+// Throws io::InputError for a scenario the truth cannot represent, std::runtime_error when the
+// integration fails.
+TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& options = {});
+// DIR/truth.csv and DIR/truth.json, each written atomically.
+void write_truth(const TruthResult& result, const std::string& dir);
+
+// The physical true parameters as truth.json reports them.
+std::map<std::string, double> true_parameters(const io::Scenario& scenario);
+
+}  // namespace scoleid::model

@@ -1,0 +1,45 @@
+#include "scoleid/model/joint_forces.h"
+
+#include <cmath>
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+JointForces::JointForces(const SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
+                         std::vector<AnchorSpring> anchors)
+    : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)) {}
+
+namespace {
+double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB(1, 0), R_GB(0, 0)); }
+}  // namespace
+
+void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces, Vector_<Vec3>&,
+                            Vector& mobility_forces) const {
+  for (const auto& j : joints_) {
+    const MobilizedBody& b = matter_.getMobilizedBody(j.body);
+    const Real f = -j.k * b.getOneQ(state, j.which) - j.c * b.getOneU(state, j.which);
+    b.applyOneMobilityForce(state, j.which, f, mobility_forces);
+  }
+  for (const auto& a : anchors_) {
+    const MobilizedBody& b = matter_.getMobilizedBody(a.body);
+    const Real theta = planar_angle(b.getBodyRotation(state));
+    const Real omega = b.getBodyAngularVelocity(state)[2];
+    b.applyBodyTorque(state, Vec3(0, 0, -a.k * theta - a.c * omega), body_forces);
+  }
+}
+
+Real JointForces::calcPotentialEnergy(const State& state) const {
+  Real e = 0.0;
+  for (const auto& j : joints_) {
+    const Real q = matter_.getMobilizedBody(j.body).getOneQ(state, j.which);
+    e += 0.5 * j.k * q * q;
+  }
+  for (const auto& a : anchors_) {
+    const Real theta = planar_angle(matter_.getMobilizedBody(a.body).getBodyRotation(state));
+    e += 0.5 * a.k * theta * theta;
+  }
+  return e;
+}
+
+}  // namespace scoleid::model

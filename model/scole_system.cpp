@@ -1,0 +1,88 @@
+#include "scoleid/model/scole_system.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scoleid/model/joint_forces.h"
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+namespace {
+Inertia inertia_of(const io::RigidBodySpec& b) {
+  return Inertia(Vec3(b.Ixx, b.Iyy, b.Izz), Vec3(b.Ixy, b.Ixz, b.Iyz));
+}
+}  // namespace
+
+ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
+  length_ = sc.length;
+  root_R_ = Vec3(sc.mast_root[0], sc.mast_root[1], sc.mast_root[2]);
+  axis_B_ = axis_R_ = Vec3(0, 0, -1);
+
+  const double L = sc.length;
+  auto uniform = [L](double v) { return PiecewiseField{L, {v}}; };
+  const HenckyLumping roll = hencky_lumping(n, uniform(sc.EI_roll), uniform(2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_roll)));
+  const HenckyLumping pitch = hencky_lumping(n, uniform(sc.EI_pitch), uniform(2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_pitch)));
+  const HenckyLumping torsion = hencky_lumping(n, uniform(sc.GJ), uniform(2 * sc.zeta * std::sqrt(sc.rho_I_psi * sc.GJ)));
+  const double h = roll.h;
+
+  MobilizedBody::Free shuttle(matter_.Ground(), Transform(),
+                              Body::Rigid(MassProperties(sc.shuttle.mass, Vec3(0), inertia_of(sc.shuttle))), Transform());
+  shuttle_ = shuttle.getMobilizedBodyIndex();
+
+  const double m = sc.rho_A * h;
+  const double Ib = m * h * h / 12.0 + 0.5 * sc.rho_I_psi * h;
+  const double Ip = sc.rho_I_psi * h;
+  const Vec3 com(0, 0, -h / 2);
+  const Body::Rigid segment_body(MassProperties(m, com, Inertia(Vec3(Ib, Ib, Ip)).shiftFromMassCenter(-com, m)));
+
+  std::vector<JointSpring> joints;
+  MobilizedBody parent = shuttle;
+  for (int i = 0; i < n; ++i) {
+    const Transform X_PF = i == 0 ? Transform(root_R_) : Transform(Vec3(0, 0, -h));
+    MobilizedBody::Gimbal seg(parent, X_PF, segment_body, Transform());
+    const auto j = static_cast<std::size_t>(i);
+    joints.push_back({seg.getMobilizedBodyIndex(), 0, roll.stiffness[j], roll.damping[j]});
+    joints.push_back({seg.getMobilizedBodyIndex(), 1, pitch.stiffness[j], pitch.damping[j]});
+    joints.push_back({seg.getMobilizedBodyIndex(), 2, torsion.stiffness[j], torsion.damping[j]});
+    segment_bodies_.push_back(seg.getMobilizedBodyIndex());
+    parent = seg;
+  }
+  joint_springs_ = joints;
+
+  const Vec3 r(sc.reflector_rx, sc.reflector_ry, 0.0);
+  MobilizedBody::Weld reflector(parent, Transform(Vec3(0, 0, -h) + r),
+                                Body::Rigid(MassProperties(sc.reflector.mass, Vec3(0), inertia_of(sc.reflector))),
+                                Transform());
+  reflector_ = reflector.getMobilizedBodyIndex();
+  reflector_station_ = {reflector_, Vec3(0), root_R_ + axis_R_ * L + r};
+
+  // Carriage: massless, on a Slider along the segment x axis; proof mass on a Slider along y
+  // (the Slider moves along its frames' x axis, so the second pair of frames is turned 90° about z).
+  const Rotation x_to_y(Pi / 2, ZAxis);
+  for (double s : sc.actuator_locations) {
+    const Station st = station_at(s);
+    MobilizedBody::Slider carriage(matter_.updMobilizedBody(st.body), Transform(st.p_BS),
+                                   Body::Massless(), Transform());
+    MobilizedBody::Slider proof(carriage, Transform(x_to_y),
+                                Body::Rigid(MassProperties(sc.actuator_mass, Vec3(0), Inertia(0))),
+                                Transform(x_to_y));
+    sliders_.push_back(carriage.getMobilizedBodyIndex());
+    sliders_.push_back(proof.getMobilizedBodyIndex());
+  }
+  Force::Custom(forces_, new JointForces(matter_, std::move(joints), {}));
+}
+
+Station ScoleSystem::named_station(const std::string& at) const {
+  if (at == "shuttle") return {shuttle_, Vec3(0), Vec3(0)};
+  if (at == "reflector") return reflector_station_;
+  return {};
+}
+
+MobilizedBodyIndex ScoleSystem::actuator_slider(int k, int axis) const {
+  const std::size_t i = static_cast<std::size_t>(2 * (k - 1) + axis);
+  return k >= 1 && i < sliders_.size() ? sliders_[i] : MobilizedBodyIndex();
+}
+
+}  // namespace scoleid::model

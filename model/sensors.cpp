@@ -1,0 +1,75 @@
+#include "scoleid/model/sensors.h"
+
+#include "scoleid/io/error.h"
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Structure& st) {
+  std::vector<ResolvedSensor> out;
+  const bool beam = st.kind() == "beam";
+  for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
+    const io::SensorSpec& se = sc.sensors[i];
+    const std::string field = "sensors[" + std::to_string(i) + "]";
+    ResolvedSensor r;
+    using K = ResolvedSensor::Kind;
+    r.kind = se.kind == "rotation" ? K::Rotation
+             : se.kind == "velocity" ? K::Velocity
+             : se.kind == "acceleration" ? K::Acceleration
+             : se.kind == "line_of_sight" ? K::LineOfSight : K::Displacement;
+    r.reference = st.reference_body();
+    r.root_R = st.station_at(0.0).p_RS0;
+    const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
+    if (beam) {
+      if (se.at != "beam")
+        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
+      if (r.kind == K::LineOfSight)
+        io::fail_field(sc.source, field + ".kind", "is not defined for a beam", "'line_of_sight'");
+      r.station = st.station_at(se.location);
+      r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+    } else {
+      if (se.at == "beam")
+        io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
+      if (d.norm() == 0)
+        io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
+      r.d_R = d;
+      r.station = se.at == "mast" ? st.station_at(se.location) : st.named_station(se.at);
+      if (se.at == "shuttle") r.reference = GroundIndex;
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+double read_sensor(const SimbodyMatterSubsystem& matter, const State& state, const ResolvedSensor& s) {
+  const MobilizedBody& B = matter.getMobilizedBody(s.station.body);
+  const MobilizedBody& R = matter.getMobilizedBody(s.reference);
+  using K = ResolvedSensor::Kind;
+  switch (s.kind) {
+    case K::Displacement: {
+      const Vec3 p_RP = B.findStationLocationInAnotherBody(state, s.station.p_BS, R);
+      return dot(p_RP - s.station.p_RS0, s.d_R);
+    }
+    case K::Rotation: {
+      const Rotation R_RB = B.findBodyRotationInAnotherBody(state, R);
+      const Vec4 aa = R_RB.convertRotationToAngleAxis();
+      return aa[0] * dot(Vec3(aa[1], aa[2], aa[3]), s.d_R);
+    }
+    case K::Velocity:
+      return dot(B.findStationVelocityInAnotherBody(state, s.station.p_BS, R), s.d_R);
+    case K::Acceleration: {
+      const Vec3 a_G = B.findStationAccelerationInGround(state, s.station.p_BS);
+      return dot(R.getBodyRotation(state).transpose() * a_G, s.d_R);
+    }
+    case K::LineOfSight: {
+      const Vec3 p_RP = B.findStationLocationInAnotherBody(state, s.station.p_BS, R);
+      const Vec3 u0 = (s.station.p_RS0 - s.root_R).normalize();
+      const Vec3 u = (p_RP - s.root_R).normalize();
+      return dot(cross(u0, u), s.d_R);
+    }
+  }
+  return 0.0;
+}
+
+}  // namespace scoleid::model

@@ -1,0 +1,240 @@
+#include "scoleid/model/truth_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "scoleid/io/error.h"
+#include "scoleid/model/beam_chain.h"
+#include "scoleid/model/inputs.h"
+#include "scoleid/model/scole_system.h"
+#include "scoleid/model/sensors.h"
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+const char* const kDefaultIntegrator = "cpodes";
+
+std::vector<std::string> integrator_names() {
+  return {"auto", "rk-merson", "rk-feldberg", "rk3", "cpodes", "verlet", "semi-explicit-euler2"};
+}
+
+std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system, double accuracy) {
+  const std::string n = name == "auto" ? kDefaultIntegrator : name;
+  std::unique_ptr<Integrator> integ;
+  if (n == "rk-merson") integ = std::make_unique<RungeKuttaMersonIntegrator>(system);
+  else if (n == "rk-feldberg") integ = std::make_unique<RungeKuttaFeldbergIntegrator>(system);
+  else if (n == "rk3") integ = std::make_unique<RungeKutta3Integrator>(system);
+  else if (n == "cpodes") integ = std::make_unique<CPodesIntegrator>(system, CPodes::BDF, CPodes::Newton);
+  else if (n == "verlet") integ = std::make_unique<VerletIntegrator>(system);
+  else if (n == "semi-explicit-euler2") integ = std::make_unique<SemiExplicitEuler2Integrator>(system);
+  else throw std::invalid_argument("unknown integrator '" + name + "'");
+  integ->setAccuracy(accuracy);
+  integ->setConstraintTolerance(std::min(1e-3, accuracy));
+  integ->setAllowInterpolation(true);
+  integ->setProjectInterpolatedStates(true);
+  integ->setInternalStepLimit(0);
+  return integ;
+}
+
+std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
+  if (sc.structure == "scole") return std::make_unique<ScoleSystem>(sc.scole, segments);
+  return std::make_unique<BeamChain>(sc.beam, segments);
+}
+
+bool SimulateOptions::IsValid(std::string* why) const {
+  auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
+  if (!(accuracy > 0 && accuracy < 1)) return bad("accuracy must be in (0, 1)");
+  if (!(final_time > 0)) return bad("final_time must be > 0");
+  if (!(sample_interval > 0 && sample_interval <= final_time)) return bad("sample_interval must be in (0, final_time]");
+  const auto names = integrator_names();
+  if (std::find(names.begin(), names.end(), integrator) == names.end())
+    return bad("unknown integrator '" + integrator + "'");
+  return true;
+}
+
+std::string SimulateSummary::BriefReport() const {
+  std::ostringstream os;
+  os << (termination == Termination::Completed ? "completed" : "FAILED") << ": " << simulated_seconds
+     << " s simulated in " << wall_seconds << " s wall (real-time factor " << real_time_factor() << "), "
+     << integrator << ", " << steps_taken << " steps (" << steps_attempted << " attempted), "
+     << realizations << " realizations, " << samples << " samples";
+  if (!message.empty()) os << "; " << message;
+  return os.str();
+}
+
+SimulateSummary simulate(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
+                         const std::function<void(const State&)>& on_sample) {
+  std::string why;
+  if (!opt.IsValid(&why)) throw std::invalid_argument("simulate: " + why);
+  SimulateSummary sum;
+  sum.integrator = opt.integrator == "auto" ? kDefaultIntegrator : opt.integrator;
+  const auto wall0 = std::chrono::steady_clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
+
+  auto integ = make_integrator(opt.integrator, system, opt.accuracy);
+  integ->setFinalTime(opt.final_time);
+  integ->initialize(initial);
+  std::vector<double> bps;
+  for (double b : opt.breakpoints)
+    if (b > initial.getTime() && b < opt.final_time) bps.push_back(b);
+  std::sort(bps.begin(), bps.end());
+
+  const int K = static_cast<int>(std::floor(opt.final_time / opt.sample_interval + 1e-9));
+  const double t_start = initial.getTime();
+  double next_progress = 2.0;
+  std::size_t ib = 0;
+  for (int k = 0; k <= K; ++k) {
+    const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
+    const double eps = 1e-12 * std::max(1.0, std::abs(tk));
+    while (integ->getTime() < tk - eps) {
+      while (ib < bps.size() && bps[ib] <= integ->getTime() + eps) ++ib;
+      const double tb = ib < bps.size() ? bps[ib] : Infinity;
+      const Integrator::SuccessfulStepStatus st = integ->stepTo(tk, tb);
+      if (integ->isSimulationOver() && integ->getTerminationReason() != Integrator::ReachedFinalTime)
+        throw std::runtime_error("integration failed at t = " + io::format_value(integ->getTime()) + ": " +
+                                 Integrator::getTerminationReasonString(integ->getTerminationReason()));
+      if (st == Integrator::ReachedScheduledEvent) {
+        // Restart the method at the input discontinuity (no history carried across it).
+        integ->reinitialize(Stage::Time, false);
+        ++ib;
+      }
+      if (opt.progress && wall() > next_progress) {
+        std::fprintf(stderr, "\r%5.1f%% of %g s simulated, real-time factor %.2f   ",
+                     100.0 * integ->getTime() / opt.final_time, opt.final_time, integ->getTime() / wall());
+        next_progress = wall() + 2.0;
+      }
+    }
+    const State& s = integ->getState();
+    system.realize(s, Stage::Acceleration);
+    on_sample(s);
+    ++sum.samples;
+  }
+  if (opt.progress && next_progress > 2.0) std::fprintf(stderr, "\n");
+  sum.steps_taken = integ->getNumStepsTaken();
+  sum.steps_attempted = integ->getNumStepsAttempted();
+  sum.realizations = integ->getNumRealizations();
+  sum.simulated_seconds = opt.final_time - t_start;
+  sum.wall_seconds = wall();
+  return sum;
+}
+
+bool TruthOptions::IsValid(std::string* why) const {
+  auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
+  if (segments < 0) return bad("segments must be >= 0");
+  if (accuracy < 0 || accuracy >= 1) return bad("accuracy must be in [0, 1)");
+  if (!integrator.empty()) {
+    const auto names = integrator_names();
+    if (std::find(names.begin(), names.end(), integrator) == names.end())
+      return bad("unknown integrator '" + integrator + "'");
+  }
+  return true;
+}
+
+std::map<std::string, double> true_parameters(const io::Scenario& sc) {
+  std::map<std::string, double> p;
+  if (sc.structure == "scole") {
+    const auto& c = sc.scole;
+    p = {{"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch}, {"GJ", c.GJ},
+         {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}};
+    return p;
+  }
+  const auto& b = sc.beam;
+  p["rho_A"] = b.rho_A;
+  p["zeta"] = b.zeta;
+  if (b.EI.size() == 1) {
+    p["EI"] = b.EI[0];
+  } else {
+    for (std::size_t k = 0; k < b.EI.size(); ++k) p["EI_" + std::to_string(k + 1)] = b.EI[k];
+  }
+  return p;
+}
+
+TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
+  std::string why;
+  if (!opt.IsValid(&why)) throw std::invalid_argument("run_truth: " + why);
+  const int n = opt.segments > 0 ? opt.segments : sc.truth.segments;
+  const std::string integrator = opt.integrator.empty() ? sc.truth.integrator : opt.integrator;
+  const double accuracy = opt.accuracy > 0 ? opt.accuracy : sc.truth.accuracy;
+  {
+    const auto names = integrator_names();
+    if (std::find(names.begin(), names.end(), integrator) == names.end()) {
+      std::string list;
+      for (const auto& x : names) list += (list.empty() ? "" : "|") + x;
+      io::fail_field(sc.source, "truth.integrator", "must be one of " + list, "'" + integrator + "'");
+    }
+    if (!(accuracy < 1)) io::fail_field(sc.source, "truth.accuracy", "must be < 1", io::format_value(accuracy));
+  }
+
+  auto structure = build_structure(sc, n);
+  const auto inputs = resolve_inputs(sc, *structure);
+  const auto sensors = resolve_sensors(sc, *structure);
+  Force::Custom(structure->forces(), new InputForces(structure->matter(), structure->reference_body(), inputs));
+  structure->system().realizeTopology();
+  State state = structure->system().getDefaultState();
+
+  SimulateOptions so;
+  so.integrator = integrator;
+  so.accuracy = accuracy;
+  so.final_time = sc.simulation.duration;
+  so.sample_interval = sc.truth.output_interval > 0 ? sc.truth.output_interval : sc.simulation.sample_interval;
+  so.progress = opt.progress;
+  for (const auto& in : sc.inputs)
+    for (double b : in.signal.breakpoints()) so.breakpoints.push_back(b);
+
+  TruthResult res;
+  io::DataTable& tab = res.table;
+  for (const auto& in : sc.inputs) tab.names.push_back(in.name);
+  for (const auto& se : sc.sensors) tab.names.push_back(se.name);
+  tab.columns.assign(tab.names.size(), {});
+  const auto& matter = structure->matter();
+  res.summary = simulate(structure->system(), state, so, [&](const State& s) {
+    tab.t.push_back(s.getTime());
+    std::size_t j = 0;
+    for (const auto& in : sc.inputs) tab.columns[j++].push_back(in.signal(s.getTime()));
+    for (const auto& se : sensors) tab.columns[j++].push_back(read_sensor(matter, s, se));
+  });
+
+  std::mt19937_64 rng(sc.simulation.seed);
+  for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
+    const double sd = sc.sensors[i].noise_std;
+    if (!(sd > 0)) continue;
+    std::normal_distribution<double> noise(0.0, sd);
+    for (double& v : tab.columns[sc.inputs.size() + i]) v += noise(rng);
+  }
+
+  io::TruthMeta& m = res.meta;
+  m.scenario = sc.name;
+  m.structure = sc.structure;
+  for (const auto& in : sc.inputs)
+    m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
+  for (const auto& se : sc.sensors)
+    m.columns.push_back({se.name, se.unit, "output", se.kind, se.at, se.location, se.direction, se.noise_std});
+  m.true_parameters = true_parameters(sc);
+  m.generator = {{"program", "scole-truth"},
+                 {"segments", n},
+                 {"integrator", res.summary.integrator},
+                 {"accuracy", accuracy},
+                 {"seed", sc.simulation.seed},
+                 {"lumping", "Hencky bar chain (joint springs from dual-cell compliance)"},
+                 {"simbody_version", std::to_string(SimTK_SIMBODY_MAJOR_VERSION) + "." +
+                                         std::to_string(SimTK_SIMBODY_MINOR_VERSION)},
+                 {"steps", res.summary.steps_taken},
+                 {"wall_seconds", res.summary.wall_seconds},
+                 {"real_time_factor", res.summary.real_time_factor()}};
+  m.settings = io::to_json(sc);
+  return res;
+}
+
+void write_truth(const TruthResult& r, const std::string& dir) {
+  io::ensure_directory(dir);
+  io::write_csv(dir + "/truth.csv", r.table);
+  io::write_json_atomic(dir + "/truth.json", io::to_json(r.meta));
+}
+
+}  // namespace scoleid::model
