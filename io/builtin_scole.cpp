@@ -1,8 +1,85 @@
-// SCOLE built-in scenarios (DESIGN §4), slug-ft-s.
+// SCOLE built-in scenarios (DESIGN §4), slug-ft-s, nominal configuration (the `scole:` defaults).
+// Excitation as in the paper (Fig. 6): a force and a moment at the antenna (reflector) end.
+// Haversine pulses of about half the period of the mode they target: the first bending pair
+// (about 0.3 Hz, roll and pitch) and the first torsion mode (about 0.5 Hz, the reflector's
+// offset inertia on GJ). Sensors: roll and pitch displacement of the mast tip (shuttle y and x)
+// and the tip torsion (the reflector's rotation about the mast axis z relative to the shuttle).
 #include "scoleid/io/builtin.h"
 
 namespace scoleid::io {
 
-std::vector<BuiltinScenario> scole_builtin_scenarios() { return {}; }
+namespace {
+constexpr const char* kExcitation = R"(inputs:
+  - {name: F_x, at: reflector, kind: force, direction: x, unit: lb, signal: {type: haversine, amplitude: 10, t0: 0, width: 1.5}}
+  - {name: F_y, at: reflector, kind: force, direction: y, unit: lb, signal: {type: haversine, amplitude: 10, t0: 0.5, width: 1.5}}
+  - {name: M_z, at: reflector, kind: moment, direction: z, unit: lb ft, signal: {type: haversine, amplitude: 200, t0: 0, width: 1}}
+)";
+}  // namespace
+
+std::vector<BuiltinScenario> scole_builtin_scenarios() {
+  return {
+      {"paper-scole-1",
+       "Paper SCOLE Case I: q1 = EI/rho_A, q2 = 1/rho_A from force and moment pulses at the reflector",
+       std::string(R"(name: paper-scole-1
+description: "Paper SCOLE Case I: q1 = EI/rho_A, q2 = 1/rho_A; force and moment pulses at the reflector"
+structure: scole
+)") + kExcitation + R"(sensors:
+  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
+  - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x, unit: ft}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z, unit: rad}
+simulation: {duration: 20, sample_interval: 0.01, seed: 1}
+identification:
+  parameterization: paper
+  estimate: [q1, q2]
+  initial: {rho_A: 0.085, EI: 3.6e7}
+  elements: 10
+truth: {segments: 40}
+)"},
+      {"paper-scole-2",
+       "Paper SCOLE Case II: EI, rho_A, rho_I_psi, zeta (physical) from force and moment pulses at the reflector",
+       std::string(R"(name: paper-scole-2
+description: "Paper SCOLE Case II: EI, rho_A, rho_I_psi, zeta; force and moment pulses at the reflector"
+structure: scole
+)") + kExcitation + R"(sensors:
+  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
+  - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x, unit: ft}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z, unit: rad}
+  - {name: roll_mid, at: mast, kind: displacement, location: 65, direction: y, unit: ft}
+  - {name: pitch_mid, at: mast, kind: displacement, location: 65, direction: x, unit: ft}
+  - {name: yaw_mid, at: mast, kind: rotation, location: 65, direction: z, unit: rad}
+simulation: {duration: 20, sample_interval: 0.01, seed: 1}
+identification:
+  parameterization: physical
+  estimate: [EI, rho_A, rho_I_psi, zeta]
+  initial: {EI: 3.2e7, rho_A: 0.075, rho_I_psi: 1.1, zeta: 0.0025}
+  elements: 10
+truth: {segments: 40}
+)"},
+      {"scole-slew",
+       "20 deg shuttle roll slew, bang-bang roll moment over 10 s, then 10 s of residual vibration",
+       R"(name: scole-slew
+description: "20 deg rest-to-rest shuttle roll slew (bang-bang moment), nonlinear rigid-flexible coupling"
+structure: scole
+# Rest-to-rest rigid slew: theta = A w^2 / (4 I_roll). With I_roll = 1.1997e6 slug ft^2 (the
+# whole SCOLE about the roll axis through the system CM), A = 16750 lb ft and w = 10 s give 20 deg.
+inputs:
+  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16750, t0: 0, width: 10}}
+sensors:
+  - {name: roll, at: shuttle, kind: rotation, direction: x, unit: rad}
+  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
+  - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x, unit: ft}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z, unit: rad}
+  - {name: los_x, at: reflector, kind: line_of_sight, direction: x, unit: rad}
+  - {name: acc_tip_y, at: mast, kind: acceleration, location: 130, direction: y, unit: ft/s^2}
+simulation: {duration: 20, sample_interval: 0.01, seed: 1}
+identification:
+  parameterization: physical
+  estimate: [EI, rho_A]
+  initial: {EI: 3.6e7, rho_A: 0.085}
+  elements: 10
+truth: {segments: 40}
+)"},
+  };
+}
 
 }  // namespace scoleid::io

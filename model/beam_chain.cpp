@@ -27,15 +27,16 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
   std::vector<JointSpring> joints;
   std::vector<AnchorSpring> anchors;
   MobilizedBody parent = matter_.Ground();
+  // A tip mass without rotary inertia rides on the last bar's end; with rotary inertia it is a
+  // body of its own on a Pin at s = L with the end-cell spring (2EI/h): the last bar's slope is
+  // w_s at L - h/2, and only the end cell's compliance carries it to L (O(h^2), not O(h)).
+  const bool tip_body = beam.tip_inertia > 0.0;
   for (int i = 0; i < n; ++i) {
     MassProperties mp = bar;
-    if (i == n - 1 && (beam.tip_mass > 0.0 || beam.tip_inertia > 0.0)) {
-      // Bar + tip body, combined about the segment origin.
+    if (i == n - 1 && beam.tip_mass > 0.0 && !tip_body) {
       const double M = m + beam.tip_mass;
       const Vec3 com = (m * Vec3(h / 2, 0, 0) + beam.tip_mass * Vec3(h, 0, 0)) / M;
-      const Inertia I_tip = Inertia(Vec3(0, beam.tip_inertia, beam.tip_inertia)) +
-                            Inertia(Vec3(h, 0, 0), beam.tip_mass);
-      mp = MassProperties(M, com, bar.getInertia() + I_tip);
+      mp = MassProperties(M, com, bar.getInertia() + Inertia(Vec3(h, 0, 0), beam.tip_mass));
     }
     const Body::Rigid body(mp);
     const Transform X_PF = i == 0 ? Transform() : Transform(Vec3(h, 0, 0));
@@ -51,6 +52,14 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
       joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[0], lumping_.damping[0]});
     segment_bodies_.push_back(seg.getMobilizedBodyIndex());
     parent = seg;
+  }
+  if (tip_body) {
+    const MobilizedBody::Pin tip(parent, Transform(Vec3(h, 0, 0)),
+                                 Body::Rigid(MassProperties(beam.tip_mass, Vec3(0),
+                                                            Inertia(Vec3(0, beam.tip_inertia, beam.tip_inertia)))),
+                                 Transform());
+    const auto j = static_cast<std::size_t>(n);
+    joints.push_back({tip.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
   }
   if (beam.right != io::EndCondition::Free) {
     Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));

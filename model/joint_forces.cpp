@@ -11,7 +11,7 @@ JointForces::JointForces(const SimbodyMatterSubsystem& matter, std::vector<Joint
     : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)) {}
 
 namespace {
-double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB(1, 0), R_GB(0, 0)); }
+double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB[1][0], R_GB[0][0]); }
 }  // namespace
 
 void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces, Vector_<Vec3>&,

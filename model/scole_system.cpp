@@ -49,14 +49,22 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
     segment_bodies_.push_back(seg.getMobilizedBodyIndex());
     parent = seg;
   }
-  joint_springs_ = joints;
 
+  // The reflector hangs on a Gimbal at s = L carrying the free end's half-cell springs (2EI/h,
+  // 2GJ/h): the last segment's rotation is the mast's at L - h/2, and only the end cell's
+  // compliance carries it to L. Welding the reflector to the last segment instead leaves an
+  // O(h) error in the tip rotation, which the reflector's inertia turns into O(1/n) frequencies.
   const Vec3 r(sc.reflector_rx, sc.reflector_ry, 0.0);
-  MobilizedBody::Weld reflector(parent, Transform(Vec3(0, 0, -h) + r),
-                                Body::Rigid(MassProperties(sc.reflector.mass, Vec3(0), inertia_of(sc.reflector))),
-                                Transform());
+  const double mr = sc.reflector.mass;
+  MobilizedBody::Gimbal reflector(parent, Transform(Vec3(0, 0, -h)),
+                                  Body::Rigid(MassProperties(mr, r, inertia_of(sc.reflector).shiftFromMassCenter(-r, mr))),
+                                  Transform());
+  const auto tip = static_cast<std::size_t>(n);
+  joints.push_back({reflector.getMobilizedBodyIndex(), 0, roll.stiffness[tip], roll.damping[tip]});
+  joints.push_back({reflector.getMobilizedBodyIndex(), 1, pitch.stiffness[tip], pitch.damping[tip]});
+  joints.push_back({reflector.getMobilizedBodyIndex(), 2, torsion.stiffness[tip], torsion.damping[tip]});
   reflector_ = reflector.getMobilizedBodyIndex();
-  reflector_station_ = {reflector_, Vec3(0), root_R_ + axis_R_ * L + r};
+  reflector_station_ = {reflector_, r, root_R_ + axis_R_ * L + r};
 
   // Carriage: massless, on a Slider along the segment x axis; proof mass on a Slider along y
   // (the Slider moves along its frames' x axis, so the second pair of frames is turned 90° about z).
@@ -71,6 +79,7 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
     sliders_.push_back(carriage.getMobilizedBodyIndex());
     sliders_.push_back(proof.getMobilizedBodyIndex());
   }
+  joint_springs_ = joints;
   Force::Custom(forces_, new JointForces(matter_, std::move(joints), {}));
 }
 

@@ -12,7 +12,8 @@
 //         free: Planar mobilizer (x, y, rotation) to ground.
 //   right pinned: roller, Constraint::PointInPlane (tip stays on y = 0, slides along x);
 //         clamped: the same plus an AnchorSpring on the last segment; free: nothing.
-// A tip mass and its rotary inertia are added rigidly at s = L on the last segment.
+// A tip mass sits at s = L; with rotary inertia it is a body on a Pin at s = L carrying the
+// end-cell spring 2EI/h (the free-end Hencky treatment, which keeps the tip rotation O(h^2)).
 // Valid for small rotations in the sense of the PDE; the chain itself is geometrically exact.
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/structure.h"

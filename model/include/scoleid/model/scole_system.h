@@ -11,8 +11,9 @@
 // EI_roll, about y (pitch bending, displacement along x) with EI_pitch, about z (torsion) with
 // GJ; the root joint is clamped to the shuttle (2EI/h, 2GJ/h), the tip is free. Dampers are the
 // Kelvin–Voigt terms, c = 2 zeta sqrt(rho_A EI) and 2 zeta sqrt(rho_I_psi GJ).
-// Reflector: rigid body welded to the last segment with its CM at (r_x, r_y, 0) from the mast
-// tip and its inertia about its CM in axes parallel to S (undeformed).
+// Reflector: rigid body with its CM at (r_x, r_y, 0) from the mast tip and its inertia about its
+// CM in axes parallel to S (undeformed), on a Gimbal at the tip carrying the free end's half-cell
+// springs (2EI/h, 2GJ/h) — the Hencky end treatment that keeps the tip rotation O(h^2).
 // Proof-mass actuators at s2, s3: a massless carriage on a Slider along the segment's x, and
 // the proof mass on a Slider along y on the carriage; a commanded slider force acts on the
 // proof mass and reacts on the mast (internal forces: total momentum is conserved).
