@@ -1,5 +1,6 @@
 #include "scoleid/identify/second_order_solver.h"
 
+#include <arkode/arkode_arkstep.h>
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -25,6 +26,7 @@ bool SolverOptions::IsValid(std::string* why) const {
   if (max_steps < 1) return bad("max_steps must be >= 1");
   if (!(max_step >= 0)) return bad("max_step must be >= 0");
   if (max_order < 1 || max_order > 5) return bad("max_order must be in [1, 5]");
+  if (!(step >= 0)) return bad("step must be >= 0");
   return true;
 }
 
@@ -73,6 +75,10 @@ struct CvodeMem {
   }
   ~CvodeMem() { CVodeFree(&mem); }
 };
+struct ArkodeMem {
+  void* mem = nullptr;
+  ~ArkodeMem() { ARKStepFree(&mem); }
+};
 
 void check(int retval, const char* what) {
   if (retval < 0) throw std::runtime_error(std::string(what) + " failed with flag " + std::to_string(retval));
@@ -94,10 +100,11 @@ struct SecondOrderSolver::Impl {
   mutable double gamma_factored = std::numeric_limits<double>::quiet_NaN();
   mutable long factorizations = 0;
   mutable long linear_solves = 0;
-  mutable std::vector<double> group_max;
+  mutable std::vector<double> group_max, group_floor;
   mutable const Forcing* forcing = nullptr;
   mutable Eigen::VectorXd F, tmp;
-  mutable void* cvode = nullptr;
+  mutable void* integrator_mem = nullptr;
+  mutable int (*get_gamma)(void*, double*) = nullptr;
   mutable std::string callback_error;
 
   void rhs(double t, const double* y, double* ydot) const {
@@ -136,6 +143,32 @@ struct SecondOrderSolver::Impl {
     b = newton_ldlt.solve(tmp);
     a = r1 + gamma * b;
   }
+  // Reference scale of each group: the quasi-static response x_ref = (K + σM)⁻¹ F to the
+  // largest forcing seen on a probe grid, σ = (2π/(t1 − t0))² (so free-floating structures get
+  // the rigid-body excursion over the horizon); velocities x_ref · 2π/(t1 − t0).
+  void reference_scales(double t0, double t1, const Forcing& f, const std::vector<double>& bps) const {
+    const double span = t1 - t0, w0 = 2.0 * 3.14159265358979323846 / span;
+    std::vector<double> probes;
+    const int np = 256;
+    for (int k = 0; k <= np; ++k) probes.push_back(t0 + span * k / np);
+    for (double b : bps) probes.push_back(b);
+    Eigen::VectorXd best = Eigen::VectorXd::Zero(n), Fp(n);
+    for (double t : probes) {
+      Fp.setZero();
+      f(t, Fp.data());
+      if (Fp.squaredNorm() > best.squaredNorm()) best = Fp;
+    }
+    group_floor.assign(static_cast<std::size_t>(2 * ngroups), opt.atol_floor);
+    if (best.squaredNorm() == 0.0) return;
+    SparseMatrix Ks = K + (w0 * w0) * M;
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt(Ks);
+    const Eigen::VectorXd xr = ldlt.solve(best);
+    for (int i = 0; i < n; ++i) {
+      const auto g = static_cast<std::size_t>(group[static_cast<std::size_t>(i)]);
+      group_floor[g] = std::max(group_floor[g], std::abs(xr[i]));
+      group_floor[g + static_cast<std::size_t>(ngroups)] = std::max(group_floor[g + static_cast<std::size_t>(ngroups)], std::abs(xr[i]) * w0 * opt.velocity_scale);
+    }
+  }
   void weights(const double* y, double* w) const {
     const double rtol = opt.rtol;
     for (int i = 0; i < 2 * n; ++i) {
@@ -144,7 +177,7 @@ struct SecondOrderSolver::Impl {
     }
     for (int i = 0; i < 2 * n; ++i) {
       const int g = (i < n ? group[static_cast<std::size_t>(i)] : ngroups + group[static_cast<std::size_t>(i - n)]);
-      const double atol = rtol * std::max(group_max[static_cast<std::size_t>(g)], opt.atol_floor);
+      const double atol = rtol * std::max(group_max[static_cast<std::size_t>(g)], group_floor[static_cast<std::size_t>(g)]);
       w[i] = 1.0 / (rtol * std::abs(y[i]) + atol);
     }
   }
@@ -164,6 +197,8 @@ int cv_rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
   }
 }
 
+int ark_rhs(realtype t, N_Vector y, N_Vector ydot, void* user) { return cv_rhs(t, y, ydot, user); }
+
 int cv_ewt(N_Vector y, N_Vector ewt, void* user) {
   impl_of(user)->weights(N_VGetArrayPointer(y), N_VGetArrayPointer(ewt));
   return 0;
@@ -177,7 +212,7 @@ int ls_solve(SUNLinearSolver LS, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   auto* s = impl_of(LS->content);
   try {
     double gamma = 0.0;
-    CVodeGetCurrentGamma(s->cvode, &gamma);
+    s->get_gamma(s->integrator_mem, &gamma);
     s->newton_solve(gamma, N_VGetArrayPointer(b), N_VGetArrayPointer(x));
     return 0;
   } catch (const std::exception& e) {
@@ -246,6 +281,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   s.factorizations = 0;
   s.linear_solves = 0;
   s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);
+  s.reference_scales(t0, t1, forcing, breakpoints);
   s.callback_error.clear();
 
   std::vector<double> stops;
@@ -258,14 +294,6 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   Context ctx;
   Vector y(2 * n, ctx.ctx);
   N_VConst(0.0, y.v);
-  CvodeMem cv(ctx.ctx);
-  s.cvode = cv.mem;
-  check(CVodeInit(cv.mem, cv_rhs, t0, y.v), "CVodeInit");
-  check(CVodeSetUserData(cv.mem, &s), "CVodeSetUserData");
-  check(CVodeWFtolerances(cv.mem, cv_ewt), "CVodeWFtolerances");
-  check(CVodeSetMaxNumSteps(cv.mem, s.opt.max_steps), "CVodeSetMaxNumSteps");
-  check(CVodeSetMaxOrd(cv.mem, s.opt.max_order), "CVodeSetMaxOrd");
-  if (s.opt.max_step > 0) check(CVodeSetMaxStep(cv.mem, s.opt.max_step), "CVodeSetMaxStep");
   SUNLinearSolver LS = SUNLinSolNewEmpty(ctx.ctx);
   if (!LS) throw std::runtime_error("SUNLinSolNewEmpty failed");
   LS->content = &s;
@@ -278,7 +306,59 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     SUNLinearSolver ls;
     ~LSOwner() { SUNLinSolFree(ls); }
   } ls_owner{LS};
-  check(CVodeSetLinearSolver(cv.mem, LS, nullptr), "CVodeSetLinearSolver");
+
+  const bool bdf = s.opt.integrator == SolverOptions::Integrator::Bdf;
+  std::unique_ptr<CvodeMem> cv;
+  ArkodeMem ark;
+  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
+  if (bdf) {
+    cv = std::make_unique<CvodeMem>(ctx.ctx);
+    s.integrator_mem = cv->mem;
+    s.get_gamma = CVodeGetCurrentGamma;
+    check(CVodeInit(cv->mem, cv_rhs, t0, y.v), "CVodeInit");
+    check(CVodeSetUserData(cv->mem, &s), "CVodeSetUserData");
+    check(CVodeWFtolerances(cv->mem, cv_ewt), "CVodeWFtolerances");
+    check(CVodeSetMaxNumSteps(cv->mem, s.opt.max_steps), "CVodeSetMaxNumSteps");
+    check(CVodeSetMaxOrd(cv->mem, s.opt.max_order), "CVodeSetMaxOrd");
+    if (s.opt.max_step > 0) check(CVodeSetMaxStep(cv->mem, s.opt.max_step), "CVodeSetMaxStep");
+    check(CVodeSetLinearSolver(cv->mem, LS, nullptr), "CVodeSetLinearSolver");
+  } else {
+    ark.mem = ARKStepCreate(nullptr, ark_rhs, t0, y.v, ctx.ctx);
+    if (!ark.mem) throw std::runtime_error("ARKStepCreate failed");
+    s.integrator_mem = ark.mem;
+    s.get_gamma = ARKStepGetCurrentGamma;
+    check(ARKStepSetUserData(ark.mem, &s), "ARKStepSetUserData");
+    check(ARKStepSetTableNum(ark.mem, ARKODE_ESDIRK436L2SA_6_3_4, ARKODE_ERK_NONE), "ARKStepSetTableNum");
+    check(ARKStepWFtolerances(ark.mem, cv_ewt), "ARKStepWFtolerances");
+    check(ARKStepSetLinearSolver(ark.mem, LS, nullptr), "ARKStepSetLinearSolver");
+    check(ARKStepSetLinear(ark.mem, 0), "ARKStepSetLinear");
+    check(ARKStepSetDeduceImplicitRhs(ark.mem, SUNTRUE), "ARKStepSetDeduceImplicitRhs");
+    check(ARKStepSetMaxNumSteps(ark.mem, s.opt.max_steps), "ARKStepSetMaxNumSteps");
+    check(ARKStepSetFixedStep(ark.mem, h), "ARKStepSetFixedStep");
+  }
+  auto set_stop = [&](double stop) {
+    if (bdf) check(CVodeSetStopTime(cv->mem, stop), "CVodeSetStopTime");
+    else check(ARKStepSetStopTime(ark.mem, stop), "ARKStepSetStopTime");
+  };
+  auto one_step = [&](double stop, double& t) {
+    return bdf ? CVode(cv->mem, stop, y.v, &t, CV_ONE_STEP) : ARKStepEvolve(ark.mem, stop, y.v, &t, ARK_ONE_STEP);
+  };
+  long steps = 0, rhs = 0, etf = 0, nni = 0;
+  auto collect = [&]() {
+    long st = 0, fe = 0, fi = 0, ef = 0, ni = 0;
+    if (bdf) {
+      CVodeGetNumSteps(cv->mem, &st);
+      CVodeGetNumRhsEvals(cv->mem, &fe);
+      CVodeGetNumErrTestFails(cv->mem, &ef);
+      CVodeGetNumNonlinSolvIters(cv->mem, &ni);
+    } else {
+      ARKStepGetNumSteps(ark.mem, &st);
+      ARKStepGetNumRhsEvals(ark.mem, &fe, &fi);
+      ARKStepGetNumErrTestFails(ark.mem, &ef);
+      ARKStepGetNumNonlinSolvIters(ark.mem, &ni);
+    }
+    steps += st; rhs += fe + fi; etf += ef; nni += ni;
+  };
 
   Trajectory traj(n);
   std::vector<double> a(static_cast<std::size_t>(n));
@@ -290,44 +370,42 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   };
   record(t0, y.data(), false);
 
-  long steps = 0, rhs = 0, etf = 0, nni = 0;
   double t = t0;
   for (std::size_t seg = 0; seg < stops.size(); ++seg) {
     const double stop = stops[seg];
-    check(CVodeSetStopTime(cv.mem, stop), "CVodeSetStopTime");
+    set_stop(stop);
     while (t < stop) {
-      const int flag = CVode(cv.mem, stop, y.v, &t, CV_ONE_STEP);
+      const int flag = one_step(stop, t);
       if (flag < 0) {
-        std::string msg = "CVODES failed at t = " + std::to_string(t) + " with flag " + std::to_string(flag);
+        std::string msg = std::string(bdf ? "CVODES" : "ARKODE") + " failed at t = " + std::to_string(t) +
+                          " with flag " + std::to_string(flag);
         if (!s.callback_error.empty()) msg += ": " + s.callback_error;
         throw std::runtime_error(msg);
       }
+      if (stop - t <= 1e-12 * std::max(1.0, std::abs(stop))) t = stop;
       const bool at_break = (t >= stop) && seg + 1 < stops.size();
       record(t, y.data(), at_break);
     }
     if (seg + 1 < stops.size()) {
-      // Restart past the discontinuity: right limit recorded at the same time.
-      long st = 0, fe = 0, ef = 0, ni = 0;
-      CVodeGetNumSteps(cv.mem, &st);
-      CVodeGetNumRhsEvals(cv.mem, &fe);
-      CVodeGetNumErrTestFails(cv.mem, &ef);
-      CVodeGetNumNonlinSolvIters(cv.mem, &ni);
-      steps += st; rhs += fe; etf += ef; nni += ni;
+      // Restart past the discontinuity: right limit recorded at the same time. CVodeReInit
+      // zeroes the CVODES counters (ARKStepReset keeps ARKODE's), so collect them first.
+      if (bdf) collect();
       record(t, y.data(), false);
-      check(CVodeReInit(cv.mem, t, y.v), "CVodeReInit");
+      if (bdf) {
+        check(CVodeReInit(cv->mem, t, y.v), "CVodeReInit");
+      } else {
+        check(ARKStepReset(ark.mem, t, y.v), "ARKStepReset");
+        check(ARKStepSetFixedStep(ark.mem, h), "ARKStepSetFixedStep");
+      }
     }
   }
-  long st = 0, fe = 0, ef = 0, ni = 0;
-  CVodeGetNumSteps(cv.mem, &st);
-  CVodeGetNumRhsEvals(cv.mem, &fe);
-  CVodeGetNumErrTestFails(cv.mem, &ef);
-  CVodeGetNumNonlinSolvIters(cv.mem, &ni);
+  collect();
   if (summary) {
     summary->ok = true;
-    summary->steps = steps + st;
-    summary->rhs_evaluations = rhs + fe;
-    summary->error_test_failures = etf + ef;
-    summary->nonlinear_iterations = nni + ni;
+    summary->steps = steps;
+    summary->rhs_evaluations = rhs;
+    summary->error_test_failures = etf;
+    summary->nonlinear_iterations = nni;
     summary->factorizations = s.factorizations;
     summary->linear_solves = s.linear_solves;
     summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -380,8 +380,9 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     if (!(id.steepest_weights[i] > 0))
       fail_field(source, "identification.steepest_weights[" + std::to_string(i) + "]", "must be > 0",
                  format_value(id.steepest_weights[i]));
+  id.integrator = r.choice("integrator", id.integrator, {"esdirk", "bdf"});
+  id.time_step = r.nonneg("time_step", id.time_step);
   id.rtol = r.positive("rtol", id.rtol);
-  id.atol = r.nonneg("atol", id.atol);
 }
 
 void parse_truth(const YAML::Node& n, const std::string& source, TruthModelSpec& t) {
@@ -501,7 +502,8 @@ nlohmann::json to_json(const Scenario& s) {
                          {"initial", id.initial}, {"elements", id.elements}, {"sections", id.sections}, {"data_elements", id.data_elements},
                          {"method", id.method}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
-                         {"steepest_weights", id.steepest_weights}, {"rtol", id.rtol}, {"atol", id.atol}};
+                         {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
+                         {"time_step", id.time_step}, {"rtol", id.rtol}};
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
                 {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval}};
   return j;

@@ -3,8 +3,17 @@
 //
 //     M ẍ + D ẋ + K x = F(t),    x(t0) = 0, ẋ(t0) = 0,
 //
-// with SUNDIALS CVODES (variable-order BDF) on the first-order form y = [x; v]:
-//     ẋ = v,   v̇ = M⁻¹ (F(t) − D v − K x).
+// with SUNDIALS on the first-order form y = [x; v]:  ẋ = v,   v̇ = M⁻¹ (F(t) − D v − K x).
+// Two integrators:
+//   esdirk (default)  ARKODE ARKStep, ESDIRK4(3)6L[2]SA (Kennedy & Carpenter): 4th order,
+//                     L-stable, fixed step h. A point load excites every mode of the mesh; the
+//                     modes with ω h ≫ 1 are the ones the mesh represents worst, and an L-stable
+//                     method damps their oscillation (keeping their quasi-static part) instead
+//                     of tracking it with ~ω_max·T steps. The step is chosen from the data's
+//                     sample interval; the time error is O(h⁴) in the resolved band.
+//   bdf               CVODES variable-order BDF with error control at rtol: the adaptive
+//                     reference (it must resolve every excited mode, so it is far slower on
+//                     undamped structures; see the benchmark).
 // The Newton systems (I − γJ) [a; b] = [r1; r2] are solved through the structure of J instead
 // of forming the dense M⁻¹K:
 //     (M + γD + γ²K) b = M r2 − γ K r1,    a = r1 + γ b,
@@ -16,9 +25,10 @@
 // forward sensitivities. Forcing discontinuities are passed as breakpoints: the integrator stops
 // there and restarts, recording left and right limits.
 //
-// Error weights: w_i = 1/(rtol |y_i| + atol_g), with atol_g = rtol · (largest |y_j| seen so far in
-// y_i's group) — DOFs of like units (displacements, rotations, their rates) share a group, so no
-// absolute scale has to be guessed.
+// Error weights: w_i = 1/(rtol |y_i| + atol_g), atol_g = rtol · max(largest |y_j| seen so far in
+// y_i's group, the group's reference scale). DOFs of like units (displacements, rotations, their
+// rates) share a group; the reference scale is the quasi-static response to the largest forcing
+// (see reference_scales), so no absolute tolerance has to be guessed by the user.
 #include <functional>
 #include <memory>
 #include <string>
@@ -30,11 +40,15 @@
 namespace scoleid::identify {
 
 struct SolverOptions {
+  enum class Integrator { Esdirk, Bdf };
+  Integrator integrator = Integrator::Esdirk;
+  double step = 0.0;           // esdirk: fixed step; 0 = (t1 − t0)/2000
   double rtol = 1e-9;
-  double atol_floor = 1e-300;  // absolute floor of the group scales (only matters while y = 0)
+  double atol_floor = 1e-280;  // absolute floor of the group scales (only matters for zero forcing)
   long max_steps = 2000000;
   double max_step = 0.0;       // 0 = unlimited
   int max_order = 5;
+  double velocity_scale = 1.0;  // bdf: velocity reference scale multiplier
   bool IsValid(std::string* why) const;
 };
 

@@ -114,10 +114,11 @@ struct IdentificationSpec {
   std::string method = "auto";  // auto | gauss-newton | lbfgs | steepest-descent
   int max_iterations = 50;
   double gradient_tolerance = 1e-9;  // on the scaled gradient
-  double step_tolerance = 1e-10;     // relative parameter change
+  double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
-  double rtol = 1e-9;                 // time-integration tolerances
-  double atol = 0.0;                  // 0 = scaled automatically from the response
+  std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | bdf (adaptive CVODES)
+  double time_step = 0.0;             // esdirk step; 0 = simulation.sample_interval / 2
+  double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
 };
 
 struct TruthModelSpec {

@@ -1,0 +1,23 @@
+#pragma once
+// Sampled measurements z(t_i) and their continuous interpolant z̃(t) used by the cost
+//   J = ½ ∫₀ᵀ (C u − z̃)ᵀ R (C u − z̃) dt.
+// z̃ is the local cubic (4-point Lagrange) interpolant of the samples: O(Δt⁴) between samples,
+// so for smooth noise-free responses the interpolant adds no bias at the 1e-6 level (a linear
+// interpolant would add O(Δt²)).
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+namespace scoleid::identify {
+
+struct Measurements {
+  std::vector<std::string> names;  // one per sensor (model order)
+  std::vector<double> t;           // strictly increasing sample times
+  Eigen::MatrixXd z;               // samples × sensors
+
+  int sensors() const { return static_cast<int>(z.cols()); }
+  // z̃(tt) into out (length sensors()); clamped beyond the ends.
+  void eval(double tt, double* out) const;
+};
+
+}  // namespace scoleid::identify

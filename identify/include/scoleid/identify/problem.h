@@ -1,0 +1,43 @@
+#pragma once
+// An identification problem assembled from a scenario: the FE model on the identifier's mesh,
+// the named parameters, the input signals and the measurements.
+//
+// Measurements come either from a data file (columns matched to the scenario's sensors by
+// name; an input whose name is a column is driven by that column, piecewise linear, otherwise
+// by the scenario's signal) or are synthesised: the same structure on a finer mesh
+// (identification.data_elements, at least 2× the identifier's elements) with the true
+// parameters, integrated at a tolerance 100× tighter, sampled, plus each sensor's Gaussian noise
+// (seeded) — so the identifier never sees its own discretisation.
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "scoleid/identify/beam_model.h"
+#include "scoleid/identify/measurements.h"
+#include "scoleid/identify/objective.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::identify {
+
+struct Problem {
+  io::Scenario scenario;
+  BeamFE fe;
+  std::unique_ptr<Parameterization> params;
+  std::vector<io::Signal> signals;
+  Measurements data;
+  std::string data_source;                    // "synthetic (N elements)" or the CSV path
+  std::map<std::string, double> true_values;  // by parameter name, where known
+  ObjectiveOptions objective_options;
+};
+
+// Throws io::InputError for anything wrong with the scenario or the data.
+std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::optional<std::string>& data_csv);
+
+// Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
+Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
+// The identifier's fixed time step: identification.time_step, or half the sample interval.
+double identifier_step(const io::Scenario& scenario);
+
+}  // namespace scoleid::identify

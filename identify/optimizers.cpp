@@ -1,0 +1,263 @@
+#include "scoleid/identify/optimizers.h"
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <sstream>
+
+namespace scoleid::identify {
+
+bool OptimizerOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (method != "gauss-newton" && method != "lbfgs" && method != "steepest-descent")
+    return bad("method must be gauss-newton, lbfgs or steepest-descent");
+  if (max_iterations < 0) return bad("max_iterations must be >= 0");
+  if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
+  for (double w : steepest_weights)
+    if (!(w > 0)) return bad("steepest_weights must be > 0");
+  return true;
+}
+
+const char* to_string(OptimizerSummary::Termination t) {
+  using T = OptimizerSummary::Termination;
+  switch (t) {
+    case T::StepTolerance: return "step_tolerance";
+    case T::GradientTolerance: return "gradient_tolerance";
+    case T::CostFloor: return "cost_floor";
+    case T::MaxIterations: return "max_iterations";
+    case T::LineSearchFailed: return "line_search_failed";
+  }
+  return "?";
+}
+
+std::string OptimizerSummary::BriefReport() const {
+  std::ostringstream os;
+  os << to_string(termination) << " after " << iterations_done << " iterations, J = " << cost << ", "
+     << wall_seconds << " s";
+  if (!message.empty()) os << " (" << message << ")";
+  return os.str();
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using T = OptimizerSummary::Termination;
+
+struct Run {
+  Objective& obj;
+  const OptimizerOptions& opt;
+  const std::function<void(const IterationRecord&)>& cb;
+  OptimizerSummary sum;
+
+  void record(int k, double J, const VectorXd& q, const VectorXd& gx) {
+    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0};
+    sum.iterations.push_back(r);
+    if (cb) cb(r);
+  }
+  bool small_gradient(const VectorXd& gx, double J) const {
+    return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
+  }
+  // Evaluate J and ∂J/∂x at x, or return false if the point is outside the model's domain.
+  bool eval_grad(const VectorXd& x, double& J, VectorXd& gx) {
+    try {
+      const VectorXd q = x.array().exp();
+      VectorXd gq;
+      J = obj.cost_and_gradient(q, gq);
+      gx = q.cwiseProduct(gq);
+      return std::isfinite(J);
+    } catch (const std::domain_error&) {
+      return false;
+    } catch (const std::runtime_error&) {
+      return false;  // integrator failure at an extreme trial point: treat as infeasible
+    }
+  }
+};
+
+void gauss_newton(Run& r, VectorXd x) {
+  auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx) {
+    try {
+      const VectorXd q = xx.array().exp();
+      VectorXd g;
+      MatrixXd H;
+      J = r.obj.gauss_newton(q, g, H);
+      gx = q.cwiseProduct(g);
+      Hx = q.asDiagonal() * H * q.asDiagonal();
+      return std::isfinite(J);
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  double J;
+  VectorXd gx;
+  MatrixXd Hx;
+  if (!gn_at(x, J, gx, Hx)) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.sum.q = x.array().exp();
+    return;
+  }
+  r.record(0, J, x.array().exp(), gx);
+  double lambda = 0.0;
+  int k = 0;
+  r.sum.termination = T::MaxIterations;
+  while (true) {
+    if (J <= r.opt.cost_floor) { r.sum.termination = T::CostFloor; break; }
+    if (r.small_gradient(gx, J)) { r.sum.termination = T::GradientTolerance; break; }
+    if (k >= r.opt.max_iterations) break;
+    bool accepted = false;
+    for (int attempt = 0; attempt < 12 && !accepted; ++attempt) {
+      MatrixXd A = Hx;
+      A.diagonal() += lambda * Hx.diagonal().cwiseMax(1e-300);
+      VectorXd dx = A.ldlt().solve(-gx);
+      // Keep a single step within a factor e of the current values.
+      const double mx = dx.cwiseAbs().maxCoeff();
+      if (mx > 1.0) dx *= 1.0 / mx;
+      double Jn;
+      VectorXd gn;
+      MatrixXd Hn;
+      if (gn_at(x + dx, Jn, gn, Hn) && Jn <= J) {
+        x += dx;
+        const double step = dx.cwiseAbs().maxCoeff();
+        J = Jn;
+        gx = gn;
+        Hx = Hn;
+        lambda = lambda > 0 ? lambda / 10.0 : 0.0;
+        if (lambda < 1e-6) lambda = 0.0;
+        accepted = true;
+        ++k;
+        r.record(k, J, x.array().exp(), gx);
+        if (step < r.opt.step_tolerance) {
+          r.sum.termination = T::StepTolerance;
+          r.sum.iterations_done = k;
+          r.sum.q = x.array().exp();
+          r.sum.cost = J;
+          return;
+        }
+      } else {
+        lambda = lambda > 0 ? lambda * 10.0 : 1e-3;
+      }
+    }
+    if (!accepted) {
+      r.sum.termination = T::StepTolerance;
+      r.sum.message = "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
+      break;
+    }
+  }
+  r.sum.iterations_done = k;
+  r.sum.q = x.array().exp();
+  r.sum.cost = J;
+}
+
+void lbfgs(Run& r, VectorXd x, bool steepest) {
+  double J;
+  VectorXd gx;
+  if (!r.eval_grad(x, J, gx)) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.sum.q = x.array().exp();
+    return;
+  }
+  r.record(0, J, x.array().exp(), gx);
+  std::deque<std::pair<VectorXd, VectorXd>> mem;  // (s, y)
+  const int m = 8;
+  double alpha0 = 1.0;
+  const bool fixed_weights = steepest && !r.opt.steepest_weights.empty();
+  VectorXd w;
+  if (fixed_weights) {
+    w = Eigen::Map<const VectorXd>(r.opt.steepest_weights.data(), static_cast<Eigen::Index>(r.opt.steepest_weights.size()));
+    if (w.size() != x.size()) throw std::invalid_argument("steepest_weights: one weight per parameter");
+  }
+  int k = 0;
+  r.sum.termination = T::MaxIterations;
+  while (true) {
+    if (J <= r.opt.cost_floor) { r.sum.termination = T::CostFloor; break; }
+    if (r.small_gradient(gx, J)) { r.sum.termination = T::GradientTolerance; break; }
+    if (k >= r.opt.max_iterations) break;
+    VectorXd d;
+    if (fixed_weights) {
+      // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
+      const VectorXd q = x.array().exp();
+      d = -(w.array() * (gx.array() / q.array()) / q.array()).matrix();
+    } else if (steepest || mem.empty()) {
+      d = -gx;
+      if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
+      if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
+    } else {
+      // two-loop recursion
+      VectorXd qv = gx;
+      std::vector<double> al(mem.size());
+      for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
+        const auto& [s, y] = mem[static_cast<std::size_t>(i)];
+        al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
+        qv -= al[static_cast<std::size_t>(i)] * y;
+      }
+      const auto& [sl, yl] = mem.back();
+      qv *= sl.dot(yl) / yl.dot(yl);
+      for (std::size_t i = 0; i < mem.size(); ++i) {
+        const auto& [s, y] = mem[i];
+        const double b = y.dot(qv) / y.dot(s);
+        qv += (al[i] - b) * s;
+      }
+      d = -qv;
+    }
+    if (gx.dot(d) >= 0) {
+      mem.clear();
+      d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
+    }
+    const double mx = d.cwiseAbs().maxCoeff();
+    if (mx > 1.0) d *= 1.0 / mx;
+    double a = 1.0, Jn = 0.0;
+    VectorXd gn;
+    bool ok = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      if (r.eval_grad(x + a * d, Jn, gn) && Jn <= J + 1e-4 * a * gx.dot(d) && Jn <= J) {
+        ok = true;
+        break;
+      }
+      a *= 0.5;
+    }
+    if (!ok) {
+      r.sum.termination = T::LineSearchFailed;
+      r.sum.message = "no decrease along the search direction";
+      break;
+    }
+    const VectorXd s = a * d, y = gn - gx;
+    x += s;
+    J = Jn;
+    gx = gn;
+    if (!steepest && y.dot(s) > 1e-300) {
+      mem.emplace_back(s, y);
+      if (static_cast<int>(mem.size()) > m) mem.pop_front();
+    }
+    if (steepest && !fixed_weights) alpha0 = std::min(1e3, a * 2.0 * alpha0);
+    ++k;
+    r.record(k, J, x.array().exp(), gx);
+    if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance) {
+      r.sum.termination = T::StepTolerance;
+      break;
+    }
+  }
+  r.sum.iterations_done = k;
+  r.sum.q = x.array().exp();
+  r.sum.cost = J;
+}
+
+}  // namespace
+
+OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const OptimizerOptions& options,
+                          const std::function<void(const IterationRecord&)>& on_iteration) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("OptimizerOptions: " + why);
+  const auto t0 = Clock::now();
+  Run r{objective, options, on_iteration, {}};
+  const VectorXd x0 = q0.array().log();
+  if (options.method == "gauss-newton") gauss_newton(r, x0);
+  else lbfgs(r, x0, options.method == "steepest-descent");
+  r.sum.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return r.sum;
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,166 @@
+#include "scoleid/identify/problem.h"
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "scoleid/io/error.h"
+
+namespace scoleid::identify {
+
+using io::fail_field;
+using io::InputError;
+
+namespace {
+
+std::vector<io::Signal> scenario_signals(const io::Scenario& sc) {
+  std::vector<io::Signal> s;
+  for (const auto& in : sc.inputs) s.push_back(in.signal);
+  return s;
+}
+
+std::vector<double> sample_times(const io::Scenario& sc) {
+  std::vector<double> t;
+  const double dt = sc.simulation.sample_interval, T = sc.simulation.duration;
+  const long n = static_cast<long>(std::floor(T / dt + 1e-9));
+  for (long k = 0; k <= n; ++k) t.push_back(k * dt);
+  if (T - t.back() > 1e-9 * dt) t.push_back(T);
+  return t;
+}
+
+// Synthetic data are integrated with a step 10x finer than the identifier's default.
+double data_step(const io::Scenario& sc) { return identifier_step(sc) / 10.0; }
+
+void require_beam(const io::Scenario& sc) {
+  if (sc.structure != "beam")
+    throw InputError(sc.source + ": structure '" + sc.structure +
+                     "' is not supported by this identifier build (beam structures only)");
+}
+
+}  // namespace
+
+double identifier_step(const io::Scenario& sc) {
+  if (sc.identification.time_step > 0) return sc.identification.time_step;
+  return sc.simulation.sample_interval / 2.0;
+}
+
+Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
+  require_beam(sc);
+  const BeamFE fe = build_beam(sc.beam, elements, static_cast<int>(sc.beam.EI.size()), sc.inputs, sc.sensors, sc.source);
+  const AssembledModel ops = assemble(fe.model, beam_coefficients(fe, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta));
+  SolverOptions so;
+  so.rtol = rtol;
+  so.step = step;
+  SecondOrderSolver solver(ops.M, ops.D, ops.K, fe.model.dof_group, so);
+  const auto signals = scenario_signals(sc);
+  const int n = fe.model.ndof;
+  SecondOrderSolver::Forcing f = [&](double t, double* F) {
+    Eigen::Map<VectorXd> Fm(F, n);
+    for (std::size_t i = 0; i < signals.size(); ++i) Fm += signals[i](t) * ops.loads[i];
+  };
+  std::vector<double> bps;
+  for (const auto& s : signals)
+    for (double b : s.breakpoints()) bps.push_back(b);
+  const auto times = sample_times(sc);
+  const Trajectory u = solver.solve(0.0, times.back(), f, bps);
+  Measurements m;
+  m.t = times;
+  const MatrixXd C = fe.model.output_matrix();
+  m.z.resize(static_cast<Eigen::Index>(times.size()), C.rows());
+  VectorXd x(n), v(n);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    u.eval(times[k], x.data(), v.data());
+    m.z.row(static_cast<Eigen::Index>(k)) = (C * x).transpose();
+  }
+  for (const auto& s : sc.sensors) m.names.push_back(s.name);
+  if (add_noise) {
+    std::mt19937_64 rng(sc.simulation.seed);
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+      const double sd = sc.sensors[j].noise_std;
+      if (sd <= 0) continue;
+      std::normal_distribution<double> N(0.0, sd);
+      for (Eigen::Index k = 0; k < m.z.rows(); ++k) m.z(k, static_cast<Eigen::Index>(j)) += N(rng);
+    }
+  }
+  return m;
+}
+
+std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
+  require_beam(sc);
+  if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
+  if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
+  auto p = std::make_unique<Problem>();
+  p->scenario = sc;
+  const auto& id = sc.identification;
+  p->fe = build_beam(sc.beam, id.elements, id.sections, sc.inputs, sc.sensors, sc.source);
+  auto bp = std::make_unique<BeamParameterization>(p->fe, sc.beam, id, sc.source);
+  const VectorXd truth = bp->truth();
+  p->params = std::move(bp);
+  p->signals = scenario_signals(sc);
+
+  if (data_csv) {
+    const io::DataTable tab = io::read_csv(*data_csv);
+    // Truth metadata beside the CSV, when present, supplies the true values.
+    const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
+    std::map<std::string, double> meta_truth;
+    if (std::filesystem::exists(meta_path)) {
+      const io::TruthMeta meta = io::read_truth_meta(meta_path.string());
+      meta_truth = meta.true_parameters;
+      for (const auto& c : meta.columns) {
+        for (const auto& s : sc.sensors)
+          if (s.name == c.name && c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
+            throw InputError(meta_path.string() + ": column '" + c.name + "' is a " + c.quantity +
+                             " but the scenario's sensor is a " + s.kind);
+      }
+    }
+    p->data.t = tab.t;
+    p->data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+      const int col = tab.find(sc.sensors[j].name);
+      if (col < 0)
+        throw InputError("data file '" + *data_csv + "': no column for sensor '" + sc.sensors[j].name +
+                         "' (sensors[" + std::to_string(j) + "] of " + sc.source + ")");
+      for (std::size_t k = 0; k < tab.t.size(); ++k)
+        p->data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
+      p->data.names.push_back(sc.sensors[j].name);
+    }
+    for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+      const int col = tab.find(sc.inputs[i].name);
+      if (col >= 0) p->signals[i] = io::Signal::table(tab.t, tab.columns[static_cast<std::size_t>(col)]);
+    }
+    if (tab.t.front() < 0.0)
+      throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
+    p->data_source = *data_csv;
+    // True values from the metadata, translated to this parameterization.
+    if (!meta_truth.empty()) {
+      io::BeamSpec tb = sc.beam;
+      if (meta_truth.count("rho_A")) tb.rho_A = meta_truth.at("rho_A");
+      if (meta_truth.count("zeta")) tb.zeta = meta_truth.at("zeta");
+      if (meta_truth.count("EI")) tb.EI = {meta_truth.at("EI")};
+      std::vector<double> sec;
+      for (int k = 1; meta_truth.count("EI_" + std::to_string(k)); ++k) sec.push_back(meta_truth.at("EI_" + std::to_string(k)));
+      if (!sec.empty()) tb.EI = sec;
+      const BeamParameterization tp(p->fe, tb, id, sc.source);
+      const VectorXd tv = tp.truth();
+      for (int i = 0; i < tv.size(); ++i)
+        if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+    }
+  } else {
+    const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
+    if (data_elements < 2 * id.elements)
+      fail_field(sc.source, "identification.data_elements",
+                 "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
+                 std::to_string(data_elements));
+    p->data = synthesize(sc, data_elements, id.rtol, data_step(sc), true);
+    p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
+    for (int i = 0; i < truth.size(); ++i)
+      if (std::isfinite(truth[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = truth[i];
+  }
+  p->objective_options.solver.rtol = id.rtol;
+  p->objective_options.solver.step = identifier_step(sc);
+  p->objective_options.solver.integrator =
+      id.integrator == "bdf" ? SolverOptions::Integrator::Bdf : SolverOptions::Integrator::Esdirk;
+  return p;
+}
+
+}  // namespace scoleid::identify
