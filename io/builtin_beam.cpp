@@ -59,7 +59,7 @@ identification:
   parameterization: physical
   estimate: [EI_1, EI_2]
   initial: {EI_1: 21000, EI_2: 39000}
-  elements: 10
+  elements: 20
 truth: {segments: 40}
 )"},
       {"beam-ei8",

@@ -1,0 +1,219 @@
+#include "scoleid/identify/identify_run.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+// Paper-style iteration table: iteration, parameters, physical values, cost.
+class Table {
+public:
+  Table(const Parameterization& p, bool physical_columns) : p_(p), phys_(physical_columns) {}
+  void header() const {
+    std::printf("%5s", "iter");
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
+    if (p_.size() > kMaxCols) std::printf(" %5s", "...");
+    if (phys_)
+      for (const char* n : {"rho_A", "EI", "zeta"}) std::printf(" %13s", n);
+    std::printf(" %13s\n", "cost");
+  }
+  void row(const IterationRecord& r) const {
+    std::printf("%5d", r.k);
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13.6g", r.q[i]);
+    if (p_.size() > kMaxCols) std::printf(" %5s", "");
+    if (phys_) {
+      const auto ph = p_.physical(r.q);
+      for (const char* n : {"rho_A", "EI", "zeta"}) {
+        const auto it = ph.find(n);
+        std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
+      }
+    }
+    std::printf(" %13.6e\n", r.cost);
+    std::fflush(stdout);
+  }
+
+private:
+  static constexpr int kMaxCols = 8;
+  const Parameterization& p_;
+  bool phys_;
+};
+
+Identifiability identifiability(Objective& obj, const Problem& p, const VectorXd& q) {
+  Identifiability id;
+  const int P = obj.size(), ns = p.data.sensors();
+  const auto N = static_cast<Eigen::Index>(p.data.t.size());
+  const MatrixXd Y = obj.predict(q);
+  const MatrixXd G = obj.output_sensitivities(q);
+  // Noise level per sensor.
+  bool from_scenario = true;
+  for (int k = 0; k < ns; ++k) {
+    double sd = p.scenario.sensors[static_cast<std::size_t>(k)].noise_std;
+    if (!(sd > 0)) {
+      from_scenario = false;
+      const VectorXd r = Y.col(k) - p.data.z.col(k);
+      const double dof = std::max<double>(1.0, static_cast<double>(N) - static_cast<double>(P) / ns);
+      sd = std::sqrt(r.squaredNorm() / dof);
+      if (!(sd > 0)) sd = 1e-300;
+    }
+    id.noise_std.push_back(sd);
+  }
+  id.noise_source = from_scenario ? "scenario" : "residual";
+  MatrixXd F = MatrixXd::Zero(P, P);
+  for (Eigen::Index i = 0; i < N; ++i)
+    for (int k = 0; k < ns; ++k) {
+      const Eigen::RowVectorXd g = G.row(i * ns + k);
+      F += g.transpose() * g / (id.noise_std[static_cast<std::size_t>(k)] * id.noise_std[static_cast<std::size_t>(k)]);
+    }
+  const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
+  const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
+  id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
+  id.std = VectorXd::Constant(P, std::nan(""));
+  id.identifiable.assign(static_cast<std::size_t>(P), false);
+  if (lmin > lmax * 1e-14) {
+    const MatrixXd Cr = Fr.inverse();
+    for (int i = 0; i < P; ++i) {
+      const double rel = std::sqrt(std::max(0.0, Cr(i, i)));
+      id.std[i] = rel * q[i];
+      id.identifiable[static_cast<std::size_t>(i)] = rel < 0.5;
+    }
+  }
+  return id;
+}
+
+double safe(double v) { return std::isfinite(v) ? v : 0.0; }
+
+}  // namespace
+
+RunResult run_identification(Problem& p, const RunOptions& ro) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RunResult r;
+  r.scenario = p.scenario.name;
+  r.names = p.params->names();
+  r.initial = p.params->initial();
+  r.truth = p.true_values;
+  std::string method = ro.method.empty() ? p.scenario.identification.method : ro.method;
+  if (method == "auto") method = p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
+  r.method = method;
+
+  Objective obj(p.fe.model, *p.params, p.signals, p.data, p.objective_options);
+  OptimizerOptions oo;
+  oo.method = method;
+  oo.max_iterations = ro.max_iterations.value_or(p.scenario.identification.max_iterations);
+  oo.gradient_tolerance = p.scenario.identification.gradient_tolerance;
+  oo.step_tolerance = p.scenario.identification.step_tolerance;
+  oo.steepest_weights = p.scenario.identification.steepest_weights;
+  if (!oo.steepest_weights.empty() && static_cast<int>(oo.steepest_weights.size()) != p.params->size())
+    io::fail_field(p.scenario.source, "identification.steepest_weights",
+                   "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
+                   std::to_string(oo.steepest_weights.size()) + " values");
+  Table table(*p.params, p.params->names().size() <= 3 &&
+                             dynamic_cast<const BeamParameterization*>(p.params.get()) &&
+                             static_cast<const BeamParameterization*>(p.params.get())->paper_form());
+  if (ro.verbose) table.header();
+  r.summary = minimize(obj, r.initial, oo, [&](const IterationRecord& rec) {
+    if (ro.verbose) table.row(rec);
+  });
+  r.estimate = r.summary.q;
+  if (ro.compute_std) r.ident = identifiability(obj, p, r.estimate);
+  r.counters = obj.counters();
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+nlohmann::json RunResult::to_json(const Problem& p) const {
+  using nlohmann::json;
+  json params = json::array();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    json e{{"name", names[i]}, {"initial", initial[static_cast<Eigen::Index>(i)]},
+           {"estimate", estimate[static_cast<Eigen::Index>(i)]}};
+    const auto it = truth.find(names[i]);
+    if (it != truth.end()) {
+      e["truth"] = it->second;
+      e["relative_error"] = estimate[static_cast<Eigen::Index>(i)] / it->second - 1.0;
+    }
+    if (ident.std.size() > static_cast<Eigen::Index>(i)) {
+      e["std"] = std::isfinite(ident.std[static_cast<Eigen::Index>(i)]) ? json(ident.std[static_cast<Eigen::Index>(i)]) : json(nullptr);
+      e["identifiable"] = static_cast<bool>(ident.identifiable[i]);
+    }
+    params.push_back(e);
+  }
+  json iters = json::array();
+  for (const auto& it : summary.iterations) {
+    json values = json::object();
+    for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = it.q[static_cast<Eigen::Index>(i)];
+    iters.push_back({{"k", it.k}, {"cost", it.cost}, {"values", values}, {"physical", p.params->physical(it.q)},
+                     {"gradient_norm", it.gradient_norm}});
+  }
+  json out{{"scenario", scenario},
+           {"method", method},
+           {"parameters", params},
+           {"physical_estimate", p.params->physical(estimate)},
+           {"iterations", iters},
+           {"termination", to_string(summary.termination)},
+           {"termination_message", summary.message},
+           {"converged", summary.converged()},
+           {"cost", summary.cost},
+           {"gradient_evaluations", counters.gradient_evaluations},
+           {"forward_solves", counters.forward_solves},
+           {"costate_solves", counters.costate_solves},
+           {"sensitivity_solves", counters.sensitivity_solves},
+           {"wall_seconds", wall_seconds},
+           {"timing_seconds",
+            {{"forward", counters.forward_seconds},
+             {"costate", counters.costate_seconds},
+             {"sensitivity", counters.sensitivity_seconds},
+             {"quadrature", counters.quadrature_seconds},
+             {"optimizer_total", summary.wall_seconds}}},
+           {"integrator",
+            {{"name", p.objective_options.solver.integrator == SolverOptions::Integrator::Esdirk ? "arkode-esdirk436l2sa" : "cvodes-bdf"},
+             {"step", p.objective_options.solver.step},
+             {"rtol", p.objective_options.solver.rtol},
+             {"steps", counters.solver.steps}}},
+           {"data_source", p.data_source},
+           {"elements", p.fe.elements},
+           {"settings", io::to_json(p.scenario)}};
+  if (ident.std.size() > 0) {
+    out["identifiability"] = {{"condition_number", safe(ident.condition_number)},
+                              {"noise_std", ident.noise_std},
+                              {"noise_source", ident.noise_source}};
+  }
+  return out;
+}
+
+void write_outputs(const std::string& dir, Problem& p, const RunResult& r) {
+  io::ensure_directory(dir);
+  // fit.csv: measured, predicted and residual per sensor at the sample times.
+  Objective obj(p.fe.model, *p.params, p.signals, p.data, p.objective_options);
+  const MatrixXd Y = obj.predict(r.estimate);
+  io::DataTable tab;
+  tab.t = p.data.t;
+  for (int k = 0; k < p.data.sensors(); ++k) {
+    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+    tab.names.push_back(n + "_measured");
+    tab.names.push_back(n + "_predicted");
+    tab.names.push_back(n + "_residual");
+    std::vector<double> m(p.data.t.size()), y(p.data.t.size()), e(p.data.t.size());
+    for (std::size_t i = 0; i < p.data.t.size(); ++i) {
+      m[i] = p.data.z(static_cast<Eigen::Index>(i), k);
+      y[i] = Y(static_cast<Eigen::Index>(i), k);
+      e[i] = y[i] - m[i];
+    }
+    tab.columns.push_back(m);
+    tab.columns.push_back(y);
+    tab.columns.push_back(e);
+  }
+  io::write_csv((std::filesystem::path(dir) / "fit.csv").string(), tab);
+  io::write_json_atomic((std::filesystem::path(dir) / "identify.json").string(), r.to_json(p));
+}
+
+}  // namespace scoleid::identify
