@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <random>
 
+#include "scoleid/identify/modal.h"
 #include "scoleid/io/error.h"
 
 namespace scoleid::identify {
@@ -28,9 +29,6 @@ std::vector<double> sample_times(const io::Scenario& sc) {
   return t;
 }
 
-// Synthetic data are integrated with a step 10x finer than the identifier's default.
-double data_step(const io::Scenario& sc) { return identifier_step(sc) / 10.0; }
-
 void require_beam(const io::Scenario& sc) {
   if (sc.structure != "beam")
     throw InputError(sc.source + ": structure '" + sc.structure +
@@ -39,9 +37,26 @@ void require_beam(const io::Scenario& sc) {
 
 }  // namespace
 
-double identifier_step(const io::Scenario& sc) {
+double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
   if (sc.identification.time_step > 0) return sc.identification.time_step;
-  return sc.simulation.sample_interval / 2.0;
+  // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
+  // an L-stable step damps what it does not resolve, and P parameters are fixed mostly by the
+  // first P modes' frequencies and shapes.
+  VectorXd c;
+  MatrixXd dcdq;
+  params.coefficients(params.initial(), c, dcdq);
+  const AssembledModel ops = assemble(model, c);
+  const std::vector<double> w = natural_frequencies(ops.M, ops.K);
+  const double wmax = w.empty() ? 0.0 : w.back();
+  std::vector<double> flexible;
+  for (double x : w)
+    if (x > 1e-6 * wmax) flexible.push_back(x);
+  double h = sc.simulation.sample_interval;
+  if (!flexible.empty()) {
+    const std::size_t r = std::min(flexible.size(), static_cast<std::size_t>(params.size() + 2)) - 1;
+    h = std::min(h, 0.3 / flexible[r]);
+  }
+  return h;
 }
 
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
@@ -151,13 +166,14 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       fail_field(sc.source, "identification.data_elements",
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
-    p->data = synthesize(sc, data_elements, id.rtol, data_step(sc), true);
+    // Synthetic data: a step 4x finer than the identifier's.
+    p->data = synthesize(sc, data_elements, id.rtol, identifier_step(sc, p->fe.model, *p->params) / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     for (int i = 0; i < truth.size(); ++i)
       if (std::isfinite(truth[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = truth[i];
   }
   p->objective_options.solver.rtol = id.rtol;
-  p->objective_options.solver.step = identifier_step(sc);
+  p->objective_options.solver.step = identifier_step(sc, p->fe.model, *p->params);
   p->objective_options.solver.integrator =
       id.integrator == "bdf" ? SolverOptions::Integrator::Bdf : SolverOptions::Integrator::Esdirk;
   return p;

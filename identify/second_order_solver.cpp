@@ -328,7 +328,8 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     s.integrator_mem = ark.mem;
     s.get_gamma = ARKStepGetCurrentGamma;
     check(ARKStepSetUserData(ark.mem, &s), "ARKStepSetUserData");
-    check(ARKStepSetTableNum(ark.mem, ARKODE_ESDIRK436L2SA_6_3_4, ARKODE_ERK_NONE), "ARKStepSetTableNum");
+    const auto table = s.opt.dirk_table < 0 ? ARKODE_ESDIRK324L2SA_4_2_3 : static_cast<ARKODE_DIRKTableID>(s.opt.dirk_table);
+    check(ARKStepSetTableNum(ark.mem, table, ARKODE_ERK_NONE), "ARKStepSetTableNum");
     check(ARKStepWFtolerances(ark.mem, cv_ewt), "ARKStepWFtolerances");
     check(ARKStepSetLinearSolver(ark.mem, LS, nullptr), "ARKStepSetLinearSolver");
     check(ARKStepSetLinear(ark.mem, 0), "ARKStepSetLinear");

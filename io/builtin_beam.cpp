@@ -90,7 +90,7 @@ identification:
   parameterization: physical
   estimate: [EI_1, EI_2, EI_3, EI_4, EI_5, EI_6, EI_7, EI_8]
   initial: {EI: 30000}
-  elements: 16
+  elements: 32
 truth: {segments: 64}
 )"},
   };

@@ -6,7 +6,7 @@
 // name; an input whose name is a column is driven by that column, piecewise linear, otherwise
 // by the scenario's signal) or are synthesised: the same structure on a finer mesh
 // (identification.data_elements, at least 2× the identifier's elements) with the true
-// parameters, integrated at a tolerance 100× tighter, sampled, plus each sensor's Gaussian noise
+// parameters, integrated with a 4× finer time step, sampled, plus each sensor's Gaussian noise
 // (seeded) — so the identifier never sees its own discretisation.
 #include <map>
 #include <memory>
@@ -37,7 +37,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
-// The identifier's fixed time step: identification.time_step, or half the sample interval.
-double identifier_step(const io::Scenario& scenario);
+// The identifier's fixed time step: identification.time_step if set, else
+// min(sample interval, 0.3 / ω_{P+2}) with ω_{P+2} the FE frequency of flexible mode P + 2 at the
+// starting parameters (P = number of estimated parameters).
+double identifier_step(const io::Scenario& scenario, const StructuralModel& model, const Parameterization& params);
 
 }  // namespace scoleid::identify

@@ -5,8 +5,8 @@
 //
 // with SUNDIALS on the first-order form y = [x; v]:  ẋ = v,   v̇ = M⁻¹ (F(t) − D v − K x).
 // Two integrators:
-//   esdirk (default)  ARKODE ARKStep, ESDIRK4(3)6L[2]SA (Kennedy & Carpenter): 4th order,
-//                     L-stable, fixed step h. A point load excites every mode of the mesh; the
+//   esdirk (default)  ARKODE ARKStep, ESDIRK3(2)4L[2]SA (Kennedy & Carpenter): 3rd order,
+//                     L-stable, 4 stages, fixed step h. A point load excites every mode of the mesh; the
 //                     modes with ω h ≫ 1 are the ones the mesh represents worst, and an L-stable
 //                     method damps their oscillation (keeping their quasi-static part) instead
 //                     of tracking it with ~ω_max·T steps. The step is chosen from the data's
@@ -43,6 +43,7 @@ struct SolverOptions {
   enum class Integrator { Esdirk, Bdf };
   Integrator integrator = Integrator::Esdirk;
   double step = 0.0;           // esdirk: fixed step; 0 = (t1 − t0)/2000
+  int dirk_table = -1;         // esdirk: ARKODE DIRK table id; −1 = ESDIRK3(2)4L[2]SA
   double rtol = 1e-9;
   double atol_floor = 1e-280;  // absolute floor of the group scales (only matters for zero forcing)
   long max_steps = 2000000;
