@@ -7,6 +7,8 @@
 #include <sundials/sundials_linearsolver.h>
 
 #include <Eigen/SparseCholesky>
+
+#include "scoleid/identify/banded_cholesky.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -50,7 +52,6 @@ void SolverSummary::Accumulate(const SolverSummary& o) {
 
 namespace {
 
-using LDLT = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>>;
 
 // RAII owners for the SUNDIALS objects of one solve.
 struct Context {
@@ -92,11 +93,11 @@ struct SecondOrderSolver::Impl {
   std::vector<int> group;
   int ngroups = 1;
   SolverOptions opt;
-  LDLT mass_ldlt;
+  BandedCholesky mass_chol;
+  std::vector<int> lower_slot;  // for each stored nonzero: its place in the band, or −1 (upper)
 
   // Per-solve state (solve() is const but single-threaded per object).
-  mutable LDLT newton_ldlt;
-  mutable SparseMatrix S;
+  mutable BandedCholesky newton_chol;
   mutable double gamma_factored = std::numeric_limits<double>::quiet_NaN();
   mutable long factorizations = 0;
   mutable long linear_solves = 0;
@@ -117,20 +118,26 @@ struct SecondOrderSolver::Impl {
   }
   void acceleration(const double* Fp, const double* x, const double* v, double* a) const {
     Eigen::Map<const Eigen::VectorXd> X(x, n), V(v, n), Fm(Fp, n);
-    tmp = Fm - D * V - K * X;
-    Eigen::Map<Eigen::VectorXd>(a, n) = mass_ldlt.solve(tmp);
+    Eigen::Map<Eigen::VectorXd> A(a, n);
+    A = Fm;
+    A.noalias() -= D * V;
+    A.noalias() -= K * X;
+    mass_chol.solve_in_place(a);
   }
   void factor(double gamma) const {
-    // S = M + γD + γ²K on the shared pattern: values only, the symbolic analysis is reused.
+    // S = M + γD + γ²K, written straight into the band from the shared pattern.
+    newton_chol.set_zero();
     const int nnz = static_cast<int>(M.nonZeros());
-    double* s = S.valuePtr();
     const double* m = M.valuePtr();
     const double* d = D.valuePtr();
     const double* k = K.valuePtr();
     const double g2 = gamma * gamma;
-    for (int i = 0; i < nnz; ++i) s[i] = m[i] + gamma * d[i] + g2 * k[i];
-    newton_ldlt.factorize(S);
-    if (newton_ldlt.info() != Eigen::Success) throw std::runtime_error("Newton matrix factorization failed");
+    double* band = &newton_chol.at(0, 0) - newton_chol.half_bandwidth();
+    for (int i = 0; i < nnz; ++i) {
+      const int slot = lower_slot[static_cast<std::size_t>(i)];
+      if (slot >= 0) band[slot] = m[i] + gamma * d[i] + g2 * k[i];
+    }
+    if (!newton_chol.factorize()) throw std::runtime_error("Newton matrix M + gD + g^2 K is not positive definite");
     gamma_factored = gamma;
     ++factorizations;
   }
@@ -138,9 +145,10 @@ struct SecondOrderSolver::Impl {
     if (gamma != gamma_factored) factor(gamma);
     ++linear_solves;
     Eigen::Map<const Eigen::VectorXd> r1(r, n), r2(r + n, n);
-    tmp = M * r2 - gamma * (K * r1);
     Eigen::Map<Eigen::VectorXd> a(sol, n), b(sol + n, n);
-    b = newton_ldlt.solve(tmp);
+    b.noalias() = M * r2;
+    b.noalias() -= gamma * (K * r1);
+    newton_chol.solve_in_place(sol + n);
     a = r1 + gamma * b;
   }
   // Reference scale of each group: the quasi-static response x_ref = (K + σM)⁻¹ F to the
@@ -253,12 +261,22 @@ SecondOrderSolver::SecondOrderSolver(const SparseMatrix& M, const SparseMatrix& 
   s.M = on_pattern(M, pattern);
   s.D = on_pattern(D, pattern);
   s.K = on_pattern(K, pattern);
-  s.S = pattern;
   s.group = dof_group.empty() ? std::vector<int>(static_cast<std::size_t>(s.n), 0) : std::move(dof_group);
   s.ngroups = 1 + *std::max_element(s.group.begin(), s.group.end());
-  s.mass_ldlt.compute(M);
-  if (s.mass_ldlt.info() != Eigen::Success) throw std::runtime_error("mass matrix is not positive definite");
-  s.newton_ldlt.analyzePattern(s.S);
+  const int b = BandedCholesky::bandwidth(pattern);
+  s.mass_chol.resize(s.n, b);
+  s.mass_chol.assign(M);
+  if (!s.mass_chol.factorize()) throw std::runtime_error("mass matrix is not positive definite");
+  s.newton_chol.resize(s.n, b);
+  // Band slot of each stored nonzero of the shared pattern (column-major, like M's values).
+  s.lower_slot.assign(static_cast<std::size_t>(s.M.nonZeros()), -1);
+  {
+    int idx = 0;
+    for (int k = 0; k < s.M.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(s.M, k); it; ++it, ++idx)
+        if (it.col() <= it.row())
+          s.lower_slot[static_cast<std::size_t>(idx)] = static_cast<int>(it.row()) * (b + 1) + static_cast<int>(it.col() - it.row()) + b;
+  }
   s.F.resize(s.n);
   s.tmp.resize(s.n);
 }
