@@ -2,11 +2,14 @@
 BUILD ?= build
 JOBS  ?= 2
 OUT   ?= run
+SCENARIO ?= paper-beam-1
 
 .PHONY: run test deps build bench slow clean
 
+# Main job: a Simbody truth trajectory, then the FE identifier on that data file.
 run: build
-	$(BUILD)/identify/scole-identify --scenario paper-beam-1 --out $(OUT)/paper-beam-1
+	$(BUILD)/model/scole-truth --scenario $(SCENARIO) --out $(OUT)/$(SCENARIO)/truth
+	$(BUILD)/identify/scole-identify --scenario $(SCENARIO) --data $(OUT)/$(SCENARIO)/truth/truth.csv --out $(OUT)/$(SCENARIO)/identify
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
