@@ -2,6 +2,7 @@
 // responses with the finite-element costate method. See README.md.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
@@ -34,9 +35,11 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    std::fprintf(stderr, "scole-identify: %s (see --help)\n", e.what());
+    return 2;
   }
   try {
     if (list) {
@@ -63,13 +66,15 @@ int main(int argc, char** argv) {
       const auto it = r.truth.find(r.names[i]);
       const double est = r.estimate[static_cast<Eigen::Index>(i)];
       const double sd = r.ident.std.size() ? r.ident.std[static_cast<Eigen::Index>(i)] : std::nan("");
+      char sds[32] = "-";
+      if (std::isfinite(sd)) std::snprintf(sds, sizeof sds, "%12.3e", sd);
       if (it != r.truth.end())
-        std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12.3e%s\n", r.names[i].c_str(), r.initial[static_cast<Eigen::Index>(i)], est,
-                    it->second, est / it->second - 1.0, sd,
+        std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s%s\n", r.names[i].c_str(), r.initial[static_cast<Eigen::Index>(i)], est,
+                    it->second, est / it->second - 1.0, sds,
                     r.ident.identifiable.size() && !r.ident.identifiable[i] ? "  NOT IDENTIFIABLE" : "");
       else
-        std::printf("%-10s %14.7g %14.7g %14s %12s %12.3e%s\n", r.names[i].c_str(), r.initial[static_cast<Eigen::Index>(i)], est, "-",
-                    "-", sd, r.ident.identifiable.size() && !r.ident.identifiable[i] ? "  NOT IDENTIFIABLE" : "");
+        std::printf("%-10s %14.7g %14.7g %14s %12s %12s%s\n", r.names[i].c_str(), r.initial[static_cast<Eigen::Index>(i)], est, "-",
+                    "-", sds, r.ident.identifiable.size() && !r.ident.identifiable[i] ? "  NOT IDENTIFIABLE" : "");
     }
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);

@@ -36,6 +36,22 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
       if (ms > 0) R_[static_cast<std::size_t>(k)] = 1.0 / ((T_ - t0) * ms);
     }
   }
+  auto add_terms = [&](const std::vector<OperatorTerm>& ts, int kind) {
+    for (const auto& t : ts) {
+      if (t.coefficient < 0) continue;
+      TermEntries e{t.coefficient, kind, {}, {}, {}};
+      for (int k = 0; k < t.matrix.outerSize(); ++k)
+        for (SparseMatrix::InnerIterator it(t.matrix, k); it; ++it) {
+          e.row.push_back(static_cast<int>(it.row()));
+          e.col.push_back(static_cast<int>(it.col()));
+          e.value.push_back(it.value());
+        }
+      terms_.push_back(std::move(e));
+    }
+  };
+  add_terms(model_.mass, 0);
+  add_terms(model_.damping, 1);
+  add_terms(model_.stiffness, 2);
   for (const auto& s : inputs_)
     for (double b : s.breakpoints())
       if (b > t0 && b < T_) breakpoints_.push_back(b);
@@ -160,12 +176,14 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
       J += 0.5 * wt * e;
-      for (const auto& term : model_.mass)
-        if (term.coefficient >= 0) gc[term.coefficient] -= wt * pd.dot(term.matrix * v);
-      for (const auto& term : model_.damping)
-        if (term.coefficient >= 0) gc[term.coefficient] += wt * p.dot(term.matrix * v);
-      for (const auto& term : model_.stiffness)
-        if (term.coefficient >= 0) gc[term.coefficient] += wt * p.dot(term.matrix * x);
+      // Mass term by parts: −ṗᵀ M_j u̇; damping pᵀ D_j u̇; stiffness pᵀ K_j u.
+      for (const auto& e : terms_) {
+        const double* left = e.kind == 0 ? pd.data() : p.data();
+        const double* right = e.kind == 2 ? x.data() : v.data();
+        double acc = 0.0;
+        for (std::size_t m = 0; m < e.value.size(); ++m) acc += left[e.row[m]] * e.value[m] * right[e.col[m]];
+        gc[e.coefficient] += (e.kind == 0 ? -wt : wt) * acc;
+      }
       for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
         const int ci = model_.inputs[i].coefficient;
         if (ci >= 0) gc[ci] -= wt * inputs_[i](t) * p.dot(model_.inputs[i].vector);

@@ -89,6 +89,16 @@ private:
   std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets) const;
   Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i) const;
 
+  // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
+  // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.
+  struct TermEntries {
+    int coefficient;
+    int kind;  // 0 mass, 1 damping, 2 stiffness
+    std::vector<int> row, col;
+    std::vector<double> value;
+  };
+  std::vector<TermEntries> terms_;
+
   const StructuralModel& model_;
   const Parameterization& params_;
   std::vector<io::Signal> inputs_;

@@ -1,0 +1,110 @@
+// scole-identify-bench: the identifier's speed figures, measured side by side in one run.
+//   1. adjoint gradient cost / one forward solve, for N = 2 and N = 64 stiffness sections, with
+//      central finite differences beside it;
+//   2. forward solve time vs elements (10, 20, 40, 80): growth exponent;
+//   3. Case I (paper-beam-1) identification end to end, from data in memory and from the scenario.
+// Each figure is the minimum over repetitions (wall clock, steady_clock).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+
+#include "scoleid/identify/identify_run.h"
+
+using namespace scoleid::identify;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double best_of(int reps, const std::function<void()>& f) {
+  double best = 1e300;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = Clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  return best;
+}
+
+scoleid::io::Scenario sections_scenario(int N, int elements) {
+  auto sc = scoleid::io::load_scenario("paper-beam-3");
+  sc.name = "sections-" + std::to_string(N);
+  sc.beam.EI.assign(static_cast<std::size_t>(N), 0.0);
+  for (int k = 0; k < N; ++k) sc.beam.EI[static_cast<std::size_t>(k)] = 23000.0 * (1.0 + 0.5 * std::sin(0.37 * k));
+  sc.identification.estimate.clear();
+  sc.identification.initial.clear();
+  for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
+  sc.identification.initial["EI"] = 25000.0;
+  sc.identification.elements = elements;
+  sc.identification.data_elements = 2 * elements;
+  sc.identification.time_step = 0.005;  // the same step for every N: compare like with like
+  return sc;
+}
+
+}  // namespace
+
+int main() {
+  std::printf("scole-identify-bench (wall clock, best of repetitions)\n\n");
+
+  std::printf("1. Gradient cost relative to one forward solve (64 elements, 10 s, h = 0.005)\n");
+  std::printf("%6s %12s %12s %10s %12s %10s\n", "N", "forward [s]", "adjoint [s]", "ratio", "central FD", "ratio");
+  double ratio_n2 = 0, ratio_n64 = 0, grad_n2 = 0, grad_n64 = 0;
+  for (int N : {2, 64}) {
+    auto p = make_problem(sections_scenario(N, 64), std::nullopt);
+    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    const VectorXd q = p->params->initial();
+    VectorXd g;
+    const double tf = best_of(3, [&] { obj.cost(q); });
+    const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
+    const double tfd = 2.0 * N * tf;  // 2N forward solves
+    std::printf("%6d %12.4f %12.4f %10.2f %12.4f %10.1f\n", N, tf, tg, tg / tf, tfd, tfd / tf);
+    (N == 2 ? ratio_n2 : ratio_n64) = tg / tf;
+    (N == 2 ? grad_n2 : grad_n64) = tg;
+  }
+  std::printf("   adjoint gradient time N=64 / N=2: %.2f\n\n", grad_n64 / grad_n2);
+
+  std::printf("2. Forward solve vs elements (paper-beam-1 geometry, 10 s, h = 0.01)\n");
+  std::printf("%10s %8s %12s %12s\n", "elements", "dofs", "forward [s]", "growth exp");
+  double prev = 0;
+  int prev_ne = 0;
+  for (int ne : {10, 20, 40, 80}) {
+    auto sc = scoleid::io::load_scenario("paper-beam-1");
+    sc.identification.elements = ne;
+    sc.identification.data_elements = 2 * ne;
+    sc.identification.time_step = 0.01;
+    auto p = make_problem(sc, std::nullopt);
+    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    const VectorXd q = p->params->initial();
+    const double t = best_of(3, [&] { obj.cost(q); });
+    if (prev > 0)
+      std::printf("%10d %8d %12.4f %12.2f\n", ne, p->fe.model.ndof, t, std::log(t / prev) / std::log(double(ne) / prev_ne));
+    else
+      std::printf("%10d %8d %12.4f %12s\n", ne, p->fe.model.ndof, t, "-");
+    prev = t;
+    prev_ne = ne;
+  }
+
+  std::printf("\n3. paper-beam-1 identification (Gauss-Newton, 10 elements)\n");
+  auto sc = scoleid::io::load_scenario("paper-beam-1");
+  double t_ident = 1e300, t_total = 1e300;
+  int iters = 0;
+  for (int r = 0; r < 3; ++r) {
+    const auto t0 = Clock::now();
+    auto p = make_problem(sc, std::nullopt);
+    const auto t1 = Clock::now();
+    RunOptions ro;
+    ro.verbose = false;
+    ro.compute_std = false;
+    const RunResult res = run_identification(*p, ro);
+    const auto t2 = Clock::now();
+    iters = res.summary.iterations_done;
+    t_ident = std::min(t_ident, std::chrono::duration<double>(t2 - t1).count());
+    t_total = std::min(t_total, std::chrono::duration<double>(t2 - t0).count());
+  }
+  std::printf("   identification from data in memory: %.3f s (%d iterations)\n", t_ident, iters);
+  std::printf("   with data synthesis (20 elements):  %.3f s\n", t_total);
+  std::printf("\nsummary: gradient/forward %.2f (N=2), %.2f (N=64); N=64/N=2 gradient time %.2f; Case I %.3f s\n",
+              ratio_n2, ratio_n64, grad_n64 / grad_n2, t_ident);
+  return 0;
+}

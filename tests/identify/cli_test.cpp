@@ -1,0 +1,396 @@
+// The scole-identify executable's contract for bad input, tested end to end through a shell:
+// every input error (unknown scenario, unreadable or malformed YAML, out-of-range or unknown
+// fields, unusable data CSV, bad command line) exits with code 2, prints exactly one line on
+// stderr that names the source (file or scenario), the field and the offending value, and
+// leaves no output file (identify.json, fit.csv, *.tmp.*) in the --out directory.
+// Plus the positive paths: --list-scenarios, --help, and a small identification run without
+// and then with --data (the data being the first run's measured column).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef SCOLE_IDENTIFY_EXE
+#error "SCOLE_IDENTIFY_EXE must be defined to the path of the scole-identify executable"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) {
+    if (c == '\'')
+      q += "'\\''";
+    else
+      q += c;
+  }
+  return q + "'";
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  ASSERT_TRUE(out.good()) << "cannot write " << p;
+}
+
+// Non-empty-terminated lines of a stream's text ("a\nb\n" -> {a, b}; "a\nb" -> {a, b}).
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text) {
+    if (c == '\n') {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur.push_back(c);
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+// A per-test scratch directory, unique across processes and tests, removed at the end.
+class TempDir {
+public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::random_device rd;
+    const std::string name = std::string("scoleid-cli-") + (info ? info->name() : "x") + "-" +
+                             std::to_string(::getpid()) + "-" + std::to_string(rd());
+    path_ = fs::temp_directory_path() / name;
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& s) const { return path_ / s; }
+
+private:
+  fs::path path_;
+};
+
+// Runs scole-identify with `args`; stdout through the pipe, stderr through a file in `dir`.
+Result run(const std::vector<std::string>& args, const TempDir& dir) {
+  const fs::path err_file = dir / "stderr.txt";
+  std::string cmd = shell_quote(SCOLE_IDENTIFY_EXE);
+  for (const auto& a : args) cmd += " " + shell_quote(a);
+  cmd += " 2> " + shell_quote(err_file.string()) + " < /dev/null";
+  Result r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) {
+    r.err = "popen failed for: " + cmd;
+    return r;
+  }
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err_file);
+  return r;
+}
+
+// The --out directory may exist, but must hold no identify.json, no fit.csv, no *.tmp.* file.
+void expect_no_outputs(const fs::path& out) {
+  if (!fs::exists(out)) return;
+  EXPECT_FALSE(fs::exists(out / "identify.json")) << out / "identify.json" << " left behind";
+  EXPECT_FALSE(fs::exists(out / "fit.csv")) << out / "fit.csv" << " left behind";
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    EXPECT_EQ(name.find(".tmp."), std::string::npos) << "temporary file left behind: " << e.path();
+  }
+}
+
+// The input-error contract: exit 2, exactly one stderr line holding every one of `needles`
+// (source, field, value), no output files. io::InputError lines also start "scole-identify: ";
+// command-line usage errors (prefixed = false) are only held to exit 2 and one line.
+void expect_input_error(const Result& r, const fs::path& out, const std::vector<std::string>& needles,
+                        bool prefixed = true) {
+  EXPECT_EQ(r.code, 2) << "stderr:\n" << r.err << "stdout:\n" << r.out;
+  const auto ls = lines_of(r.err);
+  EXPECT_EQ(ls.size(), 1u) << "stderr must be exactly one line, got:\n" << r.err;
+  const std::string line = ls.empty() ? std::string() : ls.front();
+  if (prefixed) {
+    EXPECT_EQ(line.rfind("scole-identify: ", 0), 0u) << "line: " << line;
+  }
+  for (const auto& n : needles)
+    EXPECT_NE(line.find(n), std::string::npos) << "'" << n << "' missing from stderr line: " << line;
+  expect_no_outputs(out);
+}
+
+// A short cantilever case: step tip load, tip sensor, q1 = EI/rho_A and q2 = 1/rho_A. Ten
+// elements keep the discretisation error against the (twice as fine) synthetic data well under
+// 1e-3 (four elements give ~4e-3 on q1) while the whole run stays well under a second.
+const char* kGood = R"(name: cli-good
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0}
+inputs:
+  - {name: P, at: beam, kind: force, location: 10, signal: {type: step, amplitude: 10, t0: 0}}
+sensors:
+  - {name: w_tip, at: beam, kind: displacement, location: 10}
+simulation: {duration: 2, sample_interval: 0.01, seed: 1}
+identification:
+  parameterization: paper
+  estimate: [q1, q2]
+  initial: {rho_A: 63, EI: 19000}
+  elements: 10
+)";
+
+// kGood with the first occurrence of `from` replaced by `to`.
+std::string good_with(const std::string& from, const std::string& to) {
+  std::string s = kGood;
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+// Writes `yaml` to DIR/s.yaml, runs it with --out DIR/out, checks the input-error contract.
+void expect_yaml_error(const std::string& yaml, const std::vector<std::string>& needles_after_source) {
+  TempDir dir;
+  const fs::path file = dir / "s.yaml", out = dir / "out";
+  write_file(file, yaml);
+  fs::create_directories(out);
+  const Result r = run({"--scenario", file.string(), "--out", out.string(), "-q"}, dir);
+  std::vector<std::string> needles{"scenario '" + file.string() + "'"};
+  needles.insert(needles.end(), needles_after_source.begin(), needles_after_source.end());
+  expect_input_error(r, out, needles);
+}
+
+// Writes `csv` to DIR/<name>, runs paper-beam-1 on it, checks the input-error contract.
+void expect_csv_error(const std::string& name, const std::string& csv, const std::vector<std::string>& needles) {
+  TempDir dir;
+  const fs::path file = dir / name, out = dir / "out";
+  write_file(file, csv);
+  fs::create_directories(out);
+  const Result r = run({"--scenario", "paper-beam-1", "--data", file.string(), "--out", out.string(), "-q"}, dir);
+  std::vector<std::string> all{"data file '" + file.string() + "'"};
+  all.insert(all.end(), needles.begin(), needles.end());
+  expect_input_error(r, out, all);
+}
+
+// The columns of a numeric CSV with a header line; `header` receives the column names.
+std::vector<std::vector<double>> csv_columns(const std::string& text, std::vector<std::string>& header) {
+  std::vector<std::vector<double>> cols;
+  const auto ls = lines_of(text);
+  header.clear();
+  if (ls.empty()) return cols;
+  {
+    std::stringstream h(ls[0]);
+    std::string f;
+    while (std::getline(h, f, ',')) header.push_back(f);
+  }
+  cols.assign(header.size(), {});
+  for (std::size_t i = 1; i < ls.size(); ++i) {
+    if (ls[i].empty()) continue;
+    std::stringstream row(ls[i]);
+    std::string f;
+    std::size_t j = 0;
+    while (std::getline(row, f, ',') && j < cols.size()) cols[j++].push_back(std::stod(f));
+  }
+  return cols;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------ bad scenario
+
+TEST(ScoleIdentifyCli, UnknownBuiltinScenario) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  const Result r = run({"--scenario", "paper-beam-9", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"scenario 'paper-beam-9'", "not a built-in scenario"});
+}
+
+TEST(ScoleIdentifyCli, MissingYamlFile) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  const Result r = run({"--scenario", "/nonexistent/dir/s.yaml", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"'/nonexistent/dir/s.yaml'", "cannot be opened"});
+}
+
+TEST(ScoleIdentifyCli, MalformedYaml) {
+  // Unterminated flow map.
+  expect_yaml_error("name: broken\nbeam: {length: 10, EI: 5\nsensors: []\n", {"malformed YAML at line "});
+}
+
+TEST(ScoleIdentifyCli, NegativeStiffness) {
+  expect_yaml_error(good_with("EI: 23000", "EI: -3"), {"beam.EI must be > 0, got -3"});
+}
+
+TEST(ScoleIdentifyCli, ZeroMassPerLength) {
+  expect_yaml_error(good_with("rho_A: 67", "rho_A: 0"), {"beam.rho_A must be > 0, got 0"});
+}
+
+TEST(ScoleIdentifyCli, NanStiffness) {
+  expect_yaml_error(good_with("EI: 23000", "EI: .nan"), {"beam.EI", ".nan"});
+}
+
+TEST(ScoleIdentifyCli, SensorOutsideBeam) {
+  expect_yaml_error(good_with("kind: displacement, location: 10", "kind: displacement, location: 12"),
+                    {"sensors[0].location", "got 12"});
+}
+
+TEST(ScoleIdentifyCli, UnknownFieldTypo) {
+  expect_yaml_error(good_with("length: 10", "lenght: 10"), {"beam.lenght", "is not a known field", "'lenght'"});
+}
+
+TEST(ScoleIdentifyCli, UnsupportedSensorKind) {
+  expect_yaml_error(good_with("kind: displacement", "kind: acceleration"), {"sensors[0].kind", "'acceleration'"});
+}
+
+// ---------------------------------------------------------------------------------- bad data
+
+TEST(ScoleIdentifyCli, MissingDataFile) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const Result r =
+      run({"--scenario", "paper-beam-1", "--data", "/nonexistent/truth.csv", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"data file '/nonexistent/truth.csv'", "cannot be opened"});
+}
+
+TEST(ScoleIdentifyCli, DataNonNumericValue) {
+  expect_csv_error("truth.csv", "t,P,w_mid\n0,10,0\n0.01,10,abc\n0.02,10,1e-5\n",
+                   {"line 3", "column 'w_mid'", "'abc'"});
+}
+
+TEST(ScoleIdentifyCli, DataNanValue) {
+  expect_csv_error("truth.csv", "t,P,w_mid\n0,10,0\n0.01,10,nan\n0.02,10,1e-5\n",
+                   {"line 3", "column 'w_mid'", "finite", "nan"});
+}
+
+TEST(ScoleIdentifyCli, DataTimeNotIncreasing) {
+  expect_csv_error("truth.csv", "t,P,w_mid\n0,10,0\n0.01,10,1e-6\n0.01,10,2e-6\n0.03,10,3e-6\n",
+                   {"line 4", "column 't'", "strictly increasing", "0.01"});
+}
+
+TEST(ScoleIdentifyCli, DataLacksSensorColumn) {
+  expect_csv_error("truth.csv", "t,P,other\n0,10,0\n0.01,10,1e-6\n0.02,10,2e-6\n", {"sensor 'w_mid'"});
+}
+
+// ------------------------------------------------------------------------------ command line
+
+TEST(ScoleIdentifyCli, UnknownOption) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  const Result r = run({"--bogus-option", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"--bogus-option"}, /*prefixed=*/false);
+}
+
+TEST(ScoleIdentifyCli, BadMethod) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  const Result r = run({"--method", "newton-raphson", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"--method", "newton-raphson"}, /*prefixed=*/false);
+}
+
+// ---------------------------------------------------------------------------- positive paths
+
+TEST(ScoleIdentifyCli, ListScenarios) {
+  TempDir dir;
+  const Result r = run({"--list-scenarios"}, dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* n : {"paper-beam-1", "paper-beam-2", "paper-beam-3"})
+    EXPECT_NE(r.out.find(n), std::string::npos) << n << " not listed:\n" << r.out;
+}
+
+TEST(ScoleIdentifyCli, Help) {
+  TempDir dir;
+  const Result r = run({"--help"}, dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("--data"), std::string::npos) << r.out;
+}
+
+TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
+  TempDir dir;
+  const fs::path yaml = dir / "good.yaml", out1 = dir / "run1", out2 = dir / "run2";
+  write_file(yaml, kGood);
+
+  // 1. Synthetic data.
+  const Result r1 = run({"--scenario", yaml.string(), "--out", out1.string(), "-q"}, dir);
+  ASSERT_EQ(r1.code, 0) << "stderr:\n" << r1.err << "stdout:\n" << r1.out;
+  ASSERT_TRUE(fs::exists(out1 / "identify.json"));
+  ASSERT_TRUE(fs::exists(out1 / "fit.csv"));
+  for (const auto& e : fs::directory_iterator(out1))
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+  nlohmann::json j1;
+  ASSERT_NO_THROW(j1 = nlohmann::json::parse(read_file(out1 / "identify.json")));
+  for (const char* k : {"parameters", "iterations", "termination", "gradient_evaluations", "forward_solves", "wall_seconds"})
+    EXPECT_TRUE(j1.contains(k)) << "identify.json lacks '" << k << "'";
+  ASSERT_TRUE(j1["parameters"].is_array());
+  ASSERT_EQ(j1["parameters"].size(), 2u);
+  std::map<std::string, double> truth;
+  for (const auto& p : j1["parameters"]) {
+    for (const char* k : {"name", "initial", "estimate", "truth", "std"})
+      EXPECT_TRUE(p.contains(k)) << "parameter lacks '" << k << "': " << p.dump();
+    if (!p.contains("name") || !p.contains("estimate") || !p.contains("truth")) continue;
+    const std::string name = p["name"].get<std::string>();
+    const double est = p["estimate"].get<double>(), tru = p["truth"].get<double>();
+    truth[name] = tru;
+    EXPECT_LT(std::abs(est / tru - 1.0), 1e-3) << name << ": estimate " << est << ", truth " << tru;
+  }
+  EXPECT_EQ(j1["parameters"][0].value("name", ""), "q1");
+  EXPECT_EQ(j1["parameters"][1].value("name", ""), "q2");
+
+  // 2. The measured column of fit.csv as a data file t,w_tip; no truth.json beside it.
+  std::vector<std::string> header;
+  const auto cols = csv_columns(read_file(out1 / "fit.csv"), header);
+  int jt = -1, jm = -1;
+  for (std::size_t k = 0; k < header.size(); ++k) {
+    if (header[k] == "t") jt = static_cast<int>(k);
+    if (header[k] == "w_tip_measured") jm = static_cast<int>(k);
+  }
+  ASSERT_GE(jt, 0) << "fit.csv has no t column";
+  ASSERT_GE(jm, 0) << "fit.csv has no w_tip_measured column";
+  ASSERT_GT(cols[static_cast<std::size_t>(jt)].size(), 100u);
+  fs::create_directories(dir / "data");
+  const fs::path csv = dir / "data" / "measured.csv";
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "t,w_tip\n";
+    for (std::size_t i = 0; i < cols[static_cast<std::size_t>(jt)].size(); ++i)
+      os << cols[static_cast<std::size_t>(jt)][i] << ',' << cols[static_cast<std::size_t>(jm)][i] << '\n';
+    write_file(csv, os.str());
+  }
+  const Result r2 = run({"--scenario", yaml.string(), "--data", csv.string(), "--out", out2.string(), "-q"}, dir);
+  ASSERT_EQ(r2.code, 0) << "stderr:\n" << r2.err << "stdout:\n" << r2.out;
+  nlohmann::json j2;
+  ASSERT_NO_THROW(j2 = nlohmann::json::parse(read_file(out2 / "identify.json")));
+  ASSERT_TRUE(j2.contains("parameters"));
+  ASSERT_EQ(j2["parameters"].size(), 2u);
+  for (const auto& p : j2["parameters"]) {
+    const std::string name = p.value("name", "");
+    ASSERT_TRUE(truth.count(name)) << name;
+    const double est = p.value("estimate", std::nan(""));
+    EXPECT_LT(std::abs(est / truth[name] - 1.0), 1e-3) << name << ": estimate " << est << ", truth " << truth[name];
+  }
+}
