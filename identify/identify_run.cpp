@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "scoleid/io/data_files.h"
@@ -212,8 +213,31 @@ void write_outputs(const std::string& dir, Problem& p, const RunResult& r) {
     tab.columns.push_back(y);
     tab.columns.push_back(e);
   }
-  io::write_csv((std::filesystem::path(dir) / "fit.csv").string(), tab);
-  io::write_json_atomic((std::filesystem::path(dir) / "identify.json").string(), r.to_json(p));
+  const auto d = std::filesystem::path(dir);
+  io::write_csv((d / "fit.csv").string(), tab);
+  // fit.gp: measured vs predicted and the residual per sensor, and the cost history; rendered to
+  // fit.png when gnuplot is available (the script stays for other terminals).
+  std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * (p.data.sensors() + 1)) +
+                   " noenhanced\nset output 'fit.png'\nset datafile separator ','\nset multiplot layout " +
+                   std::to_string(p.data.sensors() + 1) + ",1\nset grid\nset key top right\n";
+  for (int k = 0; k < p.data.sensors(); ++k) {
+    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+    const int c = 2 + 3 * k;
+    gp += "set title '" + n + "'\nset xlabel 't'\nset y2tics\nset ytics nomirror\n";
+    gp += "plot 'fit.csv' every ::1 using 1:" + std::to_string(c) + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
+          std::to_string(c + 1) + " with lines dt 2 lw 2 title 'predicted', '' every ::1 using 1:" + std::to_string(c + 2) +
+          " axes x1y2 with lines lc rgb 'gray' title 'residual (right axis)'\n";
+  }
+  gp += "unset y2tics\nset ytics mirror\nset title 'cost per iteration'\nset xlabel 'iteration'\nset logscale y\n"
+        "plot '-' using 1:2 with linespoints lw 2 notitle\n";
+  for (const auto& it : r.summary.iterations) gp += std::to_string(it.k) + "," + io::format_value(it.cost) + "\n";
+  gp += "e\nunset multiplot\n";
+  io::write_text_atomic((d / "fit.gp").string(), gp);
+  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
+    const std::string cmd = "cd '" + d.string() + "' && gnuplot fit.gp > /dev/null 2>&1";
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n");
+  }
+  io::write_json_atomic((d / "identify.json").string(), r.to_json(p));
 }
 
 }  // namespace scoleid::identify

@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
     }
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);
-    std::printf("wrote %s/identify.json and %s/fit.csv\n", out.c_str(), out.c_str());
+    std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
     return 0;
   } catch (const io::InputError& e) {
     std::fprintf(stderr, "scole-identify: %s\n", e.what());
