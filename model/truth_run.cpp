@@ -54,6 +54,14 @@ std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments)
   return std::make_unique<BeamChain>(sc.beam, segments);
 }
 
+std::unique_ptr<Structure> prepare_structure(const io::Scenario& sc, int segments) {
+  auto structure = build_structure(sc, segments);
+  const auto inputs = resolve_inputs(sc, *structure);
+  Force::Custom(structure->forces(), new InputForces(structure->matter(), structure->reference_body(), inputs));
+  structure->system().realizeTopology();
+  return structure;
+}
+
 bool SimulateOptions::IsValid(std::string* why) const {
   auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
   if (!(accuracy > 0 && accuracy < 1)) return bad("accuracy must be in (0, 1)");
@@ -178,11 +186,8 @@ TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
     if (!(accuracy < 1)) io::fail_field(sc.source, "truth.accuracy", "must be < 1", io::format_value(accuracy));
   }
 
-  auto structure = build_structure(sc, n);
-  const auto inputs = resolve_inputs(sc, *structure);
+  auto structure = prepare_structure(sc, n);
   const auto sensors = resolve_sensors(sc, *structure);
-  Force::Custom(structure->forces(), new InputForces(structure->matter(), structure->reference_body(), inputs));
-  structure->system().realizeTopology();
   State state = structure->system().getDefaultState();
 
   SimulateOptions so;

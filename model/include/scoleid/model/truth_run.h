@@ -32,6 +32,9 @@ std::unique_ptr<SimTK::Integrator> make_integrator(const std::string& name, cons
 
 // Builds the beam chain or the SCOLE system of the scenario with `segments` segments.
 std::unique_ptr<Structure> build_structure(const io::Scenario& scenario, int segments);
+// build_structure plus the scenario's inputs as a force element, topology realized: ready for
+// getDefaultState() (rest, undeformed) and simulate(). InputError if an input cannot apply.
+std::unique_ptr<Structure> prepare_structure(const io::Scenario& scenario, int segments);
 
 struct SimulateOptions {
   std::string integrator = "auto";
