@@ -5,6 +5,7 @@
 #include <random>
 
 #include "scoleid/identify/modal.h"
+#include "scoleid/identify/scole_model.h"
 #include "scoleid/io/error.h"
 
 namespace scoleid::identify {
@@ -29,10 +30,20 @@ std::vector<double> sample_times(const io::Scenario& sc) {
   return t;
 }
 
-void require_beam(const io::Scenario& sc) {
-  if (sc.structure != "beam")
-    throw InputError(sc.source + ": structure '" + sc.structure +
-                     "' is not supported by this identifier build (beam structures only)");
+void require_known_structure(const io::Scenario& sc) {
+  if (sc.structure != "beam" && sc.structure != "scole")
+    throw InputError(sc.source + ": structure '" + sc.structure + "' is not supported by this identifier (beam|scole)");
+}
+
+// The structure's FE model on `elements` elements and its coefficients at the scenario's values.
+std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elements) {
+  if (sc.structure == "scole") {
+    ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
+    return {std::move(fe.model), scole_coefficients(sc.scole)};
+  }
+  BeamFE fe = build_beam(sc.beam, elements, static_cast<int>(sc.beam.EI.size()), sc.inputs, sc.sensors, sc.source);
+  VectorXd c = beam_coefficients(fe, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta);
+  return {std::move(fe.model), std::move(c)};
 }
 
 }  // namespace
@@ -60,15 +71,15 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
 }
 
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
-  require_beam(sc);
-  const BeamFE fe = build_beam(sc.beam, elements, static_cast<int>(sc.beam.EI.size()), sc.inputs, sc.sensors, sc.source);
-  const AssembledModel ops = assemble(fe.model, beam_coefficients(fe, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta));
+  require_known_structure(sc);
+  const auto [model, coefficients] = true_model(sc, elements);
+  const AssembledModel ops = assemble(model, coefficients);
   SolverOptions so;
   so.rtol = rtol;
   so.step = step;
-  SecondOrderSolver solver(ops.M, ops.D, ops.K, fe.model.dof_group, so);
+  SecondOrderSolver solver(ops.M, ops.D, ops.K, model.dof_group, so);
   const auto signals = scenario_signals(sc);
-  const int n = fe.model.ndof;
+  const int n = model.ndof;
   SecondOrderSolver::Forcing f = [&](double t, double* F) {
     Eigen::Map<VectorXd> Fm(F, n);
     for (std::size_t i = 0; i < signals.size(); ++i) Fm += signals[i](t) * ops.loads[i];
@@ -80,7 +91,7 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
   const Trajectory u = solver.solve(0.0, times.back(), f, bps);
   Measurements m;
   m.t = times;
-  const MatrixXd C = fe.model.output_matrix();
+  const MatrixXd C = model.output_matrix();
   m.z.resize(static_cast<Eigen::Index>(times.size()), C.rows());
   VectorXd x(n), v(n);
   for (std::size_t k = 0; k < times.size(); ++k) {
@@ -101,16 +112,30 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
 }
 
 std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
-  require_beam(sc);
+  require_known_structure(sc);
   if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
   if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
   auto p = std::make_unique<Problem>();
   p->scenario = sc;
   const auto& id = sc.identification;
-  p->fe = build_beam(sc.beam, id.elements, id.sections, sc.inputs, sc.sensors, sc.source);
-  auto bp = std::make_unique<BeamParameterization>(p->fe, sc.beam, id, sc.source);
-  const VectorXd truth = bp->truth();
-  p->params = std::move(bp);
+  const bool scole = sc.structure == "scole";
+  if (scole) {
+    if (id.sections > 1)
+      fail_field(sc.source, "identification.sections", "must be 0 or 1 for a scole structure (uniform mast)",
+                 std::to_string(id.sections));
+    // The SCOLE model in the problem's FE slot: the identifier only uses its structural model,
+    // element count and length.
+    ScoleFE fe = build_scole(sc.scole, id.elements, sc.inputs, sc.sensors, sc.source);
+    p->fe.model = std::move(fe.model);
+    p->fe.length = sc.scole.length;
+    p->fe.elements = id.elements;
+    p->fe.sections = 1;
+    p->params = std::make_unique<ScoleParameterization>(sc.scole, id, sc.source);
+  } else {
+    p->fe = build_beam(sc.beam, id.elements, id.sections, sc.inputs, sc.sensors, sc.source);
+    p->params = std::make_unique<BeamParameterization>(p->fe, sc.beam, id, sc.source);
+  }
+  const VectorXd truth = p->params->truth();
   p->signals = scenario_signals(sc);
 
   if (data_csv) {
@@ -147,7 +172,22 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
     p->data_source = *data_csv;
     // True values from the metadata, translated to this parameterization.
-    if (!meta_truth.empty()) {
+    if (!meta_truth.empty() && scole) {
+      io::ScoleSpec ts = sc.scole;
+      const auto set = [&](const char* key, double& v) {
+        if (meta_truth.count(key)) v = meta_truth.at(key);
+      };
+      set("rho_A", ts.rho_A);
+      if (meta_truth.count("EI")) ts.EI_roll = ts.EI_pitch = meta_truth.at("EI");
+      set("EI_roll", ts.EI_roll);
+      set("EI_pitch", ts.EI_pitch);
+      set("GJ", ts.GJ);
+      set("rho_I_psi", ts.rho_I_psi);
+      set("zeta", ts.zeta);
+      const VectorXd tv = ScoleParameterization(ts, id, sc.source).truth();
+      for (int i = 0; i < tv.size(); ++i)
+        if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+    } else if (!meta_truth.empty()) {
       io::BeamSpec tb = sc.beam;
       if (meta_truth.count("rho_A")) tb.rho_A = meta_truth.at("rho_A");
       if (meta_truth.count("zeta")) tb.zeta = meta_truth.at("zeta");
