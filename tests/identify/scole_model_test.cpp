@@ -11,6 +11,7 @@
 #include <random>
 
 #include "scoleid/identify/analytic_beam.h"
+#include "scoleid/identify/banded_cholesky.h"
 #include "scoleid/identify/cvodes_adjoint.h"
 #include "scoleid/identify/modal.h"
 #include "scoleid/identify/problem.h"
@@ -431,4 +432,19 @@ TEST(ScoleGradient, TaylorRemainderFallsAtSecondOrder) {
       EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
     }
   }
+}
+
+TEST(ScoleModel, NewtonMatrixBandwidthDoesNotGrowWithTheMesh) {
+  // DOF order (shuttle, nodes root to tip with the proof masses beside their node, axial last)
+  // keeps M + γD + γ²K banded, so every time-step solve is linear in the number of elements.
+  std::vector<int> b;
+  for (int ne : {10, 40, 160}) {
+    const ScoleFE fe = build_scole(ScoleSpec{}, ne, {}, {}, "test");
+    const AssembledModel a = operators(fe);
+    b.push_back(BandedCholesky::bandwidth(SparseMatrix(a.M + a.D + a.K)));
+    std::printf("  %3d elements: %4d DOFs, half bandwidth %d\n", ne, fe.model.ndof, b.back());
+  }
+  EXPECT_EQ(b[0], b[1]);
+  EXPECT_EQ(b[1], b[2]);
+  EXPECT_LE(b[0], 12);
 }
