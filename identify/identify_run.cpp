@@ -79,13 +79,28 @@ Identifiability identifiability(Objective& obj, const Problem& p, const VectorXd
   const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
   id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
   id.std = VectorXd::Constant(P, std::nan(""));
-  id.identifiable.assign(static_cast<std::size_t>(P), false);
-  if (lmin > lmax * 1e-14) {
-    const MatrixXd Cr = Fr.inverse();
-    for (int i = 0; i < P; ++i) {
-      const double rel = std::sqrt(std::max(0.0, Cr(i, i)));
+  id.identifiable.assign(static_cast<std::size_t>(P), true);
+  // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
+  // with a sizeable share in them is flagged; the others get their Cramér–Rao std from the
+  // Fisher matrix restricted to them (i.e. with the flagged parameters held fixed).
+  for (int e = 0; e < P; ++e)
+    if (!(es.eigenvalues()[e] > 1e-12 * lmax))
+      for (int i = 0; i < P; ++i)
+        if (std::abs(es.eigenvectors()(i, e)) > 0.1) id.identifiable[static_cast<std::size_t>(i)] = false;
+  std::vector<int> keep;
+  for (int i = 0; i < P; ++i)
+    if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
+  if (!keep.empty()) {
+    MatrixXd Fk(keep.size(), keep.size());
+    for (std::size_t a = 0; a < keep.size(); ++a)
+      for (std::size_t b = 0; b < keep.size(); ++b) Fk(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = Fr(keep[a], keep[b]);
+    const MatrixXd Ck = Fk.inverse();
+    for (std::size_t a = 0; a < keep.size(); ++a) {
+      const double rel = std::sqrt(std::max(0.0, Ck(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a))));
+      const int i = keep[a];
       id.std[i] = rel * q[i];
-      id.identifiable[static_cast<std::size_t>(i)] = rel < 0.5;
+      // more than 50 % relative uncertainty: not determined by these data either
+      if (!(rel < 0.5)) id.identifiable[static_cast<std::size_t>(i)] = false;
     }
   }
   return id;

@@ -27,6 +27,7 @@ const char* to_string(OptimizerSummary::Termination t) {
     case T::StepTolerance: return "step_tolerance";
     case T::GradientTolerance: return "gradient_tolerance";
     case T::CostFloor: return "cost_floor";
+    case T::CostStalled: return "cost_stalled";
     case T::MaxIterations: return "max_iterations";
     case T::LineSearchFailed: return "line_search_failed";
   }
@@ -109,18 +110,25 @@ void gauss_newton(Run& r, VectorXd x) {
     if (k >= r.opt.max_iterations) break;
     bool accepted = false;
     for (int attempt = 0; attempt < 12 && !accepted; ++attempt) {
-      MatrixXd A = Hx;
-      A.diagonal() += lambda * Hx.diagonal().cwiseMax(1e-300);
-      VectorXd dx = A.ldlt().solve(-gx);
-      // Keep a single step within a factor e of the current values.
-      const double mx = dx.cwiseAbs().maxCoeff();
-      if (mx > 1.0) dx *= 1.0 / mx;
+      // Keep a single step within a factor e of the current values by raising the damping
+      // (a trust region in log q), not by shortening the whole step: a poorly determined
+      // direction must not hold back the well-determined ones.
+      const double dmax = Hx.diagonal().maxCoeff();
+      VectorXd dx;
+      for (int fit = 0; fit < 60; ++fit) {
+        MatrixXd A = Hx;
+        A.diagonal() += lambda * (Hx.diagonal().array() + 1e-9 * dmax).matrix();
+        dx = A.ldlt().solve(-gx);
+        if (dx.allFinite() && dx.cwiseAbs().maxCoeff() <= 1.0) break;
+        lambda = lambda > 0 ? lambda * 4.0 : 1e-4;
+      }
       double Jn;
       VectorXd gn;
       MatrixXd Hn;
       if (gn_at(x + dx, Jn, gn, Hn) && Jn <= J) {
         x += dx;
         const double step = dx.cwiseAbs().maxCoeff();
+        const bool stalled = J - Jn <= r.opt.cost_stall * J;
         J = Jn;
         gx = gn;
         Hx = Hn;
@@ -129,8 +137,8 @@ void gauss_newton(Run& r, VectorXd x) {
         accepted = true;
         ++k;
         r.record(k, J, x.array().exp(), gx);
-        if (step < r.opt.step_tolerance) {
-          r.sum.termination = T::StepTolerance;
+        if (step < r.opt.step_tolerance || stalled) {
+          r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
           r.sum.iterations_done = k;
           r.sum.q = x.array().exp();
           r.sum.cost = J;
@@ -225,6 +233,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
       break;
     }
     const VectorXd s = a * d, y = gn - gx;
+    const bool stalled = J - Jn <= r.opt.cost_stall * J;
     x += s;
     J = Jn;
     gx = gn;
@@ -237,6 +246,10 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
     r.record(k, J, x.array().exp(), gx);
     if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance) {
       r.sum.termination = T::StepTolerance;
+      break;
+    }
+    if (stalled && !steepest) {
+      r.sum.termination = T::CostStalled;
       break;
     }
   }

@@ -6,8 +6,10 @@
 // sensitivities G = ∂y(t_i)/∂q at the samples, W = diag(1/σ_k²) with σ_k the sensor's noise
 // standard deviation (from the scenario or truth.json), or, when no noise level is known, the
 // residual RMS of that sensor. std_i = sqrt((F⁻¹)_ii): the Cramér–Rao bound. The condition number
-// is that of F scaled to relative parameters (diag(q) F diag(q)). A parameter whose relative std
-// exceeds 0.5, or a singular F, is flagged "not identifiable".
+// is that of F scaled to relative parameters (diag(q) F diag(q)). A parameter with a share > 0.1 in
+// an eigenvector of that matrix whose eigenvalue is below 1e-12 of the largest is flagged "not
+// identifiable", and the others' std come from F restricted to them; a relative std above 0.5 is
+// flagged too.
 #include <functional>
 #include <map>
 #include <optional>

@@ -9,10 +9,12 @@
 //   lbfgs             limited-memory BFGS (m = 8) on x with an Armijo backtracking line search;
 //                     one costate gradient per trial point.
 //   gauss-newton      Levenberg–Marquardt on x from forward sensitivities:
-//                     (H + λ diag H) δ = −g; λ = 0 first (pure Gauss–Newton), ×10 on rejection.
+//                     (H + λ diag H) δ = −g; λ = 0 first (pure Gauss–Newton), ×10 on rejection,
+//                     and raised until ‖δ‖∞ <= 1 (a trust region of a factor e per step in q).
 // Termination (stated in Summary::termination): relative parameter step below step_tolerance,
-// scaled gradient ‖g_x‖∞ below gradient_tolerance·max(J, tiny), cost below cost_floor, or the
-// iteration limit.
+// scaled gradient ‖g_x‖∞ below gradient_tolerance·max(J, tiny), cost below cost_floor, relative
+// cost decrease over an accepted step below cost_stall (only directions the data barely see are
+// still moving: the identifiability report flags them), or the iteration limit.
 #include <functional>
 #include <map>
 #include <string>
@@ -28,6 +30,7 @@ struct OptimizerOptions {
   double gradient_tolerance = 1e-9;
   double step_tolerance = 1e-5;
   double cost_floor = 1e-28;
+  double cost_stall = 1e-5;   // relative decrease of J over an accepted step below which we stop
   std::vector<double> steepest_weights;  // w_i, paper form; empty = automatic
   bool IsValid(std::string* why) const;
 };
@@ -40,7 +43,7 @@ struct IterationRecord {
 };
 
 struct OptimizerSummary {
-  enum class Termination { StepTolerance, GradientTolerance, CostFloor, MaxIterations, LineSearchFailed };
+  enum class Termination { StepTolerance, GradientTolerance, CostFloor, CostStalled, MaxIterations, LineSearchFailed };
   Termination termination = Termination::MaxIterations;
   std::string message;
   VectorXd q;
@@ -50,7 +53,7 @@ struct OptimizerSummary {
   double wall_seconds = 0.0;
   bool converged() const {
     return termination == Termination::StepTolerance || termination == Termination::GradientTolerance ||
-           termination == Termination::CostFloor;
+           termination == Termination::CostFloor || termination == Termination::CostStalled;
   }
   std::string BriefReport() const;
 };
