@@ -2,7 +2,7 @@
 BUILD ?= build
 JOBS  ?= 2
 OUT   ?= run
-SCENARIO ?= paper-beam-1
+SCENARIO ?= paper-scole-1
 
 .PHONY: run test deps build bench slow clean
 
