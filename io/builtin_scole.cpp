@@ -60,10 +60,10 @@ truth: {segments: 40}
        R"(name: scole-slew
 description: "20 deg rest-to-rest shuttle roll slew (bang-bang moment), nonlinear rigid-flexible coupling"
 structure: scole
-# Rest-to-rest rigid slew: theta = A w^2 / (4 I_roll). With I_roll = 1.1997e6 slug ft^2 (the
-# whole SCOLE about the roll axis through the system CM), A = 16750 lb ft and w = 10 s give 20 deg.
+# Rest-to-rest rigid slew: theta = A w^2 / (4 I_roll). With I_roll = 1.204413e6 slug ft^2 (the
+# whole SCOLE about the roll axis through the system CM), A = 16817 lb ft and w = 10 s give 20 deg.
 inputs:
-  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16750, t0: 0, width: 10}}
+  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16817, t0: 0, width: 10}}
 sensors:
   - {name: roll, at: shuttle, kind: rotation, direction: x, unit: rad}
   - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}

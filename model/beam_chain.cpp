@@ -38,7 +38,10 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
       const Vec3 com = (m * Vec3(h / 2, 0, 0) + beam.tip_mass * Vec3(h, 0, 0)) / M;
       mp = MassProperties(M, com, bar.getInertia() + Inertia(Vec3(h, 0, 0), beam.tip_mass));
     }
-    const Body::Rigid body(mp);
+    Body::Rigid body(mp);
+    // Geometry for the visualizer only (a cylinder's axis is its y).
+    body.addDecoration(Transform(Rotation(-Pi / 2, ZAxis), Vec3(h / 2, 0, 0)),
+                       DecorativeCylinder(0.02 * length_, h / 2).setColor(Vec3(0.6, 0.6, 0.7)));
     const Transform X_PF = i == 0 ? Transform() : Transform(Vec3(h, 0, 0));
     MobilizedBody seg;
     if (i == 0 && beam.left == io::EndCondition::Free) {

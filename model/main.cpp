@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   std::string scenario = kDefaultScenario, out = "run", integrator;
   int segments = 0;
   double accuracy = 0.0;
-  bool list = false, quiet = false;
+  bool list = false, quiet = false, visualize = false;
   app.add_option("--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
   app.add_option("--out", out, "output directory (truth.csv, truth.json)")->capture_default_str();
   app.add_option("--segments", segments, "override truth.segments");
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--accuracy", accuracy, "override truth.accuracy");
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
   app.add_flag("--quiet", quiet, "no progress or summary on stderr");
+  app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -51,6 +53,10 @@ int main(int argc, char** argv) {
     opt.integrator = integrator;
     opt.accuracy = accuracy;
     opt.progress = !quiet;
+    opt.visualize = visualize;
+    auto set = [](const char* v) { const char* x = std::getenv(v); return x && *x; };
+    if (visualize && !set("DISPLAY") && !set("WAYLAND_DISPLAY"))
+      throw io::InputError("command line: --visualize needs a display (DISPLAY is not set)");
     std::string why;
     if (!opt.IsValid(&why)) throw io::InputError("command line: " + why);
     io::ensure_directory(out);

@@ -27,15 +27,19 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   const HenckyLumping torsion = hencky_lumping(n, uniform(sc.GJ), uniform(2 * sc.zeta * std::sqrt(sc.rho_I_psi * sc.GJ)));
   const double h = roll.h;
 
-  MobilizedBody::Free shuttle(matter_.Ground(), Transform(),
-                              Body::Rigid(MassProperties(sc.shuttle.mass, Vec3(0), inertia_of(sc.shuttle))), Transform());
+  // Decorations are for the visualizer only: shuttle-sized box, mast tube, reflector dish.
+  Body::Rigid shuttle_body(MassProperties(sc.shuttle.mass, Vec3(0), inertia_of(sc.shuttle)));
+  shuttle_body.addDecoration(Transform(), DecorativeBrick(Vec3(60, 12, 10)).setColor(Vec3(0.9, 0.9, 0.9)));
+  MobilizedBody::Free shuttle(matter_.Ground(), Transform(), shuttle_body, Transform());
   shuttle_ = shuttle.getMobilizedBodyIndex();
 
   const double m = sc.rho_A * h;
   const double Ib = m * h * h / 12.0 + 0.5 * sc.rho_I_psi * h;
   const double Ip = sc.rho_I_psi * h;
   const Vec3 com(0, 0, -h / 2);
-  const Body::Rigid segment_body(MassProperties(m, com, Inertia(Vec3(Ib, Ib, Ip)).shiftFromMassCenter(-com, m)));
+  Body::Rigid segment_body(MassProperties(m, com, Inertia(Vec3(Ib, Ib, Ip)).shiftFromMassCenter(-com, m)));
+  segment_body.addDecoration(Transform(Rotation(Pi / 2, XAxis), com),
+                             DecorativeCylinder(1.0, h / 2).setColor(Vec3(0.8, 0.6, 0.2)));
 
   std::vector<JointSpring> joints;
   MobilizedBody parent = shuttle;
@@ -56,9 +60,10 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   // O(h) error in the tip rotation, which the reflector's inertia turns into O(1/n) frequencies.
   const Vec3 r(sc.reflector_rx, sc.reflector_ry, 0.0);
   const double mr = sc.reflector.mass;
-  MobilizedBody::Gimbal reflector(parent, Transform(Vec3(0, 0, -h)),
-                                  Body::Rigid(MassProperties(mr, r, inertia_of(sc.reflector).shiftFromMassCenter(-r, mr))),
-                                  Transform());
+  Body::Rigid reflector_body(MassProperties(mr, r, inertia_of(sc.reflector).shiftFromMassCenter(-r, mr)));
+  reflector_body.addDecoration(Transform(Rotation(Pi / 2, XAxis), r),
+                               DecorativeCylinder(30.0, 0.5).setColor(Vec3(0.3, 0.5, 0.9)));
+  MobilizedBody::Gimbal reflector(parent, Transform(Vec3(0, 0, -h)), reflector_body, Transform());
   const auto tip = static_cast<std::size_t>(n);
   joints.push_back({reflector.getMobilizedBodyIndex(), 0, roll.stiffness[tip], roll.damping[tip]});
   joints.push_back({reflector.getMobilizedBodyIndex(), 1, pitch.stiffness[tip], pitch.damping[tip]});

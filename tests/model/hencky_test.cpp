@@ -12,6 +12,7 @@
 #include "scoleid/model/beam_chain.h"
 #include "scoleid/model/hencky.h"
 #include "scoleid/model/linearisation.h"
+#include "scoleid/model/truth_run.h"
 
 using namespace scoleid;
 using namespace scoleid::model;
@@ -154,5 +155,34 @@ TEST(HenckyChain, FrequenciesConvergeAtSecondOrder) {
       EXPECT_NEAR(rate, c.order, 0.2) << c.name << " mode " << k + 1 << " n " << ns[last - 1] << " -> " << ns[last];
       EXPECT_LT(err[2][k], 5e-3) << c.name << " mode " << k + 1 << " at n = 40";
     }
+  }
+}
+
+// The SCOLE chain (free shuttle, clamped root, reflector on its end cell, proof masses) has no
+// closed form; its first flexible frequencies self-converge at second order: the differences
+// between successive halvings shrink by 4.
+TEST(ScoleChain, FrequenciesSelfConvergeAtSecondOrder) {
+  const io::Scenario sc = io::load_scenario("paper-scole-1");
+  std::vector<std::vector<double>> f;
+  const std::vector<int> ns = {10, 20, 40, 80};
+  for (int n : ns) {
+    const auto st = prepare_structure(sc, n);
+    const auto modes = natural_modes(st->system(), st->system().getDefaultState());
+    std::vector<double> w;
+    for (std::size_t k = 0; k < 4; ++k) w.push_back(modes.at(k).frequency_hz);
+    f.push_back(w);
+  }
+  std::printf("SCOLE first four frequencies [Hz] and self-convergence rates\n");
+  for (std::size_t i = 0; i < ns.size(); ++i) {
+    std::printf("%4d", ns[i]);
+    for (std::size_t k = 0; k < 4; ++k) std::printf("  %.6f", f[i][k]);
+    std::printf("\n");
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double rate = std::log2((f[1][k] - f[0][k]) / (f[2][k] - f[1][k]));
+    const double rate2 = std::log2((f[2][k] - f[1][k]) / (f[3][k] - f[2][k]));
+    std::printf("mode %zu: rates %.2f, %.2f; |f40 - f80| / f80 = %.2e\n", k + 1, rate, rate2,
+                std::abs(f[2][k] - f[3][k]) / f[3][k]);
+    EXPECT_NEAR(rate2, 2.0, 0.2) << "mode " << k + 1;
   }
 }

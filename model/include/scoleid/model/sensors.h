@@ -4,7 +4,9 @@
 //   displacement   (p_RP - p_RP0) . d          P the station, p_RP0 its undeformed position
 //                  (beam: w(s) along +y)
 //   rotation       theta_RB . d                theta the rotation vector (angle * axis) of the
-//                  body B carrying P relative to R (beam: the slope w_s, about +z)
+//                  body B carrying P relative to R (beam: the slope w_s, about +z). A segment's
+//                  rotation is the continuum's at the segment centre; for the rotation at a free
+//                  tip read the tip body (SCOLE: "at: reflector"), which carries the end cell.
 //   velocity       (d/dt in R of p_RP) . d     (beam: w_t)
 //   acceleration   a_GP expressed in R, . d    inertial, as an accelerometer reads it (no
 //                  gravity in orbit; beam: w_tt)

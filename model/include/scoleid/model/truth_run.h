@@ -43,11 +43,12 @@ struct SimulateOptions {
   double sample_interval = 0.01;
   std::vector<double> breakpoints;   // times where the inputs jump
   bool progress = false;             // percent and real-time factor on stderr
+  double wall_limit = 0.0;           // seconds; > 0: stop early (Termination::WallLimit)
   bool IsValid(std::string* why) const;
 };
 
 struct SimulateSummary {
-  enum class Termination { Completed, Failed };
+  enum class Termination { Completed, WallLimit };
   Termination termination = Termination::Completed;
   std::string message;
   std::string integrator;
@@ -63,6 +64,8 @@ struct SimulateSummary {
 
 // Integrates `system` from `initial` (realized or not) and calls on_sample(state) at every
 // sample time with the state realized to Acceleration. Throws std::runtime_error on failure.
+// With a wall_limit it may stop early: then termination == WallLimit and simulated_seconds is
+// the time reached.
 SimulateSummary simulate(const SimTK::MultibodySystem& system, const SimTK::State& initial,
                          const SimulateOptions& options,
                          const std::function<void(const SimTK::State&)>& on_sample);
@@ -72,6 +75,7 @@ struct TruthOptions {
   std::string integrator;      // "" = scenario truth.integrator
   double accuracy = 0.0;       // 0 = scenario truth.accuracy
   bool progress = false;
+  bool visualize = false;      // show the run in simbody-visualizer (needs a display)
   bool IsValid(std::string* why) const;
 };
 
