@@ -23,9 +23,17 @@
 
 namespace scoleid::model {
 
-// Integrators by name: rk-merson, rk-feldberg, rk3, cpodes, verlet, semi-explicit-euler2, and
-// "auto" (= kDefaultIntegrator, chosen from the benchmark in model/bench.cpp).
+// Integrators by name: rk-merson, rk-feldberg, rk3, cpodes, cpodes-bdf2, verlet,
+// semi-explicit-euler2, and "auto" = choose_integrator().
 extern const char* const kDefaultIntegrator;
+// "auto": the step of every method is bounded by the chain's fastest eigenvalue lambda_max of
+// the linearisation about the initial state (linearisation.h). If it is well damped
+// (-Re/|lambda| >= 0.5: Kelvin–Voigt damping makes the top chain modes overdamped, as in
+// paper-beam-2), the stiffness is dissipative and BDF (cpodes) steps over it; otherwise the top
+// modes ring (SCOLE's zeta, undamped beams), BDF orders > 2 go unstable on them, BDF2 damps the
+// response, and the explicit kDefaultIntegrator (rk-merson) is the fastest method that meets the
+// energy criterion (model/bench.cpp).
+std::string choose_integrator(const SimTK::MultibodySystem& system, const SimTK::State& state);
 std::vector<std::string> integrator_names();
 std::unique_ptr<SimTK::Integrator> make_integrator(const std::string& name, const SimTK::System& system,
                                                    double accuracy);
