@@ -268,6 +268,18 @@ TEST(ScoleIdentifyCli, UnsupportedSensorKind) {
 
 // ---------------------------------------------------------------------------------- bad data
 
+TEST(ScoleIdentifyCli, UnsupportedScoleSensorKind) {
+  // The SCOLE identifier represents displacement, rotation and line of sight, not acceleration.
+  expect_yaml_error(R"(name: scole-acc
+structure: scole
+inputs: [{name: F_y, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, width: 1.5}}]
+sensors: [{name: acc_tip, at: mast, kind: acceleration, location: 130, direction: y}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: physical, estimate: [EI], elements: 4}
+)",
+                    {"sensors[0].kind", "'acceleration'"});
+}
+
 TEST(ScoleIdentifyCli, MissingDataFile) {
   TempDir dir;
   const fs::path out = dir / "out";
