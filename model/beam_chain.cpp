@@ -63,6 +63,7 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
                                  Transform());
     const auto j = static_cast<std::size_t>(n);
     joints.push_back({tip.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
+    tip_body_ = tip.getMobilizedBodyIndex();
   }
   if (beam.right != io::EndCondition::Free) {
     Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));

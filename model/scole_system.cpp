@@ -68,7 +68,7 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   joints.push_back({reflector.getMobilizedBodyIndex(), 0, roll.stiffness[tip], roll.damping[tip]});
   joints.push_back({reflector.getMobilizedBodyIndex(), 1, pitch.stiffness[tip], pitch.damping[tip]});
   joints.push_back({reflector.getMobilizedBodyIndex(), 2, torsion.stiffness[tip], torsion.damping[tip]});
-  reflector_ = reflector.getMobilizedBodyIndex();
+  reflector_ = tip_body_ = reflector.getMobilizedBodyIndex();
   reflector_station_ = {reflector_, r, root_R_ + axis_R_ * L + r};
 
   // Carriage: massless, on a Slider along the segment x axis; proof mass on a Slider along y

@@ -1,10 +1,46 @@
 #include "scoleid/model/sensors.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "scoleid/io/error.h"
 
 namespace scoleid::model {
 
 using namespace SimTK;
+
+namespace {
+// Rotation at arc position s: linear between segment centres (see the header).
+void interpolate_rotation(const Structure& st, double s, ResolvedSensor& r) {
+  const int n = st.segments();
+  const double h = st.length() / n;
+  const double c = s / h - 0.5;
+  int i = static_cast<int>(std::floor(c));
+  const auto& seg = st.segment_bodies();
+  if (i < 0) {
+    r.station.body = seg.front();
+    return;
+  }
+  if (i >= n - 1) {
+    r.station.body = seg.back();
+    if (st.tip_body().isValid()) {
+      r.second = st.tip_body();
+      r.weight = std::min(1.0, (s - (st.length() - h / 2)) / (h / 2));
+    }
+    return;
+  }
+  r.station.body = seg[static_cast<std::size_t>(i)];
+  r.second = seg[static_cast<std::size_t>(i + 1)];
+  r.weight = c - i;
+}
+
+double rotation_about(const SimbodyMatterSubsystem& matter, const State& state, MobilizedBodyIndex b,
+                      const MobilizedBody& R, const Vec3& d) {
+  const Rotation R_RB = matter.getMobilizedBody(b).findBodyRotationInAnotherBody(state, R);
+  const Vec4 aa = R_RB.convertRotationToAngleAxis();
+  return aa[0] * dot(Vec3(aa[1], aa[2], aa[3]), d);
+}
+}  // namespace
 
 std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Structure& st) {
   std::vector<ResolvedSensor> out;
@@ -28,6 +64,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
         io::fail_field(sc.source, field + ".kind", "is not defined for a beam", "'line_of_sight'");
       r.station = st.station_at(se.location);
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+      if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
     } else {
       if (se.at == "beam")
         io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
@@ -35,6 +72,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       r.d_R = d;
       r.station = se.at == "mast" ? st.station_at(se.location) : st.named_station(se.at);
+      if (se.at == "mast" && r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
       if (se.at == "shuttle") r.reference = GroundIndex;
     }
     out.push_back(r);
@@ -52,9 +90,9 @@ double read_sensor(const SimbodyMatterSubsystem& matter, const State& state, con
       return dot(p_RP - s.station.p_RS0, s.d_R);
     }
     case K::Rotation: {
-      const Rotation R_RB = B.findBodyRotationInAnotherBody(state, R);
-      const Vec4 aa = R_RB.convertRotationToAngleAxis();
-      return aa[0] * dot(Vec3(aa[1], aa[2], aa[3]), s.d_R);
+      const double a = rotation_about(matter, state, s.station.body, R, s.d_R);
+      if (!s.second.isValid() || s.weight == 0.0) return a;
+      return (1.0 - s.weight) * a + s.weight * rotation_about(matter, state, s.second, R, s.d_R);
     }
     case K::Velocity:
       return dot(B.findStationVelocityInAnotherBody(state, s.station.p_BS, R), s.d_R);

@@ -4,9 +4,11 @@
 //   displacement   (p_RP - p_RP0) . d          P the station, p_RP0 its undeformed position
 //                  (beam: w(s) along +y)
 //   rotation       theta_RB . d                theta the rotation vector (angle * axis) of the
-//                  body B carrying P relative to R (beam: the slope w_s, about +z). A segment's
-//                  rotation is the continuum's at the segment centre; for the rotation at a free
-//                  tip read the tip body (SCOLE: "at: reflector"), which carries the end cell.
+//                  body B relative to R (beam: the slope w_s, about +z). A segment's rotation
+//                  is the continuum's at its centre to O(h^2), so a station's rotation is
+//                  interpolated linearly between the two nearest segment centres (between the
+//                  last centre and the tip body, which carries the end cell, near a free end
+//                  with one; the end segment's alone within h/2 of an end otherwise).
 //   velocity       (d/dt in R of p_RP) . d     (beam: w_t)
 //   acceleration   a_GP expressed in R, . d    inertial, as an accelerometer reads it (no
 //                  gravity in orbit; beam: w_tt)
@@ -29,6 +31,8 @@ struct ResolvedSensor {
   enum class Kind { Displacement, Rotation, Velocity, Acceleration, LineOfSight };
   Kind kind = Kind::Displacement;
   Station station;
+  SimTK::MobilizedBodyIndex second;      // rotation: (1 - w) rot(station.body) + w rot(second)
+  double weight = 0.0;
   SimTK::Vec3 d_R{0.0};
   SimTK::MobilizedBodyIndex reference;   // R
   SimTK::Vec3 root_R{0.0};               // for line_of_sight

@@ -56,6 +56,8 @@ public:
   int segments() const { return static_cast<int>(segment_bodies_.size()); }
   double length() const { return length_; }
   const std::vector<SimTK::MobilizedBodyIndex>& segment_bodies() const { return segment_bodies_; }
+  // The body hinged at s = L on the free end's half cell (reflector, beam tip body), or invalid.
+  SimTK::MobilizedBodyIndex tip_body() const { return tip_body_; }
   const std::vector<JointSpring>& joint_springs() const { return joint_springs_; }
 
 protected:
@@ -67,6 +69,7 @@ protected:
   SimTK::Vec3 axis_B_{1, 0, 0};    // unit tangent of the chain in every segment frame
   SimTK::Vec3 axis_R_{1, 0, 0};    // the same tangent in R, undeformed
   std::vector<SimTK::MobilizedBodyIndex> segment_bodies_;  // segment i spans [i h, (i+1) h]
+  SimTK::MobilizedBodyIndex tip_body_;
   std::vector<JointSpring> joint_springs_;
 };
 
