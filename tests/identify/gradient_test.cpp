@@ -5,8 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 
+#include "test_support.h"
 #include "scoleid/identify/cvodes_adjoint.h"
 #include "scoleid/identify/problem.h"
 
@@ -93,23 +93,7 @@ TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
   for (const char* yaml : {kPaper, kSections}) {
     Case e = make(yaml, false);
-    const VectorXd q = e.p->params->initial();
-    VectorXd g;
-    const double J0 = e.obj->cost_and_gradient(q, g);
-    std::mt19937_64 rng(7);
-    std::normal_distribution<double> N(0.0, 1.0);
-    VectorXd d(q.size());
-    for (int i = 0; i < q.size(); ++i) d[i] = N(rng);
-    d /= d.norm();
-    const double slope = g.dot(q.cwiseProduct(d));
-    std::vector<double> R;
-    std::printf("  %12s %14s %8s\n", "eps", "remainder", "ratio");
-    for (int k = 0; k < 6; ++k) {
-      const double eps = 0.04 / std::pow(2.0, k);
-      const VectorXd qe = q.array() * (eps * d.array()).exp();
-      R.push_back(std::abs(e.obj->cost(qe) - J0 - eps * slope));
-      std::printf("  %12.4e %14.6e %8.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
-    }
+    const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 7);
     // Second order: the remainder quarters at each halving (ratio 4; first order would give 2).
     for (std::size_t k = 1; k < 5; ++k) {
       EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;

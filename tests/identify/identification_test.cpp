@@ -8,8 +8,11 @@
 
 #include "scoleid/identify/analytic_beam.h"
 #include "scoleid/identify/identify_run.h"
+#include "test_support.h"
 
 using namespace scoleid::identify;
+using test_support::first_within;
+using test_support::max_rel_error;
 
 namespace {
 
@@ -22,19 +25,7 @@ RunResult identify_builtin(Problem& p, const std::string& method = "", int max_i
   return run_identification(p, ro);
 }
 
-double max_rel_error(const Problem& p, const VectorXd& q) {
-  double e = 0.0;
-  for (int i = 0; i < q.size(); ++i)
-    e = std::max(e, std::abs(q[i] / p.true_values.at(p.params->names()[static_cast<std::size_t>(i)]) - 1.0));
-  return e;
-}
 
-// First iteration whose every parameter is within `tol` of the truth (−1 if none).
-int first_within(const Problem& p, const RunResult& r, double tol) {
-  for (const auto& it : r.summary.iterations)
-    if (max_rel_error(p, it.q) <= tol) return it.k;
-  return -1;
-}
 
 // Case I data from the closed-form modal series (no FE anywhere in the data).
 Measurements series_data(const scoleid::io::Scenario& sc) {

@@ -14,26 +14,12 @@
 #include <cstdio>
 
 #include "scoleid/identify/identify_run.h"
+#include "test_support.h"
 #include "scoleid/identify/scole_model.h"
 
 using namespace scoleid::identify;
-
-namespace {
-
-double max_rel_error(const Problem& p, const VectorXd& q) {
-  double e = 0.0;
-  for (int i = 0; i < q.size(); ++i)
-    e = std::max(e, std::abs(q[i] / p.true_values.at(p.params->names()[static_cast<std::size_t>(i)]) - 1.0));
-  return e;
-}
-
-int first_within(const Problem& p, const RunResult& r, double tol) {
-  for (const auto& it : r.summary.iterations)
-    if (max_rel_error(p, it.q) <= tol) return it.k;
-  return -1;
-}
-
-}  // namespace
+using test_support::first_within;
+using test_support::max_rel_error;
 
 TEST(ScoleIdentification, CaseOneReachesOneInTenThousandWithinHalfThePaperIterations) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -10,6 +10,7 @@
 #include <functional>
 #include <random>
 
+#include "test_support.h"
 #include "scoleid/identify/analytic_beam.h"
 #include "scoleid/identify/banded_cholesky.h"
 #include "scoleid/identify/cvodes_adjoint.h"
@@ -410,23 +411,7 @@ TEST(ScoleGradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
   for (const char* id : {kPaperId, kPhysicalId}) {
     Case e = make_case(scole_yaml("taylor", id), false);
-    const VectorXd q = e.p->params->initial();
-    VectorXd g;
-    const double J0 = e.obj->cost_and_gradient(q, g);
-    std::mt19937_64 rng(11);
-    std::normal_distribution<double> N(0.0, 1.0);
-    VectorXd d(q.size());
-    for (int i = 0; i < q.size(); ++i) d[i] = N(rng);
-    d /= d.norm();
-    const double slope = g.dot(q.cwiseProduct(d));
-    std::vector<double> R;
-    std::printf("  %12s %14s %8s\n", "eps", "remainder", "ratio");
-    for (int k = 0; k < 6; ++k) {
-      const double eps = 0.04 / std::pow(2.0, k);
-      const VectorXd qe = q.array() * (eps * d.array()).exp();
-      R.push_back(std::abs(e.obj->cost(qe) - J0 - eps * slope));
-      std::printf("  %12.4e %14.6e %8.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
-    }
+    const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
     for (std::size_t k = 1; k < R.size(); ++k) {
       EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
       EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;

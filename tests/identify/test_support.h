@@ -1,0 +1,50 @@
+#pragma once
+// Helpers shared by the identifier tests: the Taylor remainder sequence of a gradient, and
+// relative errors of estimates against a problem's true values.
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "scoleid/identify/identify_run.h"
+
+namespace scoleid::identify::test_support {
+
+// R(ε_k) = |J(q ∘ exp(ε_k d)) − J(q) − ε_k ∇J·(q ∘ d)|, ε_k = 0.04/2^k, k = 0..5, for a random unit
+// direction d in log q (seeded). A consistent gradient gives ratios R_k/R_{k+1} → 4.
+inline std::vector<double> taylor_remainders(Objective& obj, const VectorXd& q, unsigned seed) {
+  VectorXd g;
+  const double J0 = obj.cost_and_gradient(q, g);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> N(0.0, 1.0);
+  VectorXd d(q.size());
+  for (int i = 0; i < q.size(); ++i) d[i] = N(rng);
+  d /= d.norm();
+  const double slope = g.dot(q.cwiseProduct(d));
+  std::vector<double> R;
+  std::printf("  %12s %14s %8s\n", "eps", "remainder", "ratio");
+  for (int k = 0; k < 6; ++k) {
+    const double eps = 0.04 / std::pow(2.0, k);
+    const VectorXd qe = q.array() * (eps * d.array()).exp();
+    R.push_back(std::abs(obj.cost(qe) - J0 - eps * slope));
+    std::printf("  %12.4e %14.6e %8.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
+  }
+  return R;
+}
+
+// Largest |q_i / truth_i − 1| over the estimated parameters.
+inline double max_rel_error(const Problem& p, const VectorXd& q) {
+  double e = 0.0;
+  for (int i = 0; i < q.size(); ++i)
+    e = std::max(e, std::abs(q[i] / p.true_values.at(p.params->names()[static_cast<std::size_t>(i)]) - 1.0));
+  return e;
+}
+
+// First iteration whose every parameter is within `tol` of the truth (−1 if none).
+inline int first_within(const Problem& p, const RunResult& r, double tol) {
+  for (const auto& it : r.summary.iterations)
+    if (max_rel_error(p, it.q) <= tol) return it.k;
+  return -1;
+}
+
+}  // namespace scoleid::identify::test_support
