@@ -11,6 +11,9 @@
 #include "scoleid/identify/problem.h"
 
 using namespace scoleid::identify;
+using test_support::Case;
+using test_support::make_case;
+using test_support::max_rel;
 
 namespace {
 
@@ -37,30 +40,9 @@ simulation: {duration: 2, sample_interval: 0.01}
 identification: {parameterization: physical, estimate: [EI_1, EI_2, EI_3, EI_4, rho_A, zeta], initial: {EI: 28000, rho_A: 70, zeta: 0.03}, elements: 8}
 )";
 
-struct Case {
-  std::unique_ptr<Problem> p;
-  std::unique_ptr<Objective> obj;
-};
-
-Case make(const char* yaml, bool bdf) {
-  Case c;
-  auto sc = scoleid::io::parse_scenario(yaml, "test");
-  if (bdf) {
-    sc.identification.integrator = "bdf";
-    sc.identification.rtol = 1e-10;
-  }
-  c.p = make_problem(sc, std::nullopt);
-  c.obj = std::make_unique<Objective>(c.p->fe.model, *c.p->params, c.p->signals, c.p->data, c.p->objective_options);
-  return c;
-}
-
-double max_rel(const VectorXd& a, const VectorXd& b) {
-  return ((a - b).cwiseAbs().array() / b.cwiseAbs().array().max(1e-300)).maxCoeff();
-}
-
 void check_kind(const char* yaml) {
   // (1) Same integrator (ESDIRK, fixed step): costate vs central FD vs Gauss–Newton gradient.
-  Case e = make(yaml, false);
+  Case e = make_case(yaml, false);
   const VectorXd q = e.p->params->initial();
   VectorXd g_adj, g_gn;
   MatrixXd H;
@@ -71,7 +53,7 @@ void check_kind(const char* yaml) {
   EXPECT_LT(max_rel(g_adj, g_fd), 1e-4);
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-4);
   // (2) Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint (CVodeF/CVodeB) and FD.
-  Case b = make(yaml, true);
+  Case b = make_case(yaml, true);
   VectorXd g_b;
   const double Jb = b.obj->cost_and_gradient(q, g_b);
   const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
@@ -92,7 +74,7 @@ TEST(Gradient, SectionalStiffnessMassAndDamping) { check_kind(kSections); }
 TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
   for (const char* yaml : {kPaper, kSections}) {
-    Case e = make(yaml, false);
+    Case e = make_case(yaml, false);
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 7);
     // Second order: the remainder quarters at each halving (ratio 4; first order would give 2).
     for (std::size_t k = 1; k < 5; ++k) {

@@ -19,6 +19,9 @@
 #include "scoleid/identify/scole_model.h"
 
 using namespace scoleid::identify;
+using test_support::Case;
+using test_support::make_case;
+using test_support::max_rel;
 using Eigen::Vector3d;
 using scoleid::io::ScoleSpec;
 
@@ -320,28 +323,6 @@ const char* kPaperId = "identification: {parameterization: paper, estimate: [q1,
 const char* kPhysicalId =
     "identification: {parameterization: physical, estimate: [EI_roll, EI_pitch, rho_A, rho_I_psi, GJ, zeta],\n"
     "  initial: {EI_roll: 3.6e7, EI_pitch: 4.3e7, rho_A: 0.085, rho_I_psi: 1.1, GJ: 3.5e7, zeta: 0.015}, elements: 4}\n";
-
-struct Case {
-  std::unique_ptr<Problem> p;
-  std::unique_ptr<Objective> obj;
-};
-
-Case make_case(const std::string& yaml, bool bdf, double step = 0.0) {
-  Case c;
-  auto sc = scoleid::io::parse_scenario(yaml, "test");
-  sc.identification.time_step = step;
-  if (bdf) {
-    sc.identification.integrator = "bdf";
-    sc.identification.rtol = 1e-10;
-  }
-  c.p = make_problem(sc, std::nullopt);
-  c.obj = std::make_unique<Objective>(c.p->fe.model, *c.p->params, c.p->signals, c.p->data, c.p->objective_options);
-  return c;
-}
-
-double max_rel(const VectorXd& a, const VectorXd& b) {
-  return ((a - b).cwiseAbs().array() / b.cwiseAbs().array().max(1e-300)).maxCoeff();
-}
 
 // ∂J/∂q_i by central differences in log q_i with one Richardson step:
 // D(η) = (J(q_i e^η) − J(q_i e^−η)) / (2η q_i),  ∂J/∂q_i ≈ (4 D(η/2) − D(η)) / 3  (error O(η⁴)).

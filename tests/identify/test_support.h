@@ -3,6 +3,8 @@
 // relative errors of estimates against a problem's true values.
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -30,6 +32,31 @@ inline std::vector<double> taylor_remainders(Objective& obj, const VectorXd& q, 
     std::printf("  %12.4e %14.6e %8.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
   }
   return R;
+}
+
+// A problem and its objective built from scenario YAML text. `bdf` switches to CVODES BDF at
+// rtol 1e-10 (the adaptive reference); `step` > 0 fixes the ESDIRK step.
+struct Case {
+  std::unique_ptr<Problem> p;
+  std::unique_ptr<Objective> obj;
+};
+
+inline Case make_case(const std::string& yaml, bool bdf, double step = 0.0) {
+  Case c;
+  auto sc = scoleid::io::parse_scenario(yaml, "test");
+  sc.identification.time_step = step;
+  if (bdf) {
+    sc.identification.integrator = "bdf";
+    sc.identification.rtol = 1e-10;
+  }
+  c.p = make_problem(sc, std::nullopt);
+  c.obj = std::make_unique<Objective>(c.p->fe.model, *c.p->params, c.p->signals, c.p->data, c.p->objective_options);
+  return c;
+}
+
+// max_i |a_i − b_i| / |b_i|
+inline double max_rel(const VectorXd& a, const VectorXd& b) {
+  return ((a - b).cwiseAbs().array() / b.cwiseAbs().array().max(1e-300)).maxCoeff();
 }
 
 // Largest |q_i / truth_i − 1| over the estimated parameters.
