@@ -17,6 +17,7 @@
 #include "scoleid/model/linearisation.h"
 #include "scoleid/model/scole_system.h"
 #include "scoleid/model/sensors.h"
+#include "scoleid/model/trapezoidal.h"
 
 namespace scoleid::model {
 
@@ -29,7 +30,8 @@ using namespace SimTK;
 const char* const kDefaultIntegrator = "rk-merson";
 
 std::vector<std::string> integrator_names() {
-  return {"auto", "rk-merson", "rk-feldberg", "rk3", "cpodes", "cpodes-bdf2", "verlet", "semi-explicit-euler2"};
+  return {"auto", "trapezoidal", "rk-merson", "rk-feldberg", "rk3", "cpodes", "cpodes-bdf2", "verlet",
+          "semi-explicit-euler2"};
 }
 
 std::string choose_integrator(const MultibodySystem& system, const State& state) {
@@ -42,7 +44,8 @@ std::string choose_integrator(const MultibodySystem& system, const State& state)
   for (int i = 0; i < lambda.size(); ++i)
     if (std::abs(lambda[i]) > std::abs(top)) top = lambda[i];
   const double damping = std::abs(top) > 0 ? -top.real() / std::abs(top) : 0.0;
-  return damping >= 0.5 ? "cpodes" : kDefaultIntegrator;
+  if (damping >= 0.5) return "cpodes";
+  return system.getMatterSubsystem().getNumConstraints() > 0 ? kDefaultIntegrator : "trapezoidal";
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system, double accuracy) {
@@ -91,6 +94,8 @@ bool SimulateOptions::IsValid(std::string* why) const {
   if (!(final_time > 0)) return bad("final_time must be > 0");
   if (!(sample_interval > 0 && sample_interval <= final_time)) return bad("sample_interval must be in (0, final_time]");
   if (!(wall_limit >= 0)) return bad("wall_limit must be >= 0");
+  if (!(max_step >= 0)) return bad("max_step must be >= 0");
+  if (!(reference_omega >= 0)) return bad("reference_omega must be >= 0");
   const auto names = integrator_names();
   if (std::find(names.begin(), names.end(), integrator) == names.end())
     return bad("unknown integrator '" + integrator + "'");
@@ -107,6 +112,69 @@ std::string SimulateSummary::BriefReport() const {
   return os.str();
 }
 
+namespace {
+std::vector<double> breakpoints_after(const SimulateOptions& opt, double t0) {
+  std::vector<double> bps;
+  for (double b : opt.breakpoints)
+    if (b > t0 && b < opt.final_time) bps.push_back(b);
+  std::sort(bps.begin(), bps.end());
+  return bps;
+}
+
+// The sample loop of simulate() on the trapezoidal rule (trapezoidal.h): steps end on every sample
+// time and every input breakpoint.
+SimulateSummary simulate_trapezoidal(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
+                                     const std::function<void(const State&)>& on_sample, SimulateSummary sum,
+                                     std::chrono::steady_clock::time_point wall0) {
+  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
+  TrapezoidalOptions to;
+  to.accuracy = opt.accuracy;
+  to.max_step = opt.max_step;
+  to.reference_omega = opt.reference_omega;
+  TrapezoidalIntegrator integ(system, initial, to);
+  const std::vector<double> bps = breakpoints_after(opt, initial.getTime());
+  const int K = static_cast<int>(std::floor(opt.final_time / opt.sample_interval + 1e-9));
+  const double t_start = initial.getTime();
+  double next_progress = 2.0;
+  std::size_t ib = 0;
+  for (int k = 0; k <= K; ++k) {
+    const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
+    const double eps = 1e-12 * std::max(1.0, std::abs(tk));
+    while (integ.time() < tk - eps) {
+      while (ib < bps.size() && bps[ib] <= integ.time() + eps) ++ib;
+      const bool to_breakpoint = ib < bps.size() && bps[ib] < tk + eps;
+      integ.advance_to(to_breakpoint ? bps[ib] : tk, to_breakpoint);
+      if (opt.progress && wall() > next_progress) {
+        std::fprintf(stderr, "\r%5.1f%% of %g s simulated, real-time factor %.2f   ",
+                     100.0 * integ.time() / opt.final_time, opt.final_time, integ.time() / wall());
+        next_progress = wall() + 2.0;
+      }
+    }
+    on_sample(integ.state());
+    ++sum.samples;
+    if (opt.wall_limit > 0 && wall() > opt.wall_limit) {
+      sum.termination = SimulateSummary::Termination::WallLimit;
+      break;
+    }
+  }
+  if (opt.progress && next_progress > 2.0) std::fprintf(stderr, "\n");
+  const TrapezoidalSummary& ts = integ.summary();
+  sum.steps_taken = sum.steps_attempted = ts.steps;
+  sum.realizations = ts.realizations;
+  sum.simulated_seconds = integ.time() - t_start;
+  sum.wall_seconds = wall();
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "step %.4g s, %d Newton corrections, %d Jacobians, %d factorizations; frequency error "
+                "(omega h)^2/12 = %.2g at the fundamental flexible mode (%.4g Hz)",
+                ts.largest_step, ts.newton_iterations, ts.jacobians, ts.factorizations, ts.lowest_mode_frequency_error(),
+                ts.lowest_omega / (2 * Pi));
+  sum.message = buf;
+  sum.max_step = ts.largest_step;
+  return sum;
+}
+}  // namespace
+
 SimulateSummary simulate(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
                          const std::function<void(const State&)>& on_sample) {
   std::string why;
@@ -115,6 +183,7 @@ SimulateSummary simulate(const MultibodySystem& system, const State& initial, co
   const auto wall0 = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
   sum.integrator = opt.integrator == "auto" ? choose_integrator(system, initial) : opt.integrator;
+  if (sum.integrator == "trapezoidal") return simulate_trapezoidal(system, initial, opt, on_sample, sum, wall0);
 
   auto integ = make_integrator(sum.integrator, system, opt.accuracy);
   integ->setFinalTime(opt.final_time);
@@ -255,6 +324,15 @@ TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
   so.final_time = sc.simulation.duration;
   so.sample_interval = sc.truth.output_interval > 0 ? sc.truth.output_interval : sc.simulation.sample_interval;
   so.progress = opt.progress;
+  if (so.integrator == "auto") so.integrator = choose_integrator(structure->system(), state);
+  if (so.integrator == "trapezoidal") {
+    // The trapezoidal rule's step follows the structure's fundamental mode, free of the inputs
+    // (a load acting at t = 0 adds slow modes of the accelerated system, e.g. of the proof masses).
+    const auto bare = build_structure(sc, n);
+    bare->system().realizeTopology();
+    const auto modes = natural_modes(bare->system(), bare->system().getDefaultState());
+    if (!modes.empty()) so.reference_omega = modes.front().omega;
+  }
   for (const auto& in : sc.inputs)
     for (double b : in.signal.breakpoints()) so.breakpoints.push_back(b);
 

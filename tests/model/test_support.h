@@ -2,6 +2,7 @@
 // Helpers shared by the model tests: initial deformation, first period, energy drift.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "scoleid/model/linearisation.h"
 #include "scoleid/model/truth_run.h"
@@ -27,12 +28,13 @@ inline double first_period(const Structure& st) {
   return 2 * SimTK::Pi / modes.at(0).omega;
 }
 
-inline double energy_drift(const Structure& st, const State& s0, double accuracy, double periods, int* steps) {
+inline double energy_drift(const Structure& st, const State& s0, double accuracy, double periods, int* steps,
+                           const std::string& integrator = "rk-merson") {
   const auto& sys = st.system();
   sys.realize(s0, SimTK::Stage::Acceleration);
   const double E0 = sys.calcEnergy(s0);
   SimulateOptions o;
-  o.integrator = "rk-merson";
+  o.integrator = integrator;
   o.accuracy = accuracy;
   const double T1 = first_period(st);
   o.final_time = periods * T1;

@@ -1,0 +1,182 @@
+#include "scoleid/model/trapezoidal.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "scoleid/model/linearisation.h"
+
+namespace scoleid::model {
+
+using namespace SimTK;
+
+namespace {
+std::string str(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.9g", x);
+  return b;
+}
+}  // namespace
+
+bool TrapezoidalOptions::IsValid(std::string* why) const {
+  auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
+  if (!(accuracy > 0 && accuracy < 1)) return bad("accuracy must be in (0, 1)");
+  if (!(max_step >= 0)) return bad("max_step must be >= 0");
+  if (!(reference_omega >= 0)) return bad("reference_omega must be >= 0");
+  if (!(newton_fraction > 0 && newton_fraction <= 1)) return bad("newton_fraction must be in (0, 1]");
+  if (max_newton_iterations < 2) return bad("max_newton_iterations must be >= 2");
+  if (!(refresh_contraction > 0 && refresh_contraction < 1)) return bad("refresh_contraction must be in (0, 1)");
+  return true;
+}
+
+TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, const State& initial,
+                                             const TrapezoidalOptions& options)
+    : system_(system), matter_(system.getMatterSubsystem()), options_(options), state_(initial), trial_(initial) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("TrapezoidalIntegrator: " + why);
+  if (initial.getNU() == 0) throw std::invalid_argument("TrapezoidalIntegrator: the system has no mobilities");
+  if (matter_.getNumConstraints() > 0)
+    throw std::invalid_argument("TrapezoidalIntegrator: the system has constraints, which this method does not project onto");
+  realize(state_);
+  q_initial_ = state_.getQ();
+  const int nu = state_.getNU();
+  const Eigen::MatrixXd J = state_jacobian(system_, state_);
+  summary_.realizations += 4 * nu;
+  ++summary_.jacobians;
+  A_ = J.block(nu, 0, nu, nu);
+  B_ = J.block(nu, nu, nu, nu);
+  if (options_.reference_omega > 0) {
+    summary_.lowest_omega = options_.reference_omega;
+  } else {
+    // Modes about the system's default state (undeformed, at rest): a spinning or deformed
+    // initial state would add slow modes of unsprung bodies (proof masses on sliders) in the
+    // accelerated frame.
+    State rest = system_.getDefaultState();
+    const Eigen::MatrixXd J0 = state_jacobian(system_, rest);
+    summary_.realizations += 4 * nu;
+    const auto modes = modes_of(J0, LinearisationOptions{}.zero_tolerance);
+    summary_.lowest_omega = modes.empty() ? 0.0 : modes.front().omega;
+  }
+  if (options_.max_step > 0) summary_.max_step = options_.max_step;
+  else if (summary_.lowest_omega > 0) summary_.max_step = std::cbrt(12.0 * options_.accuracy) / summary_.lowest_omega;
+  else summary_.max_step = std::numeric_limits<double>::infinity();
+}
+
+void TrapezoidalIntegrator::realize(State& s) const { system_.realize(s, Stage::Acceleration); }
+
+void TrapezoidalIntegrator::refresh_jacobian(const State& at) {
+  const int nu = at.getNU();
+  const Eigen::MatrixXd J = state_jacobian(system_, at);
+  summary_.realizations += 4 * nu;
+  ++summary_.jacobians;
+  A_ = J.block(nu, 0, nu, nu);
+  B_ = J.block(nu, nu, nu, nu);
+  factors_.clear();
+}
+
+const Eigen::PartialPivLU<Eigen::MatrixXd>& TrapezoidalIntegrator::newton_matrix(double h) {
+  const long long key = std::llround(h * 1e12);
+  auto it = factors_.find(key);
+  if (it != factors_.end()) return it->second;
+  const Eigen::Index nu = A_.rows();
+  const Eigen::MatrixXd W = Eigen::MatrixXd::Identity(nu, nu) - 0.5 * h * B_ - 0.25 * h * h * A_;
+  ++summary_.factorizations;
+  return factors_.emplace(key, Eigen::PartialPivLU<Eigen::MatrixXd>(W)).first->second;
+}
+
+void TrapezoidalIntegrator::advance_to(double t_end, bool left_limit) {
+  const double t0 = time();
+  if (!(t_end > t0)) return;
+  const double span = t_end - t0;
+  const long long n = std::max<long long>(1, static_cast<long long>(std::ceil(span / summary_.max_step - 1e-9)));
+  const double h = span / static_cast<double>(n);
+  for (long long i = 1; i <= n; ++i) {
+    const double t1 = i == n ? t_end : t0 + static_cast<double>(i) * h;
+    step(t1 - time(), left_limit && i == n);
+  }
+}
+
+namespace {
+// Simbody's state vectors are contiguous: read them through Eigen without element accessors.
+Eigen::Map<const Eigen::VectorXd> view(const Vector& v) {
+  return {v.size() ? &v[0] : nullptr, v.size()};
+}
+}  // namespace
+
+void TrapezoidalIntegrator::step(double h, bool left_limit) {
+  const double t1 = state_.getTime() + h;
+  // Input's left limit at a breakpoint: the step's end is evaluated a hair before it.
+  const double t_eval = left_limit ? t1 - 1e-9 * h : t1;
+  const int nu = state_.getNU(), nq = state_.getNQ();
+  const Eigen::VectorXd q0 = view(state_.getQ()), u0 = view(state_.getU());
+  const Eigen::VectorXd qd0 = view(state_.getQDot()), a0 = view(state_.getUDot());
+  const auto qi = view(q_initial_);
+  // Corrections below 1e-13 of the state scale are round-off in the residual itself.
+  const double tol = std::max(options_.newton_fraction * options_.accuracy, 1e-13);
+  const double tiny = std::numeric_limits<double>::min();
+
+  const State* cur = &state_;
+  double prev = std::numeric_limits<double>::infinity();
+  int since_refresh = 0, refreshes = 0;
+  Vector gq(nq), gd(nu), dd_s(nu), dq(nq);
+  Eigen::VectorXd rhs(nu), du(nu), dd(nu), q_next(nq), u_next(nu);
+  for (int k = 0;; ++k) {
+    const auto q = view(cur->getQ());
+    const auto u = view(cur->getU());
+    Eigen::Map<Eigen::VectorXd>(&gq[0], nq) = q - q0 - 0.5 * h * (qd0 + view(cur->getQDot()));
+    matter_.multiplyByNInv(*cur, false, gq, gd);
+    const auto gde = view(gd);
+    rhs.noalias() = -0.5 * h * (A_ * gde);
+    rhs -= u - u0 - 0.5 * h * (a0 + view(cur->getUDot()));
+    du = newton_matrix(h).solve(rhs);
+    dd = -gde + 0.5 * h * du;
+
+    const double us = std::max(u_scale_, u.cwiseAbs().maxCoeff());
+    const double ds = std::max(d_scale_, (q - qi).cwiseAbs().maxCoeff());
+    const double norm = std::max(du.cwiseAbs().maxCoeff() / std::max(us, tiny), dd.cwiseAbs().maxCoeff() / std::max(ds, tiny));
+    if (k >= 1 && norm <= tol) break;   // *cur solves the step to within the tolerance
+    if (k >= 1) {
+      ++summary_.newton_iterations;
+      ++since_refresh;
+      const bool slow = since_refresh >= 2 && norm > options_.refresh_contraction * prev;
+      if (slow || since_refresh >= options_.max_newton_iterations) {
+        if (refreshes == 2)
+          throw std::runtime_error("trapezoidal rule: Newton iteration does not converge at t = " + str(t1) +
+                                   " (correction " + str(norm) + " of the state scale, step " + str(h) + " s)");
+        refresh_jacobian(*cur);
+        ++refreshes;
+        since_refresh = 0;
+        prev = std::numeric_limits<double>::infinity();
+        --k;   // recompute the correction at *cur with the new Newton matrix
+        continue;
+      }
+    }
+    prev = norm;
+    Eigen::Map<Eigen::VectorXd>(&dd_s[0], nu) = dd;
+    matter_.multiplyByN(*cur, false, dd_s, dq);
+    q_next = q + view(dq);
+    u_next = u + du;
+    Eigen::Map<Eigen::VectorXd>(&trial_.updQ()[0], nq) = q_next;
+    Eigen::Map<Eigen::VectorXd>(&trial_.updU()[0], nu) = u_next;
+    trial_.setTime(t_eval);
+    realize(trial_);
+    ++summary_.realizations;
+    cur = &trial_;
+  }
+  std::swap(state_, trial_);   // moves: the realized cache goes with the state
+  if (left_limit) {
+    state_.setTime(t1);
+    realize(state_);
+    ++summary_.realizations;
+  }
+  u_scale_ = std::max(u_scale_, view(state_.getU()).cwiseAbs().maxCoeff());
+  d_scale_ = std::max(d_scale_, (view(state_.getQ()) - qi).cwiseAbs().maxCoeff());
+  summary_.largest_step = std::max(summary_.largest_step, h);
+  ++summary_.steps;
+}
+
+}  // namespace scoleid::model
