@@ -46,7 +46,7 @@ struct TrapezoidalOptions {
   // the truncation error: the residual left in each step is not symmetric in time and accumulates
   // over the run (energy, momentum) as a random walk; the first correction already contracts by
   // about 1e-5 on these structures, so a tight tolerance costs little.
-  double newton_fraction = 1e-3;
+  double newton_fraction = 1e-2;
   double max_step = 0.0;           // s; 0 = from accuracy and omega_1
   double reference_omega = 0.0;    // omega_1 [rad/s]; 0 = lowest oscillatory mode at the initial state
   int max_newton_iterations = 6;   // per step, before the Jacobian is refreshed (twice at most)
