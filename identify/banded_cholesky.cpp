@@ -54,17 +54,23 @@ bool BandedCholesky::factorize() {
 }
 
 void BandedCholesky::solve_in_place(double* x) const {
+  // Both sweeps read L by rows, which are contiguous in the band storage: L y = r by dot
+  // products with row i, Lᵀ x = y by axpys with row i (column-oriented back substitution).
   const int w = b_ + 1;
   const double* L = band_.data();
   for (int i = 0; i < n_; ++i) {
+    const int k0 = std::max(0, i - b_);
+    const double* Li = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
     double s = x[i];
-    for (int k = std::max(0, i - b_); k < i; ++k) s -= L[i * w + (k - i + b_)] * x[k];
-    x[i] = s / L[i * w + b_];
+    for (int k = k0; k < i; ++k) s -= *Li++ * x[k];
+    x[i] = s / *Li;
   }
   for (int i = n_ - 1; i >= 0; --i) {
-    double s = x[i];
-    for (int k = i + 1; k <= std::min(n_ - 1, i + b_); ++k) s -= L[k * w + (i - k + b_)] * x[k];
-    x[i] = s / L[i * w + b_];
+    const double* Li = L + static_cast<std::size_t>(i) * w;
+    const double xi = (x[i] /= Li[b_]);
+    const int k0 = std::max(0, i - b_);
+    const double* Lk = Li + (k0 - i + b_);
+    for (int k = k0; k < i; ++k) x[k] -= *Lk++ * xi;
   }
 }
 

@@ -108,6 +108,15 @@ Identifiability identifiability(Objective& obj, const Problem& p, const VectorXd
 
 double safe(double v) { return std::isfinite(v) ? v : 0.0; }
 
+const char* integrator_name(SolverOptions::Integrator i) {
+  switch (i) {
+    case SolverOptions::Integrator::Esdirk: return "esdirk324l2sa";
+    case SolverOptions::Integrator::EsdirkArkode: return "arkode-esdirk324l2sa";
+    case SolverOptions::Integrator::Bdf: return "cvodes-bdf";
+  }
+  return "?";
+}
+
 }  // namespace
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
@@ -191,7 +200,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
              {"quadrature", counters.quadrature_seconds},
              {"optimizer_total", summary.wall_seconds}}},
            {"integrator",
-            {{"name", p.objective_options.solver.integrator == SolverOptions::Integrator::Esdirk ? "arkode-esdirk436l2sa" : "cvodes-bdf"},
+            {{"name", integrator_name(p.objective_options.solver.integrator)},
              {"step", p.objective_options.solver.step},
              {"rtol", p.objective_options.solver.rtol},
              {"steps", counters.solver.steps}}},

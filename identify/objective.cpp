@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace scoleid::identify {
@@ -30,11 +31,7 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
     if (static_cast<int>(options_.weights.size()) != ns) throw std::invalid_argument("Objective: one weight per sensor");
     R_ = options_.weights;
   } else {
-    R_.assign(static_cast<std::size_t>(ns), 1.0);
-    for (int k = 0; k < ns; ++k) {
-      const double ms = data_.z.col(k).squaredNorm() / static_cast<double>(data_.z.rows());
-      if (ms > 0) R_[static_cast<std::size_t>(k)] = 1.0 / ((T_ - t0) * ms);
-    }
+    default_weights();
   }
   auto add_terms = [&](const std::vector<OperatorTerm>& ts, int kind) {
     for (const auto& t : ts) {
@@ -59,6 +56,42 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   breakpoints_.erase(std::unique(breakpoints_.begin(), breakpoints_.end()), breakpoints_.end());
 }
 
+void Objective::default_weights() {
+  const int ns = data_.sensors();
+  const double t0 = data_.t.front();
+  R_.assign(static_cast<std::size_t>(ns), 1.0);
+  for (int k = 0; k < ns; ++k) {
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < data_.t.size() && data_.t[i] <= T_; ++i, ++count) {
+      const double z = data_.z(static_cast<Eigen::Index>(i), k);
+      sum += z * z;
+    }
+    const double ms = count > 0 ? sum / static_cast<double>(count) : 0.0;
+    if (ms > 0) R_[static_cast<std::size_t>(k)] = 1.0 / ((T_ - t0) * ms);
+  }
+}
+
+void Objective::set_horizon(double T) {
+  const auto& t = data_.t;
+  T_ = std::clamp(T, t[1], t.back());
+  if (options_.weights.empty()) default_weights();
+}
+
+long Objective::data_points() const {
+  long n = 0;
+  for (double t : data_.t)
+    if (t <= T_) ++n;
+  return n * data_.sensors();
+}
+
+double Objective::MisfitProfile::longest_within(double bound) const {
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (misfit[i] <= bound) best = t[i];
+  return best;
+}
+
 Objective::Setup Objective::setup(const VectorXd& q) const {
   Setup s;
   for (int i = 0; i < q.size(); ++i)
@@ -69,39 +102,43 @@ Objective::Setup Objective::setup(const VectorXd& q) const {
   return s;
 }
 
-Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s) {
-  const auto t0 = Clock::now();
+SecondOrderSolver::Forcing Objective::state_forcing(const Setup& s) const {
   const auto& loads = s.ops.loads;
   const int n = model_.ndof;
-  SecondOrderSolver::Forcing f = [&](double t, double* F) {
+  return [this, &loads, n](double t, double* F) {
     Eigen::Map<VectorXd> Fm(F, n);
     for (std::size_t i = 0; i < loads.size(); ++i) {
       const double fi = inputs_[i](t);
       if (fi != 0.0) Fm += fi * loads[i];
     }
   };
+}
+
+Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s, double t_end) {
+  const auto t0 = Clock::now();
   SolverSummary sum;
-  Trajectory u = solver.solve(data_.t.front(), T_, f, breakpoints_, &sum);
+  Trajectory u = solver.solve(data_.t.front(), t_end, state_forcing(s), breakpoints_, &sum);
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(t0);
   return u;
 }
 
-std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets) const {
+std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const {
   std::vector<double> g;
   for (const auto* s : sets) g.insert(g.end(), s->begin(), s->end());
   g.insert(g.end(), data_.t.begin(), data_.t.end());
+  g.push_back(t_end);
   std::sort(g.begin(), g.end());
   g.erase(std::unique(g.begin(), g.end()), g.end());
   const double t0 = data_.t.front();
-  g.erase(std::remove_if(g.begin(), g.end(), [&](double t) { return t < t0 || t > T_; }), g.end());
+  g.erase(std::remove_if(g.begin(), g.end(), [&](double t) { return t < t0 || t > t_end; }), g.end());
   return g;
 }
 
 double Objective::cost_of(const Trajectory& u) const {
   const int n = model_.ndof, ns = data_.sensors();
-  const auto grid = union_grid({&u.times()});
+  const auto grid = union_grid({&u.times()}, T_);
   VectorXd x(n), v(n), z(ns);
   double J = 0.0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
@@ -119,10 +156,41 @@ double Objective::cost_of(const Trajectory& u) const {
   return J;
 }
 
+Objective::MisfitProfile Objective::misfit_profile(const Trajectory& u) const {
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t_end = data_.t.back();
+  const auto grid = union_grid({&u.times()}, t_end);
+  VectorXd x(n), v(n), z(ns), rr = VectorXd::Zero(ns), zz = VectorXd::Zero(ns);
+  MisfitProfile prof;
+  std::size_t next = 1;  // next sample time to report
+  auto report = [&](double t) {
+    while (next < data_.t.size() && data_.t[next] <= t) {
+      double m = 0.0;
+      for (int k = 0; k < ns; ++k) m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
+      prof.t.push_back(data_.t[next]);
+      prof.misfit.push_back(m / ns);
+      ++next;
+    }
+  };
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int g = 0; g < 3; ++g) {
+      const double t = grid[k] + kGx[g] * h;
+      u.eval(t, x.data(), v.data());
+      data_.eval(t, z.data());
+      const VectorXd r = C_ * x - z;
+      rr += kGw[g] * h * r.cwiseAbs2();
+      zz += kGw[g] * h * z.cwiseAbs2();
+    }
+    report(grid[k + 1]);
+  }
+  return prof;
+}
+
 double Objective::cost(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s);
+  const Trajectory u = forward(solver, s, T_);
   const auto t0 = Clock::now();
   const double J = cost_of(u);
   counters_.quadrature_seconds += since(t0);
@@ -132,7 +200,7 @@ double Objective::cost(const VectorXd& q) {
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s);
+  const Trajectory u = forward(solver, s, T_);
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
 
@@ -148,7 +216,8 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     Eigen::Map<VectorXd>(F, n) = -CtR * rb;
   };
   std::vector<double> bp_tau;
-  for (double b : breakpoints_) bp_tau.push_back(T_ - b);
+  for (double b : breakpoints_)
+    if (b < T_) bp_tau.push_back(T_ - b);
   std::sort(bp_tau.begin(), bp_tau.end());
   SolverSummary sum;
   const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
@@ -161,7 +230,7 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   std::vector<double> ptimes;
   ptimes.reserve(P.size());
   for (double tau : P.times()) ptimes.push_back(T_ - tau);
-  const auto grid = union_grid({&u.times(), &ptimes});
+  const auto grid = union_grid({&u.times(), &ptimes}, T_);
   VectorXd x(n), v(n), p(n), pd(n), z(ns), gc = VectorXd::Zero(model_.ncoef), w(n);
   double J = 0.0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
@@ -196,10 +265,9 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   return J;
 }
 
-Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i) const {
+Objective::Derivative Objective::derivative(const Setup& s, int i) const {
   const int n = model_.ndof;
-  // ∂_i M, ∂_i D, ∂_i K, ∂_i b assembled once.
-  VectorXd dcol = s.dcdq.col(i);
+  const VectorXd dcol = s.dcdq.col(i);
   // Constant terms (coefficient −1) do not enter the derivative.
   auto only_coef = [&](const std::vector<OperatorTerm>& terms) {
     SparseMatrix A(n, n);
@@ -207,10 +275,16 @@ Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& 
       if (t.coefficient >= 0 && dcol[t.coefficient] != 0.0) A += dcol[t.coefficient] * t.matrix;
     return A;
   };
-  const SparseMatrix dMc = only_coef(model_.mass), dDc = only_coef(model_.damping), dKc = only_coef(model_.stiffness);
-  std::vector<VectorXd> db;
+  Derivative d{only_coef(model_.mass), only_coef(model_.damping), only_coef(model_.stiffness), {}};
   for (const auto& in : model_.inputs)
-    db.push_back(in.coefficient >= 0 ? VectorXd(dcol[in.coefficient] * in.vector) : VectorXd(VectorXd::Zero(n)));
+    d.db.push_back(in.coefficient >= 0 ? VectorXd(dcol[in.coefficient] * in.vector) : VectorXd(VectorXd::Zero(n)));
+  return d;
+}
+
+Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i,
+                                  double t_end) const {
+  const int n = model_.ndof;
+  const Derivative d = derivative(s, i);
   VectorXd x(n), v(n), a(n), Fe(n);
   SecondOrderSolver::Forcing f = [&](double t, double* F) {
     u.eval(t, x.data(), v.data());
@@ -218,25 +292,58 @@ Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& 
     for (std::size_t k = 0; k < s.ops.loads.size(); ++k) Fe += inputs_[k](t) * s.ops.loads[k];
     solver.acceleration(Fe.data(), x.data(), v.data(), a.data());
     Eigen::Map<VectorXd> Fm(F, n);
-    Fm = -(dMc * a + dDc * v + dKc * x);
-    for (std::size_t k = 0; k < db.size(); ++k) Fm += inputs_[k](t) * db[k];
+    Fm = -(d.dM * a + d.dD * v + d.dK * x);
+    for (std::size_t k = 0; k < d.db.size(); ++k) Fm += inputs_[k](t) * d.db[k];
   };
-  return solver.solve(data_.t.front(), T_, f, breakpoints_, nullptr);
+  return solver.solve(data_.t.front(), t_end, f, breakpoints_, nullptr);
 }
 
-double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
-  const Setup s = setup(q);
-  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s);
-  const int P = size(), n = model_.ndof, ns = data_.sensors();
-  auto ts = Clock::now();
+std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s,
+                                                            double state_end, double tangent_end, Trajectory& u) {
+  const int P = size(), n = model_.ndof;
+  const auto ts = Clock::now();
   std::vector<Trajectory> S;
-  for (int i = 0; i < P; ++i) S.push_back(sensitivity(solver, s, u, i));
+  if (solver.has_tangent_solve()) {
+    std::vector<Derivative> d;
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    std::vector<double> f(inputs_.size());
+    SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* v, const double* a, double* Gp) {
+      const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
+      for (std::size_t k = 0; k < inputs_.size(); ++k) f[k] = inputs_[k](t);
+      for (int i = 0; i < P; ++i) {
+        Eigen::Map<VectorXd> Gi(Gp + static_cast<std::size_t>(i) * n, n);
+        const Derivative& di = d[static_cast<std::size_t>(i)];
+        Gi.noalias() -= di.dM * A;
+        Gi.noalias() -= di.dD * V;
+        Gi.noalias() -= di.dK * X;
+        for (std::size_t k = 0; k < f.size(); ++k)
+          if (f[k] != 0.0) Gi += f[k] * di.db[k];
+      }
+    };
+    SolverSummary sum;
+    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), P, G, tangent_end, breakpoints_, &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    u = std::move(sol.state);
+    S = std::move(sol.tangents);
+  } else {
+    u = forward(solver, s, state_end);
+    for (int i = 0; i < P; ++i) S.push_back(sensitivity(solver, s, u, i, tangent_end));
+  }
   counters_.sensitivity_solves += P;
   counters_.sensitivity_seconds += since(ts);
+  return S;
+}
+
+double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const int P = size(), n = model_.ndof, ns = data_.sensors();
+  Trajectory u;
+  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, profile ? data_.t.back() : T_, T_, u);
 
   const auto tq = Clock::now();
-  const auto grid = union_grid({&u.times()});
+  const auto grid = union_grid({&u.times()}, T_);
   VectorXd x(n), v(n), z(ns), si(n), sv(n);
   MatrixXd CS(ns, P);
   gradient = VectorXd::Zero(P);
@@ -260,8 +367,19 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
       H += wt * CS.transpose() * RCS;
     }
   }
+  if (profile) *profile = misfit_profile(u);
   counters_.quadrature_seconds += since(tq);
   return J;
+}
+
+Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const Trajectory u = forward(solver, s, data_.t.back());
+  const auto t0 = Clock::now();
+  MisfitProfile p = misfit_profile(u);
+  counters_.quadrature_seconds += since(t0);
+  return p;
 }
 
 VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {
@@ -279,7 +397,7 @@ VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {
 MatrixXd Objective::predict(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s);
+  const Trajectory u = forward(solver, s, data_.t.back());
   const int n = model_.ndof;
   MatrixXd Y(static_cast<Eigen::Index>(data_.t.size()), data_.sensors());
   VectorXd x(n), v(n);
@@ -293,18 +411,17 @@ MatrixXd Objective::predict(const VectorXd& q) {
 MatrixXd Objective::output_sensitivities(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
+  Trajectory u;
+  const double t_end = data_.t.back();
+  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, t_end, t_end, u);
   MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
   VectorXd x(n), v(n);
-  for (int i = 0; i < P; ++i) {
-    const Trajectory Si = sensitivity(solver, s, u, i);
-    ++counters_.sensitivity_solves;
+  for (int i = 0; i < P; ++i)
     for (std::size_t k = 0; k < data_.t.size(); ++k) {
-      Si.eval(data_.t[k], x.data(), v.data());
+      S[static_cast<std::size_t>(i)].eval(data_.t[k], x.data(), v.data());
       G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) = C_ * x;
     }
-  }
   return G;
 }
 

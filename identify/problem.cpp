@@ -214,8 +214,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   }
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = identifier_step(sc, p->fe.model, *p->params);
-  p->objective_options.solver.integrator =
-      id.integrator == "bdf" ? SolverOptions::Integrator::Bdf : SolverOptions::Integrator::Esdirk;
+  p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
+                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
+                                                                              : SolverOptions::Integrator::Esdirk;
   return p;
 }
 

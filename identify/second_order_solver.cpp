@@ -9,6 +9,8 @@
 #include <Eigen/SparseCholesky>
 
 #include "scoleid/identify/banded_cholesky.h"
+#include "scoleid/identify/esdirk_stepper.h"
+#include "scoleid/identify/newton_matrix.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -94,11 +96,10 @@ struct SecondOrderSolver::Impl {
   int ngroups = 1;
   SolverOptions opt;
   BandedCholesky mass_chol;
-  std::vector<int> lower_slot;  // for each stored nonzero: its place in the band, or −1 (upper)
+  std::unique_ptr<NewtonMatrix> newton;   // mutable through the pointer: its cache
+  std::unique_ptr<EsdirkStepper> stepper;
 
   // Per-solve state (solve() is const but single-threaded per object).
-  mutable BandedCholesky newton_chol;
-  mutable double gamma_factored = std::numeric_limits<double>::quiet_NaN();
   mutable long factorizations = 0;
   mutable long linear_solves = 0;
   mutable std::vector<double> group_max, group_floor;
@@ -124,31 +125,14 @@ struct SecondOrderSolver::Impl {
     A.noalias() -= K * X;
     mass_chol.solve_in_place(a);
   }
-  void factor(double gamma) const {
-    // S = M + γD + γ²K, written straight into the band from the shared pattern.
-    newton_chol.set_zero();
-    const int nnz = static_cast<int>(M.nonZeros());
-    const double* m = M.valuePtr();
-    const double* d = D.valuePtr();
-    const double* k = K.valuePtr();
-    const double g2 = gamma * gamma;
-    double* band = &newton_chol.at(0, 0) - newton_chol.half_bandwidth();
-    for (int i = 0; i < nnz; ++i) {
-      const int slot = lower_slot[static_cast<std::size_t>(i)];
-      if (slot >= 0) band[slot] = m[i] + gamma * d[i] + g2 * k[i];
-    }
-    if (!newton_chol.factorize()) throw std::runtime_error("Newton matrix M + gD + g^2 K is not positive definite");
-    gamma_factored = gamma;
-    ++factorizations;
-  }
   void newton_solve(double gamma, const double* r, double* sol) const {
-    if (gamma != gamma_factored) factor(gamma);
+    const BandedCholesky& chol = newton->factor(gamma);
     ++linear_solves;
     Eigen::Map<const Eigen::VectorXd> r1(r, n), r2(r + n, n);
     Eigen::Map<Eigen::VectorXd> a(sol, n), b(sol + n, n);
     b.noalias() = M * r2;
     b.noalias() -= gamma * (K * r1);
-    newton_chol.solve_in_place(sol + n);
+    chol.solve_in_place(sol + n);
     a = r1 + gamma * b;
   }
   // Reference scale of each group: the quasi-static response x_ref = (K + σM)⁻¹ F to the
@@ -267,16 +251,9 @@ SecondOrderSolver::SecondOrderSolver(const SparseMatrix& M, const SparseMatrix& 
   s.mass_chol.resize(s.n, b);
   s.mass_chol.assign(M);
   if (!s.mass_chol.factorize()) throw std::runtime_error("mass matrix is not positive definite");
-  s.newton_chol.resize(s.n, b);
-  // Band slot of each stored nonzero of the shared pattern (column-major, like M's values).
-  s.lower_slot.assign(static_cast<std::size_t>(s.M.nonZeros()), -1);
-  {
-    int idx = 0;
-    for (int k = 0; k < s.M.outerSize(); ++k)
-      for (SparseMatrix::InnerIterator it(s.M, k); it; ++it, ++idx)
-        if (it.col() <= it.row())
-          s.lower_slot[static_cast<std::size_t>(idx)] = static_cast<int>(it.row()) * (b + 1) + static_cast<int>(it.col() - it.row()) + b;
-  }
+  s.newton = std::make_unique<NewtonMatrix>(s.M, s.D, s.K, b);
+  if (s.opt.integrator == SolverOptions::Integrator::Esdirk)
+    s.stepper = std::make_unique<EsdirkStepper>(s.M, s.D, s.K, s.mass_chol, *s.newton, ButcherTable::arkode_dirk(s.opt.dirk_table));
   s.F.resize(s.n);
   s.tmp.resize(s.n);
 }
@@ -284,6 +261,30 @@ SecondOrderSolver::SecondOrderSolver(const SparseMatrix& M, const SparseMatrix& 
 SecondOrderSolver::~SecondOrderSolver() = default;
 
 int SecondOrderSolver::dim() const { return impl_->n; }
+
+bool SecondOrderSolver::has_tangent_solve() const { return static_cast<bool>(impl_->stepper); }
+
+SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, double t1, const Forcing& forcing, int P,
+                                                                    const TangentForcing& tangent, double tangent_end,
+                                                                    const std::vector<double>& breakpoints,
+                                                                    SolverSummary* summary) const {
+  const Impl& s = *impl_;
+  if (!s.stepper) throw std::logic_error("solve_tangent: only the esdirk integrator steps tangents with the state");
+  const auto wall0 = std::chrono::steady_clock::now();
+  const long f0 = s.newton->factorizations();
+  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
+  EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, P, &tangent, tangent_end);
+  if (summary) {
+    *summary = {};
+    summary->ok = true;
+    summary->steps = r.counters.steps;
+    summary->rhs_evaluations = r.counters.stage_forcings;
+    summary->linear_solves = r.counters.linear_solves;
+    summary->factorizations = s.newton->factorizations() - f0;
+    summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  }
+  return {std::move(r.state), std::move(r.tangents)};
+}
 
 void SecondOrderSolver::acceleration(const double* F, const double* x, const double* v, double* a) const {
   impl_->acceleration(F, x, v, a);
@@ -294,8 +295,22 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   const auto wall0 = std::chrono::steady_clock::now();
   Impl& s = *impl_;
   const int n = s.n;
+  if (s.stepper) {
+    const long f0 = s.newton->factorizations();
+    const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
+    EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing);
+    if (summary) {
+      *summary = {};
+      summary->ok = true;
+      summary->steps = r.counters.steps;
+      summary->rhs_evaluations = r.counters.stage_forcings;
+      summary->linear_solves = r.counters.linear_solves;
+      summary->factorizations = s.newton->factorizations() - f0;
+      summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    }
+    return std::move(r.state);
+  }
   s.forcing = &forcing;
-  s.gamma_factored = std::numeric_limits<double>::quiet_NaN();
   s.factorizations = 0;
   s.linear_solves = 0;
   s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);
@@ -363,6 +378,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     return bdf ? CVode(cv->mem, stop, y.v, &t, CV_ONE_STEP) : ARKStepEvolve(ark.mem, stop, y.v, &t, ARK_ONE_STEP);
   };
   long steps = 0, rhs = 0, etf = 0, nni = 0;
+  const long factorizations0 = s.newton->factorizations();
   auto collect = [&]() {
     long st = 0, fe = 0, fi = 0, ef = 0, ni = 0;
     if (bdf) {
@@ -425,7 +441,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     summary->rhs_evaluations = rhs;
     summary->error_test_failures = etf;
     summary->nonlinear_iterations = nni;
-    summary->factorizations = s.factorizations;
+    summary->factorizations = s.newton->factorizations() - factorizations0;
     summary->linear_solves = s.linear_solves;
     summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   }

@@ -11,6 +11,56 @@ void Trajectory::push(double t, const double* x, const double* v, const double* 
   A_.insert(A_.end(), a, a + n_);
 }
 
+namespace {
+// Per-thread pool of large arrays (see the header). Bounded, so it holds at most a few dozen
+// trajectories' worth of memory.
+constexpr std::size_t kPoolEntries = 48;
+constexpr std::size_t kPoolMinimum = 1 << 14;  // doubles; smaller arrays are not worth keeping
+thread_local std::vector<std::vector<double>> pool;
+
+void take(std::vector<double>& v, std::size_t need) {
+  if (v.capacity() >= need) return;
+  std::size_t best = pool.size();
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if (pool[i].capacity() >= need && (best == pool.size() || pool[i].capacity() < pool[best].capacity())) best = i;
+  if (best < pool.size() && v.empty()) {
+    v.swap(pool[best]);
+    v.clear();
+    pool[best].swap(pool.back());
+    pool.pop_back();
+  } else {
+    v.reserve(need);
+  }
+}
+
+void give(std::vector<double>& v) {
+  if (v.capacity() < kPoolMinimum) return;
+  if (pool.size() >= kPoolEntries) {
+    // Replace the smallest pooled array if this one is larger.
+    auto it = std::min_element(pool.begin(), pool.end(), [](const auto& a, const auto& b) { return a.capacity() < b.capacity(); });
+    if (it->capacity() >= v.capacity()) return;
+    it->swap(v);
+    return;
+  }
+  pool.emplace_back();
+  pool.back().swap(v);
+}
+}  // namespace
+
+Trajectory::~Trajectory() {
+  give(X_);
+  give(V_);
+  give(A_);
+}
+
+void Trajectory::reserve(std::size_t points) {
+  t_.reserve(points);
+  const std::size_t need = points * static_cast<std::size_t>(n_);
+  take(X_, need);
+  take(V_, need);
+  take(A_, need);
+}
+
 std::size_t Trajectory::locate(double t, bool right) const {
   // Index k of the interval [t_k, t_{k+1}] with t_k < t_{k+1} containing t.
   const std::size_t K = t_.size();

@@ -380,7 +380,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     if (!(id.steepest_weights[i] > 0))
       fail_field(source, "identification.steepest_weights[" + std::to_string(i) + "]", "must be > 0",
                  format_value(id.steepest_weights[i]));
-  id.integrator = r.choice("integrator", id.integrator, {"esdirk", "bdf"});
+  id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
   id.time_step = r.nonneg("time_step", id.time_step);
   id.rtol = r.positive("rtol", id.rtol);
 }

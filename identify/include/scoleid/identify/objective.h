@@ -12,9 +12,19 @@
 //   Gauss–Newton: sensitivities S_i = ∂u/∂q_i from
 //             M S̈_i + D Ṡ_i + K S_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f),
 //             H = ∫ (C S)ᵀ R (C S) dt,  g = ∫ (C S)ᵀ R r dt.
+//             With the esdirk integrator the S_i are stepped with u on u's own stages
+//             (esdirk_stepper.h): the exact derivatives of the discrete u, one factorisation for
+//             all; otherwise each is integrated on its own with u interpolated.
 // All time integrals use 3-point Gauss–Legendre on every interval of the union of the solvers'
 // steps and the sample times, on the Hermite interpolants of the recorded solutions.
-// R is diagonal; by default R_kk = 1 / (T · mean z_k²), so J is the relative mean-square misfit.
+// R is diagonal; by default R_kk = 1 / ((T − t0) · mean z_k²) over the samples in [t0, T], so J is
+// the relative mean-square misfit.
+//
+// Horizon: T may be set below the end of the data (set_horizon); cost, gradient and Gauss–Newton
+// matrix are then those of the data on [t0, T] (with the default weights recomputed on it).
+// Gauss–Newton can also return the misfit profile of its state solve over the whole data span:
+// per sample time t_i, the mean over sensors of ∫_{t0}^{t_i} r_k² dt / ∫_{t0}^{t_i} z̃_k² dt, the
+// relative mean-square misfit of the data on [t0, t_i] (used to choose the horizon, optimizers.h).
 #include <chrono>
 #include <string>
 #include <vector>
@@ -51,6 +61,20 @@ public:
 
   int size() const { return params_.size(); }
   double horizon() const { return T_; }
+  double data_start() const { return data_.t.front(); }
+  double data_end() const { return data_.t.back(); }
+  // Restricts the cost to [t0, T] (clamped to the data span, at least two samples); T = data_end()
+  // restores the whole span.
+  void set_horizon(double T);
+  // Number of data values (samples × sensors) on the horizon.
+  long data_points() const;
+
+  // Relative mean-square misfit on [t0, t_i] for each sample time t_i (see the header comment).
+  struct MisfitProfile {
+    std::vector<double> t, misfit;
+    // The longest t_i with misfit <= bound (−inf if none).
+    double longest_within(double bound) const;
+  };
   const Parameterization& parameterization() const { return params_; }
   const StructuralModel& model() const { return model_; }
   const std::vector<double>& weights() const { return R_; }
@@ -59,8 +83,11 @@ public:
   double cost(const VectorXd& q);
   // J and ∂J/∂q by the costate: one forward and one backward solve.
   double cost_and_gradient(const VectorXd& q, VectorXd& gradient);
-  // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves.
-  double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H);
+  // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
+  // the state is integrated over the whole data span and its misfit profile returned.
+  double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr);
+  // The misfit profile over the whole data span at q (one forward solve).
+  MisfitProfile misfit_profile(const VectorXd& q);
   // ∂J/∂q by central differences with relative step h (2P forward solves).
   VectorXd finite_difference_gradient(const VectorXd& q, double h = 1e-5);
   // Model outputs C u(t_i) at the sample times (samples × sensors).
@@ -84,10 +111,23 @@ private:
     AssembledModel ops;
   };
   Setup setup(const VectorXd& q) const;
-  Trajectory forward(const SecondOrderSolver& solver, const Setup& s);
+  Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
   double cost_of(const Trajectory& u) const;
-  std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets) const;
-  Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i) const;
+  MisfitProfile misfit_profile(const Trajectory& u) const;
+  // Union of the given time sets and the sample times, restricted to [t0, t_end].
+  std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const;
+  SecondOrderSolver::Forcing state_forcing(const Setup& s) const;
+  // ∂_i M, ∂_i D, ∂_i K and ∂_i b per input, for the sensitivity forcing.
+  struct Derivative {
+    SparseMatrix dM, dD, dK;
+    std::vector<VectorXd> db;
+  };
+  Derivative derivative(const Setup& s, int i) const;
+  Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i, double t_end) const;
+  // The state over [t0, state_end] and its sensitivities over [t0, tangent_end] (tangent_end <= state_end).
+  std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,
+                                                   double tangent_end, Trajectory& u);
+  void default_weights();
 
   // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
   // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.
@@ -107,7 +147,7 @@ private:
   MatrixXd C_;
   std::vector<double> R_;
   std::vector<double> breakpoints_;
-  double T_ = 0.0;
+  double T_ = 0.0;  // horizon: end of the cost integral
   ObjectiveCounters counters_;
 };
 

@@ -116,7 +116,7 @@ struct IdentificationSpec {
   double gradient_tolerance = 1e-9;  // on the scaled gradient
   double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
-  std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | bdf (adaptive CVODES)
+  std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (resolves modes up to number P + 2)
   double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
 };
