@@ -24,7 +24,7 @@ public:
     if (p_.size() > kMaxCols) std::printf(" %5s", "...");
     if (phys_)
       for (const char* n : {"rho_A", "EI", "zeta"}) std::printf(" %13s", n);
-    std::printf(" %13s\n", "cost");
+    std::printf(" %13s %8s\n", "cost", "horizon");
   }
   void row(const IterationRecord& r) const {
     std::printf("%5d", r.k);
@@ -38,7 +38,7 @@ public:
         std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
       }
     }
-    std::printf(" %13.6e\n", r.cost);
+    std::printf(" %13.6e %8.4g\n", r.cost, r.horizon);
     std::fflush(stdout);
   }
 
@@ -137,6 +137,8 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   oo.gradient_tolerance = p.scenario.identification.gradient_tolerance;
   oo.step_tolerance = p.scenario.identification.step_tolerance;
   oo.steepest_weights = p.scenario.identification.steepest_weights;
+  oo.continuation = p.scenario.identification.continuation_misfit > 0;
+  if (oo.continuation) oo.continuation_misfit = p.scenario.identification.continuation_misfit;
   if (!oo.steepest_weights.empty() && static_cast<int>(oo.steepest_weights.size()) != p.params->size())
     io::fail_field(p.scenario.source, "identification.steepest_weights",
                    "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
@@ -177,7 +179,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     json values = json::object();
     for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = it.q[static_cast<Eigen::Index>(i)];
     iters.push_back({{"k", it.k}, {"cost", it.cost}, {"values", values}, {"physical", p.params->physical(it.q)},
-                     {"gradient_norm", it.gradient_norm}});
+                     {"gradient_norm", it.gradient_norm}, {"horizon", it.horizon}});
   }
   json out{{"scenario", scenario},
            {"method", method},

@@ -1,5 +1,7 @@
 #include "scoleid/identify/optimizers.h"
 
+#include "scoleid/identify/gauss_newton_step.h"
+
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -18,6 +20,11 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
   for (double w : steepest_weights)
     if (!(w > 0)) return bad("steepest_weights must be > 0");
+  if (!(trust_radius > 0) || !(max_trust_radius >= trust_radius)) return bad("need 0 < trust_radius <= max_trust_radius");
+  if (!(continuation_misfit > 0)) return bad("continuation_misfit must be > 0");
+  if (!(short_horizon_floor >= 0)) return bad("short_horizon_floor must be >= 0");
+  if (!(cost_stall >= 0)) return bad("cost_stall must be >= 0");
+  if (!(continuation_min_fraction > 0 && continuation_min_fraction <= 1)) return bad("continuation_min_fraction must be in (0, 1]");
   return true;
 }
 
@@ -54,7 +61,7 @@ struct Run {
   OptimizerSummary sum;
 
   void record(int k, double J, const VectorXd& q, const VectorXd& gx) {
-    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0};
+    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0, obj.horizon()};
     sum.iterations.push_back(r);
     if (cb) cb(r);
   }
@@ -78,85 +85,121 @@ struct Run {
 };
 
 void gauss_newton(Run& r, VectorXd x) {
-  auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx) {
+  Objective& obj = r.obj;
+  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const double t_min = t0 + r.opt.continuation_min_fraction * (t_end - t0);
+  // Horizon from a misfit profile: the longest T >= t_min up to which the misfit stays within
+  // the bound (never shorter than the current one).
+  auto choose_horizon = [&](const Objective::MisfitProfile& p, double current) {
+    double T = t_min;
+    for (std::size_t i = 0; i < p.t.size(); ++i) {
+      if (p.t[i] <= t_min) continue;
+      if (!(p.misfit[i] <= r.opt.continuation_misfit)) break;
+      T = p.t[i];
+    }
+    T = std::max(T, current);
+    return T >= t_end - 1e-9 * (t_end - t0) ? t_end : T;
+  };
+  const bool continuation = r.opt.continuation;
+  auto full = [&]() { return obj.horizon() >= t_end; };
+
+  Objective::MisfitProfile prof;
+  auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx, bool with_profile) {
     try {
       const VectorXd q = xx.array().exp();
       VectorXd g;
       MatrixXd H;
-      J = r.obj.gauss_newton(q, g, H);
+      J = obj.gauss_newton(q, g, H, with_profile ? &prof : nullptr);
       gx = q.cwiseProduct(g);
       Hx = q.asDiagonal() * H * q.asDiagonal();
-      return std::isfinite(J);
+      return std::isfinite(J) && gx.allFinite() && Hx.allFinite();
     } catch (const std::exception&) {
       return false;
     }
   };
-  double J;
-  VectorXd gx;
-  MatrixXd Hx;
-  if (!gn_at(x, J, gx, Hx)) {
+  auto fail_start = [&]() {
     r.sum.termination = T::LineSearchFailed;
     r.sum.message = "cost cannot be evaluated at the starting point";
     r.sum.q = x.array().exp();
-    return;
+  };
+  obj.set_horizon(t_end);
+  if (continuation) {
+    try {
+      obj.set_horizon(choose_horizon(obj.misfit_profile(x.array().exp()), t0));
+    } catch (const std::exception&) {
+      return fail_start();
+    }
   }
+  double J;
+  VectorXd gx;
+  MatrixXd Hx;
+  if (!gn_at(x, J, gx, Hx, false)) return fail_start();
   r.record(0, J, x.array().exp(), gx);
-  double lambda = 0.0;
+  double radius = r.opt.trust_radius;
   int k = 0;
   r.sum.termination = T::MaxIterations;
-  while (true) {
-    if (J <= r.opt.cost_floor) { r.sum.termination = T::CostFloor; break; }
-    if (r.small_gradient(gx, J)) { r.sum.termination = T::GradientTolerance; break; }
-    if (k >= r.opt.max_iterations) break;
-    bool accepted = false;
-    for (int attempt = 0; attempt < 12 && !accepted; ++attempt) {
-      // Keep a single step within a factor e of the current values by raising the damping
-      // (a trust region in log q), not by shortening the whole step: a poorly determined
-      // direction must not hold back the well-determined ones.
-      const double dmax = Hx.diagonal().maxCoeff();
-      VectorXd dx;
-      for (int fit = 0; fit < 60; ++fit) {
-        MatrixXd A = Hx;
-        A.diagonal() += lambda * (Hx.diagonal().array() + 1e-9 * dmax).matrix();
-        dx = A.ldlt().solve(-gx);
-        if (dx.allFinite() && dx.cwiseAbs().maxCoeff() <= 1.0) break;
-        lambda = lambda > 0 ? lambda * 4.0 : 1e-4;
+  // On a short horizon a termination test lengthens the horizon instead; true if it did.
+  auto extend = [&](double T_new) {
+    if (full() || !(T_new > obj.horizon())) return false;
+    obj.set_horizon(T_new);
+    if (!gn_at(x, J, gx, Hx, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    return true;
+  };
+  try {
+    while (true) {
+      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
+        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
+        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+        break;
       }
+      if (k >= r.opt.max_iterations) break;
+      const TrustRegionStep st = trust_region_step(Hx, gx, radius, full() ? 0.0 : r.opt.short_horizon_floor * J);
       double Jn;
       VectorXd gn;
       MatrixXd Hn;
-      if (gn_at(x + dx, Jn, gn, Hn) && Jn <= J) {
-        x += dx;
-        const double step = dx.cwiseAbs().maxCoeff();
-        const bool stalled = J - Jn <= r.opt.cost_stall * J;
-        J = Jn;
-        gx = gn;
-        Hx = Hn;
-        lambda = lambda > 0 ? lambda / 10.0 : 0.0;
-        if (lambda < 1e-6) lambda = 0.0;
-        accepted = true;
-        ++k;
-        r.record(k, J, x.array().exp(), gx);
-        if (step < r.opt.step_tolerance || stalled) {
-          r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
-          r.sum.iterations_done = k;
-          r.sum.q = x.array().exp();
-          r.sum.cost = J;
-          return;
+      const bool profile = continuation && !full();
+      const bool ok = gn_at(x + st.delta, Jn, gn, Hn, profile) && Jn < J;
+      const double rho = ok && st.predicted > 0 ? (J - Jn) / st.predicted : -1.0;
+      radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
+      if (!ok) {
+        if (radius < r.opt.step_tolerance) {
+          if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) {
+            radius = r.opt.trust_radius;
+            continue;
+          }
+          r.sum.termination = T::StepTolerance;
+          r.sum.message = "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
+          break;
         }
-      } else {
-        lambda = lambda > 0 ? lambda * 10.0 : 1e-3;
+        continue;
+      }
+      x += st.delta;
+      const double step = st.delta.cwiseAbs().maxCoeff();
+      const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
+      const bool stalled = J - Jn <= stall * J;
+      J = Jn;
+      gx = gn;
+      Hx = Hn;
+      ++k;
+      // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
+      // with its cost on the horizon the next step is taken on.
+      const bool extended = profile && extend(choose_horizon(prof, obj.horizon()));
+      r.record(k, J, x.array().exp(), gx);
+      if (extended) continue;
+      if (step < r.opt.step_tolerance || stalled) {
+        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
+        r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+        break;
       }
     }
-    if (!accepted) {
-      r.sum.termination = T::StepTolerance;
-      r.sum.message = "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
-      break;
-    }
+  } catch (const std::runtime_error& e) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = e.what();
   }
   r.sum.iterations_done = k;
   r.sum.q = x.array().exp();
-  r.sum.cost = J;
+  r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
+  obj.set_horizon(t_end);
 }
 
 void lbfgs(Run& r, VectorXd x, bool steepest) {
@@ -233,7 +276,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
       break;
     }
     const VectorXd s = a * d, y = gn - gx;
-    const bool stalled = J - Jn <= r.opt.cost_stall * J;
+    const bool stalled = J - Jn <= (r.opt.cost_stall > 0 ? r.opt.cost_stall : 1e-5) * J;
     x += s;
     J = Jn;
     gx = gn;

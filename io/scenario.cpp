@@ -375,6 +375,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
   id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
   id.step_tolerance = r.positive("step_tolerance", id.step_tolerance);
+  id.continuation_misfit = r.nonneg("continuation_misfit", id.continuation_misfit);
   id.steepest_weights = r.numbers("steepest_weights", {});
   for (std::size_t i = 0; i < id.steepest_weights.size(); ++i)
     if (!(id.steepest_weights[i] > 0))
@@ -502,6 +503,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"initial", id.initial}, {"elements", id.elements}, {"sections", id.sections}, {"data_elements", id.data_elements},
                          {"method", id.method}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
+                         {"continuation_misfit", id.continuation_misfit},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol}};
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},

@@ -8,13 +8,39 @@
 //                     weights, w_i = α q_i² (steepest descent in log q) with α from backtracking.
 //   lbfgs             limited-memory BFGS (m = 8) on x with an Armijo backtracking line search;
 //                     one costate gradient per trial point.
-//   gauss-newton      Levenberg–Marquardt on x from forward sensitivities:
-//                     (H + λ diag H) δ = −g; λ = 0 first (pure Gauss–Newton), ×10 on rejection,
-//                     and raised until ‖δ‖∞ <= 1 (a trust region of a factor e per step in q).
+//   gauss-newton      trust-region Gauss–Newton (Levenberg) on x from forward sensitivities;
+//                     see gauss_newton_step.h for the step and the radius, and below for the
+//                     horizon continuation.
+//
+// Horizon continuation (gauss-newton, `continuation`). Far from the solution the model and the
+// data drift out of phase: a frequency error δω gives a phase error δω·t that grows along the
+// record, and over many cycles the cost is no longer well described by its Gauss–Newton model
+// (its valleys repeat at every cycle slipped). The misfit of the data on [t0, T] against the model
+// therefore bounds the phase error accumulated up to T. The optimiser fits the data on a horizon
+// [t0, T] with T the longest time up to which the relative mean-square misfit per sensor
+// (objective.h, MisfitProfile) stays below `continuation_misfit` (but at least
+// `continuation_min_fraction` of the record), and after every accepted step lengthens T the same
+// way from the state solve it has just done (the misfit profile comes with it). When the fit on a
+// short horizon has converged (a termination test below fires) but the misfit beyond still exceeds
+// the bound, T is doubled. The tests for termination apply on the whole record only. Every
+// accepted step on any horizon is an iteration (the table shows its horizon and its cost there).
+// On a short horizon the data resolve fewer directions than the whole record will (the weakly
+// seen parameters are fixed mostly by its later part), so the Levenberg parameter is kept at
+// λ >= short_horizon_floor·J there: with R normalising each sensor, μ/J ≈ 2/ρ² for a direction of
+// curvature μ whose output effect equals the whole residual at a relative change ρ, so with the
+// default 0.1 a direction the short record cannot pin down to better than a factor ~5 (ρ >~ 4.5)
+// is held back until the horizon grows, instead of being thrown far by the residual of the
+// well-seen ones. On the whole record λ has no floor (plain Gauss–Newton near the solution).
+//
 // Termination (stated in Summary::termination): relative parameter step below step_tolerance,
 // scaled gradient ‖g_x‖∞ below gradient_tolerance·max(J, tiny), cost below cost_floor, relative
 // cost decrease over an accepted step below cost_stall (only directions the data barely see are
-// still moving: the identifiability report flags them), or the iteration limit.
+// still moving: the identifiability report flags them), or the iteration limit. cost_stall = 0
+// (default) is automatic: for gauss-newton 1/N, N the number of data values (samples × sensors)
+// on the horizon — fitting one more free parameter to white noise of the residual's size lowers
+// J by J/N on average, so a Gauss–Newton step that gains less is not distinguishable from
+// fitting noise; for the gradient methods, whose steps can gain little while still far from the
+// minimum, 1e-5.
 #include <functional>
 #include <map>
 #include <string>
@@ -30,8 +56,16 @@ struct OptimizerOptions {
   double gradient_tolerance = 1e-9;
   double step_tolerance = 1e-5;
   double cost_floor = 1e-28;
-  double cost_stall = 1e-5;   // relative decrease of J over an accepted step below which we stop
+  double cost_stall = 0.0;    // relative decrease of J over an accepted step below which we stop; 0 = automatic
   std::vector<double> steepest_weights;  // w_i, paper form; empty = automatic
+  // gauss-newton trust region, in the Euclidean norm of log q (1 = a factor e)
+  double trust_radius = 1.0;      // first radius
+  double max_trust_radius = 5.0;  // largest radius
+  // gauss-newton horizon continuation (see above)
+  bool continuation = true;
+  double continuation_misfit = 0.05;        // bound on the relative mean-square misfit per sensor
+  double continuation_min_fraction = 0.125;  // shortest horizon, as a fraction of the record
+  double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
   bool IsValid(std::string* why) const;
 };
 
@@ -40,6 +74,7 @@ struct IterationRecord {
   double cost = 0.0;
   VectorXd q;
   double gradient_norm = 0.0;  // ‖∂J/∂log q‖∞
+  double horizon = 0.0;        // end of the data the cost was taken over
 };
 
 struct OptimizerSummary {

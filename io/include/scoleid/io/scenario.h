@@ -115,6 +115,10 @@ struct IdentificationSpec {
   int max_iterations = 50;
   double gradient_tolerance = 1e-9;  // on the scaled gradient
   double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
+  // Gauss–Newton horizon continuation: fit the data up to the time where the relative
+  // mean-square misfit per sensor reaches this bound, lengthening the horizon as the fit improves
+  // (identify/include/scoleid/identify/optimizers.h); 0 = fit the whole record from the start.
+  double continuation_misfit = 0.05;
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (resolves modes up to number P + 2)
