@@ -48,64 +48,6 @@ private:
   bool phys_;
 };
 
-Identifiability identifiability(Objective& obj, const Problem& p, const VectorXd& q) {
-  Identifiability id;
-  const int P = obj.size(), ns = p.data.sensors();
-  const auto N = static_cast<Eigen::Index>(p.data.t.size());
-  const MatrixXd Y = obj.predict(q);
-  const MatrixXd G = obj.output_sensitivities(q);
-  // Noise level per sensor.
-  bool from_scenario = true;
-  for (int k = 0; k < ns; ++k) {
-    double sd = p.scenario.sensors[static_cast<std::size_t>(k)].noise_std;
-    if (!(sd > 0)) {
-      from_scenario = false;
-      const VectorXd r = Y.col(k) - p.data.z.col(k);
-      const double dof = std::max<double>(1.0, static_cast<double>(N) - static_cast<double>(P) / ns);
-      sd = std::sqrt(r.squaredNorm() / dof);
-      if (!(sd > 0)) sd = 1e-300;
-    }
-    id.noise_std.push_back(sd);
-  }
-  id.noise_source = from_scenario ? "scenario" : "residual";
-  MatrixXd F = MatrixXd::Zero(P, P);
-  for (Eigen::Index i = 0; i < N; ++i)
-    for (int k = 0; k < ns; ++k) {
-      const Eigen::RowVectorXd g = G.row(i * ns + k);
-      F += g.transpose() * g / (id.noise_std[static_cast<std::size_t>(k)] * id.noise_std[static_cast<std::size_t>(k)]);
-    }
-  const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
-  const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
-  id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
-  id.std = VectorXd::Constant(P, std::nan(""));
-  id.identifiable.assign(static_cast<std::size_t>(P), true);
-  // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
-  // with a sizeable share in them is flagged; the others get their Cramér–Rao std from the
-  // Fisher matrix restricted to them (i.e. with the flagged parameters held fixed).
-  for (int e = 0; e < P; ++e)
-    if (!(es.eigenvalues()[e] > 1e-12 * lmax))
-      for (int i = 0; i < P; ++i)
-        if (std::abs(es.eigenvectors()(i, e)) > 0.1) id.identifiable[static_cast<std::size_t>(i)] = false;
-  std::vector<int> keep;
-  for (int i = 0; i < P; ++i)
-    if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
-  if (!keep.empty()) {
-    MatrixXd Fk(keep.size(), keep.size());
-    for (std::size_t a = 0; a < keep.size(); ++a)
-      for (std::size_t b = 0; b < keep.size(); ++b) Fk(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = Fr(keep[a], keep[b]);
-    const MatrixXd Ck = Fk.inverse();
-    for (std::size_t a = 0; a < keep.size(); ++a) {
-      const double rel = std::sqrt(std::max(0.0, Ck(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a))));
-      const int i = keep[a];
-      id.std[i] = rel * q[i];
-      // more than 50 % relative uncertainty: not determined by these data either
-      if (!(rel < 0.5)) id.identifiable[static_cast<std::size_t>(i)] = false;
-    }
-  }
-  return id;
-}
-
 double safe(double v) { return std::isfinite(v) ? v : 0.0; }
 
 const char* integrator_name(SolverOptions::Integrator i) {
@@ -151,7 +93,11 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     if (ro.verbose) table.row(rec);
   });
   r.estimate = r.summary.q;
-  if (ro.compute_std) r.ident = identifiability(obj, p, r.estimate);
+  if (ro.compute_std) {
+    const auto ti = std::chrono::steady_clock::now();
+    r.ident = analyse_identifiability(obj, p.scenario.sensors, r.estimate);
+    r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
+  }
   r.counters = obj.counters();
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -170,6 +116,9 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     }
     if (ident.std.size() > static_cast<Eigen::Index>(i)) {
       e["std"] = std::isfinite(ident.std[static_cast<Eigen::Index>(i)]) ? json(ident.std[static_cast<Eigen::Index>(i)]) : json(nullptr);
+      e["bias_bound"] = std::isfinite(ident.bias_bound[static_cast<Eigen::Index>(i)])
+                            ? json(ident.bias_bound[static_cast<Eigen::Index>(i)])
+                            : json(nullptr);
       e["identifiable"] = static_cast<bool>(ident.identifiable[i]);
     }
     params.push_back(e);
@@ -200,7 +149,8 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
              {"costate", counters.costate_seconds},
              {"sensitivity", counters.sensitivity_seconds},
              {"quadrature", counters.quadrature_seconds},
-             {"optimizer_total", summary.wall_seconds}}},
+             {"optimizer_total", summary.wall_seconds},
+             {"identifiability", identifiability_seconds}}},
            {"integrator",
             {{"name", integrator_name(p.objective_options.solver.integrator)},
              {"step", p.objective_options.solver.step},
@@ -212,7 +162,9 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
   if (ident.std.size() > 0) {
     out["identifiability"] = {{"condition_number", safe(ident.condition_number)},
                               {"noise_std", ident.noise_std},
-                              {"noise_source", ident.noise_source}};
+                              {"noise_source", ident.noise_source},
+                              {"chi2", ident.chi2},
+                              {"data_values", ident.data_values}};
   }
   return out;
 }

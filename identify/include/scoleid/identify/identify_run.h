@@ -2,14 +2,8 @@
 // One identification run: scenario (+ optional data file) → estimates, iteration history,
 // identifiability, written as identify.json (DESIGN §6) and fit.csv (t, measured, predicted).
 //
-// Identifiability: at the estimate, the Fisher information F = Gᵀ W G from the output
-// sensitivities G = ∂y(t_i)/∂q at the samples, W = diag(1/σ_k²) with σ_k the sensor's noise
-// standard deviation (from the scenario or truth.json), or, when no noise level is known, the
-// residual RMS of that sensor. std_i = sqrt((F⁻¹)_ii): the Cramér–Rao bound. The condition number
-// is that of F scaled to relative parameters (diag(q) F diag(q)). A parameter with a share > 0.1 in
-// an eigenvector of that matrix whose eigenvalue is below 1e-12 of the largest is flagged "not
-// identifiable", and the others' std come from F restricted to them; a relative std above 0.5 is
-// flagged too.
+// Identifiability (identifiability.h): Fisher-information std, a model-error bound and the
+// flags, at the estimate.
 #include <functional>
 #include <map>
 #include <optional>
@@ -18,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scoleid/identify/identifiability.h"
 #include "scoleid/identify/optimizers.h"
 #include "scoleid/identify/problem.h"
 
@@ -31,14 +26,6 @@ struct RunOptions {
   std::optional<int> max_iterations;
 };
 
-struct Identifiability {
-  VectorXd std;                 // per parameter (NaN when F is singular)
-  double condition_number = 0;  // of the relative Fisher matrix
-  std::vector<bool> identifiable;
-  std::vector<double> noise_std;  // σ_k used per sensor
-  std::string noise_source;       // "scenario" | "residual"
-};
-
 struct RunResult {
   std::string scenario;
   std::string method;
@@ -49,6 +36,7 @@ struct RunResult {
   ObjectiveCounters counters;
   Identifiability ident;
   double wall_seconds = 0;
+  double identifiability_seconds = 0;
   nlohmann::json to_json(const Problem& p) const;
 };
 
