@@ -173,8 +173,40 @@ void gauss_newton(Run& r, VectorXd x) {
         }
         continue;
       }
-      x += st.delta;
-      const double step = st.delta.cwiseAbs().maxCoeff();
+      // The cost fell by clearly more than the Gauss–Newton model predicted: the minimum along δ
+      // lies further out (the model's curvature along δ is too large — a curved valley, a large
+      // residual). Try 2δ, 4δ, … with one state solve each while the cost keeps falling.
+      VectorXd delta = st.delta;
+      if (rho > r.opt.extrapolation_ratio) {
+        double best = 1.0, Jb = Jn;
+        for (double a = 2.0; a <= r.opt.max_extrapolation && a * st.delta.norm() <= r.opt.max_trust_radius; a *= 2.0) {
+          double Ja = 0.0;
+          try {
+            Ja = obj.cost((x + a * st.delta).array().exp());
+          } catch (const std::exception&) {
+            break;
+          }
+          if (!(Ja < Jb)) break;
+          best = a;
+          Jb = Ja;
+        }
+        if (best > 1.0) {
+          VectorXd g2;
+          MatrixXd H2;
+          double J2;
+          if (gn_at(x + best * st.delta, J2, g2, H2, profile) && J2 < Jn) {
+            delta = best * st.delta;
+            Jn = J2;
+            gn = g2;
+            Hn = H2;
+            radius = std::max(radius, std::min(delta.norm(), r.opt.max_trust_radius));
+          } else if (profile) {
+            gn_at(x + st.delta, Jn, gn, Hn, profile);  // restore the profile of the accepted point
+          }
+        }
+      }
+      x += delta;
+      const double step = delta.cwiseAbs().maxCoeff();
       const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
       const bool stalled = J - Jn <= stall * J;
       J = Jn;

@@ -138,6 +138,11 @@ TEST(ScoleIdentification, CaseTwoFromThePaperStartInAtMostEightIterations) {
   // From the paper's start: every parameter the data determine within 1e-4 of the truth in at
   // most 8 Gauss–Newton iterations (all iterations counted, on every horizon); ζ recovered to
   // 1e-4 or flagged not identifiable — never returned silently.
+  // ρI_ψ (118 slug ft² of the 27 400 the torsion mode carries) ends near 4e-5, but its
+  // model-error bound is ~5e-3: what is left is discretisation bias, partly absorbed by ζ, which
+  // the fit drives towards 0 to offset the integrator's own damping. With ζ held at its true
+  // value ρI_ψ comes out 1.6e-3 high, and with a 20-element identifier mesh 2e-4 low — so a
+  // change of discretisation can move ρI_ψ past 1e-4 while staying inside its bound.
   const auto t0 = std::chrono::steady_clock::now();
   auto p = make_problem(scoleid::io::load_scenario("paper-scole-2"), std::nullopt);
   RunOptions ro;

@@ -13,7 +13,9 @@
 //
 // Radius (Nocedal & Wright, Alg. 4.1): with ρ = (J − J_new) / (m(0) − m(δ)) the ratio of actual to
 // predicted decrease, Δ ← ‖δ‖/4 if ρ < 1/4; Δ ← min(2Δ, Δ_max) if ρ > 3/4 and the step reached the
-// boundary. A step is accepted when J_new < J.
+// boundary. A step is accepted when J_new < J. When ρ is well above 1 the model's curvature along
+// δ is too large (a curved valley, a large residual) and plain Gauss–Newton would creep; the
+// optimiser then tries 2δ, 4δ, … while the cost keeps falling (optimizers.h).
 #include <Eigen/Dense>
 
 namespace scoleid::identify {

@@ -61,6 +61,10 @@ struct OptimizerOptions {
   // gauss-newton trust region, in the Euclidean norm of log q (1 = a factor e)
   double trust_radius = 1.0;      // first radius
   double max_trust_radius = 5.0;  // largest radius
+  // gauss-newton extrapolation along an accepted step whose actual decrease exceeds the
+  // predicted one by this ratio: 2δ, 4δ, … up to max_extrapolation·δ while the cost falls
+  double extrapolation_ratio = 1.25;
+  double max_extrapolation = 8.0;
   // gauss-newton horizon continuation (see above)
   bool continuation = true;
   double continuation_misfit = 0.05;        // bound on the relative mean-square misfit per sensor
