@@ -46,7 +46,7 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
   const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
   id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
   id.std = VectorXd::Constant(P, std::nan(""));
-  id.bias_bound = VectorXd::Constant(P, std::nan(""));
+  id.resolution = VectorXd::Constant(P, std::nan(""));
   id.identifiable.assign(static_cast<std::size_t>(P), true);
   // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
   // with a sizeable share in them is flagged; the others get their bounds from the Fisher matrix
@@ -67,12 +67,12 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
     const MatrixXd Ck = Fk.inverse();
     for (Eigen::Index a = 0; a < K; ++a) {
       const double rel = std::sqrt(std::max(0.0, Ck(a, a)));
-      const double rel_bias = rel * std::sqrt(systematic);
+      const double rel_res = rel * std::sqrt(systematic);
       const int i = keep[static_cast<std::size_t>(a)];
       id.std[i] = rel * q[i];
-      id.bias_bound[i] = rel_bias * q[i];
-      // more than 50 % relative uncertainty or possible bias: not determined by these data
-      if (!(rel < 0.5) || !(rel_bias < 0.5)) id.identifiable[static_cast<std::size_t>(i)] = false;
+      id.resolution[i] = rel_res * q[i];
+      // more than 50 % relative uncertainty or resolution: not determined by these data
+      if (!(rel < 0.5) || !(rel_res < 0.5)) id.identifiable[static_cast<std::size_t>(i)] = false;
     }
   }
   return id;

@@ -116,8 +116,8 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     }
     if (ident.std.size() > static_cast<Eigen::Index>(i)) {
       e["std"] = std::isfinite(ident.std[static_cast<Eigen::Index>(i)]) ? json(ident.std[static_cast<Eigen::Index>(i)]) : json(nullptr);
-      e["bias_bound"] = std::isfinite(ident.bias_bound[static_cast<Eigen::Index>(i)])
-                            ? json(ident.bias_bound[static_cast<Eigen::Index>(i)])
+      e["resolution"] = std::isfinite(ident.resolution[static_cast<Eigen::Index>(i)])
+                            ? json(ident.resolution[static_cast<Eigen::Index>(i)])
                             : json(nullptr);
       e["identifiable"] = static_cast<bool>(ident.identifiable[i]);
     }

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
     identify::write_outputs(out, *problem, r);
     // Summary against the truth where known.
     std::printf("\n%-10s %14s %14s %14s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth", "rel.error", "std",
-                "bias bound");
+                "resolution");
     for (std::size_t i = 0; i < r.names.size(); ++i) {
       const auto it = r.truth.find(r.names[i]);
       const auto e = static_cast<Eigen::Index>(i);
@@ -73,14 +73,14 @@ int main(int argc, char** argv) {
         if (v.size() > e && std::isfinite(v[e])) std::snprintf(buf, sizeof buf, "%12.3e", v[e]);
         return std::string(buf);
       };
-      const std::string sd = cell(r.ident.std), bias = cell(r.ident.bias_bound);
+      const std::string sd = cell(r.ident.std), res = cell(r.ident.resolution);
       const char* flag = r.ident.identifiable.size() && !r.ident.identifiable[i] ? "  NOT IDENTIFIABLE" : "";
       if (it != r.truth.end())
         std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, it->second,
-                    est / it->second - 1.0, sd.c_str(), bias.c_str(), flag);
+                    est / it->second - 1.0, sd.c_str(), res.c_str(), flag);
       else
         std::printf("%-10s %14.7g %14.7g %14s %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, "-", "-", sd.c_str(),
-                    bias.c_str(), flag);
+                    res.c_str(), flag);
     }
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);

@@ -2,8 +2,8 @@
 // One identification run: scenario (+ optional data file) → estimates, iteration history,
 // identifiability, written as identify.json (DESIGN §6) and fit.csv (t, measured, predicted).
 //
-// Identifiability (identifiability.h): Fisher-information std, a model-error bound and the
-// flags, at the estimate.
+// Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
+// estimate.
 #include <functional>
 #include <map>
 #include <optional>
