@@ -100,7 +100,6 @@ struct SecondOrderSolver::Impl {
   std::unique_ptr<EsdirkStepper> stepper;
 
   // Per-solve state (solve() is const but single-threaded per object).
-  mutable long factorizations = 0;
   mutable long linear_solves = 0;
   mutable std::vector<double> group_max, group_floor;
   mutable const Forcing* forcing = nullptr;
@@ -311,7 +310,6 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     return std::move(r.state);
   }
   s.forcing = &forcing;
-  s.factorizations = 0;
   s.linear_solves = 0;
   s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);
   s.reference_scales(t0, t1, forcing, breakpoints);
