@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
                  "semi-explicit-euler2");
   app.add_option("--accuracy", accuracy,
                  "override truth.accuracy: local error per step (trapezoidal: on the fundamental mode, "
-                 "step <= (12 accuracy)^(1/3) / omega_1; 1e-9 keeps the energy drift below 1e-6 over 50 periods)");
+                 "step <= (12 accuracy)^(1/3) / omega_1; the default 1e-9 keeps the energy drift below 1e-6 over 50 "
+                 "periods)");
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
   app.add_flag("--quiet", quiet, "no progress or summary on stderr");
   app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");

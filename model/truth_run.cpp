@@ -23,10 +23,10 @@ namespace scoleid::model {
 
 using namespace SimTK;
 
-// For lightly damped chains, chosen from scole-truth-bench: the only method that meets the energy
-// criterion (drift < 1e-6 over 50 periods, at accuracy 1e-8) within budget. The chain's
-// top modes (about 840 Hz at n = 40 on SCOLE) bound its step; BDF orders > 2 go unstable on those
-// lightly damped modes and crawl, BDF2 is fast but dissipative (see model/bench.cpp).
+// For constrained chains (simple supports), where the trapezoidal rule does not apply: of
+// Simbody's integrators the only one that meets the energy criterion (drift < 1e-6 over 50
+// periods, at accuracy 1e-8) within budget (scole-truth-bench). The chain's top modes bound its
+// step; BDF orders > 2 go unstable on those lightly damped modes and crawl, BDF2 is dissipative.
 const char* const kDefaultIntegrator = "rk-merson";
 
 std::vector<std::string> integrator_names() {

@@ -71,7 +71,7 @@ TEST(Trapezoidal, SecondOrderOnScole) {
   for (std::size_t i = 1; i < e.size(); ++i) EXPECT_NEAR(std::log2(e[i - 1] / e[i]), 2.0, 0.15) << i;
 }
 
-// At the default step rule (accuracy 1e-8 on the fundamental mode) the time-discretisation error
+// At the default step rule (accuracy 1e-9 on the fundamental mode) the time-discretisation error
 // must be small against what the truth is for: the chain's own lumping error, measured here as the
 // trajectory difference between n and 2n segments. The trapezoidal rule must also be cheaper than
 // RK-Merson at the same accuracy setting (fewer realizations of the multibody equations).
@@ -84,9 +84,9 @@ TEST(Trapezoidal, DefaultStepErrorFarBelowLumpingError) {
   const Traj ref = run(sc, *st, "rk-merson", 1e-11, 0.0);
   const double lumping = error(ref, run(sc, *st2, "rk-merson", 1e-10, 0.0));
   SimulateSummary ts, rs;
-  const double et = error(run(sc, *st, "trapezoidal", 1e-8, 0.0, &ts), ref);
-  const double er = error(run(sc, *st, "rk-merson", 1e-8, 0.0, &rs), ref);
-  std::printf("accuracy 1e-8: trapezoidal error %.3e (%d steps, %d realizations, step %.4g s), rk-merson %.3e (%d steps, "
+  const double et = error(run(sc, *st, "trapezoidal", 1e-9, 0.0, &ts), ref);
+  const double er = error(run(sc, *st, "rk-merson", 1e-9, 0.0, &rs), ref);
+  std::printf("accuracy 1e-9: trapezoidal error %.3e (%d steps, %d realizations, step %.4g s), rk-merson %.3e (%d steps, "
               "%d realizations); lumping n = 10 vs 20: %.3e\n", et, ts.steps_taken, ts.realizations, ts.max_step, er,
               rs.steps_taken, rs.realizations, lumping);
   EXPECT_LT(et, 0.02 * lumping);

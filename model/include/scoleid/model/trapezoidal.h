@@ -40,7 +40,7 @@
 namespace scoleid::model {
 
 struct TrapezoidalOptions {
-  double accuracy = 1e-8;          // local error per step of the fundamental flexible mode
+  double accuracy = 1e-9;          // local error per step of the fundamental flexible mode
   // Newton tolerance = newton_fraction * accuracy (relative to the running state scale; not below
   // 1e-13, the residual's round-off). Well below
   // the truncation error: the residual left in each step is not symmetric in time and accumulates

@@ -48,7 +48,7 @@ std::unique_ptr<Structure> prepare_structure(const io::Scenario& scenario, int s
 
 struct SimulateOptions {
   std::string integrator = "auto";
-  double accuracy = 1e-8;
+  double accuracy = 1e-9;
   double final_time = 1.0;
   double sample_interval = 0.01;
   std::vector<double> breakpoints;   // times where the inputs jump
