@@ -43,21 +43,16 @@ TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, cons
     throw std::invalid_argument("TrapezoidalIntegrator: the system has constraints, which this method does not project onto");
   realize(state_);
   q_initial_ = state_.getQ();
-  const int nu = state_.getNU();
-  const Eigen::MatrixXd J = state_jacobian(system_, state_);
-  summary_.realizations += 4 * nu;
-  ++summary_.jacobians;
-  A_ = J.block(nu, 0, nu, nu);
-  B_ = J.block(nu, nu, nu, nu);
+  refresh_jacobian(state_);
   if (options_.reference_omega > 0) {
     summary_.lowest_omega = options_.reference_omega;
   } else {
     // Modes about the system's default state (undeformed, at rest): a spinning or deformed
     // initial state would add slow modes of unsprung bodies (proof masses on sliders) in the
     // accelerated frame.
-    State rest = system_.getDefaultState();
+    const State rest = system_.getDefaultState();
     const Eigen::MatrixXd J0 = state_jacobian(system_, rest);
-    summary_.realizations += 4 * nu;
+    summary_.realizations += 4 * rest.getNU();
     const auto modes = modes_of(J0, LinearisationOptions{}.zero_tolerance);
     summary_.lowest_omega = modes.empty() ? 0.0 : modes.front().omega;
   }

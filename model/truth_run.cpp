@@ -113,56 +113,69 @@ std::string SimulateSummary::BriefReport() const {
 }
 
 namespace {
-std::vector<double> breakpoints_after(const SimulateOptions& opt, double t0) {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The sample loop shared by every integrator: samples at t_start + k dt, k = 0..floor(T/dt); input
+// breakpoints in between. advance(t_sample, t_breakpoint) moves the integrator forward, at most to
+// the nearer of the two (t_breakpoint = Infinity when none is left) and restarting it at a
+// breakpoint it reaches; time() is the integrator's time; current() its state realized to
+// Acceleration. Fills samples and termination of `sum`.
+void sample_loop(const SimulateOptions& opt, double t_start, Clock::time_point wall0,
+                 const std::function<void(double, double)>& advance, const std::function<double()>& time,
+                 const std::function<const State&()>& current, const std::function<void(const State&)>& on_sample,
+                 SimulateSummary& sum) {
   std::vector<double> bps;
   for (double b : opt.breakpoints)
-    if (b > t0 && b < opt.final_time) bps.push_back(b);
+    if (b > t_start && b < opt.final_time) bps.push_back(b);
   std::sort(bps.begin(), bps.end());
-  return bps;
-}
-
-// The sample loop of simulate() on the trapezoidal rule (trapezoidal.h): steps end on every sample
-// time and every input breakpoint.
-SimulateSummary simulate_trapezoidal(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
-                                     const std::function<void(const State&)>& on_sample, SimulateSummary sum,
-                                     std::chrono::steady_clock::time_point wall0) {
-  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
-  TrapezoidalOptions to;
-  to.accuracy = opt.accuracy;
-  to.max_step = opt.max_step;
-  to.reference_omega = opt.reference_omega;
-  TrapezoidalIntegrator integ(system, initial, to);
-  const std::vector<double> bps = breakpoints_after(opt, initial.getTime());
   const int K = static_cast<int>(std::floor(opt.final_time / opt.sample_interval + 1e-9));
-  const double t_start = initial.getTime();
   double next_progress = 2.0;
   std::size_t ib = 0;
   for (int k = 0; k <= K; ++k) {
     const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
     const double eps = 1e-12 * std::max(1.0, std::abs(tk));
-    while (integ.time() < tk - eps) {
-      while (ib < bps.size() && bps[ib] <= integ.time() + eps) ++ib;
-      const bool to_breakpoint = ib < bps.size() && bps[ib] < tk + eps;
-      integ.advance_to(to_breakpoint ? bps[ib] : tk, to_breakpoint);
-      if (opt.progress && wall() > next_progress) {
-        std::fprintf(stderr, "\r%5.1f%% of %g s simulated, real-time factor %.2f   ",
-                     100.0 * integ.time() / opt.final_time, opt.final_time, integ.time() / wall());
-        next_progress = wall() + 2.0;
+    while (time() < tk - eps) {
+      while (ib < bps.size() && bps[ib] <= time() + eps) ++ib;
+      advance(tk, ib < bps.size() ? bps[ib] : Infinity);
+      if (opt.progress && seconds_since(wall0) > next_progress) {
+        std::fprintf(stderr, "\r%5.1f%% of %g s simulated, real-time factor %.2f   ", 100.0 * time() / opt.final_time,
+                     opt.final_time, time() / seconds_since(wall0));
+        next_progress = seconds_since(wall0) + 2.0;
       }
     }
-    on_sample(integ.state());
+    on_sample(current());
     ++sum.samples;
-    if (opt.wall_limit > 0 && wall() > opt.wall_limit) {
+    if (opt.wall_limit > 0 && seconds_since(wall0) > opt.wall_limit) {
       sum.termination = SimulateSummary::Termination::WallLimit;
       break;
     }
   }
   if (opt.progress && next_progress > 2.0) std::fprintf(stderr, "\n");
+}
+
+// simulate() on the trapezoidal rule (trapezoidal.h): steps end on every sample time and every
+// input breakpoint.
+void simulate_trapezoidal(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
+                          const std::function<void(const State&)>& on_sample, Clock::time_point wall0,
+                          SimulateSummary& sum) {
+  TrapezoidalOptions to;
+  to.accuracy = opt.accuracy;
+  to.max_step = opt.max_step;
+  to.reference_omega = opt.reference_omega;
+  TrapezoidalIntegrator integ(system, initial, to);
+  const double eps = 1e-12 * std::max(1.0, opt.final_time);
+  sample_loop(
+      opt, initial.getTime(), wall0,
+      [&](double tk, double tb) {
+        if (tb < tk + eps) integ.advance_to(tb, true);
+        else integ.advance_to(tk);
+      },
+      [&] { return integ.time(); }, [&]() -> const State& { return integ.state(); }, on_sample, sum);
   const TrapezoidalSummary& ts = integ.summary();
   sum.steps_taken = sum.steps_attempted = ts.steps;
   sum.realizations = ts.realizations;
-  sum.simulated_seconds = integ.time() - t_start;
-  sum.wall_seconds = wall();
+  sum.simulated_seconds = integ.time() - initial.getTime();
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "step %.4g s, %d Newton corrections, %d Jacobians, %d factorizations; frequency error "
@@ -171,7 +184,35 @@ SimulateSummary simulate_trapezoidal(const MultibodySystem& system, const State&
                 ts.lowest_omega / (2 * Pi));
   sum.message = buf;
   sum.max_step = ts.largest_step;
-  return sum;
+}
+
+// simulate() on one of Simbody's integrators, stopped at every breakpoint and restarted there.
+void simulate_simbody(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
+                      const std::function<void(const State&)>& on_sample, Clock::time_point wall0,
+                      SimulateSummary& sum) {
+  auto integ = make_integrator(sum.integrator, system, opt.accuracy);
+  integ->setFinalTime(opt.final_time);
+  integ->initialize(initial);
+  sample_loop(
+      opt, initial.getTime(), wall0,
+      [&](double tk, double tb) {
+        const Integrator::SuccessfulStepStatus st = integ->stepTo(tk, tb);
+        if (integ->isSimulationOver() && integ->getTerminationReason() != Integrator::ReachedFinalTime)
+          throw std::runtime_error("integration failed at t = " + io::format_value(integ->getTime()) + ": " +
+                                   Integrator::getTerminationReasonString(integ->getTerminationReason()));
+        // Restart the method at the input discontinuity (no history carried across it).
+        if (st == Integrator::ReachedScheduledEvent) integ->reinitialize(Stage::Time, false);
+      },
+      [&] { return integ->getTime(); },
+      [&]() -> const State& {
+        system.realize(integ->getState(), Stage::Acceleration);
+        return integ->getState();
+      },
+      on_sample, sum);
+  sum.steps_taken = integ->getNumStepsTaken();
+  sum.steps_attempted = integ->getNumStepsAttempted();
+  sum.realizations = integ->getNumRealizations();
+  sum.simulated_seconds = integ->getTime() - initial.getTime();
 }
 }  // namespace
 
@@ -180,59 +221,11 @@ SimulateSummary simulate(const MultibodySystem& system, const State& initial, co
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("simulate: " + why);
   SimulateSummary sum;
-  const auto wall0 = std::chrono::steady_clock::now();
-  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
+  const auto wall0 = Clock::now();
   sum.integrator = opt.integrator == "auto" ? choose_integrator(system, initial) : opt.integrator;
-  if (sum.integrator == "trapezoidal") return simulate_trapezoidal(system, initial, opt, on_sample, sum, wall0);
-
-  auto integ = make_integrator(sum.integrator, system, opt.accuracy);
-  integ->setFinalTime(opt.final_time);
-  integ->initialize(initial);
-  std::vector<double> bps;
-  for (double b : opt.breakpoints)
-    if (b > initial.getTime() && b < opt.final_time) bps.push_back(b);
-  std::sort(bps.begin(), bps.end());
-
-  const int K = static_cast<int>(std::floor(opt.final_time / opt.sample_interval + 1e-9));
-  const double t_start = initial.getTime();
-  double next_progress = 2.0;
-  std::size_t ib = 0;
-  for (int k = 0; k <= K; ++k) {
-    const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
-    const double eps = 1e-12 * std::max(1.0, std::abs(tk));
-    while (integ->getTime() < tk - eps) {
-      while (ib < bps.size() && bps[ib] <= integ->getTime() + eps) ++ib;
-      const double tb = ib < bps.size() ? bps[ib] : Infinity;
-      const Integrator::SuccessfulStepStatus st = integ->stepTo(tk, tb);
-      if (integ->isSimulationOver() && integ->getTerminationReason() != Integrator::ReachedFinalTime)
-        throw std::runtime_error("integration failed at t = " + io::format_value(integ->getTime()) + ": " +
-                                 Integrator::getTerminationReasonString(integ->getTerminationReason()));
-      if (st == Integrator::ReachedScheduledEvent) {
-        // Restart the method at the input discontinuity (no history carried across it).
-        integ->reinitialize(Stage::Time, false);
-        ++ib;
-      }
-      if (opt.progress && wall() > next_progress) {
-        std::fprintf(stderr, "\r%5.1f%% of %g s simulated, real-time factor %.2f   ",
-                     100.0 * integ->getTime() / opt.final_time, opt.final_time, integ->getTime() / wall());
-        next_progress = wall() + 2.0;
-      }
-    }
-    const State& s = integ->getState();
-    system.realize(s, Stage::Acceleration);
-    on_sample(s);
-    ++sum.samples;
-    if (opt.wall_limit > 0 && wall() > opt.wall_limit) {
-      sum.termination = SimulateSummary::Termination::WallLimit;
-      break;
-    }
-  }
-  if (opt.progress && next_progress > 2.0) std::fprintf(stderr, "\n");
-  sum.steps_taken = integ->getNumStepsTaken();
-  sum.steps_attempted = integ->getNumStepsAttempted();
-  sum.realizations = integ->getNumRealizations();
-  sum.simulated_seconds = integ->getTime() - t_start;
-  sum.wall_seconds = wall();
+  if (sum.integrator == "trapezoidal") simulate_trapezoidal(system, initial, opt, on_sample, wall0, sum);
+  else simulate_simbody(system, initial, opt, on_sample, wall0, sum);
+  sum.wall_seconds = seconds_since(wall0);
   return sum;
 }
 

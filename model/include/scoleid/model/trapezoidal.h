@@ -32,7 +32,7 @@
 // input breakpoint is evaluated just before it (the input's left limit), the next step starts
 // from its right limit.
 #include <map>
-#include <memory>
+#include <string>
 
 #include <Eigen/Dense>
 #include <Simbody.h>
