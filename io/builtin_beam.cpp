@@ -1,4 +1,4 @@
-// The paper's beam cases (DESIGN §3): L = 10 m, step load P = 10 N at t = 0+, zero initial
+// The paper's beam cases (docs/theory.md §2.4): L = 10 m, step load P = 10 N at t = 0+, zero initial
 // state, horizon T = 10 s, SI units. The true values live in `beam:`, the paper's starting
 // values in `identification.initial`.
 #include "scoleid/io/builtin.h"

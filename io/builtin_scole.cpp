@@ -1,4 +1,4 @@
-// SCOLE built-in scenarios (DESIGN §4), slug-ft-s, nominal configuration (the `scole:` defaults).
+// SCOLE built-in scenarios (docs/theory.md §3.6), slug-ft-s, nominal configuration (the `scole:` defaults).
 // Excitation as in the paper (Fig. 6): a force and a moment at the antenna (reflector) end.
 // Haversine pulses of about half the period of the mode they target: the first bending pair
 // (about 0.3 Hz, roll and pitch) and the first torsion mode (about 0.5 Hz, the reflector's

@@ -1,4 +1,4 @@
-// Conservation laws of the Simbody truth (DESIGN §7 step 3):
+// Conservation laws of the Simbody truth (docs/theory.md §11 step 3):
 //  - no damping, no input, initial deformation: total energy (kinetic + joint-spring potential)
 //    is constant; the drift over 50 periods of the first mode measures the integrator;
 //  - free-floating SCOLE spinning, driven only by its internal proof-mass actuator forces (and its

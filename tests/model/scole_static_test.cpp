@@ -1,4 +1,4 @@
-// Static check of the SCOLE mast (DESIGN §4): a steady force F along shuttle x at the reflector
+// Static check of the SCOLE mast (docs/theory.md §3): a steady force F along shuttle x at the reflector
 // CM, offset r = (r_x, r_y) from the mast tip, loads the cantilever mast with a tip shear F and a
 // tip torque T = (r x F)_z = -r_y F. Analytic cantilever, small deflection:
 //   mast tip       u_x = F L^3 / (3 EI_pitch),                      u_y = 0

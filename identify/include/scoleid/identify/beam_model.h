@@ -1,5 +1,5 @@
 #pragma once
-// Finite-element model of the Euler–Bernoulli beam of DESIGN §3, in the form of
+// Finite-element model of the Euler–Bernoulli beam of docs/theory.md §2, in the form of
 // structural_model.h:
 //
 //   ρA w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = Σ_i f_i(t) δ(s − s_i)   (or δ′ for moments)

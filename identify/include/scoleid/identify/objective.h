@@ -1,5 +1,5 @@
 #pragma once
-// The identification functional and its derivatives (DESIGN §2, paper Eqs. 18–25).
+// The identification functional and its derivatives (docs/theory.md §6, paper Eqs. 18–25).
 //
 //   state     M ü + D u̇ + K u = Σ_i γ_i b_i f_i(t),           u(0) = u̇(0) = 0
 //   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C u − z̃(t)

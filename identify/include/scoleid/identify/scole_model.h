@@ -1,5 +1,5 @@
 #pragma once
-// Finite-element model of SCOLE (DESIGN §4) for the identifier, in the form of
+// Finite-element model of SCOLE (docs/theory.md §3, §4.3) for the identifier, in the form of
 // structural_model.h: linearised about the undeformed configuration, small motions, free-floating
 // (no gravity), slug–ft–s. Shuttle frame S: x roll, y pitch, z yaw, origin at the shuttle CM; the
 // mast leaves the shuttle at r0 = mast_root along −z, s ∈ [0, L], undeformed p(s) = r0 − s e_z.
@@ -26,7 +26,7 @@
 //   reflector  rigid, welded at s = L, CM at r = (r_x, r_y, 0) from the tip (shuttle axes):
 //              CM displacement  u_R = u(L) + Θ(L) × r,  rotation Θ(L);
 //              KE ½ m4 |u̇_R|² + ½ Θ̇ᵀ I4 Θ̇ (I4 about its CM): a constant mass term coupling
-//              torsion to both bending planes (DESIGN §4: f_φ,4 = −m4 (ü_y(L) + r_x ψ̈(L)) + F_y).
+//              torsion to both bending planes (docs/theory.md §3.2: f_φ,4 = −m4 (ü_y(L) + r_x ψ̈(L)) + F_y).
 //   proof mass k at s_k (massless carriage on a slider along x, the mass on a slider along y, no
 //              slider spring — model/scole_system.cpp): DOFs are its absolute lateral position
 //              ξ_k = (ξx, ξy); axially it moves with the mast. KE ½ m_k (ξ̇x² + ξ̇y² + ẇ²). With no

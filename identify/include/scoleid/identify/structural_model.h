@@ -9,7 +9,7 @@
 // Kelvin–Voigt coefficients, ...), so the first variation needed by the costate gradient is
 //   ∂J/∂c_j = ∫₀ᵀ pᵀ (M_j ü + D_j u̇ + K_j u − b_j f) dt
 // a sum over the terms that carry c_j; its cost is that of one pass over all terms, whatever
-// the number of coefficients (DESIGN §2, Eq. 25).
+// the number of coefficients (docs/theory.md §6; paper Eq. 25).
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <string>

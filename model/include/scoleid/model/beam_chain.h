@@ -1,5 +1,5 @@
 #pragma once
-// A planar Euler–Bernoulli beam as a Hencky bar chain in Simbody (DESIGN §3, §5).
+// A planar Euler–Bernoulli beam as a Hencky bar chain in Simbody (docs/theory.md §2, §9).
 //
 //   rho_A w_tt + (c w_sst)_ss + (EI(s) w_ss)_ss = loads,  c = 2 zeta sqrt(rho_A EI),  s in [0, L]
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The SCOLE multibody (DESIGN §4, §5), slug-ft-s.
+// The SCOLE multibody (docs/theory.md §3, §9), slug-ft-s.
 //
 // Shuttle: rigid body on a Free mobilizer, no gravity (orbit); body frame S at its CM, x roll,
 // y pitch, z yaw. Mast: n rigid segments of length h = L/n leaving the shuttle at mast_root

@@ -1,5 +1,5 @@
 #pragma once
-// Sensor read-outs of a Structure (DESIGN §5), all measured in the reference body R (ground for
+// Sensor read-outs of a Structure (docs/theory.md §9.4), all measured in the reference body R (ground for
 // a beam, the shuttle for SCOLE) along the sensor's unit direction d_R:
 //   displacement   (p_RP - p_RP0) . d          P the station, p_RP0 its undeformed position
 //                  (beam: w(s) along +y)
