@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace scoleid::identify {
@@ -48,13 +49,17 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
   id.std = VectorXd::Constant(P, std::nan(""));
   id.resolution = VectorXd::Constant(P, std::nan(""));
   id.identifiable.assign(static_cast<std::size_t>(P), true);
+  id.reason.assign(static_cast<std::size_t>(P), "");
   // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
   // with a sizeable share in them is flagged; the others get their bounds from the Fisher matrix
   // restricted to them (i.e. with the flagged parameters held fixed).
   for (int e = 0; e < P; ++e)
     if (!(es.eigenvalues()[e] > 1e-12 * lmax))
       for (int i = 0; i < P; ++i)
-        if (std::abs(es.eigenvectors()(i, e)) > 0.1) id.identifiable[static_cast<std::size_t>(i)] = false;
+        if (std::abs(es.eigenvectors()(i, e)) > 0.1) {
+          id.identifiable[static_cast<std::size_t>(i)] = false;
+          id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
+        }
   std::vector<int> keep;
   for (int i = 0; i < P; ++i)
     if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
@@ -72,7 +77,12 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
       id.std[i] = rel * q[i];
       id.resolution[i] = rel_res * q[i];
       // more than 50 % relative uncertainty or resolution: not determined by these data
-      if (!(rel < 0.5) || !(rel_res < 0.5)) id.identifiable[static_cast<std::size_t>(i)] = false;
+      if (!(rel < 0.5) || !(rel_res < 0.5)) {
+        id.identifiable[static_cast<std::size_t>(i)] = false;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "relative std %.3g and relative resolution %.3g: above 0.5", rel, rel_res);
+        id.reason[static_cast<std::size_t>(i)] = buf;
+      }
     }
   }
   return id;

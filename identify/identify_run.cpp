@@ -3,11 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 
 #include "scoleid/io/data_files.h"
+#include "scoleid/identify/fit_plot.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::identify {
 
@@ -90,12 +90,21 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
                              static_cast<const BeamParameterization*>(p.params.get())->paper_form());
   if (ro.verbose) table.header();
   r.summary = minimize(obj, r.initial, oo, [&](const IterationRecord& rec) {
+    io::check_interrupt();
     if (ro.verbose) table.row(rec);
   });
   r.estimate = r.summary.q;
   if (ro.compute_std) {
     const auto ti = std::chrono::steady_clock::now();
-    r.ident = analyse_identifiability(obj, p.scenario.sensors, r.estimate);
+    // Each sensor's stated noise level: the scenario's, else truth.json's (make_problem).
+    std::vector<io::SensorSpec> sensors = p.scenario.sensors;
+    for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
+    r.ident = analyse_identifiability(obj, sensors, r.estimate);
+    if (r.ident.noise_source == "scenario") {
+      std::string origin;
+      for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
+      r.ident.noise_source = origin;
+    }
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();
@@ -115,11 +124,18 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
       e["relative_error"] = estimate[static_cast<Eigen::Index>(i)] / it->second - 1.0;
     }
     if (ident.std.size() > static_cast<Eigen::Index>(i)) {
-      e["std"] = std::isfinite(ident.std[static_cast<Eigen::Index>(i)]) ? json(ident.std[static_cast<Eigen::Index>(i)]) : json(nullptr);
-      e["resolution"] = std::isfinite(ident.resolution[static_cast<Eigen::Index>(i)])
-                            ? json(ident.resolution[static_cast<Eigen::Index>(i)])
-                            : json(nullptr);
-      e["identifiable"] = static_cast<bool>(ident.identifiable[i]);
+      // A flagged parameter has no standard deviation worth the name: null, with the reason.
+      const bool ok = ident.identifiable[i];
+      const double sd = ident.std[static_cast<Eigen::Index>(i)], res = ident.resolution[static_cast<Eigen::Index>(i)];
+      e["std"] = ok && std::isfinite(sd) ? json(sd) : json(nullptr);
+      e["resolution"] = ok && std::isfinite(res) ? json(res) : json(nullptr);
+      e["identifiable"] = ok;
+      if (!ok && i < ident.reason.size()) e["not_identifiable_because"] = ident.reason[i];
+    } else {
+      // --no-std: not assessed, which is not the same as identifiable.
+      e["std"] = nullptr;
+      e["resolution"] = nullptr;
+      e["identifiable"] = nullptr;
     }
     params.push_back(e);
   }
@@ -160,17 +176,24 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"elements", p.fe.elements},
            {"settings", io::to_json(p.scenario)}};
   if (ident.std.size() > 0) {
-    out["identifiability"] = {{"condition_number", safe(ident.condition_number)},
+    out["identifiability"] = {{"assessed", true},
+                              {"condition_number", safe(ident.condition_number)},
                               {"noise_std", ident.noise_std},
                               {"noise_source", ident.noise_source},
                               {"chi2", ident.chi2},
                               {"data_values", ident.data_values}};
+  } else {
+    out["identifiability"] = {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
   }
+  if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0)
+    out["data_columns"] = {{"sensors", p.columns.sensors},
+                           {"inputs_from_data", p.columns.inputs_from_data},
+                           {"inputs_from_scenario", p.columns.inputs_from_scenario},
+                           {"unused", p.columns.unused}};
   return out;
 }
 
-void write_outputs(const std::string& dir, Problem& p, const RunResult& r) {
-  io::ensure_directory(dir);
+void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.csv: measured, predicted and residual per sensor at the sample times.
   Objective obj(p.fe.model, *p.params, p.signals, p.data, p.objective_options);
   const MatrixXd Y = obj.predict(r.estimate);
@@ -191,31 +214,17 @@ void write_outputs(const std::string& dir, Problem& p, const RunResult& r) {
     tab.columns.push_back(y);
     tab.columns.push_back(e);
   }
-  const auto d = std::filesystem::path(dir);
-  io::write_csv((d / "fit.csv").string(), tab);
-  // fit.gp: measured vs predicted and the residual per sensor, and the cost history; rendered to
-  // fit.png when gnuplot is available (the script stays for other terminals).
-  std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * (p.data.sensors() + 1)) +
-                   " noenhanced\nset output 'fit.png'\nset datafile separator ','\nset multiplot layout " +
-                   std::to_string(p.data.sensors() + 1) + ",1\nset grid\nset key top right\n";
-  for (int k = 0; k < p.data.sensors(); ++k) {
-    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
-    const int c = 2 + 3 * k;
-    gp += "set title '" + n + "'\nset xlabel 't'\nset y2tics\nset ytics nomirror\n";
-    gp += "plot 'fit.csv' every ::1 using 1:" + std::to_string(c) + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
-          std::to_string(c + 1) + " with lines dt 2 lw 2 title 'predicted', '' every ::1 using 1:" + std::to_string(c + 2) +
-          " axes x1y2 with lines lc rgb 'gray' title 'residual (right axis)'\n";
+  io::write_csv(dir.path("fit.csv"), tab);
+  // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
+  std::vector<std::pair<int, double>> cost;
+  for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
+  io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost));
+  switch (render_gnuplot(dir.staging(), "fit.gp")) {
+    case RenderStatus::Rendered: break;
+    case RenderStatus::NoGnuplot: std::fprintf(stderr, "scole-identify: note: gnuplot is not installed; no fit.png\n"); break;
+    case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n"); break;
   }
-  gp += "unset y2tics\nset ytics mirror\nset title 'cost per iteration'\nset xlabel 'iteration'\nset logscale y\n"
-        "plot '-' using 1:2 with linespoints lw 2 notitle\n";
-  for (const auto& it : r.summary.iterations) gp += std::to_string(it.k) + "," + io::format_value(it.cost) + "\n";
-  gp += "e\nunset multiplot\n";
-  io::write_text_atomic((d / "fit.gp").string(), gp);
-  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
-    const std::string cmd = "cd '" + d.string() + "' && gnuplot fit.gp > /dev/null 2>&1";
-    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n");
-  }
-  io::write_json_atomic((d / "identify.json").string(), r.to_json(p));
+  io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
 }
 
 }  // namespace scoleid::identify

@@ -8,6 +8,8 @@
 
 #include "scoleid/identify/identify_run.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/validation.h"
 
 using namespace scoleid;
 using Eigen::VectorXd;
@@ -20,7 +22,10 @@ int main(int argc, char** argv) {
       "the identifier's, so the identifier never fits its own discretisation. Writes DIR/identify.json\n"
       "(estimates, truth, std, iteration history, counts, timings, settings) and DIR/fit.csv\n"
       "(measured, predicted, residual per sensor), and prints the iteration table.\n\n"
-      "Exit codes: 0 success, 1 run failed, 2 bad usage or bad input."};
+      "Exit codes: 0 converged; 1 the run failed, or did not converge (its outputs are written, marked\n"
+      "\"converged\": false); 2 bad usage or bad input (nothing written); 130/143 interrupted by\n"
+      "SIGINT/SIGTERM (nothing written). The outputs of a run appear together or not at all: they are\n"
+      "written beside --out and moved into place as one directory at the end."};
   std::string scenario = "paper-beam-1";
   std::string data, out, method;
   int max_iterations = -1;
@@ -30,37 +35,59 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", out, "output directory (default: run/<scenario name>)");
   app.add_option("-m,--method", method, "optimiser: auto | gauss-newton | lbfgs | steepest-descent (default: the scenario's)")
       ->check(CLI::IsMember({"auto", "gauss-newton", "lbfgs", "steepest-descent"}));
-  app.add_option("--max-iterations", max_iterations, "override identification.max_iterations");
+  app.add_option("--max-iterations", max_iterations, "override identification.max_iterations (>= 0)")
+      ->check(CLI::Range(0, 100000));
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
-  app.add_flag("--no-std", no_std, "skip the Fisher-information standard deviations");
+  app.add_flag("--no-std", no_std,
+               "skip the Fisher-information standard deviations and with them the identifiability flags "
+               "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "scole-identify: %s (see --help)\n", e.what());
+    std::fprintf(stderr, "scole-identify: %s (see --help)\n", io::one_line(e.what()).c_str());
     return 2;
   }
+  io::install_interrupt_handlers();
   try {
     if (list) {
       for (const auto& n : io::builtin_scenario_names())
         std::printf("%-16s %s\n", n.c_str(), io::builtin_scenario_description(n).c_str());
       return 0;
     }
-    const io::Scenario sc = io::load_scenario(scenario);
+    io::Scenario sc = io::load_scenario(scenario);
     identify::RunOptions ro;
     if (!data.empty()) ro.data_csv = data;
     ro.method = method;
     ro.compute_std = !no_std;
     ro.verbose = !quiet;
-    if (max_iterations >= 0) ro.max_iterations = max_iterations;
-    auto problem = identify::make_problem(sc, ro.data_csv);
+    if (max_iterations >= 0) {
+      ro.max_iterations = max_iterations;
+      sc.identification.max_iterations = max_iterations;
+    }
+    io::validate_scenario(sc);  // the overrides pass the same checks as the file
     if (out.empty()) out = "run/" + sc.name;
+    // The output directory is checked (and its staging area made) before any work.
+    io::RunDirectory run_dir(out, identify::output_files(), "scole-identify");
+    auto problem = identify::make_problem(sc, ro.data_csv);
     std::fprintf(stderr, "scole-identify: %s, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
                  problem->fe.elements, problem->params->size(), problem->data_source.c_str());
+    if (ro.data_csv) {
+      auto list = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+        return s.empty() ? std::string("none") : s;
+      };
+      const auto& c = problem->columns;
+      std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
+                   list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
+                   list(c.unused).c_str());
+    }
     const identify::RunResult r = identify::run_identification(*problem, ro);
-    identify::write_outputs(out, *problem, r);
+    identify::write_outputs(run_dir, *problem, r);
+    run_dir.commit();
     // Summary against the truth where known.
     std::printf("\n%-10s %14s %14s %14s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth", "rel.error", "std",
                 "resolution");
@@ -73,8 +100,9 @@ int main(int argc, char** argv) {
         if (v.size() > e && std::isfinite(v[e])) std::snprintf(buf, sizeof buf, "%12.3e", v[e]);
         return std::string(buf);
       };
-      const std::string sd = cell(r.ident.std), res = cell(r.ident.resolution);
-      const char* flag = r.ident.identifiable.size() && !r.ident.identifiable[i] ? "  NOT IDENTIFIABLE" : "";
+      const bool flagged = r.ident.identifiable.size() && !r.ident.identifiable[i];
+      const char* flag = flagged ? "  NOT IDENTIFIABLE" : r.ident.identifiable.empty() ? "  (not assessed)" : "";
+      const std::string sd = flagged ? "-" : cell(r.ident.std), res = flagged ? "-" : cell(r.ident.resolution);
       if (it != r.truth.end())
         std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, it->second,
                     est / it->second - 1.0, sd.c_str(), res.c_str(), flag);
@@ -85,12 +113,20 @@ int main(int argc, char** argv) {
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
+    if (!r.summary.converged()) {
+      std::fprintf(stderr, "scole-identify: did not converge (%s: %s); outputs written with \"converged\": false\n",
+                   identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());
+      return 1;
+    }
     return 0;
   } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-identify: %s\n", e.what());
+    std::fprintf(stderr, "scole-identify: %s\n", io::one_line(e.what()).c_str());
     return 2;
+  } catch (const io::Interrupted& e) {
+    std::fprintf(stderr, "scole-identify: %s\n", e.what());
+    return e.exit_code();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-identify: run failed: %s\n", e.what());
+    std::fprintf(stderr, "scole-identify: run failed: %s\n", io::one_line(e.what()).c_str());
     return 1;
   }
 }

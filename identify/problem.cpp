@@ -1,5 +1,6 @@
 #include "scoleid/identify/problem.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -7,6 +8,7 @@
 #include "scoleid/identify/modal.h"
 #include "scoleid/identify/scole_model.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
 
 namespace scoleid::identify {
 
@@ -48,11 +50,7 @@ std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elem
 
 }  // namespace
 
-double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
-  if (sc.identification.time_step > 0) return sc.identification.time_step;
-  // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
-  // an L-stable step damps what it does not resolve, and P parameters are fixed mostly by the
-  // first P modes' frequencies and shapes.
+double resolved_frequency(const StructuralModel& model, const Parameterization& params) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
@@ -62,13 +60,68 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   std::vector<double> flexible;
   for (double x : w)
     if (x > 1e-6 * wmax) flexible.push_back(x);
+  if (flexible.empty()) return 0.0;
+  const std::size_t r = std::min(flexible.size(), static_cast<std::size_t>(params.size() + 2)) - 1;
+  return flexible[r];
+}
+
+double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
+  if (sc.identification.time_step > 0) return sc.identification.time_step;
+  // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
+  // an L-stable step damps what it does not resolve, and P parameters are fixed mostly by the
+  // first P modes' frequencies and shapes.
+  const double w = resolved_frequency(model, params);
   double h = sc.simulation.sample_interval;
-  if (!flexible.empty()) {
-    const std::size_t r = std::min(flexible.size(), static_cast<std::size_t>(params.size() + 2)) - 1;
-    h = std::min(h, 0.3 / flexible[r]);
-  }
+  if (w > 0) h = std::min(h, 0.3 / w);
   return h;
 }
+
+namespace {
+// Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
+// scenario that does not resolve the modes the parameters live in (ω_{P+2} h > 1: the L-stable
+// step would damp them away and the fit would absorb that into the parameters), and trajectory
+// storage beyond io::limits (state, costate and, for Gauss–Newton or the standard deviations,
+// one sensitivity trajectory per parameter; synthetic data on its finer mesh and step).
+void check_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params, double h,
+                bool synthetic) {
+  const auto& id = sc.identification;
+  const double T = sc.simulation.duration;
+  const std::string field = id.time_step > 0 ? "identification.time_step" : "identification.elements";
+  const std::string got = id.time_step > 0 ? io::format_value(id.time_step) : std::to_string(id.elements);
+  if (id.time_step > 0 && id.integrator != "bdf") {
+    const double w = resolved_frequency(model, params);
+    if (w * h > 1.0)
+      fail_field(sc.source, "identification.time_step",
+                 "must resolve flexible mode " + std::to_string(params.size() + 2) + " (" +
+                     io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
+                     io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
+                     io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
+                 io::format_value(h));
+  }
+  const double steps = T / h;
+  const double trajectories = 2.0 + params.size();
+  const double bytes = (steps + 1.0) * model.ndof * 3.0 * 8.0 * trajectories;
+  if (!(steps <= io::limits::kMaxSteps) || !(bytes <= io::limits::kMaxTrajectoryBytes))
+    fail_field(sc.source, field,
+               "gives " + io::format_value(std::ceil(steps)) + " steps of " + std::to_string(model.ndof) + " DOF (about " +
+                   io::format_value(std::ceil(bytes / 1048576.0)) + " MiB of trajectories); the limits are " +
+                   io::format_value(io::limits::kMaxSteps) + " steps and " +
+                   io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
+               got);
+  if (synthetic) {
+    const int de = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
+    const double dsteps = 4.0 * steps;
+    const double dbytes = (dsteps + 1.0) * model.ndof * (static_cast<double>(de) / id.elements) * 3.0 * 8.0;
+    if (!(dsteps <= io::limits::kMaxSteps) || !(dbytes <= io::limits::kMaxTrajectoryBytes))
+      fail_field(sc.source, field,
+                 "makes the synthetic data (" + std::to_string(de) + " elements, step h/4) take " +
+                     io::format_value(std::ceil(dsteps)) + " steps (about " + io::format_value(std::ceil(dbytes / 1048576.0)) +
+                     " MiB); the limits are " + io::format_value(io::limits::kMaxSteps) + " steps and " +
+                     io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
+                 got);
+  }
+}
+}  // namespace
 
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
   require_known_structure(sc);
@@ -138,19 +191,44 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   const VectorXd truth = p->params->truth();
   p->signals = scenario_signals(sc);
 
+  p->noise_std.assign(sc.sensors.size(), 0.0);
+  p->noise_origin.assign(sc.sensors.size(), "");
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+    if (sc.sensors[j].noise_std > 0) {
+      p->noise_std[j] = sc.sensors[j].noise_std;
+      p->noise_origin[j] = "scenario";
+    }
   if (data_csv) {
     const io::DataTable tab = io::read_csv(*data_csv);
-    // Truth metadata beside the CSV, when present, supplies the true values.
+    // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
     const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
     std::map<std::string, double> meta_truth;
     if (std::filesystem::exists(meta_path)) {
       const io::TruthMeta meta = io::read_truth_meta(meta_path.string());
       meta_truth = meta.true_parameters;
+      // The two files must come from one run: the same columns.
+      std::vector<std::string> described;
+      for (const auto& c : meta.columns) described.push_back(c.name);
+      for (const auto& n : tab.names)
+        if (std::find(described.begin(), described.end(), n) == described.end())
+          throw InputError(meta_path.string() + ": does not describe column '" + n + "' of data file '" + *data_csv +
+                           "'; the two files are not from the same run");
+      for (const auto& n : described)
+        if (tab.find(n) < 0)
+          throw InputError(meta_path.string() + ": describes column '" + n + "', which data file '" + *data_csv +
+                           "' lacks; the two files are not from the same run");
       for (const auto& c : meta.columns) {
-        for (const auto& s : sc.sensors)
-          if (s.name == c.name && c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
+        for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+          const auto& s = sc.sensors[j];
+          if (s.name != c.name) continue;
+          if (c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
             throw InputError(meta_path.string() + ": column '" + c.name + "' is a " + c.quantity +
                              " but the scenario's sensor is a " + s.kind);
+          if (p->noise_std[j] <= 0 && c.noise_std > 0) {
+            p->noise_std[j] = c.noise_std;
+            p->noise_origin[j] = "truth.json";
+          }
+        }
       }
     }
     p->data.t = tab.t;
@@ -164,10 +242,31 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
         p->data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
       p->data.names.push_back(sc.sensors[j].name);
     }
-    for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
-      const int col = tab.find(sc.inputs[i].name);
-      if (col >= 0) p->signals[i] = io::Signal::table(tab.t, tab.columns[static_cast<std::size_t>(col)]);
+    std::vector<bool> used(tab.names.size(), false);
+    for (const auto& s : sc.sensors) {
+      used[static_cast<std::size_t>(tab.find(s.name))] = true;
+      p->columns.sensors.push_back(s.name);
     }
+    for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+      const auto& in = sc.inputs[i];
+      const int col = tab.find(in.name);
+      const std::string field = "inputs[" + std::to_string(i) + "]";
+      if (in.signal_from == "data" && col < 0)
+        throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' (" + field +
+                         ".signal_from is data, in " + sc.source + ")");
+      if (in.signal_from != "scenario" && col >= 0) {
+        p->signals[i] = io::Signal::table(tab.t, tab.columns[static_cast<std::size_t>(col)]);
+        used[static_cast<std::size_t>(col)] = true;
+        p->columns.inputs_from_data.push_back(in.name);
+      } else {
+        if (in.signal.terms().empty())
+          throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' and " + field +
+                           " of " + sc.source + " gives no signal");
+        p->columns.inputs_from_scenario.push_back(in.name);
+      }
+    }
+    for (std::size_t c = 0; c < tab.names.size(); ++c)
+      if (!used[c]) p->columns.unused.push_back(tab.names[c]);
     if (tab.t.front() < 0.0)
       throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
     p->data_source = *data_csv;
@@ -206,12 +305,14 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       fail_field(sc.source, "identification.data_elements",
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
+    check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), true);
     // Synthetic data: a step 4x finer than the identifier's.
     p->data = synthesize(sc, data_elements, id.rtol, identifier_step(sc, p->fe.model, *p->params) / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     for (int i = 0; i < truth.size(); ++i)
       if (std::isfinite(truth[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = truth[i];
   }
+  if (data_csv) check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), false);
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = identifier_step(sc, p->fe.model, *p->params);
   p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf

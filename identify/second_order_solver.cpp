@@ -11,6 +11,7 @@
 #include "scoleid/identify/banded_cholesky.h"
 #include "scoleid/identify/esdirk_stepper.h"
 #include "scoleid/identify/newton_matrix.h"
+#include "scoleid/io/interrupt.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -291,6 +292,7 @@ void SecondOrderSolver::acceleration(const double* F, const double* x, const dou
 
 Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
                                     SolverSummary* summary) const {
+  io::check_interrupt();  // a SIGINT/SIGTERM ends the run between solves (io/interrupt.h)
   const auto wall0 = std::chrono::steady_clock::now();
   Impl& s = *impl_;
   const int n = s.n;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/validation.h"
 
 namespace scoleid::io {
 
@@ -67,8 +68,17 @@ std::vector<std::string> split_csv_line(const std::string& line) {
 }  // namespace
 
 DataTable read_csv(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("data file '" + path + "': cannot be opened");
+  return read_csv_stream(in, path);
+}
+
+DataTable read_csv_text(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
+  return read_csv_stream(in, path);
+}
+
+DataTable read_csv_stream(std::istream& in, const std::string& path) {
   DataTable tab;
   tab.source = path;
   std::string line;
@@ -82,6 +92,7 @@ DataTable read_csv(const std::string& path) {
   }
   if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos)
     throw InputError("data file '" + path + "': empty, expected a header line starting with 't'");
+  check_utf8(line, "data file '" + path + "': line " + std::to_string(lineno));
   const auto header = split_csv_line(line);
   if (header.empty() || header[0] != "t")
     throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
@@ -174,7 +185,9 @@ void write_csv(const std::string& path, const DataTable& tab) {
 }
 
 void write_json_atomic(const std::string& path, const nlohmann::json& j) {
-  write_text_atomic(path, j.dump(2) + "\n");
+  // Every string the programs put in JSON is validated UTF-8; the replacement handler is the last
+  // line of defence, so a stray byte can never abort a run at its end.
+  write_text_atomic(path, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 nlohmann::json read_json(const std::string& path) {
@@ -222,10 +235,23 @@ TruthMeta truth_meta_from_json(const nlohmann::json& j, const std::string& sourc
         cm.location = c.value("location", 0.0);
         cm.direction = c.value("direction", std::vector<double>{0, 0, 0});
         cm.noise_std = c.value("noise_std", 0.0);
+        const std::string f = "columns['" + one_line(cm.name) + "']";
+        for (const auto& other : m.columns)
+          if (other.name == cm.name) fail_field(source, f, "must appear once", "a second column of that name");
+        if (!std::isfinite(cm.noise_std) || cm.noise_std < 0)
+          fail_field(source, f + ".noise_std", "must be a finite number >= 0", format_value(cm.noise_std));
+        if (!std::isfinite(cm.location)) fail_field(source, f + ".location", "must be finite", format_value(cm.location));
+        for (double d : cm.direction)
+          if (!std::isfinite(d)) fail_field(source, f + ".direction", "must be finite", format_value(d));
         m.columns.push_back(cm);
       }
     }
-    if (j.contains("true_parameters")) m.true_parameters = j.at("true_parameters").get<std::map<std::string, double>>();
+    if (j.contains("true_parameters")) {
+      m.true_parameters = j.at("true_parameters").get<std::map<std::string, double>>();
+      for (const auto& [k, v] : m.true_parameters)
+        if (!std::isfinite(v) || !(v >= 0))
+          fail_field(source, "true_parameters." + one_line(k), "must be a finite number >= 0", format_value(v));
+    }
     if (j.contains("generator")) m.generator = j.at("generator");
     if (j.contains("settings")) m.settings = j.at("settings");
   } catch (const nlohmann::json::exception& e) {

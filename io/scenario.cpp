@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
+#include "scoleid/io/validation.h"
 
 namespace scoleid::io {
 
@@ -136,6 +138,7 @@ public:
       fail_field(source_, f, "must be a number", "'" + text + "'");
     }
     if (!std::isfinite(v)) fail_field(source_, f, "must be a finite number", "'" + text + "'");
+    check_magnitude(source_, f, v);
     return v;
   }
 
@@ -163,6 +166,39 @@ private:
   std::string source_, path_;
   std::set<std::string> seen_;
 };
+
+// One pass over the document before it is read:
+// - a repeated key is refused (yaml-cpp keeps every pair and node[key] answers the first, so the
+//   later value would be dropped silently);
+// - every scalar, key or value, must be UTF-8 after YAML's escapes are decoded ("\N" and "\_"
+//   decode to the single bytes 0x85 and 0xA0, which no JSON writer accepts);
+// - an alias is the node it refers to: each collection is visited once (by its position in the
+//   text), so a self-referencing alias ends and nested aliases cost their size, not their expansion.
+void check_document(const YAML::Node& n, const std::string& source, const std::string& path,
+                    std::set<std::size_t>& seen) {
+  const std::string at = path.empty() ? "document" : path;
+  if (n.IsScalar()) {
+    if (first_invalid_utf8(n.Scalar()) != std::string::npos)
+      fail_field(source, at, "must be UTF-8 text", "a value with an invalid byte sequence");
+    return;
+  }
+  if (!n.IsMap() && !n.IsSequence()) return;
+  if (!seen.insert(static_cast<std::size_t>(n.Mark().pos)).second) return;
+  if (n.IsMap()) {
+    std::set<std::string> keys;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) fail_field(source, at, "must have plain keys", "a " + Reader::kind(kv.first) + " as a key");
+      const std::string key = kv.first.Scalar();
+      if (first_invalid_utf8(key) != std::string::npos)
+        fail_field(source, at, "must have UTF-8 keys", "a key with an invalid byte sequence");
+      const std::string f = path.empty() ? key : path + "." + key;
+      if (!keys.insert(key).second) fail_field(source, f, "appears more than once", "a second '" + key + "'");
+      check_document(kv.second, source, f, seen);
+    }
+  } else {
+    for (std::size_t i = 0; i < n.size(); ++i) check_document(n[i], source, path + "[" + std::to_string(i) + "]", seen);
+  }
+}
 
 EndCondition parse_end(Reader& r, const std::string& key, EndCondition dflt) {
   const std::string v = r.choice(key, to_string(dflt), {"pinned", "clamped", "free"});
@@ -327,6 +363,7 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     check_location(sc, r.field("location"), in.at, in.location);
     in.direction = parse_direction(r, "direction");
     in.unit = r.str("unit", "");
+    in.signal_from = r.choice("signal_from", in.signal_from, {"auto", "data", "scenario"});
     in.signal = parse_signal(r.child("signal"), sc.source, r.field("signal"));
     sc.inputs.push_back(std::move(in));
   }
@@ -368,9 +405,9 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
       id.initial[key] = v;
     }
   }
-  id.elements = r.integer("elements", id.elements, 1, 4096);
-  id.sections = r.integer("sections", id.sections, 0, 4096);
-  id.data_elements = r.integer("data_elements", id.data_elements, 0, 16384);
+  id.elements = r.integer("elements", id.elements, 1, limits::kMaxElements);
+  id.sections = r.integer("sections", id.sections, 0, limits::kMaxElements);
+  id.data_elements = r.integer("data_elements", id.data_elements, 0, limits::kMaxDataElements);
   id.method = r.choice("method", id.method, {"auto", "gauss-newton", "lbfgs", "steepest-descent"});
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
   id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
@@ -388,15 +425,17 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
 
 void parse_truth(const YAML::Node& n, const std::string& source, TruthModelSpec& t) {
   Reader r(n, source, "truth");
-  t.segments = r.integer("segments", t.segments, 2, 100000);
+  t.segments = r.integer("segments", t.segments, 2, limits::kMaxSegments);
   t.integrator = r.str("integrator", t.integrator);
   t.accuracy = r.positive("accuracy", t.accuracy);
+  if (!(t.accuracy < 1)) fail_field(source, "truth.accuracy", "must be < 1", format_value(t.accuracy));
   t.output_interval = r.nonneg("output_interval", t.output_interval);
 }
 
 }  // namespace
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source) {
+  check_utf8(yaml_text, source);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -408,6 +447,8 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
   Scenario sc;
   sc.source = source;
   try {
+    std::set<std::size_t> seen;
+    check_document(root, source, "", seen);
     Reader r(root, source, "");
     sc.name = r.str("name", "unnamed");
     sc.description = r.str("description", "");
@@ -431,6 +472,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
+  validate_scenario(sc);
   return sc;
 }
 
@@ -491,7 +533,8 @@ nlohmann::json to_json(const Scenario& s) {
   j["inputs"] = json::array();
   for (const auto& in : s.inputs)
     j["inputs"].push_back({{"name", in.name}, {"at", in.at}, {"kind", in.kind}, {"location", in.location},
-                           {"direction", in.direction}, {"unit", in.unit}, {"signal", signal(in.signal)}});
+                           {"direction", in.direction}, {"unit", in.unit}, {"signal_from", in.signal_from},
+                           {"signal", signal(in.signal)}});
   j["sensors"] = json::array();
   for (const auto& se : s.sensors)
     j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", se.kind}, {"location", se.location},

@@ -1,8 +1,9 @@
-// scole-truth: the Simbody truth generator (DESIGN §5, §6).
+// scole-truth: the Simbody truth generator (docs/theory.md §9, §10).
 //   scole-truth --scenario NAME|FILE --out DIR   writes DIR/truth.csv and DIR/truth.json
 //   scole-truth --list-scenarios
 //   scole-truth                                  the default SCOLE scenario into ./run/
-// Exit codes: 0 success, 1 run failed, 2 bad usage or bad input; one line on stderr on failure.
+// Exit codes: 0 success, 1 run failed, 2 bad usage or bad input, 130/143 interrupted; one line on
+// stderr on failure, and then no output (truth.csv and truth.json appear together or not at all).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -12,6 +13,9 @@
 #include <string>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/limits.h"
+#include "scoleid/io/validation.h"
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/truth_run.h"
 
@@ -28,7 +32,8 @@ int main(int argc, char** argv) {
   bool list = false, quiet = false, visualize = false;
   app.add_option("--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
   app.add_option("--out", out, "output directory (truth.csv, truth.json)")->capture_default_str();
-  app.add_option("--segments", segments, "override truth.segments");
+  app.add_option("--segments", segments,
+                 "override truth.segments (2.." + std::to_string(io::limits::kMaxSegments) + ")");
   app.add_option("--integrator", integrator,
                  "override truth.integrator: auto (default: trapezoidal for unconstrained, lightly damped chains "
                  "such as SCOLE; cpodes when the top chain modes are overdamped; rk-merson for constrained "
@@ -41,20 +46,39 @@ int main(int argc, char** argv) {
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
   app.add_flag("--quiet", quiet, "no progress or summary on stderr");
   app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");
+  app.footer(
+      "Exit codes: 0 success; 1 the run failed; 2 bad usage or bad input; 130/143 interrupted by SIGINT/SIGTERM. "
+      "On any failure nothing is written: truth.csv and truth.json are staged beside --out and moved into place "
+      "together at the end.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "scole-truth: %s\n", e.what());
+    std::fprintf(stderr, "scole-truth: %s\n", io::one_line(e.what()).c_str());
     return 2;
   }
+  io::install_interrupt_handlers();
   try {
     if (list) {
       for (const auto& n : io::builtin_scenario_names())
         std::printf("%-14s %s\n", n.c_str(), io::builtin_scenario_description(n).c_str());
       return 0;
     }
-    const io::Scenario sc = io::load_scenario(scenario);
+    io::Scenario sc = io::load_scenario(scenario);
+    // Command-line overrides go into the scenario and through the same checks as the file.
+    if (app.count("--segments")) {
+      if (segments < 2 || segments > io::limits::kMaxSegments)
+        throw io::InputError("command line: --segments must be an integer in [2, " +
+                             std::to_string(io::limits::kMaxSegments) + "], got " + std::to_string(segments));
+      sc.truth.segments = segments;
+    }
+    if (app.count("--accuracy")) {
+      if (!(accuracy > 0 && accuracy < 1))
+        throw io::InputError("command line: --accuracy must be in (0, 1), got " + io::format_value(accuracy));
+      sc.truth.accuracy = accuracy;
+    }
+    if (!integrator.empty()) sc.truth.integrator = integrator;
+    io::validate_scenario(sc);
     model::TruthOptions opt;
     opt.segments = segments;
     opt.integrator = integrator;
@@ -66,18 +90,22 @@ int main(int argc, char** argv) {
       throw io::InputError("command line: --visualize needs a display (DISPLAY is not set)");
     std::string why;
     if (!opt.IsValid(&why)) throw io::InputError("command line: " + why);
-    io::ensure_directory(out);
+    io::RunDirectory run_dir(out, model::output_files(), "scole-truth");
     const model::TruthResult res = model::run_truth(sc, opt);
-    model::write_truth(res, out);
+    model::write_truth(res, run_dir);
+    run_dir.commit();
     if (!quiet)
       std::fprintf(stderr, "scole-truth: %s: %s -> %s/truth.csv\n", sc.name.c_str(),
                    res.summary.BriefReport().c_str(), out.c_str());
     return 0;
   } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-truth: %s\n", e.what());
+    std::fprintf(stderr, "scole-truth: %s\n", io::one_line(e.what()).c_str());
     return 2;
+  } catch (const io::Interrupted& e) {
+    std::fprintf(stderr, "\nscole-truth: %s\n", e.what());
+    return e.exit_code();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-truth: run failed: %s\n", e.what());
+    std::fprintf(stderr, "scole-truth: run failed: %s\n", io::one_line(e.what()).c_str());
     return 1;
   }
 }

@@ -12,6 +12,8 @@
 #include <stdexcept>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/limits.h"
 #include "scoleid/model/beam_chain.h"
 #include "scoleid/model/inputs.h"
 #include "scoleid/model/linearisation.h"
@@ -135,6 +137,7 @@ void sample_loop(const SimulateOptions& opt, double t_start, Clock::time_point w
   for (int k = 0; k <= K; ++k) {
     const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
     const double eps = 1e-12 * std::max(1.0, std::abs(tk));
+    io::check_interrupt();  // SIGINT/SIGTERM: end between samples, nothing written (io/interrupt.h)
     while (time() < tk - eps) {
       while (ib < bps.size() && bps[ib] <= time() + eps) ++ib;
       advance(tk, ib < bps.size() ? bps[ib] : Infinity);
@@ -253,8 +256,9 @@ Array_<String> visualizer_search_path() {
 
 bool TruthOptions::IsValid(std::string* why) const {
   auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
-  if (segments < 0) return bad("segments must be >= 0");
-  if (accuracy < 0 || accuracy >= 1) return bad("accuracy must be in [0, 1)");
+  if (segments < 0 || segments > io::limits::kMaxSegments)
+    return bad("segments must be 0 (the scenario's) or in [2, " + std::to_string(io::limits::kMaxSegments) + "]");
+  if (!(accuracy >= 0 && accuracy < 1)) return bad("accuracy must be 0 (the scenario's) or in (0, 1)");
   if (!integrator.empty()) {
     const auto names = integrator_names();
     if (std::find(names.begin(), names.end(), integrator) == names.end())
@@ -325,6 +329,16 @@ TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
     bare->system().realizeTopology();
     const auto modes = natural_modes(bare->system(), bare->system().getDefaultState());
     if (!modes.empty()) so.reference_omega = modes.front().omega;
+    // Its step is (12 accuracy)^(1/3) / omega_1 at most (trapezoidal.h): refuse a run that would
+    // take more steps than io::limits allows before starting it.
+    const double steps = so.final_time * so.reference_omega / std::cbrt(12.0 * accuracy);
+    if (!(steps <= io::limits::kMaxSteps))
+      io::fail_field(sc.source, "truth.accuracy",
+                     "gives about " + io::format_value(std::ceil(steps)) + " trapezoidal steps over " +
+                         io::format_value(so.final_time) + " s (fundamental mode " +
+                         io::format_value(so.reference_omega / (2 * Pi)) + " Hz), more than the limit of " +
+                         io::format_value(io::limits::kMaxSteps),
+                     io::format_value(accuracy));
   }
   for (const auto& in : sc.inputs)
     for (double b : in.signal.breakpoints()) so.breakpoints.push_back(b);
@@ -376,10 +390,9 @@ TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
   return res;
 }
 
-void write_truth(const TruthResult& r, const std::string& dir) {
-  io::ensure_directory(dir);
-  io::write_csv(dir + "/truth.csv", r.table);
-  io::write_json_atomic(dir + "/truth.json", io::to_json(r.meta));
+void write_truth(const TruthResult& r, io::RunDirectory& dir) {
+  io::write_csv(dir.path("truth.csv"), r.table);
+  io::write_json_atomic(dir.path("truth.json"), io::to_json(r.meta));
 }
 
 }  // namespace scoleid::model

@@ -142,7 +142,11 @@ int main() {
       ro.verbose = false;
       const RunResult r = run_identification(*p, ro);
       const auto t2 = Clock::now();
-      write_outputs(dir.string(), *p, r);
+      {
+        scoleid::io::RunDirectory run_dir(dir.string(), output_files(), "scole-identify-bench");
+        write_outputs(run_dir, *p, r);
+        run_dir.commit();
+      }
       const auto t3 = Clock::now();
       auto s = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
       int within = -1;

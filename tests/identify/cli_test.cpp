@@ -9,7 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -100,7 +102,8 @@ private:
 // Runs scole-identify with `args`; stdout through the pipe, stderr through a file in `dir`.
 Result run(const std::vector<std::string>& args, const TempDir& dir) {
   const fs::path err_file = dir / "stderr.txt";
-  std::string cmd = shell_quote(SCOLE_IDENTIFY_EXE);
+  // From inside `dir`: a command smuggled through a name would leave its marker file there.
+  std::string cmd = "cd " + shell_quote(dir.path().string()) + " && " + shell_quote(SCOLE_IDENTIFY_EXE);
   for (const auto& a : args) cmd += " " + shell_quote(a);
   cmd += " 2> " + shell_quote(err_file.string()) + " < /dev/null";
   Result r;
@@ -405,4 +408,227 @@ TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
     const double est = p.value("estimate", std::nan(""));
     EXPECT_LT(std::abs(est / truth[name] - 1.0), 1e-3) << name << ": estimate " << est << ", truth " << truth[name];
   }
+}
+
+// ------------------------------------------------------------------------------- hardening
+// Each finding of a hostile-but-fair review, reproduced end to end.
+
+namespace {
+bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+nlohmann::json read_json_file(const fs::path& p) { return nlohmann::json::parse(read_file(p)); }
+
+// Starts scole-identify with `args` in `dir`, sends `sig` after `delay` seconds, returns the
+// exit code (or -1).
+int run_and_signal(const std::vector<std::string>& args, const TempDir& dir, double delay, int sig) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::chdir(dir.path().c_str()) != 0) ::_exit(99);
+    std::FILE* devnull = std::fopen("/dev/null", "w");
+    if (devnull) {
+      ::dup2(fileno(devnull), 1);
+      ::dup2(fileno(devnull), 2);
+    }
+    std::vector<char*> argv{const_cast<char*>(SCOLE_IDENTIFY_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(SCOLE_IDENTIFY_EXE, argv.data());
+    ::_exit(98);
+  }
+  ::usleep(static_cast<useconds_t>(delay * 1e6));
+  ::kill(pid, sig);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Only `keep` in `dir` (no staging directory, no temporary file).
+void expect_only(const fs::path& dir, const std::vector<std::string>& keep) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    EXPECT_NE(std::find(keep.begin(), keep.end(), n), keep.end()) << "left behind: " << e.path();
+  }
+}
+}  // namespace
+
+TEST(ScoleIdentifyHardening, OutDirectoryWithQuotesAndSemicolonsRunsNothingAndStillPlots) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path out = dir / "mast's runs; touch pwned; '";
+  const Result r = run({"--scenario", (dir / "good.yaml").string(), "--out", out.string(), "-q"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "pwned")) << "the --out text ran a command";
+  EXPECT_TRUE(fs::exists(out / "identify.json"));
+  if (have_gnuplot()) EXPECT_TRUE(fs::exists(out / "fit.png")) << "no plot in a directory whose name holds a quote";
+}
+
+TEST(ScoleIdentifyHardening, SensorNameWithShellOrGnuplotSyntaxIsRefused) {
+  expect_yaml_error(good_with("name: w_tip", "name: \"w'; print system(\\\"touch pwned\\\"); #\""),
+                    {"sensors[0].name", "[A-Za-z0-9_.-]"});
+}
+
+TEST(ScoleIdentifyHardening, NotConvergedExitsOneWithOutputsMarked) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path out = dir / "out";
+  const Result r = run({"--scenario", (dir / "good.yaml").string(), "--out", out.string(), "-q", "--max-iterations", "1"}, dir);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("did not converge"), std::string::npos) << r.err;
+  ASSERT_TRUE(fs::exists(out / "identify.json"));
+  EXPECT_EQ(read_json_file(out / "identify.json").value("converged", true), false);
+}
+
+TEST(ScoleIdentifyHardening, NegativeMaxIterationsIsRefused) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  const Result r = run({"--scenario", "paper-beam-1", "--out", out.string(), "--max-iterations", "-5"}, dir);
+  expect_input_error(r, out, {"--max-iterations", "-5"}, /*prefixed=*/false);
+}
+
+TEST(ScoleIdentifyHardening, TimeStepThatCannotResolveTheModesIsRefused) {
+  expect_yaml_error(good_with("elements: 10", "elements: 10\n  time_step: 5"),
+                    {"identification.time_step", "must resolve flexible mode 4", "got 5"});
+}
+
+TEST(ScoleIdentifyHardening, SizesAreBoundedBeforeAnyWork) {
+  expect_yaml_error(good_with("elements: 10", "elements: 10\n  time_step: 1e-12"), {"identification.time_step", "steps", "1e-12"});
+  expect_yaml_error(good_with("duration: 2", "duration: 1e9"), {"simulation.sample_interval", "samples", "limit"});
+  expect_yaml_error(good_with("EI: 23000", "EI: 1e300"), {"beam.EI", "magnitude", "1e+300"});
+  expect_yaml_error(good_with("amplitude: 10", "amplitude: 1e308"), {"inputs[0].signal.amplitude", "magnitude"});
+}
+
+TEST(ScoleIdentifyHardening, DuplicateKeysAndInvalidUtf8AreRefused) {
+  expect_yaml_error(good_with("rho_A: 67,", "rho_A: 67, rho_A: 70,"), {"beam.rho_A appears more than once"});
+  expect_yaml_error(std::string(kGood) + "description: \"\\N\"\n", {"description", "UTF-8"});
+}
+
+TEST(ScoleIdentifyHardening, UnwritableOutIsReportedBeforeTheRun) {
+  TempDir dir;
+  write_file(dir / "file", "x");
+  const fs::path out = dir / "file" / "out";
+  const Result r = run({"--scenario", "paper-beam-1", "--out", out.string()}, dir);
+  // One line (the run's own progress line never appears): checked before any work.
+  expect_input_error(r, out, {"output directory", "file/out"});
+}
+
+TEST(ScoleIdentifyHardening, ForeignFilesInOutAreNeitherReplacedNorMixed) {
+  TempDir dir;
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  write_file(out / "notes.txt", "mine");
+  const Result r = run({"--scenario", "paper-beam-1", "--out", out.string()}, dir);
+  expect_input_error(r, out, {"output directory", "notes.txt"});
+  EXPECT_EQ(read_file(out / "notes.txt"), "mine");
+}
+
+TEST(ScoleIdentifyHardening, EarlierRunIsReplacedWholeOrKept) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path out = dir / "out";
+  ASSERT_EQ(run({"--scenario", (dir / "good.yaml").string(), "--out", out.string(), "-q"}, dir).code, 0);
+  const std::string first = read_file(out / "identify.json");
+  // A failing run (bad data) leaves the earlier run exactly as it was.
+  write_file(dir / "bad.csv", "t,w_tip\n0,0\n0.01,nan\n");
+  const Result bad = run({"--scenario", (dir / "good.yaml").string(), "--data", (dir / "bad.csv").string(), "--out",
+                          out.string(), "-q"}, dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(read_file(out / "identify.json"), first);
+  expect_only(dir.path(), {"good.yaml", "bad.csv", "out", "stderr.txt"});
+}
+
+TEST(ScoleIdentifyHardening, SigtermAndSigintLeaveNothingHalfWritten) {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    TempDir dir;
+    const fs::path out = dir / "out";
+    // beam-ei8 takes several seconds; the signal lands mid-run.
+    const int code = run_and_signal({"--scenario", "beam-ei8", "--out", out.string(), "-q"}, dir, 1.0, sig);
+    EXPECT_EQ(code, 128 + sig);
+    EXPECT_FALSE(fs::exists(out)) << "outputs of an interrupted run";
+    expect_only(dir.path(), {});
+  }
+}
+
+TEST(ScoleIdentifyHardening, FlaggedParametersHaveNoStdAndNoStdMeansNotAssessed) {
+  TempDir dir;
+  const fs::path out = dir / "out", out2 = dir / "out2";
+  const Result r = run({"--scenario", "paper-scole-2", "--out", out.string(), "-q"}, dir);
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  int flagged = 0;
+  const auto j1 = read_json_file(out / "identify.json");
+  for (const auto& p : j1["parameters"]) {
+    if (p["identifiable"].is_boolean() && !p["identifiable"].get<bool>()) {
+      ++flagged;
+      EXPECT_TRUE(p["std"].is_null()) << p.dump();
+      EXPECT_TRUE(p.contains("not_identifiable_because")) << p.dump();
+    } else {
+      EXPECT_TRUE(p["std"].is_number()) << p.dump();
+    }
+  }
+  EXPECT_GE(flagged, 1) << "paper-scole-2's zeta is not identifiable from its data";
+  const Result r2 = run({"--scenario", "paper-beam-1", "--out", out2.string(), "-q", "--no-std"}, dir);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  const auto j = read_json_file(out2 / "identify.json");
+  for (const auto& p : j["parameters"]) EXPECT_TRUE(p["identifiable"].is_null()) << p.dump();
+  EXPECT_EQ(j["identifiability"].value("assessed", true), false);
+}
+
+TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path out1 = dir / "run1";
+  ASSERT_EQ(run({"--scenario", (dir / "good.yaml").string(), "--out", out1.string(), "-q"}, dir).code, 0);
+  std::vector<std::string> header;
+  const auto cols = csv_columns(read_file(out1 / "fit.csv"), header);
+  const auto col = [&](const std::string& n) {
+    const auto it = std::find(header.begin(), header.end(), n);
+    return cols[static_cast<std::size_t>(it - header.begin())];
+  };
+  const auto t = col("t"), w = col("w_tip_measured");
+  fs::create_directories(dir / "data");
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "t,P,w_tip,spare\n";
+    for (std::size_t i = 0; i < t.size(); ++i) os << t[i] << ",10," << w[i] << ",0\n";
+    write_file(dir / "data" / "truth.csv", os.str());
+  }
+  const std::string csv = (dir / "data" / "truth.csv").string();
+  // 1. Every column accounted for, in identify.json and on stderr.
+  const fs::path out2 = dir / "run2";
+  const Result r2 = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", out2.string(), "-q"}, dir);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  EXPECT_NE(r2.err.find("unused spare"), std::string::npos) << r2.err;
+  const auto j2 = read_json_file(out2 / "identify.json");
+  EXPECT_EQ(j2["data_columns"]["unused"], nlohmann::json::array({"spare"}));
+  EXPECT_EQ(j2["data_columns"]["inputs_from_data"], nlohmann::json::array({"P"}));
+  // 2. An input declared to come from the data, absent from it: refused.
+  write_file(dir / "from_data.yaml", good_with("location: 10, signal:", "location: 10, signal_from: data, signal:"));
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "t,w_tip\n";
+    for (std::size_t i = 0; i < t.size(); ++i) os << t[i] << "," << w[i] << "\n";
+    fs::create_directories(dir / "nop");
+    write_file(dir / "nop" / "m.csv", os.str());
+  }
+  const Result r3 = run({"--scenario", (dir / "from_data.yaml").string(), "--data", (dir / "nop" / "m.csv").string(),
+                         "--out", (dir / "run3").string(), "-q"}, dir);
+  expect_input_error(r3, dir / "run3", {"no column for input 'P'", "signal_from is data"});
+  // 3. truth.json's noise levels are used; a truth.json of another run is refused.
+  nlohmann::json meta = {{"scenario", "cli-good"},
+                         {"columns", {{{"name", "P"}, {"kind", "input"}, {"quantity", "force"}},
+                                      {{"name", "w_tip"}, {"kind", "output"}, {"quantity", "displacement"}, {"noise_std", 1e-7}},
+                                      {{"name", "spare"}, {"kind", "output"}, {"quantity", "displacement"}}}},
+                         {"true_parameters", {{"rho_A", 67}, {"EI", 23000}, {"zeta", 0}}}};
+  write_file(dir / "data" / "truth.json", meta.dump());
+  const fs::path out4 = dir / "run4";
+  const Result r4 = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", out4.string(), "-q"}, dir);
+  ASSERT_EQ(r4.code, 0) << r4.err;
+  const auto j4 = read_json_file(out4 / "identify.json");
+  EXPECT_EQ(j4["identifiability"]["noise_source"], "truth.json");
+  EXPECT_DOUBLE_EQ(j4["identifiability"]["noise_std"][0].get<double>(), 1e-7);
+  meta["columns"][2]["name"] = "other";
+  write_file(dir / "data" / "truth.json", meta.dump());
+  const Result r5 = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", (dir / "run5").string(), "-q"}, dir);
+  expect_input_error(r5, dir / "run5", {"truth.json", "not from the same run"});
 }

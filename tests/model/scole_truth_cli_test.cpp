@@ -1,4 +1,4 @@
-// The scole-truth executable's contract (DESIGN §6): exit codes, one-line errors naming the
+// The scole-truth executable's contract (docs/theory.md §10): exit codes, one-line errors naming the
 // file, the field and the value, no partial output; and on success truth.csv / truth.json with
 // the scenario's columns, sampled 0..T inclusive, holding the beam's physical response.
 #include <gtest/gtest.h>
@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -155,4 +157,95 @@ TEST_F(ScoleTruthCli, StepLoadPeaksAtTwiceTheStaticDeflection) {
   EXPECT_EQ(meta.true_parameters.at("EI"), 23000.0);
   EXPECT_EQ(meta.true_parameters.at("rho_A"), 67.0);
   EXPECT_EQ(meta.true_parameters.at("zeta"), 0.0);
+}
+
+// ------------------------------------------------------------------------------- hardening
+
+namespace {
+std::string with(const std::string& from, const std::string& to) {
+  std::string s = kBeam;
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+}  // namespace
+
+TEST_F(ScoleTruthCli, CommandLineOverridesPassTheScenarioChecks) {
+  const std::string file = write("s.yaml", kBeam);
+  const fs::path out = dir_ / "out";
+  for (const std::string& opt : {"--segments 10000000", "--segments 1", "--accuracy nan", "--accuracy 2"}) {
+    const CliResult r = run("--scenario " + file + " --out " + out.string() + " " + opt);
+    EXPECT_EQ(r.code, 2) << opt << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(opt.substr(0, opt.find(' '))), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST_F(ScoleTruthCli, CountsAndMagnitudesAreBoundedBeforeAnyWork) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {with("duration: 4", "duration: 1e9"), "simulation.sample_interval"},
+      {with("sample_interval: 0.01", "sample_interval: 1e-9"), "simulation.sample_interval"},
+      {with("EI: 23000", "EI: 1e300"), "beam.EI"},
+      {with("amplitude: 10", "amplitude: 1e308"), "inputs[0].signal.amplitude"},
+      {with("segments: 20", "segments: 10000000"), "truth.segments"}};
+  for (const auto& [yaml, field] : cases) {
+    const std::string file = write("s.yaml", yaml);
+    const auto t0 = std::chrono::steady_clock::now();
+    const CliResult r = run("--scenario " + file + " --out " + (dir_ / "out").string());
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0) << field;
+    EXPECT_EQ(r.code, 2) << field << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(field), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out"));
+  }
+}
+
+TEST_F(ScoleTruthCli, NamesThatWouldBreakTheCsvAreRefused) {
+  for (const std::string& name : {std::string("'w,tip'"), std::string("\"w\\ntip\""), std::string("''"), std::string("P")}) {
+    const std::string file = write("s.yaml", with("name: w_mid", "name: " + name));
+    const CliResult r = run("--scenario " + file + " --out " + (dir_ / "out").string());
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("sensors[0].name"), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(ScoleTruthCli, SigtermMidRunLeavesNoOutputAndExits143) {
+  const fs::path out = dir_ / "out";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::FILE* devnull = std::fopen("/dev/null", "w");
+    if (devnull) {
+      ::dup2(fileno(devnull), 1);
+      ::dup2(fileno(devnull), 2);
+    }
+    ::execl(SCOLE_TRUTH_EXE, SCOLE_TRUTH_EXE, "--scenario", "paper-scole-1", "--out", out.c_str(), "--quiet",
+            static_cast<char*>(nullptr));
+    ::_exit(98);
+  }
+  ::usleep(800000);  // the 40-segment SCOLE truth takes seconds; the signal lands mid-run
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 143) << status;
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(dir_)) ADD_FAILURE() << "left behind: " << e.path();
+}
+
+TEST_F(ScoleTruthCli, TruthCsvAndJsonAreReplacedTogether) {
+  const std::string file = write("s.yaml", with("duration: 4", "duration: 0.5"));
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("--scenario " + file + " --out " + out.string()).code, 0);
+  const auto first = scoleid::io::read_csv((out / "truth.csv").string());
+  // A second run that fails leaves both files of the first; a later good run replaces both.
+  const std::string bad = write("bad.yaml", with("rho_A: 67", "rho_A: -1"));
+  ASSERT_EQ(run("--scenario " + bad + " --out " + out.string()).code, 2);
+  EXPECT_EQ(scoleid::io::read_csv((out / "truth.csv").string()).t.size(), first.t.size());
+  const std::string longer = write("long.yaml", with("duration: 4", "duration: 1"));
+  ASSERT_EQ(run("--scenario " + longer + " --out " + out.string()).code, 0);
+  EXPECT_GT(scoleid::io::read_csv((out / "truth.csv").string()).t.size(), first.t.size());
+  EXPECT_NE(scoleid::io::read_truth_meta((out / "truth.json").string()).settings.dump().find("\"duration\":1.0"),
+            std::string::npos);
 }

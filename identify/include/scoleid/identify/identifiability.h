@@ -1,5 +1,5 @@
 #pragma once
-// What the data determine, at the estimate q̂ (DESIGN §2; issue: "a parameter that the data
+// What the data determine, at the estimate q̂ (docs/theory.md §8; issue: "a parameter that the data
 // cannot determine is flagged, not silently returned").
 //
 // Fisher information F = Gᵀ W G from the output sensitivities G = ∂y(t_i)/∂q at the samples,
@@ -37,8 +37,9 @@ struct Identifiability {
   double chi2 = 0;              // Σ r²/σ² at the estimate
   long data_values = 0;         // N = samples × sensors
   std::vector<bool> identifiable;
+  std::vector<std::string> reason;  // why a parameter is flagged ("" when it is not)
   std::vector<double> noise_std;  // σ_k used per sensor
-  std::string noise_source;       // "scenario" | "residual"
+  std::string noise_source;       // "scenario" | "residual" (identify_run refines "scenario" to where each level came from)
 };
 
 // `sensors` supplies each sensor's stated noise_std (<= 0: unknown).

@@ -1,6 +1,6 @@
 #pragma once
 // One identification run: scenario (+ optional data file) → estimates, iteration history,
-// identifiability, written as identify.json (DESIGN §6) and fit.csv (t, measured, predicted).
+// identifiability, written as identify.json (docs/theory.md §10) and fit.csv (t, measured, predicted).
 //
 // Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
 // estimate.
@@ -15,6 +15,7 @@
 #include "scoleid/identify/identifiability.h"
 #include "scoleid/identify/optimizers.h"
 #include "scoleid/identify/problem.h"
+#include "scoleid/io/run_directory.h"
 
 namespace scoleid::identify {
 
@@ -42,7 +43,10 @@ struct RunResult {
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
 
-// Writes identify.json and fit.csv into dir (atomically). Throws io::InputError if dir cannot be made.
-void write_outputs(const std::string& dir, Problem& problem, const RunResult& r);
+// Writes identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's
+// staging area; the caller commits them as one unit (io/run_directory.h).
+void write_outputs(io::RunDirectory& dir, Problem& problem, const RunResult& r);
+// The file names write_outputs produces (what a RunDirectory for them may replace).
+inline std::vector<std::string> output_files() { return {"identify.json", "fit.csv", "fit.gp", "fit.png"}; }
 
 }  // namespace scoleid::identify

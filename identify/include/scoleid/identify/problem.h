@@ -21,6 +21,14 @@
 
 namespace scoleid::identify {
 
+// How a data file's columns were used (identify.json "data_columns", and stderr).
+struct ColumnUse {
+  std::vector<std::string> sensors;               // matched to the scenario's sensors
+  std::vector<std::string> inputs_from_data;      // inputs driven by their column
+  std::vector<std::string> inputs_from_scenario;  // inputs driven by the scenario's signal
+  std::vector<std::string> unused;                // columns that matched nothing
+};
+
 struct Problem {
   io::Scenario scenario;
   BeamFE fe;
@@ -29,6 +37,9 @@ struct Problem {
   Measurements data;
   std::string data_source;                    // "synthetic (N elements)" or the CSV path
   std::map<std::string, double> true_values;  // by parameter name, where known
+  std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
+  std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
+  ColumnUse columns;                          // with a data file
   ObjectiveOptions objective_options;
 };
 
@@ -39,7 +50,10 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
 // The identifier's fixed time step: identification.time_step if set, else
 // min(sample interval, 0.3 / ω_{P+2}) with ω_{P+2} the FE frequency of flexible mode P + 2 at the
-// starting parameters (P = number of estimated parameters).
+// starting parameters (P = number of estimated parameters). make_problem refuses a given step
+// with ω_{P+2} h > 1 and any step whose trajectories exceed io/limits.h.
+// ω_{P+2} (rad/s) at the starting parameters, or 0 for a structure without flexible modes.
+double resolved_frequency(const StructuralModel& model, const Parameterization& params);
 double identifier_step(const io::Scenario& scenario, const StructuralModel& model, const Parameterization& params);
 
 }  // namespace scoleid::identify

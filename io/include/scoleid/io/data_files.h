@@ -7,6 +7,7 @@
 //   identify.json  see identify/; written through write_json_atomic.
 // Every write goes to a temporary file in the same directory and is renamed into place, so a
 // failed run never leaves a half-written output.
+#include <istream>
 #include <map>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct DataTable {
 // header not starting with t, duplicate names, wrong field count, non-numeric or non-finite
 // values, time not strictly increasing.
 DataTable read_csv(const std::string& path);
+// The same on text already in memory / a stream; `path` names it in messages.
+DataTable read_csv_text(const std::string& text, const std::string& path);
+DataTable read_csv_stream(std::istream& in, const std::string& path);
 // 17 significant digits; atomic.
 void write_csv(const std::string& path, const DataTable& table);
 

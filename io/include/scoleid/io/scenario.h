@@ -78,6 +78,10 @@ struct InputSpec {
   double location = 0.0;
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;
+  // With a data file (scole-identify --data): "auto" drives the input by the file's column of the
+  // same name when there is one, else by `signal`; "data" requires the column (an error if it is
+  // missing); "scenario" always uses `signal`. The truth always uses `signal`.
+  std::string signal_from = "auto";
   Signal signal;
 };
 

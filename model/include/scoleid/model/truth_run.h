@@ -1,6 +1,6 @@
 #pragma once
 // Scenario -> Simbody structure -> trajectory table + metadata (the truth.csv / truth.json of
-// DESIGN §6, written through scoleid::io).
+// docs/theory.md §10, written through scoleid::io).
 //
 // The equations integrated are the structure's multibody equations of motion (beam_chain.h,
 // scole_system.h) under the scenario's inputs, from rest in the undeformed configuration.
@@ -18,6 +18,7 @@
 #include <Simbody.h>
 
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/run_directory.h"
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/structure.h"
 
@@ -101,8 +102,10 @@ struct TruthResult {
 // Throws io::InputError for a scenario the truth cannot represent, std::runtime_error when the
 // integration fails.
 TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& options = {});
-// DIR/truth.csv and DIR/truth.json, each written atomically.
-void write_truth(const TruthResult& result, const std::string& dir);
+// truth.csv and truth.json into the run directory's staging area; the caller commits them as one
+// unit (io/run_directory.h), so the two files always come from the same run.
+void write_truth(const TruthResult& result, io::RunDirectory& dir);
+inline std::vector<std::string> output_files() { return {"truth.csv", "truth.json"}; }
 
 // The physical true parameters as truth.json reports them.
 std::map<std::string, double> true_parameters(const io::Scenario& scenario);

@@ -1,0 +1,31 @@
+#pragma once
+// SIGINT and SIGTERM end a run cleanly. The handler only records the signal; long loops (the
+// truth's sample loop, the optimiser's iterations, a plotting child being waited for) call
+// check_interrupt(), which throws Interrupted. The program's main catches it, its RunDirectory
+// (run_directory.h) discards the staged outputs, and it exits 128 + signal (130 for SIGINT,
+// 143 for SIGTERM): nothing half-written, nothing from the interrupted run left behind.
+#include <stdexcept>
+
+namespace scoleid::io {
+
+class Interrupted : public std::runtime_error {
+public:
+  explicit Interrupted(int signal);
+  int signal() const { return signal_; }
+  int exit_code() const { return 128 + signal_; }
+
+private:
+  int signal_;
+};
+
+// Installs the recording handler for SIGINT and SIGTERM (without SA_RESTART, so a blocking wait
+// returns EINTR). Idempotent.
+void install_interrupt_handlers();
+// The signal received since installation, or 0.
+int interrupt_signal();
+// Throws Interrupted if a signal has been received.
+void check_interrupt();
+// Forgets a received signal (a test that raised one; a caller that has dealt with it).
+void clear_interrupt();
+
+}  // namespace scoleid::io

@@ -1,0 +1,21 @@
+#pragma once
+// Running a helper program (gnuplot) without a shell: fork, chdir, execvp with an argument
+// vector. Nothing a user typed — a directory name, a sensor name — is ever parsed as a command.
+#include <string>
+#include <vector>
+
+namespace scoleid::io {
+
+struct ProcessResult {
+  bool started = false;   // false: the program is not installed (execvp failed)
+  int exit_code = -1;     // the child's exit status when it exited normally
+  int signal = 0;         // the signal that ended it, if one did
+  bool ok() const { return started && exit_code == 0 && signal == 0; }
+};
+
+// Runs argv[0] (searched in PATH) with the given arguments in directory `cwd`, stdin from
+// /dev/null, stdout and stderr to /dev/null. Waits for it. If this process receives SIGINT or
+// SIGTERM meanwhile (interrupt.h), the child is terminated and Interrupted is thrown.
+ProcessResult run_program(const std::vector<std::string>& argv, const std::string& cwd);
+
+}  // namespace scoleid::io

@@ -1,0 +1,43 @@
+#pragma once
+// A run's outputs as one unit: all of them or none.
+//
+// The program writes every output into a staging directory created beside the target
+// (".<name>.staging-XXXXXX" in the same parent, so on the same file system) and commit() puts the
+// whole directory in place with one rename — renameat2(RENAME_EXCHANGE) when the target already
+// exists, so readers see the earlier run or the new one, never a mixture — and then deletes the
+// earlier run. A run that fails, throws, or is interrupted (interrupt.h) never commits; the
+// destructor removes the staging directory and the target is left exactly as it was.
+//
+// The target may be new, empty, or hold an earlier run of the same program (only files from
+// `owned`). Anything else in it is refused up front, so no user file is ever replaced. The
+// constructor also proves the parent is writable, before any work is done.
+#include <string>
+#include <vector>
+
+namespace scoleid::io {
+
+class RunDirectory {
+public:
+  // `program` names the caller in messages; `owned` lists the file names its runs write.
+  // Throws InputError naming the directory if it cannot be used.
+  RunDirectory(const std::string& target, std::vector<std::string> owned, const std::string& program);
+  ~RunDirectory();
+  RunDirectory(const RunDirectory&) = delete;
+  RunDirectory& operator=(const RunDirectory&) = delete;
+
+  // Where to write output `name` (one of `owned`) during the run.
+  std::string path(const std::string& name) const;
+  const std::string& staging() const { return staging_; }
+  const std::string& target() const { return target_; }
+  // Puts the staged outputs in place as one unit. Checks for an interrupt first (then nothing is
+  // committed). Throws std::runtime_error if the file system refuses.
+  void commit();
+  bool committed() const { return committed_; }
+
+private:
+  std::string target_, staging_, program_;
+  std::vector<std::string> owned_;
+  bool committed_ = false;
+};
+
+}  // namespace scoleid::io

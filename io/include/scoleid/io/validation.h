@@ -1,0 +1,40 @@
+#pragma once
+// One validation pass before any work: what a scenario (after any command-line override) must
+// satisfy beyond the per-field checks of the parser — names that need no quoting anywhere and are
+// unique across inputs and sensors, every derived count within limits.h, text that is UTF-8.
+// All failures are io::InputError naming the source, the field and the value.
+#include <string>
+
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::io {
+
+// [A-Za-z0-9_][A-Za-z0-9_.-]*, at most limits::kMaxNameLength characters, not "t" (the time
+// column of every data file).
+bool valid_name(const std::string& name);
+void check_name(const std::string& source, const std::string& field, const std::string& name);
+
+// Byte offset of the first byte that is not part of well-formed UTF-8 (RFC 3629: no overlong
+// forms, no surrogates, nothing above U+10FFFF), or std::string::npos.
+std::size_t first_invalid_utf8(const std::string& text);
+// InputError "<what>: byte N (line L) is not valid UTF-8" unless the text is well-formed.
+void check_utf8(const std::string& text, const std::string& what);
+
+// A number read from a scenario: finite, and 0 or of magnitude in
+// [limits::kMinMagnitude, limits::kMaxMagnitude].
+void check_magnitude(const std::string& source, const std::string& field, double v);
+
+// floor(duration / interval) + 1, computed without overflow (may be huge or inf).
+double sample_count(double duration, double interval);
+
+// The cross-field checks and count limits (names unique across inputs and sensors; samples,
+// values per record, segments, elements, steps of a fixed identifier step). parse_scenario
+// calls it; a program that overrides fields from its command line calls it again.
+void validate_scenario(const Scenario& scenario);
+
+// A message as one line: line breaks and other control characters shown as \n, \t, \xNN.
+// Every program prints its errors through this (a library's multi-line text, a path holding a
+// newline).
+std::string one_line(const std::string& message);
+
+}  // namespace scoleid::io

@@ -1,0 +1,39 @@
+#include "scoleid/io/interrupt.h"
+
+#include <csignal>
+#include <cstring>
+#include <string>
+
+namespace scoleid::io {
+
+namespace {
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void record_signal(int s) {
+  if (g_signal == 0) g_signal = s;
+}
+}  // namespace
+
+Interrupted::Interrupted(int s)
+    : std::runtime_error(std::string("interrupted by ") + (s == SIGINT ? "SIGINT" : s == SIGTERM ? "SIGTERM" : "a signal") +
+                         "; no output written"),
+      signal_(s) {}
+
+void install_interrupt_handlers() {
+  struct sigaction sa;
+  std::memset(&sa, 0, sizeof sa);
+  sa.sa_handler = record_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: waitpid() and friends return EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int interrupt_signal() { return static_cast<int>(g_signal); }
+
+void check_interrupt() {
+  if (const int s = interrupt_signal()) throw Interrupted(s);
+}
+
+void clear_interrupt() { g_signal = 0; }
+
+}  // namespace scoleid::io

@@ -1,0 +1,108 @@
+#include "scoleid/io/run_directory.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+
+namespace scoleid::io {
+
+namespace fs = std::filesystem;
+
+RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> owned, const std::string& program)
+    : program_(program), owned_(std::move(owned)) {
+  if (target.empty()) throw InputError(program + ": output directory must not be empty");
+  std::error_code ec;
+  fs::path t = fs::absolute(fs::path(target), ec).lexically_normal();
+  if (!t.has_filename() && t.has_parent_path()) t = t.parent_path();  // "dir/" -> "dir"
+  if (ec || t == t.root_path() || t.filename() == "." || t.filename() == "..")
+    throw InputError("output directory '" + target + "': must name a directory below an existing path");
+  target_ = t.string();
+  const fs::path parent = t.parent_path();
+  const auto st = fs::status(t, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_directory(st)) throw InputError("output directory '" + target + "': exists and is not a directory");
+    std::vector<std::string> foreign;
+    for (const auto& e : fs::directory_iterator(t, ec)) {
+      const std::string n = e.path().filename().string();
+      if (std::find(owned_.begin(), owned_.end(), n) != owned_.end() && e.is_regular_file()) continue;
+      if (n.find(".tmp.") != std::string::npos) continue;  // temporary file of an older version
+      foreign.push_back(n);
+    }
+    if (ec) throw InputError("output directory '" + target + "': cannot be read (" + ec.message() + ")");
+    if (!foreign.empty()) {
+      std::sort(foreign.begin(), foreign.end());
+      std::string list;
+      for (std::size_t i = 0; i < foreign.size() && i < 3; ++i) list += (i ? ", " : "") + foreign[i];
+      if (foreign.size() > 3) list += ", ...";
+      throw InputError("output directory '" + target + "': holds files that are not outputs of " + program + " (" +
+                       list + "); give a new or empty directory, or one holding only an earlier run's outputs");
+    }
+  }
+  fs::create_directories(parent, ec);
+  if (ec || !fs::is_directory(parent))
+    throw InputError("output directory '" + target + "': its parent cannot be created (" +
+                     (ec ? ec.message() : std::string("not a directory")) + ")");
+  std::string tmpl = (parent / ("." + t.filename().string() + ".staging-XXXXXX")).string();
+  std::vector<char> buf(tmpl.begin(), tmpl.end());
+  buf.push_back('\0');
+  if (!::mkdtemp(buf.data()))
+    throw InputError("output directory '" + target + "': cannot write in '" + parent.string() + "' (" +
+                     std::strerror(errno) + ")");
+  staging_ = buf.data();
+  // mkdtemp makes it 0700; the outputs' directory gets the mode any new directory would.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::chmod(staging_.c_str(), 0777 & ~mask);
+}
+
+RunDirectory::~RunDirectory() {
+  if (committed_ || staging_.empty()) return;
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+}
+
+std::string RunDirectory::path(const std::string& name) const { return (fs::path(staging_) / name).string(); }
+
+void RunDirectory::commit() {
+  if (committed_) return;
+  check_interrupt();
+  std::error_code ec;
+  if (!fs::exists(target_, ec)) {
+    if (::rename(staging_.c_str(), target_.c_str()) != 0)
+      throw std::runtime_error("cannot move the outputs into '" + target_ + "': " + std::strerror(errno));
+    committed_ = true;
+    return;
+  }
+  // The target exists (empty or an earlier run): swap the two directories in one step, then
+  // remove the earlier run, which now sits under the staging name.
+  if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) != 0) {
+    if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
+      throw std::runtime_error("cannot move the outputs into '" + target_ + "': " + std::strerror(errno));
+    // A file system without the exchange: move the earlier run aside, then the new one in. The
+    // target is briefly absent, never a mixture.
+    const std::string aside = staging_ + ".old";
+    if (::rename(target_.c_str(), aside.c_str()) != 0)
+      throw std::runtime_error("cannot replace '" + target_ + "': " + std::strerror(errno));
+    if (::rename(staging_.c_str(), target_.c_str()) != 0) {
+      const int err = errno;
+      ::rename(aside.c_str(), target_.c_str());
+      throw std::runtime_error("cannot move the outputs into '" + target_ + "': " + std::strerror(err));
+    }
+    committed_ = true;
+    fs::remove_all(aside, ec);
+    return;
+  }
+  committed_ = true;
+  fs::remove_all(staging_, ec);
+}
+
+}  // namespace scoleid::io

@@ -1,0 +1,164 @@
+#include "scoleid/io/validation.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
+
+namespace scoleid::io {
+
+bool valid_name(const std::string& n) {
+  if (n.empty() || n.size() > limits::kMaxNameLength || n == "t") return false;
+  auto word = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  };
+  if (!word(n[0])) return false;
+  for (char c : n)
+    if (!word(c) && c != '.' && c != '-') return false;
+  return true;
+}
+
+void check_name(const std::string& source, const std::string& field, const std::string& name) {
+  if (valid_name(name)) return;
+  fail_field(source, field,
+             "must be 1-" + std::to_string(limits::kMaxNameLength) +
+                 " characters from [A-Za-z0-9_.-], starting with a letter, digit or '_', and not 't'",
+             "'" + one_line(name) + "'");
+}
+
+std::size_t first_invalid_utf8(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  std::size_t i = 0;
+  while (i < n) {
+    const unsigned char c = p[i];
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    std::size_t len = 0;
+    unsigned lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) len = 2;
+    else if (c == 0xE0) { len = 3; lo = 0xA0; }
+    else if ((c >= 0xE1 && c <= 0xEC) || c == 0xEE || c == 0xEF) len = 3;
+    else if (c == 0xED) { len = 3; hi = 0x9F; }  // no surrogates
+    else if (c == 0xF0) { len = 4; lo = 0x90; }
+    else if (c >= 0xF1 && c <= 0xF3) len = 4;
+    else if (c == 0xF4) { len = 4; hi = 0x8F; }  // nothing above U+10FFFF
+    else return i;
+    if (i + len > n) return i;
+    if (p[i + 1] < lo || p[i + 1] > hi) return i;
+    for (std::size_t k = 2; k < len; ++k)
+      if (p[i + k] < 0x80 || p[i + k] > 0xBF) return i;
+    i += len;
+  }
+  return std::string::npos;
+}
+
+void check_utf8(const std::string& text, const std::string& what) {
+  const std::size_t at = first_invalid_utf8(text);
+  if (at == std::string::npos) return;
+  std::size_t line = 1;
+  for (std::size_t i = 0; i < at; ++i)
+    if (text[i] == '\n') ++line;
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned char>(text[at]));
+  throw InputError(what + ": byte " + std::to_string(at + 1) + " (line " + std::to_string(line) + ", " + hex +
+                   ") is not valid UTF-8");
+}
+
+void check_magnitude(const std::string& source, const std::string& field, double v) {
+  if (!std::isfinite(v)) fail_field(source, field, "must be a finite number", format_value(v));
+  const double a = std::abs(v);
+  if (a != 0.0 && (a < limits::kMinMagnitude || a > limits::kMaxMagnitude))
+    fail_field(source, field,
+               "must be 0 or of magnitude between " + format_value(limits::kMinMagnitude) + " and " +
+                   format_value(limits::kMaxMagnitude),
+               format_value(v));
+}
+
+double sample_count(double duration, double interval) {
+  if (!(interval > 0) || !(duration >= 0)) return INFINITY;
+  return std::floor(duration / interval + 1e-9) + 1.0;
+}
+
+void validate_scenario(const Scenario& sc) {
+  const std::string& src = sc.source;
+  check_name(src, "name", sc.name);
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    const std::string f = "inputs[" + std::to_string(i) + "].name";
+    check_name(src, f, sc.inputs[i].name);
+    if (!names.insert(sc.inputs[i].name).second) fail_field(src, f, "must be unique", "'" + sc.inputs[i].name + "'");
+  }
+  for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
+    const std::string f = "sensors[" + std::to_string(i) + "].name";
+    check_name(src, f, sc.sensors[i].name);
+    if (!names.insert(sc.sensors[i].name).second)
+      fail_field(src, f, "must be unique among inputs and sensors", "'" + sc.sensors[i].name + "'");
+  }
+  const double columns = 1.0 + static_cast<double>(sc.inputs.size() + sc.sensors.size());
+  auto check_record = [&](const std::string& field, double interval) {
+    const double n = sample_count(sc.simulation.duration, interval);
+    if (!(n <= limits::kMaxSamples))
+      fail_field(src, field,
+                 "gives " + format_value(n) + " samples over simulation.duration " + format_value(sc.simulation.duration) +
+                     ", more than the limit of " + format_value(limits::kMaxSamples),
+                 format_value(interval));
+    if (!(n * columns <= limits::kMaxRecordValues))
+      fail_field(src, field,
+                 "gives " + format_value(n) + " samples x " + format_value(columns) + " columns, more than the limit of " +
+                     format_value(limits::kMaxRecordValues) + " values",
+                 format_value(interval));
+  };
+  check_record("simulation.sample_interval", sc.simulation.sample_interval);
+  if (sc.truth.output_interval > 0) check_record("truth.output_interval", sc.truth.output_interval);
+  if (sc.truth.segments < 2 || sc.truth.segments > limits::kMaxSegments)
+    fail_field(src, "truth.segments", "must be an integer in [2, " + std::to_string(limits::kMaxSegments) + "]",
+               std::to_string(sc.truth.segments));
+  if (!(sc.truth.accuracy > 0 && sc.truth.accuracy < 1))
+    fail_field(src, "truth.accuracy", "must be in (0, 1)", format_value(sc.truth.accuracy));
+  const auto& id = sc.identification;
+  if (id.elements < 1 || id.elements > limits::kMaxElements)
+    fail_field(src, "identification.elements", "must be an integer in [1, " + std::to_string(limits::kMaxElements) + "]",
+               std::to_string(id.elements));
+  if (id.data_elements < 0 || id.data_elements > limits::kMaxDataElements)
+    fail_field(src, "identification.data_elements",
+               "must be an integer in [0, " + std::to_string(limits::kMaxDataElements) + "]", std::to_string(id.data_elements));
+  if (id.max_iterations < 0)
+    fail_field(src, "identification.max_iterations", "must be >= 0", std::to_string(id.max_iterations));
+  if (id.time_step > 0) {
+    const double steps = sc.simulation.duration / id.time_step;
+    if (!(steps <= limits::kMaxSteps))
+      fail_field(src, "identification.time_step",
+                 "gives " + format_value(std::ceil(steps)) + " steps over simulation.duration " +
+                     format_value(sc.simulation.duration) + ", more than the limit of " + format_value(limits::kMaxSteps),
+                 format_value(id.time_step));
+  }
+}
+
+std::string one_line(const std::string& m) {
+  std::string out;
+  out.reserve(m.size());
+  // Trailing line breaks carry nothing.
+  std::size_t end = m.size();
+  while (end > 0 && (m[end - 1] == '\n' || m[end - 1] == '\r')) --end;
+  for (std::size_t i = 0; i < end; ++i) {
+    const unsigned char c = static_cast<unsigned char>(m[i]);
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (c < 0x20 || c == 0x7F) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02X", c);
+      out += b;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
+}  // namespace scoleid::io
