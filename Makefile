@@ -4,7 +4,11 @@ JOBS  ?= 2
 OUT   ?= run
 SCENARIO ?= paper-scole-1
 
-.PHONY: run test deps build bench slow clean
+.PHONY: run test deps build bench slow clean fuzz asan
+
+FUZZ_BUILD   ?= build-fuzz
+ASAN_BUILD   ?= build-asan
+FUZZ_SECONDS ?= 60
 
 # Main job: a Simbody truth trajectory, then the FE identifier on that data file.
 run: build
@@ -26,6 +30,23 @@ deps:
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD) -j $(JOBS)
+
+# libFuzzer harnesses of the io loaders (clang, ASan + UBSan), each for FUZZ_SECONDS on a
+# build-directory copy of tests/fuzz/corpus/; reproducers go to $(FUZZ_BUILD)/tests/fuzz/artifacts/.
+fuzz:
+	bash .ci/install-deps clang libclang-rt-dev
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DSCOLEID_FUZZ=ON -DSCOLEID_FUZZ_SECONDS=$(FUZZ_SECONDS)
+	cmake --build $(FUZZ_BUILD) -j $(JOBS)
+	cd $(FUZZ_BUILD) && ctest --output-on-failure -L fuzz
+
+# The default suite under AddressSanitizer + UBSan; any report (leaks included) fails its test.
+asan: deps
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSCOLEID_SANITIZE=ON
+	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  ctest --output-on-failure -j $(JOBS) -LE 'slow|fuzz'
 
 clean:
 	rm -rf $(BUILD)

@@ -1,0 +1,21 @@
+// libFuzzer harness: arbitrary bytes as a truth.csv. Only InputError may escape the loader.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const scoleid::io::DataTable tab = scoleid::io::read_csv_text(text, "fuzz.csv");
+    // A table that loaded is well formed: one column per name, each as long as t.
+    if (tab.columns.size() != tab.names.size()) __builtin_trap();
+    for (const auto& c : tab.columns)
+      if (c.size() != tab.t.size()) __builtin_trap();
+    if (!tab.names.empty()) (void)tab.interpolate(0, 0.5 * (tab.t.front() + tab.t.back()));
+  } catch (const scoleid::io::InputError&) {
+  }
+  return 0;
+}
