@@ -38,6 +38,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", max_iterations, "override identification.max_iterations (>= 0)")
       ->check(CLI::Range(0, 100000));
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
+  std::string print_name;
+  app.add_option("--print-scenario", print_name,
+                 "print built-in scenario NAME as YAML and exit (start a scenario file by editing it)");
   app.add_flag("--no-std", no_std,
                "skip the Fisher-information standard deviations and with them the identifiability flags "
                "(identify.json then says \"identifiable\": null, not assessed)");
@@ -52,6 +55,13 @@ int main(int argc, char** argv) {
   }
   io::install_interrupt_handlers();
   try {
+    if (!print_name.empty()) {
+      const std::string yaml = io::builtin_scenario_yaml(print_name);
+      if (yaml.empty()) io::load_scenario(print_name);  // names the built-ins in its error
+      if (yaml.empty()) throw io::InputError("--print-scenario: '" + print_name + "' is not a built-in scenario");
+      std::fputs(yaml.c_str(), stdout);
+      return 0;
+    }
     if (list) {
       for (const auto& n : io::builtin_scenario_names())
         std::printf("%-16s %s\n", n.c_str(), io::builtin_scenario_description(n).c_str());

@@ -188,7 +188,14 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     p->fe = build_beam(sc.beam, id.elements, id.sections, sc.inputs, sc.sensors, sc.source);
     p->params = std::make_unique<BeamParameterization>(p->fe, sc.beam, id, sc.source);
   }
-  const VectorXd truth = p->params->truth();
+  // True values of the estimated parameters for a structure (the truth's), translated to this
+  // parameterization.
+  const auto set_true_values = [&](const io::Scenario& truth_sc) {
+    const VectorXd tv = scole ? ScoleParameterization(truth_sc.scole, id, sc.source).truth()
+                              : BeamParameterization(p->fe, truth_sc.beam, id, sc.source).truth();
+    for (int i = 0; i < tv.size(); ++i)
+      if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+  };
   p->signals = scenario_signals(sc);
 
   p->noise_std.assign(sc.sensors.size(), 0.0);
@@ -271,8 +278,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
     p->data_source = *data_csv;
     // True values from the metadata, translated to this parameterization.
+    io::Scenario truth_sc = sc;
     if (!meta_truth.empty() && scole) {
-      io::ScoleSpec ts = sc.scole;
+      io::ScoleSpec& ts = truth_sc.scole;
       const auto set = [&](const char* key, double& v) {
         if (meta_truth.count(key)) v = meta_truth.at(key);
       };
@@ -283,21 +291,16 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       set("GJ", ts.GJ);
       set("rho_I_psi", ts.rho_I_psi);
       set("zeta", ts.zeta);
-      const VectorXd tv = ScoleParameterization(ts, id, sc.source).truth();
-      for (int i = 0; i < tv.size(); ++i)
-        if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+      set_true_values(truth_sc);
     } else if (!meta_truth.empty()) {
-      io::BeamSpec tb = sc.beam;
+      io::BeamSpec& tb = truth_sc.beam;
       if (meta_truth.count("rho_A")) tb.rho_A = meta_truth.at("rho_A");
       if (meta_truth.count("zeta")) tb.zeta = meta_truth.at("zeta");
       if (meta_truth.count("EI")) tb.EI = {meta_truth.at("EI")};
       std::vector<double> sec;
       for (int k = 1; meta_truth.count("EI_" + std::to_string(k)); ++k) sec.push_back(meta_truth.at("EI_" + std::to_string(k)));
       if (!sec.empty()) tb.EI = sec;
-      const BeamParameterization tp(p->fe, tb, id, sc.source);
-      const VectorXd tv = tp.truth();
-      for (int i = 0; i < tv.size(); ++i)
-        if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+      set_true_values(truth_sc);
     }
   } else {
     const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
@@ -306,11 +309,12 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
     check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), true);
-    // Synthetic data: a step 4x finer than the identifier's.
-    p->data = synthesize(sc, data_elements, id.rtol, identifier_step(sc, p->fe.model, *p->params) / 4.0, true);
+    // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
+    // 4x finer than the identifier's.
+    const io::Scenario truth_sc = io::truth_scenario(sc);
+    p->data = synthesize(truth_sc, data_elements, id.rtol, identifier_step(sc, p->fe.model, *p->params) / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
-    for (int i = 0; i < truth.size(); ++i)
-      if (std::isfinite(truth[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = truth[i];
+    set_true_values(truth_sc);
   }
   if (data_csv) check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), false);
   p->objective_options.solver.rtol = id.rtol;

@@ -286,18 +286,20 @@ void parse_rigid(const YAML::Node& n, const std::string& source, const std::stri
   b.Iyz = r.num("Iyz", b.Iyz);
 }
 
-void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b) {
-  Reader r(n, source, "beam");
+// Reads the fields present onto `b` (the defaults, or the scenario's values for truth.overrides);
+// `path` is the section's dotted name in messages.
+void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, const std::string& path = "beam") {
+  Reader r(n, source, path);
   b.length = r.positive("length", b.length);
   b.left = parse_end(r, "left", b.left);
   b.right = parse_end(r, "right", b.right);
   b.rho_A = r.positive("rho_A", b.rho_A);
   b.EI = r.numbers("EI", b.EI);
   if (b.EI.empty() || b.EI.size() > 4096)
-    fail_field(source, "beam.EI", "must hold 1 to 4096 section values", std::to_string(b.EI.size()));
+    fail_field(source, r.field("EI"), "must hold 1 to 4096 section values", std::to_string(b.EI.size()));
   for (std::size_t i = 0; i < b.EI.size(); ++i)
     if (!(b.EI[i] > 0.0))
-      fail_field(source, b.EI.size() == 1 ? "beam.EI" : "beam.EI[" + std::to_string(i) + "]",
+      fail_field(source, b.EI.size() == 1 ? r.field("EI") : r.field("EI") + "[" + std::to_string(i) + "]",
                  "must be > 0", format_value(b.EI[i]));
   b.zeta = r.nonneg("zeta", b.zeta);
   b.tip_mass = r.nonneg("tip_mass", b.tip_mass);
@@ -307,8 +309,9 @@ void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b) {
   }
 }
 
-void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s) {
-  Reader r(n, source, "scole");
+void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, const std::string& path = "scole") {
+  Reader r(n, source, path);
+  const bool base = path == "scole";
   s.length = r.positive("length", s.length);
   s.rho_A = r.positive("rho_A", s.rho_A);
   if (r.has("EI")) s.EI_roll = s.EI_pitch = r.positive("EI", s.EI_roll);
@@ -317,19 +320,21 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s) {
   s.GJ = r.positive("GJ", s.GJ);
   s.rho_I_psi = r.positive("rho_I_psi", s.rho_I_psi);
   s.zeta = r.nonneg("zeta", s.zeta);
-  if (r.has("shuttle")) parse_rigid(r.child("shuttle"), source, "scole.shuttle", s.shuttle);
-  if (r.has("reflector")) parse_rigid(r.child("reflector"), source, "scole.reflector", s.reflector);
+  if (r.has("shuttle")) parse_rigid(r.child("shuttle"), source, r.field("shuttle"), s.shuttle);
+  if (r.has("reflector")) parse_rigid(r.child("reflector"), source, r.field("reflector"), s.reflector);
   s.reflector_rx = r.num("reflector_rx", s.reflector_rx);
   s.reflector_ry = r.num("reflector_ry", s.reflector_ry);
   s.mast_root = r.numbers("mast_root", s.mast_root);
   if (s.mast_root.size() != 3)
-    fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(s.mast_root.size()) + " values");
-  // Actuators default to L/3 and 2L/3 of the length actually configured.
-  s.actuator_locations = r.numbers("actuator_locations", {s.length / 3.0, 2.0 * s.length / 3.0});
+    fail_field(source, r.field("mast_root"), "must be a 3-vector", std::to_string(s.mast_root.size()) + " values");
+  // Actuators default to L/3 and 2L/3 of the length actually configured (an override keeps the
+  // scenario's stations unless it names them).
+  s.actuator_locations = r.numbers("actuator_locations", base ? std::vector<double>{s.length / 3.0, 2.0 * s.length / 3.0}
+                                                              : s.actuator_locations);
   for (std::size_t i = 0; i < s.actuator_locations.size(); ++i) {
     const double a = s.actuator_locations[i];
     if (!(a > 0.0 && a < s.length))
-      fail_field(source, "scole.actuator_locations[" + std::to_string(i) + "]",
+      fail_field(source, r.field("actuator_locations") + "[" + std::to_string(i) + "]",
                  "must lie inside the mast (0, " + format_value(s.length) + ")", format_value(a));
   }
   s.actuator_mass = r.positive("actuator_mass", s.actuator_mass);
@@ -423,13 +428,23 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.rtol = r.positive("rtol", id.rtol);
 }
 
-void parse_truth(const YAML::Node& n, const std::string& source, TruthModelSpec& t) {
+void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
+  TruthModelSpec& t = sc.truth;
   Reader r(n, source, "truth");
   t.segments = r.integer("segments", t.segments, 2, limits::kMaxSegments);
   t.integrator = r.str("integrator", t.integrator);
   t.accuracy = r.positive("accuracy", t.accuracy);
   if (!(t.accuracy < 1)) fail_field(source, "truth.accuracy", "must be < 1", format_value(t.accuracy));
   t.output_interval = r.nonneg("output_interval", t.output_interval);
+  if (r.has("overrides")) {
+    // Kept as text and applied on demand (truth_scenario), onto whatever the structure section
+    // holds then; applied once here so that its errors surface while parsing.
+    YAML::Emitter e;
+    e << r.child("overrides");
+    t.overrides = e.c_str();
+    t.overrides_source = source;
+    truth_scenario(sc);
+  }
 }
 
 }  // namespace
@@ -468,13 +483,35 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     parse_inputs(r.child("inputs"), sc);
     parse_sensors(r.child("sensors"), sc);
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
-    if (r.has("truth")) parse_truth(r.child("truth"), source, sc.truth);
+    if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   validate_scenario(sc);
   return sc;
 }
+
+Scenario truth_scenario(const Scenario& s) {
+  Scenario t = s;
+  if (s.truth.overrides.empty()) return t;
+  const std::string& source = s.truth.overrides_source.empty() ? s.source : s.truth.overrides_source;
+  try {
+    Reader o(YAML::Load(s.truth.overrides), source, "truth.overrides");
+    if (o.has("beam")) {
+      if (s.structure != "beam") fail_field(source, "truth.overrides.beam", "must match the structure", "'" + s.structure + "'");
+      parse_beam(o.child("beam"), source, t.beam, "truth.overrides.beam");
+    }
+    if (o.has("scole")) {
+      if (s.structure != "scole") fail_field(source, "truth.overrides.scole", "must match the structure", "'" + s.structure + "'");
+      parse_scole(o.child("scole"), source, t.scole, "truth.overrides.scole");
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": truth.overrides: malformed YAML: " + e.msg);
+  }
+  return t;
+}
+
+bool has_truth_overrides(const Scenario& s) { return to_json(s)["truth"].contains("overrides"); }
 
 Scenario load_scenario(const std::string& name_or_file) {
   const std::string builtin = builtin_scenario_yaml(name_or_file);
@@ -518,17 +555,40 @@ nlohmann::json to_json(const Scenario& s) {
   j["description"] = s.description;
   j["source"] = s.source;
   j["structure"] = s.structure;
+  auto beam = [](const BeamSpec& b) {
+    return json{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
+                {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta},
+                {"tip_mass", b.tip_mass}, {"tip_inertia", b.tip_inertia}};
+  };
+  auto scole = [&](const ScoleSpec& c) {
+    return json{{"length", c.length}, {"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch},
+                {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}, {"shuttle", rigid(c.shuttle)},
+                {"reflector", rigid(c.reflector)}, {"reflector_rx", c.reflector_rx},
+                {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
+                {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass}};
+  };
+  // The structure section, and the truth's overrides as the fields whose values differ from it.
+  json structure, truth_structure;
+  const Scenario ts = truth_scenario(s);
   if (s.structure == "beam") {
-    j["beam"] = {{"length", s.beam.length}, {"left", to_string(s.beam.left)}, {"right", to_string(s.beam.right)},
-                 {"rho_A", s.beam.rho_A}, {"EI", s.beam.EI}, {"zeta", s.beam.zeta},
-                 {"tip_mass", s.beam.tip_mass}, {"tip_inertia", s.beam.tip_inertia}};
+    structure = beam(s.beam);
+    truth_structure = beam(ts.beam);
   } else {
-    const auto& c = s.scole;
-    j["scole"] = {{"length", c.length}, {"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch},
-                  {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}, {"shuttle", rigid(c.shuttle)},
-                  {"reflector", rigid(c.reflector)}, {"reflector_rx", c.reflector_rx},
-                  {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
-                  {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass}};
+    structure = scole(s.scole);
+    truth_structure = scole(ts.scole);
+  }
+  j[s.structure] = structure;
+  json overrides = json::object();
+  for (const auto& [k, v] : truth_structure.items()) {
+    if (v == structure[k]) continue;
+    if (v.is_object()) {
+      json sub = json::object();
+      for (const auto& [k2, v2] : v.items())
+        if (v2 != structure[k][k2]) sub[k2] = v2;
+      overrides[k] = sub;
+    } else {
+      overrides[k] = v;
+    }
   }
   j["inputs"] = json::array();
   for (const auto& in : s.inputs)
@@ -551,6 +611,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"time_step", id.time_step}, {"rtol", id.rtol}};
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
                 {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval}};
+  if (!overrides.empty()) j["truth"]["overrides"] = {{s.structure, overrides}};
   return j;
 }
 

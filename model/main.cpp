@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
                  "step <= (12 accuracy)^(1/3) / omega_1; the default 1e-9 keeps the energy drift below 1e-6 over 50 "
                  "periods)");
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
+  std::string print_name;
+  app.add_option("--print-scenario", print_name,
+                 "print built-in scenario NAME as YAML and exit (start a scenario file by editing it)");
   app.add_flag("--quiet", quiet, "no progress or summary on stderr");
   app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");
   app.footer(
@@ -59,6 +62,13 @@ int main(int argc, char** argv) {
   }
   io::install_interrupt_handlers();
   try {
+    if (!print_name.empty()) {
+      const std::string yaml = io::builtin_scenario_yaml(print_name);
+      if (yaml.empty()) io::load_scenario(print_name);  // names the built-ins in its error
+      if (yaml.empty()) throw io::InputError("--print-scenario: '" + print_name + "' is not a built-in scenario");
+      std::fputs(yaml.c_str(), stdout);
+      return 0;
+    }
     if (list) {
       for (const auto& n : io::builtin_scenario_names())
         std::printf("%-14s %s\n", n.c_str(), io::builtin_scenario_description(n).c_str());

@@ -286,7 +286,10 @@ std::map<std::string, double> true_parameters(const io::Scenario& sc) {
   return p;
 }
 
-TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
+TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
+  // The truth simulates the scenario's structure with truth.overrides applied; truth.json
+  // reports the values it used and echoes the scenario with its overrides.
+  const io::Scenario sc = io::truth_scenario(scenario);
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("run_truth: " + why);
   const int n = opt.segments > 0 ? opt.segments : sc.truth.segments;
@@ -386,7 +389,7 @@ TruthResult run_truth(const io::Scenario& sc, const TruthOptions& opt) {
                  {"steps", res.summary.steps_taken},
                  {"wall_seconds", res.summary.wall_seconds},
                  {"real_time_factor", res.summary.real_time_factor()}};
-  m.settings = io::to_json(sc);
+  m.settings = io::to_json(scenario);
   return res;
 }
 

@@ -21,6 +21,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "scoleid/io/scenario.h"
 
 #ifndef SCOLE_IDENTIFY_EXE
 #error "SCOLE_IDENTIFY_EXE must be defined to the path of the scole-identify executable"
@@ -631,4 +632,36 @@ TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
   write_file(dir / "data" / "truth.json", meta.dump());
   const Result r5 = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", (dir / "run5").string(), "-q"}, dir);
   expect_input_error(r5, dir / "run5", {"truth.json", "not from the same run"});
+}
+
+TEST(ScoleIdentifyCli, PrintScenarioRoundTripsEveryBuiltin) {
+  TempDir dir;
+  for (const auto& name : scoleid::io::builtin_scenario_names()) {
+    const Result r = run({"--print-scenario", name}, dir);
+    ASSERT_EQ(r.code, 0) << name << ": " << r.err;
+    // Saved and loaded as a file, it is the built-in field for field.
+    write_file(dir / "copy.yaml", r.out);
+    nlohmann::json a = scoleid::io::to_json(scoleid::io::load_scenario((dir / "copy.yaml").string()));
+    nlohmann::json b = scoleid::io::to_json(scoleid::io::load_scenario(name));
+    a.erase("source");
+    b.erase("source");
+    EXPECT_EQ(a, b) << name;
+  }
+  const Result bad = run({"--print-scenario", "no-such"}, dir);
+  EXPECT_EQ(bad.code, 2);
+}
+
+TEST(ScoleIdentifyCli, TruthOverridesShapeTheSyntheticDataAndTheReportedTruth) {
+  // The truth's EI differs from the scenario's (the identifier's starting model): the synthetic
+  // data come from the truth's structure, so q1 converges to the truth's EI / rho_A, and the
+  // report compares against it.
+  TempDir dir;
+  write_file(dir / "o.yaml", std::string(kGood) + "truth:\n  overrides:\n    beam: {EI: 25000}\n");
+  const Result r = run({"--scenario", (dir / "o.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_file(dir / "out" / "identify.json"));
+  const auto& q1 = j["parameters"][0];
+  EXPECT_NEAR(q1["truth"].get<double>(), 25000.0 / 67.0, 1e-9 * 25000.0 / 67.0);
+  EXPECT_LT(std::abs(q1["relative_error"].get<double>()), 1e-3) << q1.dump();
+  EXPECT_EQ(j["settings"]["truth"]["overrides"]["beam"]["EI"], nlohmann::json::array({25000.0}));
 }

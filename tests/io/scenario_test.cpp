@@ -100,3 +100,42 @@ TEST(Scenario, TableSignalNeedsIncreasingTimes) {
       "inputs: [{name: f, location: 1, signal: {type: table, times: [0, 2, 1], values: [0, 1, 2]}}]");
   EXPECT_EQ(e, "scenario 'x.yaml': inputs[0].signal.times[2] must be increasing, got 1");
 }
+
+// truth.overrides: structure fields in which the truth differs from the identifier's model.
+TEST(TruthOverrides, ChangeTheTruthOnlyAndAreEchoed) {
+  const Scenario s = parse_scenario(R"(name: mismatch
+structure: scole
+scole: {reflector_rx: 18.75, actuator_locations: [40, 90]}
+truth:
+  segments: 10
+  overrides:
+    scole: {reflector_rx: 19.6875, reflector: {mass: 13.041}}
+)", "scenario 'm.yaml'");
+  EXPECT_DOUBLE_EQ(s.scole.reflector_rx, 18.75);  // the identifier's model
+  EXPECT_DOUBLE_EQ(s.scole.reflector.mass, 12.42);
+  const Scenario t = truth_scenario(s);
+  EXPECT_DOUBLE_EQ(t.scole.reflector_rx, 19.6875);
+  EXPECT_DOUBLE_EQ(t.scole.reflector.mass, 13.041);
+  EXPECT_DOUBLE_EQ(t.scole.reflector.Ixx, s.scole.reflector.Ixx);            // untouched fields kept
+  EXPECT_EQ(t.scole.actuator_locations, (std::vector<double>{40, 90}));       // not reset to L/3, 2L/3
+  EXPECT_TRUE(has_truth_overrides(s));
+  const nlohmann::json j = to_json(s)["truth"]["overrides"]["scole"];
+  EXPECT_EQ(j, (nlohmann::json{{"reflector_rx", 19.6875}, {"reflector", {{"mass", 13.041}}}}));
+  // Applied on demand: a programmatic change to the structure shows through in the truth.
+  Scenario s2 = s;
+  s2.scole.GJ = 1.0e7;
+  EXPECT_DOUBLE_EQ(truth_scenario(s2).scole.GJ, 1.0e7);
+  EXPECT_FALSE(has_truth_overrides(parse_scenario("name: plain\n", "s")));
+}
+
+TEST(TruthOverrides, UnknownFieldsOrTheOtherStructureAreRefused) {
+  EXPECT_NE(error_of("name: m\nstructure: scole\ntruth: {overrides: {scole: {reflektor_rx: 1}}}\n")
+                .find("truth.overrides.scole.reflektor_rx is not a known field"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: m\nstructure: scole\ntruth: {overrides: {beam: {EI: 1}}}\n")
+                .find("truth.overrides.beam must match the structure"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: m\ntruth: {overrides: {beam: {EI: -1}}}\n").find("truth.overrides.beam.EI must be > 0, got -1"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: m\ntruth: {overrides: {plate: {}}}\n").find("truth.overrides.plate"), std::string::npos);
+}

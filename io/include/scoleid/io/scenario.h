@@ -14,7 +14,9 @@
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
 //   simulation:{ duration, sample_interval, seed }
 //   identification: { parameterization, estimate, initial, elements, data_elements, method, ... }
-//   truth:     { segments, integrator, accuracy, ... }   (the Simbody generator's settings)
+//   truth:     { segments, integrator, accuracy, ..., overrides: {beam: {...}} | {scole: {...}} }
+//              (the Simbody generator's settings; overrides: structure fields in which the truth
+//              differs from the identifier's model — how a model-mismatch scenario is written)
 #include <map>
 #include <string>
 #include <vector>
@@ -136,6 +138,10 @@ struct TruthModelSpec {
   // undamped chain below 1e-6 over 50 periods from here (model/trapezoidal.h).
   double accuracy = 1e-9;
   double output_interval = 0.0;   // 0 = simulation.sample_interval
+  // truth.overrides as YAML text ("" = none): a partial beam: or scole: section applied on top of
+  // the scenario's structure for the truth only (truth_scenario). The identifier never reads it.
+  std::string overrides;
+  std::string overrides_source;   // where it was read, for messages
 };
 
 struct Scenario {
@@ -151,6 +157,11 @@ struct Scenario {
   IdentificationSpec identification;
   TruthModelSpec truth;
 };
+
+// The scenario as the truth sees it: truth.overrides applied to its structure section.
+Scenario truth_scenario(const Scenario& scenario);
+// Whether truth.overrides changes any structure field.
+bool has_truth_overrides(const Scenario& scenario);
 
 // NAME (a built-in) or a path to a YAML file. Throws InputError.
 Scenario load_scenario(const std::string& name_or_file);

@@ -99,8 +99,9 @@ struct TruthResult {
   SimulateSummary summary;
 };
 
-// Throws io::InputError for a scenario the truth cannot represent, std::runtime_error when the
-// integration fails.
+// Simulates io::truth_scenario(scenario): the structure with truth.overrides applied; truth.json's
+// true_parameters are the values it used. Throws io::InputError for a scenario the truth cannot
+// represent, std::runtime_error when the integration fails.
 TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& options = {});
 // truth.csv and truth.json into the run directory's staging area; the caller commits them as one
 // unit (io/run_directory.h), so the two files always come from the same run.
