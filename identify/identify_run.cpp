@@ -72,7 +72,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   if (method == "auto") method = p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
   r.method = method;
 
-  Objective obj(p.fe.model, *p.params, p.signals, p.data, p.objective_options);
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   OptimizerOptions oo;
   oo.method = method;
   oo.max_iterations = ro.max_iterations.value_or(p.scenario.identification.max_iterations);
@@ -85,9 +85,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     io::fail_field(p.scenario.source, "identification.steepest_weights",
                    "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
                    std::to_string(oo.steepest_weights.size()) + " values");
-  Table table(*p.params, p.params->names().size() <= 3 &&
-                             dynamic_cast<const BeamParameterization*>(p.params.get()) &&
-                             static_cast<const BeamParameterization*>(p.params.get())->paper_form());
+  Table table(*p.params, p.params->names().size() <= 3 && p.params->paper_form());
   if (ro.verbose) table.header();
   r.summary = minimize(obj, r.initial, oo, [&](const IterationRecord& rec) {
     io::check_interrupt();
@@ -173,7 +171,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
              {"rtol", p.objective_options.solver.rtol},
              {"steps", counters.solver.steps}}},
            {"data_source", p.data_source},
-           {"elements", p.fe.elements},
+           {"elements", p.structure->elements()},
            {"settings", io::to_json(p.scenario)}};
   if (ident.std.size() > 0) {
     out["identifiability"] = {{"assessed", true},
@@ -195,7 +193,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
 
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.csv: measured, predicted and residual per sensor at the sample times.
-  Objective obj(p.fe.model, *p.params, p.signals, p.data, p.objective_options);
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   const MatrixXd Y = obj.predict(r.estimate);
   io::DataTable tab;
   tab.t = p.data.t;

@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
     io::RunDirectory run_dir(out, identify::output_files(), "scole-identify");
     auto problem = identify::make_problem(sc, ro.data_csv);
     std::fprintf(stderr, "scole-identify: %s, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
-                 problem->fe.elements, problem->params->size(), problem->data_source.c_str());
+                 problem->structure->elements(), problem->params->size(), problem->data_source.c_str());
     if (ro.data_csv) {
       auto list = [](const std::vector<std::string>& v) {
         std::string s;

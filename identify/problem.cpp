@@ -9,6 +9,7 @@
 #include "scoleid/identify/scole_model.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/structure_parameters.h"
 
 namespace scoleid::identify {
 
@@ -32,20 +33,13 @@ std::vector<double> sample_times(const io::Scenario& sc) {
   return t;
 }
 
-void require_known_structure(const io::Scenario& sc) {
-  if (sc.structure != "beam" && sc.structure != "scole")
-    throw InputError(sc.source + ": structure '" + sc.structure + "' is not supported by this identifier (beam|scole)");
-}
-
-// The structure's FE model on `elements` elements and its coefficients at the scenario's values.
+// The structure's FE model on `elements` elements, with the structure's own sections (not the
+// identifier's), and its coefficients at the scenario's values.
 std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elements) {
-  if (sc.structure == "scole") {
-    ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
-    return {std::move(fe.model), scole_coefficients(sc.scole)};
-  }
-  BeamFE fe = build_beam(sc.beam, elements, static_cast<int>(sc.beam.EI.size()), sc.inputs, sc.sensors, sc.source);
-  VectorXd c = beam_coefficients(fe, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta);
-  return {std::move(fe.model), std::move(c)};
+  io::Scenario own = sc;
+  own.identification.sections = 0;
+  const auto st = make_structure(own, elements);
+  return {st->model(), st->coefficients(own)};
 }
 
 }  // namespace
@@ -124,7 +118,6 @@ void check_step(const io::Scenario& sc, const StructuralModel& model, const Para
 }  // namespace
 
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
-  require_known_structure(sc);
   const auto [model, coefficients] = true_model(sc, elements);
   const AssembledModel ops = assemble(model, coefficients);
   SolverOptions so;
@@ -165,34 +158,17 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
 }
 
 std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
-  require_known_structure(sc);
   if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
   if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
   auto p = std::make_unique<Problem>();
   p->scenario = sc;
   const auto& id = sc.identification;
-  const bool scole = sc.structure == "scole";
-  if (scole) {
-    if (id.sections > 1)
-      fail_field(sc.source, "identification.sections", "must be 0 or 1 for a scole structure (uniform mast)",
-                 std::to_string(id.sections));
-    // The SCOLE model in the problem's FE slot: the identifier only uses its structural model,
-    // element count and length.
-    ScoleFE fe = build_scole(sc.scole, id.elements, sc.inputs, sc.sensors, sc.source);
-    p->fe.model = std::move(fe.model);
-    p->fe.length = sc.scole.length;
-    p->fe.elements = id.elements;
-    p->fe.sections = 1;
-    p->params = std::make_unique<ScoleParameterization>(sc.scole, id, sc.source);
-  } else {
-    p->fe = build_beam(sc.beam, id.elements, id.sections, sc.inputs, sc.sensors, sc.source);
-    p->params = std::make_unique<BeamParameterization>(p->fe, sc.beam, id, sc.source);
-  }
+  p->structure = make_structure(sc, id.elements);
+  p->params = p->structure->parameterize(sc);
   // True values of the estimated parameters for a structure (the truth's), translated to this
   // parameterization.
   const auto set_true_values = [&](const io::Scenario& truth_sc) {
-    const VectorXd tv = scole ? ScoleParameterization(truth_sc.scole, id, sc.source).truth()
-                              : BeamParameterization(p->fe, truth_sc.beam, id, sc.source).truth();
+    const VectorXd tv = p->structure->parameterize(truth_sc)->truth();
     for (int i = 0; i < tv.size(); ++i)
       if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
   };
@@ -278,28 +254,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
     p->data_source = *data_csv;
     // True values from the metadata, translated to this parameterization.
-    io::Scenario truth_sc = sc;
-    if (!meta_truth.empty() && scole) {
-      io::ScoleSpec& ts = truth_sc.scole;
-      const auto set = [&](const char* key, double& v) {
-        if (meta_truth.count(key)) v = meta_truth.at(key);
-      };
-      set("rho_A", ts.rho_A);
-      if (meta_truth.count("EI")) ts.EI_roll = ts.EI_pitch = meta_truth.at("EI");
-      set("EI_roll", ts.EI_roll);
-      set("EI_pitch", ts.EI_pitch);
-      set("GJ", ts.GJ);
-      set("rho_I_psi", ts.rho_I_psi);
-      set("zeta", ts.zeta);
-      set_true_values(truth_sc);
-    } else if (!meta_truth.empty()) {
-      io::BeamSpec& tb = truth_sc.beam;
-      if (meta_truth.count("rho_A")) tb.rho_A = meta_truth.at("rho_A");
-      if (meta_truth.count("zeta")) tb.zeta = meta_truth.at("zeta");
-      if (meta_truth.count("EI")) tb.EI = {meta_truth.at("EI")};
-      std::vector<double> sec;
-      for (int k = 1; meta_truth.count("EI_" + std::to_string(k)); ++k) sec.push_back(meta_truth.at("EI_" + std::to_string(k)));
-      if (!sec.empty()) tb.EI = sec;
+    if (!meta_truth.empty()) {
+      io::Scenario truth_sc = sc;
+      io::set_structure_parameters(truth_sc, meta_truth);
       set_true_values(truth_sc);
     }
   } else {
@@ -308,17 +265,17 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       fail_field(sc.source, "identification.data_elements",
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
-    check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), true);
+    check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), true);
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
-    p->data = synthesize(truth_sc, data_elements, id.rtol, identifier_step(sc, p->fe.model, *p->params) / 4.0, true);
+    p->data = synthesize(truth_sc, data_elements, id.rtol, identifier_step(sc, p->model(), *p->params) / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     set_true_values(truth_sc);
   }
-  if (data_csv) check_step(sc, p->fe.model, *p->params, identifier_step(sc, p->fe.model, *p->params), false);
+  if (data_csv) check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), false);
   p->objective_options.solver.rtol = id.rtol;
-  p->objective_options.solver.step = identifier_step(sc, p->fe.model, *p->params);
+  p->objective_options.solver.step = identifier_step(sc, p->model(), *p->params);
   p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                            : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                               : SolverOptions::Integrator::Esdirk;

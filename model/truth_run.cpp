@@ -14,6 +14,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/structure_parameters.h"
 #include "scoleid/model/beam_chain.h"
 #include "scoleid/model/inputs.h"
 #include "scoleid/model/linearisation.h"
@@ -267,24 +268,7 @@ bool TruthOptions::IsValid(std::string* why) const {
   return true;
 }
 
-std::map<std::string, double> true_parameters(const io::Scenario& sc) {
-  std::map<std::string, double> p;
-  if (sc.structure == "scole") {
-    const auto& c = sc.scole;
-    p = {{"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch}, {"GJ", c.GJ},
-         {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}};
-    return p;
-  }
-  const auto& b = sc.beam;
-  p["rho_A"] = b.rho_A;
-  p["zeta"] = b.zeta;
-  if (b.EI.size() == 1) {
-    p["EI"] = b.EI[0];
-  } else {
-    for (std::size_t k = 0; k < b.EI.size(); ++k) p["EI_" + std::to_string(k + 1)] = b.EI[k];
-  }
-  return p;
-}
+std::map<std::string, double> true_parameters(const io::Scenario& sc) { return io::structure_parameters(sc); }
 
 TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   // The truth simulates the scenario's structure with truth.overrides applied; truth.json

@@ -56,7 +56,7 @@ int main() {
   double ratio_n2 = 0, ratio_n64 = 0, grad_n2 = 0, grad_n64 = 0;
   for (int N : {2, 64}) {
     auto p = make_problem(sections_scenario(N, 64), std::nullopt);
-    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
     VectorXd g;
     const double tf = best_of(3, [&] { obj.cost(q); });
@@ -78,13 +78,13 @@ int main() {
     sc.identification.data_elements = 2 * ne;
     sc.identification.time_step = 0.01;
     auto p = make_problem(sc, std::nullopt);
-    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
     const double t = best_of(3, [&] { obj.cost(q); });
     if (prev > 0)
-      std::printf("%10d %8d %12.4f %12.2f\n", ne, p->fe.model.ndof, t, std::log(t / prev) / std::log(double(ne) / prev_ne));
+      std::printf("%10d %8d %12.4f %12.2f\n", ne, p->model().ndof, t, std::log(t / prev) / std::log(double(ne) / prev_ne));
     else
-      std::printf("%10d %8d %12.4f %12s\n", ne, p->fe.model.ndof, t, "-");
+      std::printf("%10d %8d %12.4f %12s\n", ne, p->model().ndof, t, "-");
     prev = t;
     prev_ne = ne;
   }
@@ -116,13 +116,13 @@ int main() {
     ssc.identification.elements = 20;
     ssc.identification.data_elements = 40;
     auto p = make_problem(ssc, std::nullopt);
-    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
     VectorXd g;
     const double tf = best_of(3, [&] { obj.cost(q); });
     const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
     scole_ratio = tg / tf;
-    std::printf("   %d DOFs, step %.2e s: forward %.4f s, adjoint gradient %.4f s, ratio %.2f\n", p->fe.model.ndof,
+    std::printf("   %d DOFs, step %.2e s: forward %.4f s, adjoint gradient %.4f s, ratio %.2f\n", p->model().ndof,
                 p->objective_options.solver.step, tf, tg, scole_ratio);
   }
   std::printf("\n5. paper-scole-2 end to end (EI, rho_A, rho_I_psi, zeta from the paper's start; best of 3)\n");

@@ -31,8 +31,8 @@ double max_abs(const MatrixXd& A) { return A.cwiseAbs().maxCoeff(); }
 TEST(EsdirkStepper, ReproducesArkodeOnTheSameTable) {
   auto a = scole_problem("esdirk"), b = scole_problem("esdirk-arkode");
   const VectorXd q = a->params->initial();
-  Objective oa(a->fe.model, *a->params, a->signals, a->data, a->objective_options);
-  Objective ob(b->fe.model, *b->params, b->signals, b->data, b->objective_options);
+  Objective oa(a->model(), *a->params, a->signals, a->data, a->objective_options);
+  Objective ob(b->model(), *b->params, b->signals, b->data, b->objective_options);
   const auto t0 = std::chrono::steady_clock::now();
   const MatrixXd Ya = oa.predict(q);
   const auto t1 = std::chrono::steady_clock::now();
@@ -52,7 +52,7 @@ TEST(EsdirkStepper, TangentsAreTheDerivativesOfTheDiscreteState) {
   // drift, so rounding is ~1e-12 of the peak, and ζ moves them by only ~4e-5 of it per 100 %.
   auto p = scole_problem("esdirk");
   const VectorXd q = p->params->initial();
-  Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+  Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
   const MatrixXd G = obj.output_sensitivities(q);  // tangents stepped with the state
   const int ns = p->data.sensors();
   auto central = [&](int i, double h) {
@@ -81,7 +81,7 @@ TEST(EsdirkStepper, GaussNewtonGradientIsTheGradientOfTheDiscreteCost) {
   for (const char* integrator : {"esdirk", "esdirk-arkode"}) {
     auto p = scole_problem(integrator);
     const VectorXd q = p->params->initial();
-    Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+    Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     VectorXd g;
     MatrixXd H;
     obj.gauss_newton(q, g, H);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scoleid/identify/beam_model.h"
 #include "scoleid/identify/analytic_beam.h"
 #include "scoleid/identify/identify_run.h"
 #include "test_support.h"

@@ -71,7 +71,7 @@ TEST(ScoleIdentification, CaseTwoZetaIsBelowWhatTheIdentifierResolves) {
   auto sc = scoleid::io::load_scenario("paper-scole-2");
   auto p = make_problem(sc, std::nullopt);
   const VectorXd q = p->params->truth();
-  Objective obj(p->fe.model, *p->params, p->signals, p->data, p->objective_options);
+  Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
   const MatrixXd Y = obj.predict(q);
   const MatrixXd G = obj.output_sensitivities(q);  // (samples·sensors) × P, row-major by sample
   const int ns = p->data.sensors();

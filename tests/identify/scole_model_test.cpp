@@ -354,7 +354,7 @@ void check_gradient(const std::string& yaml) {
     MatrixXd H;
     a.obj->cost_and_gradient(q, g_adj);
     a.obj->gauss_newton(q, g_gn, H);
-    std::printf("  esdirk, automatic step %.3e (%d DOFs): costate vs Gauss-Newton %.2e\n", h, a.p->fe.model.ndof,
+    std::printf("  esdirk, automatic step %.3e (%d DOFs): costate vs Gauss-Newton %.2e\n", h, a.p->model().ndof,
                 max_rel(g_adj, g_gn));
   }
   Case e = make_case(yaml, false, h / 4.0);

@@ -50,7 +50,7 @@ inline Case make_case(const std::string& yaml, bool bdf, double step = 0.0) {
     sc.identification.rtol = 1e-10;
   }
   c.p = make_problem(sc, std::nullopt);
-  c.obj = std::make_unique<Objective>(c.p->fe.model, *c.p->params, c.p->signals, c.p->data, c.p->objective_options);
+  c.obj = std::make_unique<Objective>(c.p->model(), *c.p->params, c.p->signals, c.p->data, c.p->objective_options);
   return c;
 }
 

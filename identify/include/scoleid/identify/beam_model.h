@@ -57,7 +57,7 @@ public:
   std::map<std::string, double> physical(const VectorXd& q) const override;
   VectorXd initial() const override { return initial_; }
   VectorXd truth() const override { return truth_; }
-  bool paper_form() const { return paper_; }
+  bool paper_form() const override { return paper_; }
 
   template <class T>
   struct State {

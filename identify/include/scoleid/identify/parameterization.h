@@ -22,6 +22,9 @@ public:
   virtual VectorXd initial() const = 0;
   // True values when the scenario knows them (empty otherwise).
   virtual VectorXd truth() const = 0;
+  // The paper's form (the equation divided by ρA: q1 = EI/ρA, q2 = 1/ρA, ...), whose iteration
+  // table also shows the physical ρA, EI, ζ.
+  virtual bool paper_form() const { return false; }
 };
 
 }  // namespace scoleid::identify

@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "scoleid/identify/beam_model.h"
+#include "scoleid/identify/structure.h"
 #include "scoleid/identify/measurements.h"
 #include "scoleid/identify/objective.h"
 #include "scoleid/io/data_files.h"
@@ -31,7 +31,7 @@ struct ColumnUse {
 
 struct Problem {
   io::Scenario scenario;
-  BeamFE fe;
+  std::unique_ptr<FEStructure> structure;     // the FE model on the identifier's mesh
   std::unique_ptr<Parameterization> params;
   std::vector<io::Signal> signals;
   Measurements data;
@@ -40,6 +40,7 @@ struct Problem {
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
   ColumnUse columns;                          // with a data file
+  const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };
 
