@@ -1,7 +1,6 @@
 #include "scoleid/identify/beam_model.h"
 
 #include <cmath>
-#include <complex>
 
 #include "scoleid/identify/hermite_beam.h"
 #include "scoleid/io/error.h"
@@ -188,162 +187,42 @@ bool sections_nest(int scenario_sections, int model_sections) {
 }
 }  // namespace
 
-BeamParameterization::BeamParameterization(const BeamFE& fe, const io::BeamSpec& truth,
-                                           const io::IdentificationSpec& id, const std::string& source)
-    : sections_(fe.sections), ncoef_(fe.model.ncoef), paper_(id.parameterization == "paper") {
-  names_ = id.estimate;
-  if (names_.empty()) fail_field(source, "identification.estimate", "must name at least one parameter", "none");
-  std::vector<std::string> allowed;
-  if (paper_) {
-    allowed = {"q1", "q2", "q3"};
-  } else {
-    allowed = {"rho_A", "EI", "zeta"};
-    for (int s = 0; s < sections_; ++s) allowed.push_back("EI_" + std::to_string(s + 1));
+ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) {
+  const int N = fe.sections;
+  ParameterSpace sp;
+  sp.structure = "beam";
+  const std::vector<double> EI = expand_sections(beam.EI, N);
+  const bool nest = sections_nest(static_cast<int>(beam.EI.size()), N);
+  sp.quantities.push_back("rho_A");
+  sp.value.push_back(beam.rho_A);
+  sp.true_value.push_back(true);
+  ParameterSpace::Group ei{"EI", {}, false};
+  for (int k = 0; k < N; ++k) {
+    sp.quantities.push_back("EI_" + std::to_string(k + 1));
+    sp.value.push_back(EI[static_cast<std::size_t>(k)]);
+    sp.true_value.push_back(nest);
+    ei.members.push_back(1 + k);
   }
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    bool ok = false;
-    for (const auto& a : allowed) ok = ok || a == names_[i];
-    if (!ok) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
-      fail_field(source, "identification.estimate[" + std::to_string(i) + "]",
-                 "must be one of " + list + " (" + id.parameterization + " parameterization)", "'" + names_[i] + "'");
+  sp.quantities.push_back("zeta");
+  sp.value.push_back(beam.zeta);
+  sp.true_value.push_back(true);
+  sp.groups.push_back(ei);
+  sp.rho_A = 0;
+  sp.zeta = N + 1;
+  sp.has_q3 = true;
+  if (N > 1) sp.paper_requirement = "needs a uniform beam (one EI section), not " + std::to_string(N) + " sections";
+  sp.ncoef = fe.model.ncoef;
+  // c = [ρA, EI_1..EI_N, c_1..c_N], c_k = 2ζ√(ρA EI_k) (Kelvin–Voigt, docs/theory.md §2.2).
+  sp.coefficients = [N](const std::vector<ParameterSpace::Cd>& f) {
+    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(1 + 2 * N));
+    c[0] = f[0];
+    for (int k = 0; k < N; ++k) {
+      c[static_cast<std::size_t>(1 + k)] = f[static_cast<std::size_t>(1 + k)];
+      c[static_cast<std::size_t>(1 + N + k)] = 2.0 * f[static_cast<std::size_t>(N + 1)] * std::sqrt(f[0] * f[static_cast<std::size_t>(1 + k)]);
     }
-    for (std::size_t j = 0; j < i; ++j)
-      if (names_[j] == names_[i])
-        fail_field(source, "identification.estimate[" + std::to_string(i) + "]", "is listed twice", "'" + names_[i] + "'");
-    if (!paper_ && names_[i] == "EI")
-      for (const auto& o : names_)
-        if (o.rfind("EI_", 0) == 0)
-          fail_field(source, "identification.estimate", "cannot hold both EI and sectional EI_k", "'" + o + "'");
-  }
-  if (paper_ && sections_ > 1)
-    fail_field(source, "identification.parameterization", "paper form needs a uniform beam (one EI section)",
-               std::to_string(sections_) + " sections");
-  for (const auto& [key, v] : id.initial) {
-    bool ok = key == "rho_A" || key == "EI" || key == "zeta" || key == "q1" || key == "q2" || key == "q3";
-    if (key.rfind("EI_", 0) == 0) {
-      const int k = std::atoi(key.c_str() + 3);
-      ok = k >= 1 && k <= sections_ && key == "EI_" + std::to_string(k);
-    }
-    if (!ok) fail_field(source, "identification.initial." + key, "is not a parameter of this beam", format_value(v));
-  }
-
-  // Physical starting state: the scenario's values, overridden by identification.initial.
-  const auto get = [&](const std::string& k, double d) {
-    const auto it = id.initial.find(k);
-    return it == id.initial.end() ? d : it->second;
+    return c;
   };
-  State<double> true_state{truth.rho_A, expand_sections(truth.EI, sections_), truth.zeta};
-  start_ = true_state;
-  start_.rho_A = get("rho_A", start_.rho_A);
-  if (id.initial.count("EI")) std::fill(start_.EI.begin(), start_.EI.end(), id.initial.at("EI"));
-  for (int s = 0; s < sections_; ++s) start_.EI[static_cast<std::size_t>(s)] = get("EI_" + std::to_string(s + 1), start_.EI[static_cast<std::size_t>(s)]);
-  start_.zeta = get("zeta", start_.zeta);
-
-  initial_ = parameters_of(start_);
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    const auto it = id.initial.find(names_[i]);
-    if (it != id.initial.end()) initial_[static_cast<Eigen::Index>(i)] = it->second;
-    if (!(initial_[static_cast<Eigen::Index>(i)] > 0.0))
-      fail_field(source, "identification.initial." + names_[i], "must be > 0 (parameters are positive)",
-                 format_value(initial_[static_cast<Eigen::Index>(i)]));
-  }
-  truth_ = parameters_of(true_state);
-  if (!sections_nest(static_cast<int>(truth.EI.size()), sections_))
-    for (std::size_t i = 0; i < names_.size(); ++i)
-      if (names_[i].rfind("EI", 0) == 0) truth_[static_cast<Eigen::Index>(i)] = std::nan("");
+  return sp;
 }
-
-VectorXd BeamParameterization::parameters_of(const State<double>& s) const {
-  VectorXd q(static_cast<Eigen::Index>(names_.size()));
-  double mean_EI = 0.0;
-  for (double e : s.EI) mean_EI += e / static_cast<double>(s.EI.size());
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    const std::string& n = names_[i];
-    double v = 0.0;
-    if (n == "rho_A") v = s.rho_A;
-    else if (n == "EI") v = mean_EI;
-    else if (n == "zeta") v = s.zeta;
-    else if (n == "q1") v = s.EI[0] / s.rho_A;
-    else if (n == "q2") v = 1.0 / s.rho_A;
-    else if (n == "q3") v = 2.0 * s.zeta * std::sqrt(s.EI[0] / s.rho_A);
-    else v = s.EI[static_cast<std::size_t>(std::atoi(n.c_str() + 3) - 1)];
-    q[static_cast<Eigen::Index>(i)] = v;
-  }
-  return q;
-}
-
-template <class T>
-BeamParameterization::State<T> BeamParameterization::state(const std::vector<T>& q) const {
-  State<T> s{T(start_.rho_A), {}, T(start_.zeta)};
-  for (double e : start_.EI) s.EI.push_back(T(e));
-  auto find = [&](const char* name) -> int {
-    for (std::size_t i = 0; i < names_.size(); ++i)
-      if (names_[i] == name) return static_cast<int>(i);
-    return -1;
-  };
-  if (paper_) {
-    // Paper form: the equation divided by ρA. Unestimated q's keep their starting values.
-    const int i1 = find("q1"), i2 = find("q2"), i3 = find("q3");
-    const T q1 = i1 >= 0 ? q[static_cast<std::size_t>(i1)] : T(start_.EI[0] / start_.rho_A);
-    const T q2 = i2 >= 0 ? q[static_cast<std::size_t>(i2)] : T(1.0 / start_.rho_A);
-    const T q3 = i3 >= 0 ? q[static_cast<std::size_t>(i3)] : T(2.0 * start_.zeta * std::sqrt(start_.EI[0] / start_.rho_A));
-    s.rho_A = T(1.0) / q2;
-    s.EI[0] = q1 / q2;
-    s.zeta = q3 / (T(2.0) * std::sqrt(q1));
-    return s;
-  }
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    const std::string& n = names_[i];
-    if (n == "rho_A") s.rho_A = q[i];
-    else if (n == "zeta") s.zeta = q[i];
-    else if (n == "EI") for (auto& e : s.EI) e = q[i];
-    else s.EI[static_cast<std::size_t>(std::atoi(n.c_str() + 3) - 1)] = q[i];
-  }
-  return s;
-}
-
-void BeamParameterization::coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const {
-  using C = std::complex<double>;
-  const int P = static_cast<int>(names_.size());
-  auto coef = [&](const std::vector<C>& qc, std::vector<C>& out) {
-    const State<C> s = state(qc);
-    out.assign(static_cast<std::size_t>(ncoef_), C(0.0));
-    out[0] = s.rho_A;
-    for (int k = 0; k < sections_; ++k) {
-      out[static_cast<std::size_t>(1 + k)] = s.EI[static_cast<std::size_t>(k)];
-      out[static_cast<std::size_t>(1 + sections_ + k)] = C(2.0) * s.zeta * std::sqrt(s.rho_A * s.EI[static_cast<std::size_t>(k)]);
-    }
-  };
-  std::vector<C> qc(static_cast<std::size_t>(P)), out;
-  for (int i = 0; i < P; ++i) qc[static_cast<std::size_t>(i)] = C(q[i], 0.0);
-  coef(qc, out);
-  c.resize(ncoef_);
-  for (int j = 0; j < ncoef_; ++j) c[j] = out[static_cast<std::size_t>(j)].real();
-  // Complex-step derivative: exact to rounding, no subtractive cancellation.
-  dcdq.setZero(ncoef_, P);
-  for (int i = 0; i < P; ++i) {
-    const double h = 1e-30 * std::max(1.0, std::abs(q[i]));
-    qc[static_cast<std::size_t>(i)] = C(q[i], h);
-    coef(qc, out);
-    for (int j = 0; j < ncoef_; ++j) dcdq(j, i) = out[static_cast<std::size_t>(j)].imag() / h;
-    qc[static_cast<std::size_t>(i)] = C(q[i], 0.0);
-  }
-}
-
-std::map<std::string, double> BeamParameterization::physical(const VectorXd& q) const {
-  std::vector<double> qv(q.data(), q.data() + q.size());
-  const State<double> s = state(qv);
-  std::map<std::string, double> out{{"rho_A", s.rho_A}, {"zeta", s.zeta}};
-  if (sections_ == 1) {
-    out["EI"] = s.EI[0];
-  } else {
-    for (int k = 0; k < sections_; ++k) out["EI_" + std::to_string(k + 1)] = s.EI[static_cast<std::size_t>(k)];
-  }
-  return out;
-}
-
-template BeamParameterization::State<double> BeamParameterization::state(const std::vector<double>&) const;
 
 }  // namespace scoleid::identify

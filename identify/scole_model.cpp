@@ -228,7 +228,7 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   StructuralModel& m = fe.model;
   m.ndof = n;
   m.ncoef = ScoleFE::kCount;
-  m.coefficient_names = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "c_roll", "c_pitch", "c_tors"};
+  m.coefficient_names = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "c_roll", "c_pitch", "c_tors", "m_reflector"};
   m.dof_group.assign(static_cast<std::size_t>(n), 0);  // 0: displacements [ft], 1: rotations [rad]
   for (int i : {kTx, kTy, kTz}) m.dof_group[static_cast<std::size_t>(fe.shuttle_dof(i))] = 1;
   for (int nd = 1; nd <= ne; ++nd)
@@ -236,7 +236,7 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
       m.dof_group[static_cast<std::size_t>(fe.node_dof(nd, f))] = 1;
 
   // Element operators on the full vector.
-  std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const;
+  std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const, mass_refl;
   const hermite::Mat4 Me = hermite::mass(h, 0.0, h), Ke = hermite::stiffness(h, 0.0, h);
   for (int e = 0; e < ne; ++e) {
     for (int a = 0; a < 4; ++a)
@@ -267,7 +267,7 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     add_quadratic(mass_const, fr.shuttle_rotation(), inertia_matrix(sc.shuttle));
   }
   // Reflector: translation of its CM and rotation of the tip section.
-  add_quadratic(mass_const, fr.reflector(), sc.reflector.mass * MatrixXd::Identity(3, 3));
+  add_quadratic(mass_refl, fr.reflector(), MatrixXd::Identity(3, 3));  // × m_reflector
   add_quadratic(mass_const, fr.rotation(L), inertia_matrix(sc.reflector));
   // Proof masses: free laterally, axially with the mast.
   for (int k = 0; k < nact; ++k) {
@@ -287,7 +287,10 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     return R;
   };
   const SparseMatrix Kr = reduce(stiff_roll), Kp = reduce(stiff_pitch), Kt = reduce(stiff_tors);
-  m.mass = {{reduce(mass_bend), ScoleFE::kRhoA}, {reduce(mass_tors), ScoleFE::kRhoIPsi}, {reduce(mass_const), -1}};
+  m.mass = {{reduce(mass_bend), ScoleFE::kRhoA},
+            {reduce(mass_tors), ScoleFE::kRhoIPsi},
+            {reduce(mass_refl), ScoleFE::kMReflector},
+            {reduce(mass_const), -1}};
   m.stiffness = {{Kr, ScoleFE::kEIRoll}, {Kp, ScoleFE::kEIPitch}, {Kt, ScoleFE::kGJ}};
   m.damping = {{Kr, ScoleFE::kCRoll}, {Kp, ScoleFE::kCPitch}, {Kt, ScoleFE::kCTors}};
 
@@ -387,159 +390,30 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
 VectorXd scole_coefficients(const io::ScoleSpec& s) {
   VectorXd c(ScoleFE::kCount);
   c << s.rho_A, s.EI_roll, s.EI_pitch, s.GJ, s.rho_I_psi, 2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_roll),
-      2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_pitch), 2.0 * s.zeta * std::sqrt(s.rho_I_psi * s.GJ);
+      2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_pitch), 2.0 * s.zeta * std::sqrt(s.rho_I_psi * s.GJ), s.reflector.mass;
   return c;
 }
 
 // ---------------------------------------------------------------------------------------------
 
-ScoleParameterization::ScoleParameterization(const io::ScoleSpec& truth, const io::IdentificationSpec& id,
-                                             const std::string& source)
-    : paper_(id.parameterization == "paper") {
-  names_ = id.estimate;
-  if (names_.empty()) fail_field(source, "identification.estimate", "must name at least one parameter", "none");
-  const std::vector<std::string> allowed =
-      paper_ ? std::vector<std::string>{"q1", "q2"}
-             : std::vector<std::string>{"rho_A", "EI", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta"};
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    if (std::find(allowed.begin(), allowed.end(), names_[i]) == allowed.end()) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
-      fail_field(source, "identification.estimate[" + std::to_string(i) + "]",
-                 "must be one of " + list + " (" + id.parameterization + " parameterization of SCOLE)",
-                 "'" + names_[i] + "'");
-    }
-    for (std::size_t j = 0; j < i; ++j)
-      if (names_[j] == names_[i])
-        fail_field(source, "identification.estimate[" + std::to_string(i) + "]", "is listed twice", "'" + names_[i] + "'");
-    if (names_[i] == "EI")
-      for (const auto& o : names_)
-        if (o == "EI_roll" || o == "EI_pitch")
-          fail_field(source, "identification.estimate", "cannot hold both EI (both planes) and " + o, "'" + o + "'");
-  }
-  static const std::vector<std::string> keys = {"rho_A", "EI", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta", "q1", "q2"};
-  for (const auto& [key, v] : id.initial)
-    if (std::find(keys.begin(), keys.end(), key) == keys.end())
-      fail_field(source, "identification.initial." + key, "is not a parameter of SCOLE", format_value(v));
-
-  const State<double> true_state{truth.rho_A, truth.EI_roll, truth.EI_pitch, truth.GJ, truth.rho_I_psi, truth.zeta};
-  // Physical starting state: the scenario's values overridden by identification.initial
-  // (EI sets both planes; q1, q2 translate to EI and ρA).
-  start_ = true_state;
-  const auto& ini = id.initial;
-  if (ini.count("rho_A")) start_.rho_A = ini.at("rho_A");
-  if (ini.count("EI")) start_.EI_roll = start_.EI_pitch = ini.at("EI");
-  if (ini.count("EI_roll")) start_.EI_roll = ini.at("EI_roll");
-  if (ini.count("EI_pitch")) start_.EI_pitch = ini.at("EI_pitch");
-  if (ini.count("GJ")) start_.GJ = ini.at("GJ");
-  if (ini.count("rho_I_psi")) start_.rho_I_psi = ini.at("rho_I_psi");
-  if (ini.count("zeta")) start_.zeta = ini.at("zeta");
-  if (ini.count("q2")) start_.rho_A = 1.0 / ini.at("q2");
-  if (ini.count("q1")) start_.EI_roll = start_.EI_pitch = ini.at("q1") * start_.rho_A;
-
-  const bool both_planes = std::find(names_.begin(), names_.end(), "EI") != names_.end() ||
-                           std::find(names_.begin(), names_.end(), "q1") != names_.end();
-  if (both_planes && start_.EI_roll != start_.EI_pitch)
-    fail_field(source, "identification.estimate",
-               "estimates one EI for both bending planes, but the starting EI_roll and EI_pitch differ (give "
-               "identification.initial.EI, or estimate EI_roll and EI_pitch)",
-               format_value(start_.EI_roll) + " and " + format_value(start_.EI_pitch));
-  initial_ = parameters_of(start_);
-  for (std::size_t i = 0; i < names_.size(); ++i)
-    if (!(initial_[static_cast<Eigen::Index>(i)] > 0.0))
-      fail_field(source, "identification.initial." + names_[i], "must be > 0 (parameters are positive)",
-                 format_value(initial_[static_cast<Eigen::Index>(i)]));
-  truth_ = parameters_of(true_state);  // EI, q1: NaN when the true planes differ
-}
-
-VectorXd ScoleParameterization::parameters_of(const State<double>& s) const {
-  VectorXd q(static_cast<Eigen::Index>(names_.size()));
-  const double EI = s.EI_roll == s.EI_pitch ? s.EI_roll : std::nan("");
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    const std::string& n = names_[i];
-    double v = 0.0;
-    if (n == "rho_A") v = s.rho_A;
-    else if (n == "EI") v = EI;
-    else if (n == "EI_roll") v = s.EI_roll;
-    else if (n == "EI_pitch") v = s.EI_pitch;
-    else if (n == "GJ") v = s.GJ;
-    else if (n == "rho_I_psi") v = s.rho_I_psi;
-    else if (n == "zeta") v = s.zeta;
-    else if (n == "q1") v = EI / s.rho_A;
-    else if (n == "q2") v = 1.0 / s.rho_A;
-    q[static_cast<Eigen::Index>(i)] = v;
-  }
-  return q;
-}
-
-template <class T>
-ScoleParameterization::State<T> ScoleParameterization::state(const std::vector<T>& q) const {
-  State<T> s{T(start_.rho_A), T(start_.EI_roll), T(start_.EI_pitch), T(start_.GJ), T(start_.rho_I_psi), T(start_.zeta)};
-  if (paper_) {
-    // The bending equations divided by ρA; unestimated q's keep their starting values.
-    T q1 = T(start_.EI_roll / start_.rho_A), q2 = T(1.0 / start_.rho_A);
-    for (std::size_t i = 0; i < names_.size(); ++i) (names_[i] == "q1" ? q1 : q2) = q[i];
-    s.rho_A = T(1.0) / q2;
-    s.EI_roll = s.EI_pitch = q1 / q2;
-    return s;
-  }
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    const std::string& n = names_[i];
-    if (n == "rho_A") s.rho_A = q[i];
-    else if (n == "EI") s.EI_roll = s.EI_pitch = q[i];
-    else if (n == "EI_roll") s.EI_roll = q[i];
-    else if (n == "EI_pitch") s.EI_pitch = q[i];
-    else if (n == "GJ") s.GJ = q[i];
-    else if (n == "rho_I_psi") s.rho_I_psi = q[i];
-    else if (n == "zeta") s.zeta = q[i];
-  }
-  return s;
-}
-
-void ScoleParameterization::coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const {
-  using C = std::complex<double>;
-  const int P = static_cast<int>(names_.size());
-  auto coef = [&](const std::vector<C>& qc, std::vector<C>& out) {
-    const State<C> s = state(qc);
-    out = {s.rho_A,
-           s.EI_roll,
-           s.EI_pitch,
-           s.GJ,
-           s.rho_I_psi,
-           C(2.0) * s.zeta * std::sqrt(s.rho_A * s.EI_roll),
-           C(2.0) * s.zeta * std::sqrt(s.rho_A * s.EI_pitch),
-           C(2.0) * s.zeta * std::sqrt(s.rho_I_psi * s.GJ)};
+ParameterSpace scole_parameter_space(const io::ScoleSpec& sc) {
+  ParameterSpace sp;
+  sp.structure = "SCOLE";
+  sp.quantities = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta", "m_reflector"};
+  sp.value = {sc.rho_A, sc.EI_roll, sc.EI_pitch, sc.GJ, sc.rho_I_psi, sc.zeta, sc.reflector.mass};
+  sp.true_value.assign(sp.quantities.size(), true);
+  sp.groups = {{"EI", {1, 2}, true}};
+  sp.rho_A = 0;
+  sp.zeta = 5;
+  sp.has_q3 = false;
+  sp.ncoef = ScoleFE::kCount;
+  // c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors, m_reflector] (scole_model.h).
+  sp.coefficients = [](const std::vector<ParameterSpace::Cd>& f) {
+    const auto two = ParameterSpace::Cd(2.0);
+    return std::vector<ParameterSpace::Cd>{f[0], f[1], f[2], f[3], f[4], two * f[5] * std::sqrt(f[0] * f[1]),
+                                           two * f[5] * std::sqrt(f[0] * f[2]), two * f[5] * std::sqrt(f[4] * f[3]), f[6]};
   };
-  std::vector<C> qc(static_cast<std::size_t>(P)), out;
-  for (int i = 0; i < P; ++i) qc[static_cast<std::size_t>(i)] = C(q[i], 0.0);
-  coef(qc, out);
-  const int nc = ScoleFE::kCount;
-  c.resize(nc);
-  for (int j = 0; j < nc; ++j) c[j] = out[static_cast<std::size_t>(j)].real();
-  // Complex-step derivative: exact to rounding.
-  dcdq.setZero(nc, P);
-  for (int i = 0; i < P; ++i) {
-    const double h = 1e-30 * std::max(1.0, std::abs(q[i]));
-    qc[static_cast<std::size_t>(i)] = C(q[i], h);
-    coef(qc, out);
-    for (int j = 0; j < nc; ++j) dcdq(j, i) = out[static_cast<std::size_t>(j)].imag() / h;
-    qc[static_cast<std::size_t>(i)] = C(q[i], 0.0);
-  }
+  return sp;
 }
-
-std::map<std::string, double> ScoleParameterization::physical(const VectorXd& q) const {
-  const std::vector<double> qv(q.data(), q.data() + q.size());
-  const State<double> s = state(qv);
-  std::map<std::string, double> out{{"rho_A", s.rho_A}, {"GJ", s.GJ}, {"rho_I_psi", s.rho_I_psi}, {"zeta", s.zeta}};
-  if (s.EI_roll == s.EI_pitch) {
-    out["EI"] = s.EI_roll;
-  } else {
-    out["EI_roll"] = s.EI_roll;
-    out["EI_pitch"] = s.EI_pitch;
-  }
-  return out;
-}
-
-template ScoleParameterization::State<double> ScoleParameterization::state(const std::vector<double>&) const;
 
 }  // namespace scoleid::identify

@@ -19,7 +19,7 @@ public:
   int elements() const override { return fe_.elements; }
   double length() const override { return fe_.length; }
   std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
-    return std::make_unique<BeamParameterization>(fe_, sc.beam, sc.identification, sc.source);
+    return std::make_unique<PhysicalParameterization>(beam_parameter_space(fe_, sc.beam), sc.identification, sc.source);
   }
   VectorXd coefficients(const io::Scenario& sc) const override {
     return beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta);
@@ -37,7 +37,7 @@ public:
   int elements() const override { return fe_.elements; }
   double length() const override { return fe_.spec.length; }
   std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
-    return std::make_unique<ScoleParameterization>(sc.scole, sc.identification, sc.source);
+    return std::make_unique<PhysicalParameterization>(scole_parameter_space(sc.scole), sc.identification, sc.source);
   }
   VectorXd coefficients(const io::Scenario& sc) const override { return scole_coefficients(sc.scole); }
 

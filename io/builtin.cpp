@@ -1,4 +1,5 @@
 #include "scoleid/io/builtin.h"
+#include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
 
 namespace scoleid::io {
@@ -15,6 +16,14 @@ std::vector<std::string> builtin_scenario_names() {
   std::vector<std::string> names;
   for (const auto& s : all_builtins()) names.push_back(s.name);
   return names;
+}
+
+std::string builtin_scenario_text(const std::string& name) {
+  const std::string yaml = builtin_scenario_yaml(name);
+  if (!yaml.empty()) return yaml;
+  std::string names;
+  for (const auto& n : builtin_scenario_names()) names += (names.empty() ? "" : ", ") + n;
+  throw InputError("--print-scenario: '" + name + "' is not a built-in scenario (" + names + ")");
 }
 
 std::string builtin_scenario_yaml(const std::string& name) {

@@ -23,7 +23,8 @@ std::vector<Row> rows(const Scenario& sc) {
          {{"rho_I_psi", "mast torsional inertia per unit length", "mass·length"},
           [](Scenario& s) -> double& { return s.scole.rho_I_psi; }},
          {{"zeta", "mast damping parameter ζ (docs/theory.md §3.3)", "see §3.3"},
-          [](Scenario& s) -> double& { return s.scole.zeta; }}};
+          [](Scenario& s) -> double& { return s.scole.zeta; }},
+         {{"m_reflector", "reflector mass", "mass"}, [](Scenario& s) -> double& { return s.scole.reflector.mass; }}};
     return r;
   }
   r = {{{"rho_A", "mass per unit length", "mass/length"}, [](Scenario& s) -> double& { return s.beam.rho_A; }},

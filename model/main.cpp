@@ -63,10 +63,7 @@ int main(int argc, char** argv) {
   io::install_interrupt_handlers();
   try {
     if (!print_name.empty()) {
-      const std::string yaml = io::builtin_scenario_yaml(print_name);
-      if (yaml.empty()) io::load_scenario(print_name);  // names the built-ins in its error
-      if (yaml.empty()) throw io::InputError("--print-scenario: '" + print_name + "' is not a built-in scenario");
-      std::fputs(yaml.c_str(), stdout);
+      std::fputs(io::builtin_scenario_text(print_name).c_str(), stdout);
       return 0;
     }
     if (list) {

@@ -319,6 +319,10 @@ std::string scole_yaml(const char* name, const char* identification) {
   return std::string("name: ") + name + "\nstructure: scole\nscole: {zeta: 0.01}\n" + kScoleInputs + identification;
 }
 
+// The reflector's mass, a quantity of SCOLE's parameter table like any other.
+const char* kReflectorId =
+    "identification: {parameterization: physical, estimate: [m_reflector, EI, rho_A],\n"
+    "  initial: {m_reflector: 11.5, EI: 3.8e7, rho_A: 0.09}, elements: 4}\n";
 const char* kPaperId = "identification: {parameterization: paper, estimate: [q1, q2], initial: {rho_A: 0.085, EI: 3.6e7}, elements: 4}\n";
 const char* kPhysicalId =
     "identification: {parameterization: physical, estimate: [EI_roll, EI_pitch, rho_A, rho_I_psi, GJ, zeta],\n"
@@ -387,10 +391,11 @@ void check_gradient(const std::string& yaml) {
 
 TEST(ScoleGradient, PaperParameters) { check_gradient(scole_yaml("grad-scole-paper", kPaperId)); }
 TEST(ScoleGradient, PhysicalParameters) { check_gradient(scole_yaml("grad-scole-physical", kPhysicalId)); }
+TEST(ScoleGradient, ReflectorMass) { check_gradient(scole_yaml("grad-scole-reflector", kReflectorId)); }
 
 TEST(ScoleGradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
-  for (const char* id : {kPaperId, kPhysicalId}) {
+  for (const char* id : {kPaperId, kPhysicalId, kReflectorId}) {
     Case e = make_case(scole_yaml("taylor", id), false);
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
     for (std::size_t k = 1; k < R.size(); ++k) {

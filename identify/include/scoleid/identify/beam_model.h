@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "scoleid/identify/parameterization.h"
+#include "scoleid/identify/physical_parameterization.h"
 #include "scoleid/identify/structural_model.h"
 #include "scoleid/io/scenario.h"
 
@@ -43,40 +43,10 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
 // Coefficients c for a physical state (ρA, EI per section, ζ).
 VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta);
 
-// Named parameters for a beam (see io::IdentificationSpec):
-//   physical: rho_A, EI (all sections), EI_k (k = 1..N), zeta
-//   paper:    q1 = EI/ρA, q2 = 1/ρA, q3 = 2ζ sqrt(EI/ρA)  (the beam equation divided by ρA)
-// Quantities not estimated keep their starting values: the scenario's values overridden by
-// identification.initial.
-class BeamParameterization final : public Parameterization {
-public:
-  BeamParameterization(const BeamFE& fe, const io::BeamSpec& truth, const io::IdentificationSpec& id,
-                       const std::string& source);
-  const std::vector<std::string>& names() const override { return names_; }
-  void coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const override;
-  std::map<std::string, double> physical(const VectorXd& q) const override;
-  VectorXd initial() const override { return initial_; }
-  VectorXd truth() const override { return truth_; }
-  bool paper_form() const override { return paper_; }
-
-  template <class T>
-  struct State {
-    T rho_A;
-    std::vector<T> EI;
-    T zeta;
-  };
-  template <class T>
-  State<T> state(const std::vector<T>& q) const;
-
-private:
-  VectorXd parameters_of(const State<double>& s) const;
-
-  int sections_ = 1;
-  int ncoef_ = 0;
-  bool paper_ = false;
-  std::vector<std::string> names_;
-  State<double> start_;  // physical starting state (fixed values for what is not estimated)
-  VectorXd initial_, truth_;
-};
+// The beam's parameter space (physical_parameterization.h): φ = [ρA, EI_1..EI_N (the model's N
+// sections), ζ], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
+// q3 = 2ζ√(EI/ρA) (uniform beams only). φ's values: the scenario's beam (sections expanded to
+// the model's; a model section's true EI is known when it lies inside one scenario section).
+ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam);
 
 }  // namespace scoleid::identify

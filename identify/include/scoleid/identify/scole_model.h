@@ -32,8 +32,9 @@
 //              ξ_k = (ξx, ξy); axially it moves with the mast. KE ½ m_k (ξ̇x² + ξ̇y² + ẇ²). With no
 //              slider stiffness these DOFs are free: K has 6 + 2·(actuators) zero eigenvalues,
 //              and an unforced proof mass does not load the mast laterally.
-// Coefficients c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors]; the shuttle,
-// reflector and proof masses are constant terms (coefficient −1).
+// Coefficients c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors, m_reflector]; the
+// reflector's translational mass is its own term (so m_reflector can be estimated); the shuttle,
+// the reflector's rotary inertia and the proof masses are constant terms (coefficient −1).
 //
 // DOF order (keeps M + γD + γ²K banded): X, Y, θx, θy, θz; then nodes 1..n, each
 // (u_x, u_x', u_y, u_y', ψ), the proof masses' (ξx, ξy) right after the node nearest them;
@@ -56,7 +57,7 @@
 #include <string>
 #include <vector>
 
-#include "scoleid/identify/parameterization.h"
+#include "scoleid/identify/physical_parameterization.h"
 #include "scoleid/identify/structural_model.h"
 #include "scoleid/io/scenario.h"
 
@@ -67,7 +68,7 @@ struct ScoleFE {
   io::ScoleSpec spec;
   int elements = 0;
 
-  enum Coefficient { kRhoA = 0, kEIRoll, kEIPitch, kGJ, kRhoIPsi, kCRoll, kCPitch, kCTors, kCount };
+  enum Coefficient { kRhoA = 0, kEIRoll, kEIPitch, kGJ, kRhoIPsi, kCRoll, kCPitch, kCTors, kMReflector, kCount };
   // Field of a mast node DOF.
   enum Field { kUx = 0, kUxSlope, kUy, kUySlope, kPsi };
 
@@ -103,35 +104,9 @@ ScoleFE build_scole(const io::ScoleSpec& scole, int elements, const std::vector<
 // Coefficients c for the physical values of a ScoleSpec.
 VectorXd scole_coefficients(const io::ScoleSpec& s);
 
-// Named parameters for SCOLE (see io::IdentificationSpec):
-//   physical: rho_A, EI (both planes), EI_roll, EI_pitch, GJ, rho_I_psi, zeta
-//   paper:    q1 = EI/ρA (both planes), q2 = 1/ρA (the bending equations divided by ρA)
-// Quantities not estimated keep their starting values: the scenario's, overridden by
-// identification.initial (keys: the physical names above and q1, q2; EI sets both planes).
-class ScoleParameterization final : public Parameterization {
-public:
-  ScoleParameterization(const io::ScoleSpec& truth, const io::IdentificationSpec& id, const std::string& source);
-  const std::vector<std::string>& names() const override { return names_; }
-  void coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const override;
-  std::map<std::string, double> physical(const VectorXd& q) const override;
-  VectorXd initial() const override { return initial_; }
-  VectorXd truth() const override { return truth_; }
-  bool paper_form() const override { return paper_; }
-
-  template <class T>
-  struct State {
-    T rho_A, EI_roll, EI_pitch, GJ, rho_I_psi, zeta;
-  };
-  template <class T>
-  State<T> state(const std::vector<T>& q) const;
-
-private:
-  VectorXd parameters_of(const State<double>& s) const;
-
-  bool paper_ = false;
-  std::vector<std::string> names_;
-  State<double> start_;
-  VectorXd initial_, truth_;
-};
+// SCOLE's parameter space (physical_parameterization.h): φ = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, ζ,
+// m_reflector], the group EI (both bending planes), the paper form q1 = EI/ρA, q2 = 1/ρA (the
+// bending equations divided by ρA).
+ParameterSpace scole_parameter_space(const io::ScoleSpec& scole);
 
 }  // namespace scoleid::identify

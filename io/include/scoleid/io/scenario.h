@@ -170,6 +170,8 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
 
 std::vector<std::string> builtin_scenario_names();
 std::string builtin_scenario_yaml(const std::string& name);  // "" if unknown
+// The same, or InputError naming the built-ins (--print-scenario).
+std::string builtin_scenario_text(const std::string& name);
 std::string builtin_scenario_description(const std::string& name);
 
 // Every field, defaults included: the settings a run actually used, echoed into its outputs.
