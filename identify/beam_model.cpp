@@ -142,8 +142,8 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
     if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
-    if (se.kind != "displacement" && se.kind != "rotation")
-      fail_field(source, f + ".kind", "is not supported by the beam identifier (displacement|rotation)",
+    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "velocity" && se.kind != "acceleration")
+      fail_field(source, f + ".kind", "is not supported by the beam identifier (displacement|rotation|velocity|acceleration)",
                  "'" + se.kind + "'");
     if (!(se.location >= 0.0 && se.location <= beam.length))
       fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
@@ -151,6 +151,8 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     ModelSensor ms;
     ms.name = se.name;
     ms.kind = se.kind;
+    // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
+    ms.order = se.kind == "velocity" ? 1 : se.kind == "acceleration" ? 2 : 0;
     ms.row = se.kind == "rotation" ? fe.rotation_row(se.location) : fe.displacement_row(se.location);
     m.sensors.push_back(std::move(ms));
   }

@@ -102,6 +102,8 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
   d.D = MatrixXd(ops.D);
   d.K = MatrixXd(ops.K);
   d.Minv = d.M.inverse();
+  if (m.has_rate_outputs())
+    throw std::invalid_argument("cvodes_adjoint_gradient: velocity and acceleration sensors are not supported by the reference");
   d.C = m.output_matrix();
   d.loads = ops.loads;
   d.R = Eigen::Map<const VectorXd>(obj.weights().data(), d.ns);

@@ -23,7 +23,12 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   if (data_.sensors() != static_cast<int>(model_.sensors.size()))
     throw std::invalid_argument("Objective: one measurement column per model sensor");
   if (data_.t.size() < 2) throw std::invalid_argument("Objective: at least two samples");
-  C_ = model_.output_matrix();
+  C_ = model_.output_matrix(0);
+  if (model_.has_rate_outputs()) {
+    C1_ = model_.output_matrix(1);
+    C2_ = model_.output_matrix(2);
+    accelerations_ = C2_.cwiseAbs().maxCoeff() > 0.0;
+  }
   T_ = data_.t.back();
   const double t0 = data_.t.front();
   const int ns = data_.sensors();
@@ -114,6 +119,42 @@ SecondOrderSolver::Forcing Objective::state_forcing(const Setup& s) const {
   };
 }
 
+VectorXd Objective::output_at(const Setup& s, const SecondOrderSolver& solver, double t, const VectorXd& x,
+                              const VectorXd& v, VectorXd* a) const {
+  if (C1_.size() == 0) return C_ * x;
+  VectorXd y = C_ * x + C1_ * v;
+  if (accelerations_) {
+    const int n = model_.ndof;
+    VectorXd F = VectorXd::Zero(n), acc(n);
+    for (std::size_t i = 0; i < s.ops.loads.size(); ++i) {
+      const double fi = inputs_[i](t);
+      if (fi != 0.0) F += fi * s.ops.loads[i];
+    }
+    solver.acceleration(F.data(), x.data(), v.data(), acc.data());
+    y += C2_ * acc;
+    if (a) *a = acc;
+  }
+  return y;
+}
+
+VectorXd Objective::tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
+                                      const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const {
+  if (C1_.size() == 0) return C_ * si;
+  VectorXd y = C_ * si + C1_ * svi;
+  if (accelerations_) {
+    // S̈ from the sensitivity equation M S̈ + D Ṡ + K S = −(∂M ü + ∂D u̇ + ∂K u − ∂b f).
+    const int n = model_.ndof;
+    VectorXd G = -(d.dM * a + d.dD * v + d.dK * x), acc(n);
+    for (std::size_t k = 0; k < d.db.size(); ++k) {
+      const double fk = inputs_[k](t);
+      if (fk != 0.0) G += fk * d.db[k];
+    }
+    solver.acceleration(G.data(), si.data(), svi.data(), acc.data());
+    y += C2_ * acc;
+  }
+  return y;
+}
+
 Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s, double t_end) {
   const auto t0 = Clock::now();
   SolverSummary sum;
@@ -136,7 +177,7 @@ std::vector<double> Objective::union_grid(const std::vector<const std::vector<do
   return g;
 }
 
-double Objective::cost_of(const Trajectory& u) const {
+double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const {
   const int n = model_.ndof, ns = data_.sensors();
   const auto grid = union_grid({&u.times()}, T_);
   VectorXd x(n), v(n), z(ns);
@@ -147,7 +188,7 @@ double Objective::cost_of(const Trajectory& u) const {
       const double t = grid[k] + kGx[g] * h;
       u.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
-      const VectorXd r = C_ * x - z;
+      const VectorXd r = output_at(s, solver, t, x, v) - z;
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
       J += 0.5 * kGw[g] * h * e;
@@ -156,7 +197,8 @@ double Objective::cost_of(const Trajectory& u) const {
   return J;
 }
 
-Objective::MisfitProfile Objective::misfit_profile(const Trajectory& u) const {
+Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,
+                                                  const Trajectory& u) const {
   const int n = model_.ndof, ns = data_.sensors();
   const double t_end = data_.t.back();
   const auto grid = union_grid({&u.times()}, t_end);
@@ -178,7 +220,7 @@ Objective::MisfitProfile Objective::misfit_profile(const Trajectory& u) const {
       const double t = grid[k] + kGx[g] * h;
       u.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
-      const VectorXd r = C_ * x - z;
+      const VectorXd r = output_at(s, solver, t, x, v) - z;
       rr += kGw[g] * h * r.cwiseAbs2();
       zz += kGw[g] * h * z.cwiseAbs2();
     }
@@ -192,12 +234,18 @@ double Objective::cost(const VectorXd& q) {
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const Trajectory u = forward(solver, s, T_);
   const auto t0 = Clock::now();
-  const double J = cost_of(u);
+  const double J = cost_of(s, solver, u);
   counters_.quadrature_seconds += since(t0);
   return J;
 }
 
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
+  if (C1_.size() != 0) {
+    // Velocity and acceleration sensors: the gradient from the forward sensitivities (the exact
+    // derivative of the discrete cost, P extra solves) until the costate carries their forcing.
+    MatrixXd H;
+    return gauss_newton(q, gradient, H);
+  }
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const Trajectory u = forward(solver, s, T_);
@@ -344,8 +392,11 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
 
   const auto tq = Clock::now();
   const auto grid = union_grid({&u.times()}, T_);
-  VectorXd x(n), v(n), z(ns), si(n), sv(n);
+  VectorXd x(n), v(n), a(n), z(ns), si(n), sv(n);
   MatrixXd CS(ns, P);
+  std::vector<Derivative> d;
+  if (accelerations_)
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
@@ -356,10 +407,11 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
       const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
       u.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
-      const VectorXd r = C_ * x - z;
+      const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
       for (int i = 0; i < P; ++i) {
         S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
-        CS.col(i) = C_ * si;
+        CS.col(i) = accelerations_ ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
+                                   : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
       }
       const MatrixXd RCS = Rv.asDiagonal() * CS;
       J += 0.5 * wt * r.dot(Rv.cwiseProduct(r));
@@ -367,7 +419,7 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
       H += wt * CS.transpose() * RCS;
     }
   }
-  if (profile) *profile = misfit_profile(u);
+  if (profile) *profile = misfit_profile(s, solver, u);
   counters_.quadrature_seconds += since(tq);
   return J;
 }
@@ -377,7 +429,7 @@ Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const Trajectory u = forward(solver, s, data_.t.back());
   const auto t0 = Clock::now();
-  MisfitProfile p = misfit_profile(u);
+  MisfitProfile p = misfit_profile(s, solver, u);
   counters_.quadrature_seconds += since(t0);
   return p;
 }
@@ -403,7 +455,7 @@ MatrixXd Objective::predict(const VectorXd& q) {
   VectorXd x(n), v(n);
   for (std::size_t k = 0; k < data_.t.size(); ++k) {
     u.eval(data_.t[k], x.data(), v.data());
-    Y.row(static_cast<Eigen::Index>(k)) = (C_ * x).transpose();
+    Y.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
   }
   return Y;
 }
@@ -416,12 +468,19 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
   const double t_end = data_.t.back();
   const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, t_end, t_end, u);
   MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
-  VectorXd x(n), v(n);
-  for (int i = 0; i < P; ++i)
+  VectorXd x(n), v(n), a(n), ux(n), uv(n);
+  for (int i = 0; i < P; ++i) {
+    const Derivative d = accelerations_ ? derivative(s, i) : Derivative{};
     for (std::size_t k = 0; k < data_.t.size(); ++k) {
-      S[static_cast<std::size_t>(i)].eval(data_.t[k], x.data(), v.data());
-      G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) = C_ * x;
+      const double t = data_.t[k];
+      S[static_cast<std::size_t>(i)].eval(t, x.data(), v.data());
+      if (accelerations_) {
+        u.eval(t, ux.data(), uv.data());
+        output_at(s, solver, t, ux, uv, &a);
+      }
+      G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) = tangent_output_at(solver, d, t, ux, uv, a, x, v);
     }
+  }
   return G;
 }
 

@@ -137,12 +137,21 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
   const Trajectory u = solver.solve(0.0, times.back(), f, bps);
   Measurements m;
   m.t = times;
-  const MatrixXd C = model.output_matrix();
+  // y = C_0 u + C_1 u̇ + C_2 ü, ü from the equation of motion at the sample time.
+  const MatrixXd C = model.output_matrix(0), C1 = model.output_matrix(1), C2 = model.output_matrix(2);
+  const bool rates = model.has_rate_outputs();
   m.z.resize(static_cast<Eigen::Index>(times.size()), C.rows());
-  VectorXd x(n), v(n);
+  VectorXd x(n), v(n), a(n), F(n);
   for (std::size_t k = 0; k < times.size(); ++k) {
     u.eval(times[k], x.data(), v.data());
-    m.z.row(static_cast<Eigen::Index>(k)) = (C * x).transpose();
+    VectorXd y = C * x;
+    if (rates) {
+      F.setZero();
+      f(times[k], F.data());
+      solver.acceleration(F.data(), x.data(), v.data(), a.data());
+      y += C1 * v + C2 * a;
+    }
+    m.z.row(static_cast<Eigen::Index>(k)) = y.transpose();
   }
   for (const auto& s : sc.sensors) m.names.push_back(s.name);
   if (add_noise) {

@@ -342,14 +342,28 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
-    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight")
-      fail_field(source, f + ".kind",
-                 "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight: outputs act on the "
-                 "displacements)",
-                 "'" + se.kind + "'");
     const Vector3d d = direction(se.direction, f + ".direction");
     Eigen::RowVectorXd row;
-    if (se.at == "shuttle") {
+    int order = 0;
+    if (se.kind == "velocity" || se.kind == "acceleration") {
+      // velocity: d/dt of the displacement sensor's quantity (relative to the shuttle frame; the
+      // shuttle's own CM in ground), a row on u̇. acceleration: the inertial acceleration of the
+      // point along d (an accelerometer), the absolute displacement's row on ü.
+      order = se.kind == "velocity" ? 1 : 2;
+      if (se.at != "shuttle" && se.at != "mast" && se.at != "reflector")
+        fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
+      const bool mast = se.at == "mast";
+      if (mast) check_station(se.location, f + ".location");
+      const MatrixXd absolute = se.at == "shuttle" ? fr.shuttle_rigid(Vector3d::Zero())
+                                : mast           ? fr.displacement(se.location)
+                                                 : fr.reflector();
+      const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
+      row = d.transpose() * (order == 2 || se.at == "shuttle" ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
+    } else if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight") {
+      fail_field(source, f + ".kind",
+                 "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
+                 "'" + se.kind + "'");
+    } else if (se.at == "shuttle") {
       if (se.kind == "line_of_sight")
         fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
       // Reference: ground; the shuttle's CM displacement and attitude.
@@ -381,6 +395,7 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     ModelSensor ms;
     ms.name = se.name;
     ms.kind = se.kind;
+    ms.order = order;
     ms.row = row * fe.T;
     m.sensors.push_back(std::move(ms));
   }

@@ -12,10 +12,17 @@ SparseMatrix StructuralModel::assemble(const std::vector<OperatorTerm>& terms, c
   return A;
 }
 
-MatrixXd StructuralModel::output_matrix() const {
-  MatrixXd C(static_cast<int>(sensors.size()), ndof);
-  for (std::size_t k = 0; k < sensors.size(); ++k) C.row(static_cast<int>(k)) = sensors[k].row;
+MatrixXd StructuralModel::output_matrix(int order) const {
+  MatrixXd C = MatrixXd::Zero(static_cast<int>(sensors.size()), ndof);
+  for (std::size_t k = 0; k < sensors.size(); ++k)
+    if (sensors[k].order == order) C.row(static_cast<int>(k)) = sensors[k].row;
   return C;
+}
+
+bool StructuralModel::has_rate_outputs() const {
+  for (const auto& s : sensors)
+    if (s.order > 0) return true;
+  return false;
 }
 
 AssembledModel assemble(const StructuralModel& model, const VectorXd& c) {

@@ -36,7 +36,8 @@ struct BeamFE {
 };
 
 // `source` names the scenario in error messages. Inputs of kind force/moment at `location`;
-// sensors of kind displacement/rotation (others are rejected with InputError).
+// sensors of kind displacement/rotation (rows on u), velocity (u̇), acceleration (ü); others are
+// rejected with InputError.
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
                   const std::vector<io::SensorSpec>& sensors, const std::string& source);
 

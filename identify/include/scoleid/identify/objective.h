@@ -2,7 +2,11 @@
 // The identification functional and its derivatives (docs/theory.md §6, paper Eqs. 18–25).
 //
 //   state     M ü + D u̇ + K u = Σ_i γ_i b_i f_i(t),           u(0) = u̇(0) = 0
-//   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C u − z̃(t)
+//   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C u − z̃(t)   (displacement-type sensors; velocity and
+//             acceleration sensors add C_1 u̇ + C_2 ü, ü from the equation of motion at each
+//             quadrature point, and their Gauss–Newton rows C_1 Ṡ + C_2 S̈ likewise. With them the
+//             gradient is taken from the forward sensitivities: the costate below has no forcing
+//             for u̇ and ü outputs yet.)
 //   costate   M p̈ − D ṗ + K p = −Cᵀ R r,                      p(T) = ṗ(T) = 0   (Eqs. 23–24)
 //             integrated backward as P(τ) = p(T − τ):  M P'' + D P' + K P = −Cᵀ R r(T − τ)
 //   gradient  ∂J/∂q_i = ∫₀ᵀ pᵀ (∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) dt                (Eq. 25)
@@ -112,8 +116,16 @@ private:
   };
   Setup setup(const VectorXd& q) const;
   Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
-  double cost_of(const Trajectory& u) const;
-  MisfitProfile misfit_profile(const Trajectory& u) const;
+  double cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  MisfitProfile misfit_profile(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  // Outputs at t from the state (x, v): C_0 x + C_1 v + C_2 a, a from the equation of motion
+  // (returned through `a` when a sensor reads it).
+  struct Derivative;
+  VectorXd output_at(const Setup& s, const SecondOrderSolver& solver, double t, const VectorXd& x, const VectorXd& v,
+                     VectorXd* a = nullptr) const;
+  // Output sensitivity at t: C_0 S + C_1 Ṡ + C_2 S̈, S̈ from the sensitivity equation.
+  VectorXd tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
+                             const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const;
   // Union of the given time sets and the sample times, restricted to [t0, t_end].
   std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const;
   SecondOrderSolver::Forcing state_forcing(const Setup& s) const;
@@ -144,7 +156,9 @@ private:
   std::vector<io::Signal> inputs_;
   Measurements data_;
   ObjectiveOptions options_;
-  MatrixXd C_;
+  MatrixXd C_;            // rows on u
+  MatrixXd C1_, C2_;      // rows on u̇ and ü (empty without velocity or acceleration sensors)
+  bool accelerations_ = false;
   std::vector<double> R_;
   std::vector<double> breakpoints_;
   double T_ = 0.0;  // horizon: end of the cost integral

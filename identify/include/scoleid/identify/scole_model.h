@@ -53,7 +53,9 @@
 //   rotation      θ_RB·d = (Θ_B − θ)·d, Θ_B = Θ(s) on the mast, Θ(L) for the reflector
 //   line_of_sight (u0 × u)·d, u, u0 unit vectors root→P: linearised (u0 × δp_rel)·d / |p_P0 − r0|
 //   at: shuttle   (R = ground): displacement X·d, rotation θ·d
-//   velocity and acceleration act on u̇, ü (outputs here are rows on u) and are rejected.
+//   velocity      d/dt of the displacement quantity (relative; the shuttle's CM in ground): its row on u̇
+//   acceleration  inertial acceleration of the point along d (an accelerometer): the absolute
+//                 displacement's row (u_x, u_y, w)(s), u_R or the shuttle CM, on ü
 #include <string>
 #include <vector>
 

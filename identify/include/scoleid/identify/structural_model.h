@@ -32,9 +32,11 @@ struct ModelInput {
   int coefficient = -1;   // γ_i = c[coefficient], or 1
 };
 
+// A sensor is a row on u, u̇ or ü: y_k = C_k u^(order).
 struct ModelSensor {
   std::string name;
-  std::string kind;       // displacement | rotation (rows act on u)
+  std::string kind;       // displacement | rotation | line_of_sight (order 0) | velocity (1) | acceleration (2)
+  int order = 0;          // derivative the row acts on
   Eigen::RowVectorXd row; // C_k
 };
 
@@ -52,8 +54,11 @@ struct StructuralModel {
     const int k = inputs[static_cast<std::size_t>(i)].coefficient;
     return k < 0 ? 1.0 : c[k];
   }
-  // Output matrix C (sensors × ndof).
-  MatrixXd output_matrix() const;
+  // Output matrix C_order (sensors × ndof): the rows of the sensors acting on the order-th time
+  // derivative of u, zero rows for the others; y = C_0 u + C_1 u̇ + C_2 ü.
+  MatrixXd output_matrix(int order = 0) const;
+  // Whether any sensor acts on u̇ or ü.
+  bool has_rate_outputs() const;
 };
 
 // Assembled operators at one coefficient vector.
