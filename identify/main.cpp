@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"

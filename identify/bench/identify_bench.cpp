@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <functional>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 
 using namespace scoleid::identify;
 using Clock = std::chrono::steady_clock;

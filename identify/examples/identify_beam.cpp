@@ -19,7 +19,7 @@
 #include <filesystem>
 #include <string>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/scenario.h"
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 #include "test_support.h"
 
 using namespace scoleid::identify;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 
 using namespace scoleid::identify;
 

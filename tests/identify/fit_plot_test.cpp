@@ -1,7 +1,7 @@
 // fit.gp / fit.png (identify/fit_plot.h): a name is only ever text to gnuplot. Sensor names
 // holding quotes, semicolons and gnuplot's own `system` command are drawn as titles, run
 // nothing, and the plot is still rendered; the directory may hold quotes too.
-#include "scoleid/identify/fit_plot.h"
+#include "scoleid/identify/run/fit_plot.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "scoleid/identify/gauss_newton_step.h"
+#include "scoleid/identify/inverse/gauss_newton_step.h"
 
 using namespace scoleid::identify;
 using Eigen::MatrixXd;

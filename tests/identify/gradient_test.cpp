@@ -7,8 +7,8 @@
 #include <cstdio>
 
 #include "test_support.h"
-#include "scoleid/identify/cvodes_adjoint.h"
-#include "scoleid/identify/problem.h"
+#include "scoleid/identify/inverse/cvodes_adjoint.h"
+#include "scoleid/identify/run/problem.h"
 
 using namespace scoleid::identify;
 using test_support::Case;

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "scoleid/identify/analytic_beam.h"
-#include "scoleid/identify/beam_model.h"
-#include "scoleid/identify/modal.h"
+#include "scoleid/identify/fe/analytic_beam.h"
+#include "scoleid/identify/fe/beam_model.h"
+#include "scoleid/identify/fe/modal.h"
 
 using namespace scoleid::identify;
 using scoleid::io::BeamSpec;

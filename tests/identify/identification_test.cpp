@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "scoleid/identify/beam_model.h"
-#include "scoleid/identify/analytic_beam.h"
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/fe/beam_model.h"
+#include "scoleid/identify/fe/analytic_beam.h"
+#include "scoleid/identify/run/identify_run.h"
 #include "test_support.h"
 
 using namespace scoleid::identify;

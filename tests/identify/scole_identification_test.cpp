@@ -14,9 +14,9 @@
 #include <complex>
 #include <cstdio>
 
-#include "scoleid/identify/esdirk_stepper.h"
-#include "scoleid/identify/identify_run.h"
-#include "scoleid/identify/scole_model.h"
+#include "scoleid/identify/time/esdirk_stepper.h"
+#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify/fe/scole_model.h"
 #include "test_support.h"
 
 using namespace scoleid::identify;

@@ -11,12 +11,12 @@
 #include <random>
 
 #include "test_support.h"
-#include "scoleid/identify/analytic_beam.h"
-#include "scoleid/identify/banded_cholesky.h"
-#include "scoleid/identify/cvodes_adjoint.h"
-#include "scoleid/identify/modal.h"
-#include "scoleid/identify/problem.h"
-#include "scoleid/identify/scole_model.h"
+#include "scoleid/identify/fe/analytic_beam.h"
+#include "scoleid/identify/time/banded_cholesky.h"
+#include "scoleid/identify/inverse/cvodes_adjoint.h"
+#include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/run/problem.h"
+#include "scoleid/identify/fe/scole_model.h"
 
 using namespace scoleid::identify;
 using test_support::Case;

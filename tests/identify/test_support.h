@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "scoleid/identify/identify_run.h"
+#include "scoleid/identify/run/identify_run.h"
 
 namespace scoleid::identify::test_support {
 

@@ -123,7 +123,7 @@ struct IdentificationSpec {
   double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
   // Gauss–Newton horizon continuation: fit the data up to the time where the relative
   // mean-square misfit per sensor reaches this bound, lengthening the horizon as the fit improves
-  // (identify/include/scoleid/identify/optimizers.h); 0 = fit the whole record from the start.
+  // (identify/include/scoleid/identify/inverse/optimizers.h); 0 = fit the whole record from the start.
   double continuation_misfit = 0.05;
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)

@@ -1,0 +1,230 @@
+#include "scoleid/identify/fe/beam_model.h"
+
+#include <cmath>
+
+#include "scoleid/identify/fe/hermite_beam.h"
+#include "scoleid/io/error.h"
+
+namespace scoleid::identify {
+
+using io::EndCondition;
+using io::fail_field;
+using io::format_value;
+
+namespace {
+
+int element_of(double s, double L, int ne, double& xi) {
+  const double h = L / ne;
+  int e = static_cast<int>(std::floor(s / h));
+  if (e >= ne) e = ne - 1;
+  if (e < 0) e = 0;
+  xi = (s - e * h) / h;
+  return e;
+}
+
+Eigen::RowVectorXd field_row(const BeamFE& fe, double s, bool rotation) {
+  Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(fe.model.ndof);
+  double xi = 0.0;
+  const double h = fe.length / fe.elements;
+  const int e = element_of(s, fe.length, fe.elements, xi);
+  const hermite::Vec4 n = rotation ? hermite::slope(xi, h) : hermite::shape(xi, h);
+  for (int a = 0; a < 4; ++a) {
+    const int r = fe.full_to_reduced[static_cast<std::size_t>(2 * e + a)];
+    if (r >= 0) row[r] += n[a];
+  }
+  return row;
+}
+
+}  // namespace
+
+Eigen::RowVectorXd BeamFE::displacement_row(double s) const { return field_row(*this, s, false); }
+Eigen::RowVectorXd BeamFE::rotation_row(double s) const { return field_row(*this, s, true); }
+
+BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
+                  const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+  if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
+  if (sections < 1) sections = static_cast<int>(beam.EI.size());
+  BeamFE fe;
+  fe.length = beam.length;
+  fe.elements = elements;
+  fe.sections = sections;
+  const int nfull = 2 * (elements + 1);
+
+  // Constrained DOFs.
+  std::vector<bool> fixed(static_cast<std::size_t>(nfull), false);
+  auto constrain = [&](int node, EndCondition ec) {
+    if (ec == EndCondition::Pinned || ec == EndCondition::Clamped) fixed[static_cast<std::size_t>(2 * node)] = true;
+    if (ec == EndCondition::Clamped) fixed[static_cast<std::size_t>(2 * node + 1)] = true;
+  };
+  constrain(0, beam.left);
+  constrain(elements, beam.right);
+  fe.full_to_reduced.assign(static_cast<std::size_t>(nfull), -1);
+  int n = 0;
+  for (int i = 0; i < nfull; ++i)
+    if (!fixed[static_cast<std::size_t>(i)]) fe.full_to_reduced[static_cast<std::size_t>(i)] = n++;
+  if (n == 0) fail_field(source, "beam", "leaves no free degree of freedom", std::to_string(elements) + " elements");
+
+  StructuralModel& m = fe.model;
+  m.ndof = n;
+  m.ncoef = 1 + 2 * sections;
+  m.coefficient_names.push_back("rho_A");
+  for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("EI_" + std::to_string(s + 1));
+  for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("c_" + std::to_string(s + 1));
+  m.dof_group.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < nfull; ++i) {
+    const int r = fe.full_to_reduced[static_cast<std::size_t>(i)];
+    if (r >= 0) m.dof_group[static_cast<std::size_t>(r)] = i % 2;  // 0: w, 1: θ
+  }
+
+  using Trip = Eigen::Triplet<double>;
+  const double h = beam.length / elements;
+  const double hs = beam.length / sections;
+  std::vector<Trip> mass;
+  std::vector<std::vector<Trip>> stiff(static_cast<std::size_t>(sections));
+  auto scatter = [&](std::vector<Trip>& out, int e, const hermite::Mat4& k) {
+    for (int a = 0; a < 4; ++a) {
+      const int ra = fe.full_to_reduced[static_cast<std::size_t>(2 * e + a)];
+      if (ra < 0) continue;
+      for (int b = 0; b < 4; ++b) {
+        const int rb = fe.full_to_reduced[static_cast<std::size_t>(2 * e + b)];
+        if (rb >= 0) out.emplace_back(ra, rb, k(a, b));
+      }
+    }
+  };
+  for (int e = 0; e < elements; ++e) {
+    scatter(mass, e, hermite::mass(h, 0.0, h));
+    // Split the element at section boundaries so EI jumps are integrated exactly.
+    const double sa = e * h, sb = (e + 1) * h;
+    int s = std::min(sections - 1, static_cast<int>(std::floor(sa / hs + 1e-12)));
+    double lo = sa;
+    while (lo < sb - 1e-12 * h) {
+      const double hi = std::min(sb, (s + 1) * hs);
+      if (hi > lo + 1e-12 * h) scatter(stiff[static_cast<std::size_t>(s)], e, hermite::stiffness(h, lo - sa, hi - sa));
+      lo = hi;
+      s = std::min(sections - 1, s + 1);
+      if (hi >= sb) break;
+    }
+  }
+  auto to_sparse = [n](const std::vector<Trip>& t) {
+    SparseMatrix A(n, n);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    return A;
+  };
+  m.mass.push_back({to_sparse(mass), fe.coef_rho_A()});
+  for (int s = 0; s < sections; ++s) {
+    const SparseMatrix Ks = to_sparse(stiff[static_cast<std::size_t>(s)]);
+    m.stiffness.push_back({Ks, fe.coef_EI(s)});
+    m.damping.push_back({Ks, fe.coef_damping(s)});
+  }
+  if (beam.tip_mass > 0.0 || beam.tip_inertia > 0.0) {
+    std::vector<Trip> tip;
+    const int rw = fe.full_to_reduced[static_cast<std::size_t>(2 * elements)];
+    const int rt = fe.full_to_reduced[static_cast<std::size_t>(2 * elements + 1)];
+    if (rw >= 0 && beam.tip_mass > 0.0) tip.emplace_back(rw, rw, beam.tip_mass);
+    if (rt >= 0 && beam.tip_inertia > 0.0) tip.emplace_back(rt, rt, beam.tip_inertia);
+    if (!tip.empty()) m.mass.push_back({to_sparse(tip), -1});
+  }
+
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto& in = inputs[i];
+    const std::string f = "inputs[" + std::to_string(i) + "]";
+    if (in.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + in.at + "'");
+    if (!(in.location >= 0.0 && in.location <= beam.length))
+      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
+                 format_value(in.location));
+    ModelInput mi;
+    mi.name = in.name;
+    mi.vector = (in.kind == "moment" ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
+    m.inputs.push_back(std::move(mi));
+  }
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const auto& se = sensors[k];
+    const std::string f = "sensors[" + std::to_string(k) + "]";
+    if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
+    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "velocity" && se.kind != "acceleration")
+      fail_field(source, f + ".kind", "is not supported by the beam identifier (displacement|rotation|velocity|acceleration)",
+                 "'" + se.kind + "'");
+    if (!(se.location >= 0.0 && se.location <= beam.length))
+      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
+                 format_value(se.location));
+    ModelSensor ms;
+    ms.name = se.name;
+    ms.kind = se.kind;
+    // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
+    ms.order = se.kind == "velocity" ? 1 : se.kind == "acceleration" ? 2 : 0;
+    ms.row = se.kind == "rotation" ? fe.rotation_row(se.location) : fe.displacement_row(se.location);
+    m.sensors.push_back(std::move(ms));
+  }
+  return fe;
+}
+
+VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta) {
+  VectorXd c(fe.model.ncoef);
+  c[fe.coef_rho_A()] = rho_A;
+  for (int s = 0; s < fe.sections; ++s) {
+    const double ei = EI.size() == 1 ? EI[0] : EI.at(static_cast<std::size_t>(s));
+    c[fe.coef_EI(s)] = ei;
+    c[fe.coef_damping(s)] = 2.0 * zeta * std::sqrt(rho_A * ei);
+  }
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+std::vector<double> expand_sections(const std::vector<double>& EI, int sections) {
+  std::vector<double> out(static_cast<std::size_t>(sections));
+  const int n = static_cast<int>(EI.size());
+  for (int s = 0; s < sections; ++s) {
+    // value at the centre of model section s, read from the scenario's own sections
+    const double x = (s + 0.5) / sections;
+    out[static_cast<std::size_t>(s)] = EI[static_cast<std::size_t>(std::min(n - 1, static_cast<int>(x * n)))];
+  }
+  return out;
+}
+// True sectional values are well defined when every model section lies inside one scenario section.
+bool sections_nest(int scenario_sections, int model_sections) {
+  return scenario_sections == 1 || model_sections % scenario_sections == 0;
+}
+}  // namespace
+
+ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) {
+  const int N = fe.sections;
+  ParameterSpace sp;
+  sp.structure = "beam";
+  const std::vector<double> EI = expand_sections(beam.EI, N);
+  const bool nest = sections_nest(static_cast<int>(beam.EI.size()), N);
+  sp.quantities.push_back("rho_A");
+  sp.value.push_back(beam.rho_A);
+  sp.true_value.push_back(true);
+  ParameterSpace::Group ei{"EI", {}, false};
+  for (int k = 0; k < N; ++k) {
+    sp.quantities.push_back("EI_" + std::to_string(k + 1));
+    sp.value.push_back(EI[static_cast<std::size_t>(k)]);
+    sp.true_value.push_back(nest);
+    ei.members.push_back(1 + k);
+  }
+  sp.quantities.push_back("zeta");
+  sp.value.push_back(beam.zeta);
+  sp.true_value.push_back(true);
+  sp.groups.push_back(ei);
+  sp.rho_A = 0;
+  sp.zeta = N + 1;
+  sp.has_q3 = true;
+  if (N > 1) sp.paper_requirement = "needs a uniform beam (one EI section), not " + std::to_string(N) + " sections";
+  sp.ncoef = fe.model.ncoef;
+  // c = [ρA, EI_1..EI_N, c_1..c_N], c_k = 2ζ√(ρA EI_k) (Kelvin–Voigt, docs/theory.md §2.2).
+  sp.coefficients = [N](const std::vector<ParameterSpace::Cd>& f) {
+    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(1 + 2 * N));
+    c[0] = f[0];
+    for (int k = 0; k < N; ++k) {
+      c[static_cast<std::size_t>(1 + k)] = f[static_cast<std::size_t>(1 + k)];
+      c[static_cast<std::size_t>(1 + N + k)] = 2.0 * f[static_cast<std::size_t>(N + 1)] * std::sqrt(f[0] * f[static_cast<std::size_t>(1 + k)]);
+    }
+    return c;
+  };
+  return sp;
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,434 @@
+#include "scoleid/identify/fe/scole_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include "scoleid/identify/fe/hermite_beam.h"
+#include "scoleid/io/error.h"
+
+namespace scoleid::identify {
+
+using Eigen::Vector3d;
+using io::fail_field;
+using io::format_value;
+
+namespace {
+
+using Trip = Eigen::Triplet<double>;
+
+enum Shuttle { kX = 0, kY, kZ, kTx, kTy, kTz };
+constexpr int kNodeDofs = 5;
+
+int full_node(int node, int field) { return 6 + kNodeDofs * node + field; }
+int full_proof(int elements, int k, int axis) { return 6 + kNodeDofs * (elements + 1) + 2 * k + axis; }
+
+// Element containing s and the local coordinate ξ ∈ [0, 1].
+int element_of(double s, double L, int ne, double& xi) {
+  const double h = L / ne;
+  const int e = std::clamp(static_cast<int>(std::floor(s / h)), 0, ne - 1);
+  xi = (s - e * h) / h;
+  return e;
+}
+
+Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+std::string vec_text(const std::vector<double>& v) {
+  return "[" + format_value(v[0]) + ", " + format_value(v[1]) + ", " + format_value(v[2]) + "]";
+}
+
+Eigen::Matrix3d inertia_matrix(const io::RigidBodySpec& b) {
+  // Products as the off-diagonal entries, as Simbody's Inertia(moments, products) takes them.
+  Eigen::Matrix3d I;
+  I << b.Ixx, b.Ixy, b.Ixz, b.Ixy, b.Iyy, b.Iyz, b.Ixz, b.Iyz, b.Izz;
+  return I;
+}
+
+// Rows on the full DOF vector (3 × nfull).
+class FullRows {
+public:
+  FullRows(const io::ScoleSpec& sc, int elements, int nfull) : sc_(sc), ne_(elements), nfull_(nfull) {}
+
+  MatrixXd zero() const { return MatrixXd::Zero(3, nfull_); }
+
+  // Axial displacement of any mast point: rigid with the shuttle.
+  Eigen::RowVectorXd axial() const {
+    Eigen::RowVectorXd a = Eigen::RowVectorXd::Zero(nfull_);
+    a[kZ] = 1.0;
+    a[kTx] = sc_.mast_root[1];
+    a[kTy] = -sc_.mast_root[0];
+    return a;
+  }
+  // Absolute displacement (u_x, u_y, w) of mast station s.
+  MatrixXd displacement(double s) const {
+    MatrixXd R = zero();
+    double xi = 0.0;
+    const double h = sc_.length / ne_;
+    const int e = element_of(s, sc_.length, ne_, xi);
+    const hermite::Vec4 n = hermite::shape(xi, h);
+    for (int a = 0; a < 4; ++a) {
+      const int node = e + a / 2, slope = a % 2;
+      R(0, full_node(node, ScoleFE::kUx + slope)) += n[a];
+      R(1, full_node(node, ScoleFE::kUy + slope)) += n[a];
+    }
+    R.row(2) = axial();
+    return R;
+  }
+  // Absolute cross-section rotation Θ = (u_y', −u_x', ψ) at s.
+  MatrixXd rotation(double s) const {
+    MatrixXd R = zero();
+    double xi = 0.0;
+    const double h = sc_.length / ne_;
+    const int e = element_of(s, sc_.length, ne_, xi);
+    const hermite::Vec4 d = hermite::slope(xi, h);
+    for (int a = 0; a < 4; ++a) {
+      const int node = e + a / 2, slope = a % 2;
+      R(0, full_node(node, ScoleFE::kUy + slope)) += d[a];
+      R(1, full_node(node, ScoleFE::kUx + slope)) -= d[a];
+    }
+    R(2, full_node(e, ScoleFE::kPsi)) += 1.0 - xi;
+    R(2, full_node(e + 1, ScoleFE::kPsi)) += xi;
+    return R;
+  }
+  // a × r for rows a (3 × n) and a constant vector r.
+  static MatrixXd cross(const MatrixXd& a, const Vector3d& r) {
+    MatrixXd c(3, a.cols());
+    c.row(0) = a.row(1) * r[2] - a.row(2) * r[1];
+    c.row(1) = a.row(2) * r[0] - a.row(0) * r[2];
+    c.row(2) = a.row(0) * r[1] - a.row(1) * r[0];
+    return c;
+  }
+  Vector3d reflector_offset() const { return {sc_.reflector_rx, sc_.reflector_ry, 0.0}; }
+  // Reflector CM: u(L) + Θ(L) × r.
+  MatrixXd reflector() const { return displacement(sc_.length) + cross(rotation(sc_.length), reflector_offset()); }
+  MatrixXd shuttle_rotation() const {
+    MatrixXd R = zero();
+    for (int i = 0; i < 3; ++i) R(i, kTx + i) = 1.0;
+    return R;
+  }
+  // X + θ × p0 (a point fixed to the shuttle at p0 from its CM).
+  MatrixXd shuttle_rigid(const Vector3d& p0) const {
+    MatrixXd R = cross(shuttle_rotation(), p0);
+    for (int i = 0; i < 3; ++i) R(i, kX + i) += 1.0;
+    return R;
+  }
+  Vector3d mast_point(double s) const { return vec3(sc_.mast_root) - s * Vector3d::UnitZ(); }
+  Vector3d reflector_point() const { return mast_point(sc_.length) + reflector_offset(); }
+
+private:
+  const io::ScoleSpec& sc_;
+  int ne_, nfull_;
+};
+
+// Adds rowsᵀ W rows (rows k × nfull, mostly zero) to a triplet list.
+void add_quadratic(std::vector<Trip>& out, const MatrixXd& rows, const MatrixXd& W) {
+  std::vector<int> cols;
+  for (int j = 0; j < rows.cols(); ++j)
+    if (rows.col(j).cwiseAbs().maxCoeff() != 0.0) cols.push_back(j);
+  const MatrixXd Wr = W * rows;
+  for (int a : cols)
+    for (int b : cols) {
+      const double v = rows.col(a).dot(Wr.col(b));
+      if (v != 0.0) out.emplace_back(a, b, v);
+    }
+}
+
+}  // namespace
+
+int ScoleFE::node_dof(int node, Field f) const { return node_reduced[static_cast<std::size_t>(kNodeDofs * node + f)]; }
+
+// The reduced rows are the full rows times T; FullRows only needs the geometry.
+MatrixXd ScoleFE::mast_displacement(double s) const { return FullRows(spec, elements, nfull).displacement(s) * T; }
+MatrixXd ScoleFE::mast_rotation(double s) const { return FullRows(spec, elements, nfull).rotation(s) * T; }
+MatrixXd ScoleFE::reflector_displacement() const { return FullRows(spec, elements, nfull).reflector() * T; }
+MatrixXd ScoleFE::shuttle_rigid_displacement(const Vector3d& p0) const {
+  return FullRows(spec, elements, nfull).shuttle_rigid(p0) * T;
+}
+MatrixXd ScoleFE::shuttle_rotation() const { return FullRows(spec, elements, nfull).shuttle_rotation() * T; }
+
+VectorXd ScoleFE::rigid_motion(const Vector3d& a, const Vector3d& theta) const {
+  VectorXd u = VectorXd::Zero(model.ndof);
+  for (int i = 0; i < 3; ++i) {
+    u[shuttle_dof(kX + i)] = a[i];
+    u[shuttle_dof(kTx + i)] = theta[i];
+  }
+  const FullRows fr(spec, elements, nfull);
+  const double h = spec.length / elements;
+  for (int n = 1; n <= elements; ++n) {
+    const Vector3d d = a + theta.cross(fr.mast_point(n * h));
+    u[node_dof(n, kUx)] = d[0];
+    u[node_dof(n, kUxSlope)] = -theta[1];
+    u[node_dof(n, kUy)] = d[1];
+    u[node_dof(n, kUySlope)] = theta[0];
+    u[node_dof(n, kPsi)] = theta[2];
+  }
+  for (std::size_t k = 0; k < spec.actuator_locations.size(); ++k) {
+    const Vector3d d = a + theta.cross(fr.mast_point(spec.actuator_locations[k]));
+    for (int ax = 0; ax < 2; ++ax) u[proof_mass_dof(static_cast<int>(k), ax)] = d[ax];
+  }
+  return u;
+}
+
+ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io::InputSpec>& inputs,
+                    const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+  if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
+  if (sc.mast_root.size() != 3)
+    fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(sc.mast_root.size()) + " values");
+  ScoleFE fe;
+  fe.spec = sc;
+  fe.elements = elements;
+  const int ne = elements;
+  const int nact = static_cast<int>(sc.actuator_locations.size());
+  const double L = sc.length, h = L / ne;
+  fe.nfull = 6 + kNodeDofs * (ne + 1) + 2 * nact;
+
+  // Reduced order: X, Y, θx, θy, θz | nodes 1..n (proof masses after their nearest node) | Z.
+  std::vector<int> order;  // full index of each reduced DOF
+  for (int i : {kX, kY, kTx, kTy, kTz}) order.push_back(i);
+  std::vector<std::vector<int>> after(static_cast<std::size_t>(ne + 1));
+  for (int k = 0; k < nact; ++k) {
+    const int node = std::clamp(static_cast<int>(std::lround(sc.actuator_locations[static_cast<std::size_t>(k)] / h)), 1, ne);
+    after[static_cast<std::size_t>(node)].push_back(k);
+  }
+  for (int n = 1; n <= ne; ++n) {
+    for (int f = 0; f < kNodeDofs; ++f) order.push_back(full_node(n, f));
+    for (int k : after[static_cast<std::size_t>(n)])
+      for (int ax = 0; ax < 2; ++ax) order.push_back(full_proof(ne, k, ax));
+  }
+  order.push_back(kZ);
+  const int n = static_cast<int>(order.size());
+  std::vector<int> reduced_of(static_cast<std::size_t>(fe.nfull), -1);
+  for (int r = 0; r < n; ++r) reduced_of[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] = r;
+  for (int i = 0; i < 6; ++i) fe.shuttle_reduced.push_back(reduced_of[static_cast<std::size_t>(i)]);
+  for (int nd = 0; nd <= ne; ++nd)
+    for (int f = 0; f < kNodeDofs; ++f) fe.node_reduced.push_back(reduced_of[static_cast<std::size_t>(full_node(nd, f))]);
+  for (int k = 0; k < nact; ++k)
+    for (int ax = 0; ax < 2; ++ax) fe.proof_reduced.push_back(reduced_of[static_cast<std::size_t>(full_proof(ne, k, ax))]);
+
+  // T: identity on the kept DOFs; the root node expressed in the shuttle's rigid motion.
+  {
+    std::vector<Trip> t;
+    for (int r = 0; r < n; ++r) t.emplace_back(order[static_cast<std::size_t>(r)], r, 1.0);
+    const Vector3d r0 = vec3(sc.mast_root);
+    auto S = [&](int i) { return fe.shuttle_reduced[static_cast<std::size_t>(i)]; };
+    t.emplace_back(full_node(0, ScoleFE::kUx), S(kX), 1.0);
+    t.emplace_back(full_node(0, ScoleFE::kUx), S(kTy), r0[2]);
+    t.emplace_back(full_node(0, ScoleFE::kUx), S(kTz), -r0[1]);
+    t.emplace_back(full_node(0, ScoleFE::kUxSlope), S(kTy), -1.0);
+    t.emplace_back(full_node(0, ScoleFE::kUy), S(kY), 1.0);
+    t.emplace_back(full_node(0, ScoleFE::kUy), S(kTz), r0[0]);
+    t.emplace_back(full_node(0, ScoleFE::kUy), S(kTx), -r0[2]);
+    t.emplace_back(full_node(0, ScoleFE::kUySlope), S(kTx), 1.0);
+    t.emplace_back(full_node(0, ScoleFE::kPsi), S(kTz), 1.0);
+    fe.T.resize(fe.nfull, n);
+    fe.T.setFromTriplets(t.begin(), t.end());
+    fe.T.makeCompressed();
+  }
+
+  StructuralModel& m = fe.model;
+  m.ndof = n;
+  m.ncoef = ScoleFE::kCount;
+  m.coefficient_names = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "c_roll", "c_pitch", "c_tors", "m_reflector"};
+  m.dof_group.assign(static_cast<std::size_t>(n), 0);  // 0: displacements [ft], 1: rotations [rad]
+  for (int i : {kTx, kTy, kTz}) m.dof_group[static_cast<std::size_t>(fe.shuttle_dof(i))] = 1;
+  for (int nd = 1; nd <= ne; ++nd)
+    for (auto f : {ScoleFE::kUxSlope, ScoleFE::kUySlope, ScoleFE::kPsi})
+      m.dof_group[static_cast<std::size_t>(fe.node_dof(nd, f))] = 1;
+
+  // Element operators on the full vector.
+  std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const, mass_refl;
+  const hermite::Mat4 Me = hermite::mass(h, 0.0, h), Ke = hermite::stiffness(h, 0.0, h);
+  for (int e = 0; e < ne; ++e) {
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        const int ax = full_node(e + a / 2, ScoleFE::kUx + a % 2), bx = full_node(e + b / 2, ScoleFE::kUx + b % 2);
+        const int ay = full_node(e + a / 2, ScoleFE::kUy + a % 2), by = full_node(e + b / 2, ScoleFE::kUy + b % 2);
+        mass_bend.emplace_back(ax, bx, Me(a, b));
+        mass_bend.emplace_back(ay, by, Me(a, b));
+        stiff_pitch.emplace_back(ax, bx, Ke(a, b));
+        stiff_roll.emplace_back(ay, by, Ke(a, b));
+      }
+    // Linear torsion element: ∫ N Nᵀ = h/6 [2 1; 1 2], ∫ N' N'ᵀ = 1/h [1 −1; −1 1].
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) {
+        const int pa = full_node(e + a, ScoleFE::kPsi), pb = full_node(e + b, ScoleFE::kPsi);
+        mass_tors.emplace_back(pa, pb, h / 6.0 * (a == b ? 2.0 : 1.0));
+        stiff_tors.emplace_back(pa, pb, (a == b ? 1.0 : -1.0) / h);
+      }
+  }
+  const FullRows fr(sc, ne, fe.nfull);
+  // The mast's rigid axial motion: ρA L w².
+  add_quadratic(mass_bend, fr.axial(), MatrixXd::Constant(1, 1, L));
+  // Shuttle.
+  {
+    MatrixXd tr = fr.zero();
+    for (int i = 0; i < 3; ++i) tr(i, kX + i) = 1.0;
+    add_quadratic(mass_const, tr, sc.shuttle.mass * MatrixXd::Identity(3, 3));
+    add_quadratic(mass_const, fr.shuttle_rotation(), inertia_matrix(sc.shuttle));
+  }
+  // Reflector: translation of its CM and rotation of the tip section.
+  add_quadratic(mass_refl, fr.reflector(), MatrixXd::Identity(3, 3));  // × m_reflector
+  add_quadratic(mass_const, fr.rotation(L), inertia_matrix(sc.reflector));
+  // Proof masses: free laterally, axially with the mast.
+  for (int k = 0; k < nact; ++k) {
+    MatrixXd p = fr.zero();
+    p(0, full_proof(ne, k, 0)) = 1.0;
+    p(1, full_proof(ne, k, 1)) = 1.0;
+    p.row(2) = fr.axial();
+    add_quadratic(mass_const, p, sc.actuator_mass * MatrixXd::Identity(3, 3));
+  }
+
+  auto reduce = [&](const std::vector<Trip>& t) {
+    SparseMatrix F(fe.nfull, fe.nfull);
+    F.setFromTriplets(t.begin(), t.end());
+    SparseMatrix R = SparseMatrix(fe.T.transpose()) * F * fe.T;
+    R.prune(0.0);
+    R.makeCompressed();
+    return R;
+  };
+  const SparseMatrix Kr = reduce(stiff_roll), Kp = reduce(stiff_pitch), Kt = reduce(stiff_tors);
+  m.mass = {{reduce(mass_bend), ScoleFE::kRhoA},
+            {reduce(mass_tors), ScoleFE::kRhoIPsi},
+            {reduce(mass_refl), ScoleFE::kMReflector},
+            {reduce(mass_const), -1}};
+  m.stiffness = {{Kr, ScoleFE::kEIRoll}, {Kp, ScoleFE::kEIPitch}, {Kt, ScoleFE::kGJ}};
+  m.damping = {{Kr, ScoleFE::kCRoll}, {Kp, ScoleFE::kCPitch}, {Kt, ScoleFE::kCTors}};
+
+  auto direction = [&](const std::vector<double>& d, const std::string& field) {
+    const Vector3d v = vec3(d);
+    if (!(v.norm() > 0.0)) fail_field(source, field, "must be given (x, y, z or a 3-vector)", "none");
+    return v;
+  };
+  auto check_station = [&](double s, const std::string& field) {
+    if (!(s >= 0.0 && s <= L))
+      fail_field(source, field, "must lie on the mast [0, " + format_value(L) + "]", format_value(s));
+  };
+
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto& in = inputs[i];
+    const std::string f = "inputs[" + std::to_string(i) + "]";
+    const Vector3d d = direction(in.direction, f + ".direction");
+    const bool moment = in.kind == "moment";
+    MatrixXd rows;
+    if (in.at == "shuttle") {
+      rows = moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
+    } else if (in.at == "reflector") {
+      rows = moment ? fr.rotation(L) : fr.reflector();
+    } else if (in.at == "mast") {
+      check_station(in.location, f + ".location");
+      rows = moment ? fr.rotation(in.location) : fr.displacement(in.location);
+    } else if (in.at == "actuator1" || in.at == "actuator2") {
+      const int k = in.at == "actuator1" ? 0 : 1;
+      if (k >= nact)
+        fail_field(source, f + ".at", "names an actuator the configuration does not have", "'" + in.at + "'");
+      if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", "'" + in.kind + "'");
+      if (std::abs(d[2]) > 1e-12)
+        fail_field(source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
+      // Slider force: +f on the proof mass, −f on the mast at s_k.
+      rows = -fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
+      rows.row(2).setZero();
+      rows(0, full_proof(ne, k, 0)) += 1.0;
+      rows(1, full_proof(ne, k, 1)) += 1.0;
+    } else {
+      fail_field(source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
+                 "'" + in.at + "'");
+    }
+    ModelInput mi;
+    mi.name = in.name;
+    mi.vector = SparseMatrix(fe.T.transpose()) * (rows.transpose() * d);
+    m.inputs.push_back(std::move(mi));
+  }
+
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const auto& se = sensors[k];
+    const std::string f = "sensors[" + std::to_string(k) + "]";
+    const Vector3d d = direction(se.direction, f + ".direction");
+    Eigen::RowVectorXd row;
+    int order = 0;
+    if (se.kind == "velocity" || se.kind == "acceleration") {
+      // velocity: d/dt of the displacement sensor's quantity (relative to the shuttle frame; the
+      // shuttle's own CM in ground), a row on u̇. acceleration: the inertial acceleration of the
+      // point along d (an accelerometer), the absolute displacement's row on ü.
+      order = se.kind == "velocity" ? 1 : 2;
+      if (se.at != "shuttle" && se.at != "mast" && se.at != "reflector")
+        fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
+      const bool mast = se.at == "mast";
+      if (mast) check_station(se.location, f + ".location");
+      const MatrixXd absolute = se.at == "shuttle" ? fr.shuttle_rigid(Vector3d::Zero())
+                                : mast           ? fr.displacement(se.location)
+                                                 : fr.reflector();
+      const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
+      row = d.transpose() * (order == 2 || se.at == "shuttle" ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
+    } else if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight") {
+      fail_field(source, f + ".kind",
+                 "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
+                 "'" + se.kind + "'");
+    } else if (se.at == "shuttle") {
+      if (se.kind == "line_of_sight")
+        fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
+      // Reference: ground; the shuttle's CM displacement and attitude.
+      row = d.transpose() * (se.kind == "rotation" ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
+    } else if (se.at == "mast" || se.at == "reflector") {
+      const bool mast = se.at == "mast";
+      if (mast) check_station(se.location, f + ".location");
+      const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
+      if (se.kind == "rotation") {
+        row = d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
+      } else {
+        // Displacement relative to the shuttle frame.
+        const MatrixXd rel = (mast ? fr.displacement(se.location) : fr.reflector()) - fr.shuttle_rigid(p0);
+        if (se.kind == "displacement") {
+          row = d.transpose() * rel;
+        } else {
+          const Vector3d chord = p0 - vec3(sc.mast_root);
+          const double ell = chord.norm();
+          if (!(ell > 0.0))
+            fail_field(source, f + ".location", "must be > 0 for a line of sight (the line starts at the root)",
+                       format_value(se.location));
+          const Vector3d u0 = chord / ell;
+          row = d.cross(u0).transpose() * rel / ell;
+        }
+      }
+    } else {
+      fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
+    }
+    ModelSensor ms;
+    ms.name = se.name;
+    ms.kind = se.kind;
+    ms.order = order;
+    ms.row = row * fe.T;
+    m.sensors.push_back(std::move(ms));
+  }
+  return fe;
+}
+
+VectorXd scole_coefficients(const io::ScoleSpec& s) {
+  VectorXd c(ScoleFE::kCount);
+  c << s.rho_A, s.EI_roll, s.EI_pitch, s.GJ, s.rho_I_psi, 2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_roll),
+      2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_pitch), 2.0 * s.zeta * std::sqrt(s.rho_I_psi * s.GJ), s.reflector.mass;
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+ParameterSpace scole_parameter_space(const io::ScoleSpec& sc) {
+  ParameterSpace sp;
+  sp.structure = "SCOLE";
+  sp.quantities = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta", "m_reflector"};
+  sp.value = {sc.rho_A, sc.EI_roll, sc.EI_pitch, sc.GJ, sc.rho_I_psi, sc.zeta, sc.reflector.mass};
+  sp.true_value.assign(sp.quantities.size(), true);
+  sp.groups = {{"EI", {1, 2}, true}};
+  sp.rho_A = 0;
+  sp.zeta = 5;
+  sp.has_q3 = false;
+  sp.ncoef = ScoleFE::kCount;
+  // c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors, m_reflector] (scole_model.h).
+  sp.coefficients = [](const std::vector<ParameterSpace::Cd>& f) {
+    const auto two = ParameterSpace::Cd(2.0);
+    return std::vector<ParameterSpace::Cd>{f[0], f[1], f[2], f[3], f[4], two * f[5] * std::sqrt(f[0] * f[1]),
+                                           two * f[5] * std::sqrt(f[0] * f[2]), two * f[5] * std::sqrt(f[4] * f[3]), f[6]};
+  };
+  return sp;
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,53 @@
+#pragma once
+// Finite-element model of the Euler–Bernoulli beam of docs/theory.md §2, in the form of
+// structural_model.h:
+//
+//   ρA w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = Σ_i f_i(t) δ(s − s_i)   (or δ′ for moments)
+//   c(s) = 2 ζ sqrt(ρA EI(s))   (Kelvin–Voigt; ζ is the first-mode damping ratio of a uniform beam)
+//
+// Hermite cubic elements on a uniform mesh; EI piecewise constant on N equal sections;
+// ends pinned (w = 0), clamped (w = w_s = 0) or free (natural conditions); optional rigid tip
+// mass and rotary inertia at s = L. Constrained DOFs are eliminated.
+// Coefficients: c = [ρA, EI_1..EI_N, c_1..c_N]. Loads and sensors anywhere on the beam, through
+// the shape functions (a sensor between nodes reads the interpolated field).
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/inverse/physical_parameterization.h"
+#include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::identify {
+
+struct BeamFE {
+  StructuralModel model;
+  double length = 0.0;
+  int elements = 0;
+  int sections = 0;
+  std::vector<int> full_to_reduced;  // 2 per node: (w, θ); -1 where constrained
+
+  int coef_rho_A() const { return 0; }
+  int coef_EI(int s) const { return 1 + s; }
+  int coef_damping(int s) const { return 1 + sections + s; }
+
+  // Rows acting on the reduced DOF vector.
+  Eigen::RowVectorXd displacement_row(double s) const;
+  Eigen::RowVectorXd rotation_row(double s) const;
+};
+
+// `source` names the scenario in error messages. Inputs of kind force/moment at `location`;
+// sensors of kind displacement/rotation (rows on u), velocity (u̇), acceleration (ü); others are
+// rejected with InputError.
+BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
+                  const std::vector<io::SensorSpec>& sensors, const std::string& source);
+
+// Coefficients c for a physical state (ρA, EI per section, ζ).
+VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta);
+
+// The beam's parameter space (physical_parameterization.h): φ = [ρA, EI_1..EI_N (the model's N
+// sections), ζ], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
+// q3 = 2ζ√(EI/ρA) (uniform beams only). φ's values: the scenario's beam (sections expanded to
+// the model's; a model section's true EI is known when it lies inside one scenario section).
+ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam);
+
+}  // namespace scoleid::identify

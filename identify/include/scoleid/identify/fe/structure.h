@@ -1,0 +1,35 @@
+#pragma once
+// The identifier's view of one structure kind (docs/theory.md §2–§4): its finite-element model on
+// the identifier's mesh, its named parameters and its model coefficients at a scenario's values.
+// make_structure() is the one place that looks at scenario.structure: adding a structure kind
+// means one FE model file and one line in its registry (structure.cpp).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::identify {
+
+class FEStructure {
+public:
+  virtual ~FEStructure() = default;
+  virtual const StructuralModel& model() const = 0;
+  virtual int elements() const = 0;
+  virtual double length() const = 0;
+  // The named parameters of sc.identification, starting from sc's structure values: the
+  // scenario's own, or (for the true values) the truth's.
+  virtual std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const = 0;
+  // Model coefficients at sc's structure values.
+  virtual VectorXd coefficients(const io::Scenario& sc) const = 0;
+};
+
+// The FE model of the scenario's structure on `elements` elements (its inputs and sensors
+// attached). io::InputError for anything the structure cannot represent, naming the field.
+std::unique_ptr<FEStructure> make_structure(const io::Scenario& sc, int elements);
+// The kinds make_structure knows.
+std::vector<std::string> structure_kinds();
+
+}  // namespace scoleid::identify

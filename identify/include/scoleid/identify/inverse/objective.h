@@ -1,0 +1,168 @@
+#pragma once
+// The identification functional and its derivatives (docs/theory.md §6, paper Eqs. 18–25).
+//
+//   state     M ü + D u̇ + K u = Σ_i γ_i b_i f_i(t),           u(0) = u̇(0) = 0
+//   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C u − z̃(t)   (displacement-type sensors; velocity and
+//             acceleration sensors add C_1 u̇ + C_2 ü, ü from the equation of motion at each
+//             quadrature point, and their Gauss–Newton rows C_1 Ṡ + C_2 S̈ likewise. With them the
+//             gradient is taken from the forward sensitivities: the costate below has no forcing
+//             for u̇ and ü outputs yet.)
+//   costate   M p̈ − D ṗ + K p = −Cᵀ R r,                      p(T) = ṗ(T) = 0   (Eqs. 23–24)
+//             integrated backward as P(τ) = p(T − τ):  M P'' + D P' + K P = −Cᵀ R r(T − τ)
+//   gradient  ∂J/∂q_i = ∫₀ᵀ pᵀ (∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) dt                (Eq. 25)
+//             evaluated per model coefficient c_j and chained through ∂c/∂q; the mass term is
+//             integrated by parts, ∫ pᵀ M_j ü dt = −∫ ṗᵀ M_j u̇ dt (p(T) = 0, u̇(0) = 0), so only
+//             displacements and velocities of the two recorded solutions enter.
+//   Gauss–Newton: sensitivities S_i = ∂u/∂q_i from
+//             M S̈_i + D Ṡ_i + K S_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f),
+//             H = ∫ (C S)ᵀ R (C S) dt,  g = ∫ (C S)ᵀ R r dt.
+//             With the esdirk integrator the S_i are stepped with u on u's own stages
+//             (esdirk_stepper.h): the exact derivatives of the discrete u, one factorisation for
+//             all; otherwise each is integrated on its own with u interpolated.
+// All time integrals use 3-point Gauss–Legendre on every interval of the union of the solvers'
+// steps and the sample times, on the Hermite interpolants of the recorded solutions.
+// R is diagonal; by default R_kk = 1 / ((T − t0) · mean z_k²) over the samples in [t0, T], so J is
+// the relative mean-square misfit.
+//
+// Horizon: T may be set below the end of the data (set_horizon); cost, gradient and Gauss–Newton
+// matrix are then those of the data on [t0, T] (with the default weights recomputed on it).
+// Gauss–Newton can also return the misfit profile of its state solve over the whole data span:
+// per sample time t_i, the mean over sensors of ∫_{t0}^{t_i} r_k² dt / ∫_{t0}^{t_i} z̃_k² dt, the
+// relative mean-square misfit of the data on [t0, t_i] (used to choose the horizon, optimizers.h).
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/inverse/measurements.h"
+#include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/time/second_order_solver.h"
+#include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/io/signal.h"
+
+namespace scoleid::identify {
+
+struct ObjectiveOptions {
+  SolverOptions solver;
+  std::vector<double> weights;  // R_kk; empty = 1/(T mean z_k²)
+};
+
+struct ObjectiveCounters {
+  long forward_solves = 0;
+  long costate_solves = 0;
+  long sensitivity_solves = 0;
+  long gradient_evaluations = 0;
+  double forward_seconds = 0.0;
+  double costate_seconds = 0.0;
+  double sensitivity_seconds = 0.0;
+  double quadrature_seconds = 0.0;
+  SolverSummary solver;  // accumulated over all solves
+};
+
+class Objective {
+public:
+  Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
+            Measurements data, ObjectiveOptions options = {});
+
+  int size() const { return params_.size(); }
+  double horizon() const { return T_; }
+  double data_start() const { return data_.t.front(); }
+  double data_end() const { return data_.t.back(); }
+  // Restricts the cost to [t0, T] (clamped to the data span, at least two samples); T = data_end()
+  // restores the whole span.
+  void set_horizon(double T);
+  // Number of data values (samples × sensors) on the horizon.
+  long data_points() const;
+
+  // Relative mean-square misfit on [t0, t_i] for each sample time t_i (see the header comment).
+  struct MisfitProfile {
+    std::vector<double> t, misfit;
+    // The longest t_i with misfit <= bound (−inf if none).
+    double longest_within(double bound) const;
+  };
+  const Parameterization& parameterization() const { return params_; }
+  const StructuralModel& model() const { return model_; }
+  const std::vector<double>& weights() const { return R_; }
+
+  // J(q): one forward solve.
+  double cost(const VectorXd& q);
+  // J and ∂J/∂q by the costate: one forward and one backward solve.
+  double cost_and_gradient(const VectorXd& q, VectorXd& gradient);
+  // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
+  // the state is integrated over the whole data span and its misfit profile returned.
+  double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr);
+  // The misfit profile over the whole data span at q (one forward solve).
+  MisfitProfile misfit_profile(const VectorXd& q);
+  // ∂J/∂q by central differences with relative step h (2P forward solves).
+  VectorXd finite_difference_gradient(const VectorXd& q, double h = 1e-5);
+  // Model outputs C u(t_i) at the sample times (samples × sensors).
+  MatrixXd predict(const VectorXd& q);
+  // Output sensitivities ∂(C u(t_i))/∂q at the sample times: (samples·sensors) × P, row-major by
+  // sample. For Fisher information.
+  MatrixXd output_sensitivities(const VectorXd& q);
+
+  const ObjectiveCounters& counters() const { return counters_; }
+  void reset_counters() { counters_ = {}; }
+
+  // The forcing f_i(t) of every input at t (for reports and the CVODES cross-check).
+  double input(int i, double t) const { return inputs_[static_cast<std::size_t>(i)](t); }
+  const std::vector<double>& breakpoints() const { return breakpoints_; }
+  const Measurements& data() const { return data_; }
+
+private:
+  struct Setup {
+    VectorXd c;
+    MatrixXd dcdq;
+    AssembledModel ops;
+  };
+  Setup setup(const VectorXd& q) const;
+  Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
+  double cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  MisfitProfile misfit_profile(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  // Outputs at t from the state (x, v): C_0 x + C_1 v + C_2 a, a from the equation of motion
+  // (returned through `a` when a sensor reads it).
+  struct Derivative;
+  VectorXd output_at(const Setup& s, const SecondOrderSolver& solver, double t, const VectorXd& x, const VectorXd& v,
+                     VectorXd* a = nullptr) const;
+  // Output sensitivity at t: C_0 S + C_1 Ṡ + C_2 S̈, S̈ from the sensitivity equation.
+  VectorXd tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
+                             const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const;
+  // Union of the given time sets and the sample times, restricted to [t0, t_end].
+  std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const;
+  SecondOrderSolver::Forcing state_forcing(const Setup& s) const;
+  // ∂_i M, ∂_i D, ∂_i K and ∂_i b per input, for the sensitivity forcing.
+  struct Derivative {
+    SparseMatrix dM, dD, dK;
+    std::vector<VectorXd> db;
+  };
+  Derivative derivative(const Setup& s, int i) const;
+  Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i, double t_end) const;
+  // The state over [t0, state_end] and its sensitivities over [t0, tangent_end] (tangent_end <= state_end).
+  std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,
+                                                   double tangent_end, Trajectory& u);
+  void default_weights();
+
+  // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
+  // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.
+  struct TermEntries {
+    int coefficient;
+    int kind;  // 0 mass, 1 damping, 2 stiffness
+    std::vector<int> row, col;
+    std::vector<double> value;
+  };
+  std::vector<TermEntries> terms_;
+
+  const StructuralModel& model_;
+  const Parameterization& params_;
+  std::vector<io::Signal> inputs_;
+  Measurements data_;
+  ObjectiveOptions options_;
+  MatrixXd C_;            // rows on u
+  MatrixXd C1_, C2_;      // rows on u̇ and ü (empty without velocity or acceleration sensors)
+  bool accelerations_ = false;
+  std::vector<double> R_;
+  std::vector<double> breakpoints_;
+  double T_ = 0.0;  // horizon: end of the cost integral
+  ObjectiveCounters counters_;
+};
+
+}  // namespace scoleid::identify

@@ -1,0 +1,72 @@
+#pragma once
+// Named parameters over a structure's physical quantities (docs/theory.md §2.3, §3): the one
+// implementation of Parameterization; a structure only describes its quantities (ParameterSpace).
+//
+// φ = the structure's physical quantities in table order (ρA, EI per section or plane, ...), with
+// the scenario's values; c(φ) its model coefficients (structural_model.h). A parameter is
+//   - a quantity by name (rho_A, EI_2, GJ, m_reflector, ...),
+//   - a group name that sets several quantities to one value (EI: every section, both planes),
+//   - or, in the paper's form (the equation divided by ρA), q1 = EI/ρA, q2 = 1/ρA and, where the
+//     structure has it, q3 = 2ζ√(EI/ρA) (EI the group; ζ follows q3 then).
+// Quantities not estimated keep their starting values: the scenario's, overridden by
+// identification.initial (keys: quantity, group and q names). ∂c/∂q by complex step: exact to
+// rounding, no step-size choice.
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/io/scenario.h"
+
+namespace scoleid::identify {
+
+struct ParameterSpace {
+  using Cd = std::complex<double>;
+  std::string structure;                 // in messages: "beam", "SCOLE"
+  std::vector<std::string> quantities;   // φ names
+  std::vector<double> value;             // φ at the scenario's values
+  std::vector<bool> true_value;          // whether value[i] is a true value (else reported NaN)
+  struct Group {
+    std::string name;
+    std::vector<int> members;
+    bool report_when_equal = true;       // physical() shows the group name when all members agree
+  };
+  std::vector<Group> groups;
+  // Paper form: the quantities behind q1, q2 (, q3): ρA, the EI group, ζ; q3 only if has_q3.
+  int rho_A = -1, zeta = -1;
+  std::string EI_group = "EI";
+  bool has_q3 = false;
+  std::string paper_requirement;          // non-empty: the paper form is refused with this reason
+  int ncoef = 0;
+  std::function<std::vector<Cd>(const std::vector<Cd>& phi)> coefficients;
+};
+
+class PhysicalParameterization final : public Parameterization {
+public:
+  using Cd = std::complex<double>;
+  // `source` names the scenario in messages (identification.estimate / .initial errors).
+  PhysicalParameterization(ParameterSpace space, const io::IdentificationSpec& id, const std::string& source);
+  const std::vector<std::string>& names() const override { return names_; }
+  void coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const override;
+  std::map<std::string, double> physical(const VectorXd& q) const override;
+  VectorXd initial() const override { return initial_; }
+  VectorXd truth() const override { return truth_; }
+  bool paper_form() const override { return paper_; }
+
+private:
+  const ParameterSpace::Group* group(const std::string& name) const;
+  int quantity(const std::string& name) const;
+  // φ for parameter values q (complex for the complex step), from the starting φ.
+  std::vector<Cd> phi(const std::vector<Cd>& q) const;
+  // Parameter values of a φ (NaN where a group's members differ or a value is not a true one).
+  VectorXd parameters_of(const std::vector<double>& phi, const std::vector<bool>* defined) const;
+
+  ParameterSpace space_;
+  bool paper_ = false;
+  std::vector<std::string> names_;
+  std::vector<double> start_;
+  VectorXd initial_, truth_;
+};
+
+}  // namespace scoleid::identify

@@ -1,0 +1,52 @@
+#pragma once
+// One identification run: scenario (+ optional data file) → estimates, iteration history,
+// identifiability, written as identify.json (docs/theory.md §10) and fit.csv (t, measured, predicted).
+//
+// Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
+// estimate.
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scoleid/identify/inverse/identifiability.h"
+#include "scoleid/identify/inverse/optimizers.h"
+#include "scoleid/identify/run/problem.h"
+#include "scoleid/io/run_directory.h"
+
+namespace scoleid::identify {
+
+struct RunOptions {
+  std::optional<std::string> data_csv;
+  std::string method;          // empty = the scenario's (auto → gauss-newton for ≤ 16 parameters, else lbfgs)
+  bool compute_std = true;
+  bool verbose = true;         // print the iteration table on stdout as it goes
+  std::optional<int> max_iterations;
+};
+
+struct RunResult {
+  std::string scenario;
+  std::string method;
+  std::vector<std::string> names;
+  VectorXd initial, estimate;
+  std::map<std::string, double> truth;
+  OptimizerSummary summary;
+  ObjectiveCounters counters;
+  Identifiability ident;
+  double wall_seconds = 0;
+  double identifiability_seconds = 0;
+  nlohmann::json to_json(const Problem& p) const;
+};
+
+RunResult run_identification(Problem& problem, const RunOptions& options);
+
+// Writes identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's
+// staging area; the caller commits them as one unit (io/run_directory.h).
+void write_outputs(io::RunDirectory& dir, Problem& problem, const RunResult& r);
+// The file names write_outputs produces (what a RunDirectory for them may replace).
+inline std::vector<std::string> output_files() { return {"identify.json", "fit.csv", "fit.gp", "fit.png"}; }
+
+}  // namespace scoleid::identify

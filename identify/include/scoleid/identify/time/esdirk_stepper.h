@@ -1,0 +1,88 @@
+#pragma once
+// Fixed-step diagonally implicit Runge–Kutta (ESDIRK/DIRK) stepping of the linear system
+//
+//     M ẍ + D ẋ + K x = F(t)
+//
+// that exploits its structure, for one right-hand side or several sharing every factorisation.
+// Butcher table (A, b, c), s stages, taken from ARKODE (default ESDIRK3(2)4L[2]SA). In
+// first-order form y = (x, v) stage i is  Y_i = y_n + h Σ_{j<i} a_ij Y'_j + h a_ii Y'_i. With
+//     x̃ = x_n + h Σ_{j<i} a_ij V_j,   ṽ = v_n + h Σ_{j<i} a_ij A_j,   g = h a_ii,
+// the stage unknowns V_i = ṽ + g A_i, X_i = x̃ + g V_i and the equation M A_i + D V_i + K X_i =
+// F(t_n + c_i h) give
+//     (M + g D + g² K) A_i = F(t_n + c_i h) − D ṽ − K (x̃ + g ṽ)
+// (newton_matrix.h): one banded Cholesky solve per implicit stage, no mass-matrix inverse, no
+// Newton iteration (the system is linear, so this is the stage's exact solution — the same
+// numbers, to rounding, as ARKODE's ARKStep with this table, an exact Jacobian and one Newton
+// iteration per stage). An explicit first stage (a_11 = 0, c_1 = 0) is y_n itself with
+// acceleration a_n; step end x_{n+1} = x_n + h Σ b_j V_j, v_{n+1} = v_n + h Σ b_j A_j, and
+// a_{n+1} = A_s when the table is stiffly accurate (b = last row of A, c_s = 1).
+//
+// Tangent systems (forward sensitivities). Columns 1..P solve
+//     M s̈_i + D ṡ_i + K s_i = G_i(t, x, ẋ, ẍ),
+// with G_i evaluated at column 0's own stage values (X_j, V_j, A_j). Differentiating the stage
+// equations of column 0 with respect to a parameter q_i gives exactly these stage equations with
+// G_i = ∂_i F − ∂_i M A_j − ∂_i D V_j − ∂_i K X_j, so the tangents are the exact derivatives of
+// the discrete forward solution (not an approximation of the continuous sensitivity): a
+// Gauss–Newton gradient built on them is the gradient of the discrete cost. All columns share the
+// stage factorisation. Tangents stop after the first step that reaches `tangent_end`.
+//
+// Steps: h on every segment between breakpoints, the last step of a segment shortened to land on
+// the breakpoint; at a breakpoint the left limit (forcing evaluated just before it) and the right
+// limit are both recorded and stepping restarts from the right limit.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/time/banded_cholesky.h"
+#include "scoleid/identify/time/newton_matrix.h"
+#include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/identify/time/trajectory.h"
+
+namespace scoleid::identify {
+
+struct ButcherTable {
+  int stages = 0;
+  std::vector<double> A;  // stages × stages, row-major
+  std::vector<double> b, c;
+  double a(int i, int j) const { return A[static_cast<std::size_t>(i * stages + j)]; }
+  bool explicit_first_stage() const;  // a_11 = 0 and c_1 = 0: stage 1 is y_n
+  bool stiffly_accurate() const;      // b = last row of A and c_s = 1: y_{n+1} is the last stage
+  // An ARKODE DIRK table by id (ARKODE_DIRKTableID); −1 = ESDIRK3(2)4L[2]SA.
+  static ButcherTable arkode_dirk(int id = -1);
+};
+
+struct StepperCounters {
+  long steps = 0;
+  long stage_forcings = 0;  // evaluations of F (column 0)
+  long linear_solves = 0;   // banded triangular solve pairs, all columns
+};
+
+class EsdirkStepper {
+public:
+  using Forcing = std::function<void(double t, double* F)>;  // F (length n), pre-zeroed
+  // G: n × P column-major, pre-zeroed; x, v, a: column 0 at the stage (or the recorded point).
+  using TangentForcing = std::function<void(double t, const double* x, const double* v, const double* a, double* G)>;
+
+  // M, D, K on one common pattern (newton_matrix.h); `mass` is the Cholesky factor of M.
+  EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
+                NewtonMatrix& newton, ButcherTable table);
+
+  struct Result {
+    Trajectory state;
+    std::vector<Trajectory> tangents;
+    StepperCounters counters;
+  };
+  // Integrates from rest over [t0, t1] with step h; `stops` are the forcing breakpoints (any order,
+  // those outside (t0, t1) ignored). P tangents (0 = state only) up to tangent_end.
+  Result run(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing, int P = 0,
+             const TangentForcing* tangent = nullptr, double tangent_end = 0.0) const;
+
+private:
+  const SparseMatrix &M_, &D_, &K_;
+  const BandedCholesky& mass_;
+  NewtonMatrix& newton_;
+  ButcherTable tab_;
+  bool explicit_first_, stiffly_accurate_;
+};
+
+}  // namespace scoleid::identify

@@ -1,0 +1,91 @@
+#include "scoleid/identify/inverse/identifiability.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace scoleid::identify {
+
+Identifiability analyse_identifiability(Objective& obj, const std::vector<io::SensorSpec>& sensors, const VectorXd& q) {
+  Identifiability id;
+  const Measurements& data = obj.data();
+  const int P = obj.size(), ns = data.sensors();
+  const auto N = static_cast<Eigen::Index>(data.t.size());
+  const MatrixXd Y = obj.predict(q);
+  const MatrixXd G = obj.output_sensitivities(q);
+  // Noise level per sensor.
+  bool from_scenario = true;
+  for (int k = 0; k < ns; ++k) {
+    double sd = static_cast<std::size_t>(k) < sensors.size() ? sensors[static_cast<std::size_t>(k)].noise_std : 0.0;
+    if (!(sd > 0)) {
+      from_scenario = false;
+      const VectorXd r = Y.col(k) - data.z.col(k);
+      const double dof = std::max<double>(1.0, static_cast<double>(N) - static_cast<double>(P) / ns);
+      sd = std::sqrt(r.squaredNorm() / dof);
+      if (!(sd > 0)) sd = 1e-300;
+    }
+    id.noise_std.push_back(sd);
+  }
+  id.noise_source = from_scenario ? "scenario" : "residual";
+  MatrixXd F = MatrixXd::Zero(P, P);
+  id.chi2 = 0.0;
+  for (Eigen::Index i = 0; i < N; ++i)
+    for (int k = 0; k < ns; ++k) {
+      const double w = 1.0 / (id.noise_std[static_cast<std::size_t>(k)] * id.noise_std[static_cast<std::size_t>(k)]);
+      const Eigen::RowVectorXd g = G.row(i * ns + k);
+      F += w * g.transpose() * g;
+      const double r = Y(i, k) - data.z(i, k);
+      id.chi2 += w * r * r;
+    }
+  id.data_values = static_cast<long>(N) * ns;
+  // Residual energy counted as model error: beyond what the stated noise explains, or all of it.
+  const double systematic = from_scenario ? std::max(0.0, id.chi2 - static_cast<double>(id.data_values)) : id.chi2;
+
+  const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
+  const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
+  id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
+  id.std = VectorXd::Constant(P, std::nan(""));
+  id.resolution = VectorXd::Constant(P, std::nan(""));
+  id.identifiable.assign(static_cast<std::size_t>(P), true);
+  id.reason.assign(static_cast<std::size_t>(P), "");
+  // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
+  // with a sizeable share in them is flagged; the others get their bounds from the Fisher matrix
+  // restricted to them (i.e. with the flagged parameters held fixed).
+  for (int e = 0; e < P; ++e)
+    if (!(es.eigenvalues()[e] > 1e-12 * lmax))
+      for (int i = 0; i < P; ++i)
+        if (std::abs(es.eigenvectors()(i, e)) > 0.1) {
+          id.identifiable[static_cast<std::size_t>(i)] = false;
+          id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
+        }
+  std::vector<int> keep;
+  for (int i = 0; i < P; ++i)
+    if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
+  if (!keep.empty()) {
+    const auto K = static_cast<Eigen::Index>(keep.size());
+    MatrixXd Fk(K, K);
+    for (Eigen::Index a = 0; a < K; ++a)
+      for (Eigen::Index b = 0; b < K; ++b)
+        Fk(a, b) = Fr(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]);
+    const MatrixXd Ck = Fk.inverse();
+    for (Eigen::Index a = 0; a < K; ++a) {
+      const double rel = std::sqrt(std::max(0.0, Ck(a, a)));
+      const double rel_res = rel * std::sqrt(systematic);
+      const int i = keep[static_cast<std::size_t>(a)];
+      id.std[i] = rel * q[i];
+      id.resolution[i] = rel_res * q[i];
+      // more than 50 % relative uncertainty or resolution: not determined by these data
+      if (!(rel < 0.5) || !(rel_res < 0.5)) {
+        id.identifiable[static_cast<std::size_t>(i)] = false;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "relative std %.3g and relative resolution %.3g: above 0.5", rel, rel_res);
+        id.reason[static_cast<std::size_t>(i)] = buf;
+      }
+    }
+  }
+  return id;
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,487 @@
+#include "scoleid/identify/inverse/objective.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace scoleid::identify {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// 3-point Gauss–Legendre on [0, 1]
+constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
+constexpr double kGw[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
+}  // namespace
+
+Objective::Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
+                     Measurements data, ObjectiveOptions options)
+    : model_(model), params_(params), inputs_(std::move(inputs)), data_(std::move(data)), options_(std::move(options)) {
+  if (inputs_.size() != model_.inputs.size()) throw std::invalid_argument("Objective: one signal per model input");
+  if (data_.sensors() != static_cast<int>(model_.sensors.size()))
+    throw std::invalid_argument("Objective: one measurement column per model sensor");
+  if (data_.t.size() < 2) throw std::invalid_argument("Objective: at least two samples");
+  C_ = model_.output_matrix(0);
+  if (model_.has_rate_outputs()) {
+    C1_ = model_.output_matrix(1);
+    C2_ = model_.output_matrix(2);
+    accelerations_ = C2_.cwiseAbs().maxCoeff() > 0.0;
+  }
+  T_ = data_.t.back();
+  const double t0 = data_.t.front();
+  const int ns = data_.sensors();
+  if (!options_.weights.empty()) {
+    if (static_cast<int>(options_.weights.size()) != ns) throw std::invalid_argument("Objective: one weight per sensor");
+    R_ = options_.weights;
+  } else {
+    default_weights();
+  }
+  auto add_terms = [&](const std::vector<OperatorTerm>& ts, int kind) {
+    for (const auto& t : ts) {
+      if (t.coefficient < 0) continue;
+      TermEntries e{t.coefficient, kind, {}, {}, {}};
+      for (int k = 0; k < t.matrix.outerSize(); ++k)
+        for (SparseMatrix::InnerIterator it(t.matrix, k); it; ++it) {
+          e.row.push_back(static_cast<int>(it.row()));
+          e.col.push_back(static_cast<int>(it.col()));
+          e.value.push_back(it.value());
+        }
+      terms_.push_back(std::move(e));
+    }
+  };
+  add_terms(model_.mass, 0);
+  add_terms(model_.damping, 1);
+  add_terms(model_.stiffness, 2);
+  for (const auto& s : inputs_)
+    for (double b : s.breakpoints())
+      if (b > t0 && b < T_) breakpoints_.push_back(b);
+  std::sort(breakpoints_.begin(), breakpoints_.end());
+  breakpoints_.erase(std::unique(breakpoints_.begin(), breakpoints_.end()), breakpoints_.end());
+}
+
+void Objective::default_weights() {
+  const int ns = data_.sensors();
+  const double t0 = data_.t.front();
+  R_.assign(static_cast<std::size_t>(ns), 1.0);
+  for (int k = 0; k < ns; ++k) {
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < data_.t.size() && data_.t[i] <= T_; ++i, ++count) {
+      const double z = data_.z(static_cast<Eigen::Index>(i), k);
+      sum += z * z;
+    }
+    const double ms = count > 0 ? sum / static_cast<double>(count) : 0.0;
+    if (ms > 0) R_[static_cast<std::size_t>(k)] = 1.0 / ((T_ - t0) * ms);
+  }
+}
+
+void Objective::set_horizon(double T) {
+  const auto& t = data_.t;
+  T_ = std::clamp(T, t[1], t.back());
+  if (options_.weights.empty()) default_weights();
+}
+
+long Objective::data_points() const {
+  long n = 0;
+  for (double t : data_.t)
+    if (t <= T_) ++n;
+  return n * data_.sensors();
+}
+
+double Objective::MisfitProfile::longest_within(double bound) const {
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (misfit[i] <= bound) best = t[i];
+  return best;
+}
+
+Objective::Setup Objective::setup(const VectorXd& q) const {
+  Setup s;
+  for (int i = 0; i < q.size(); ++i)
+    if (!(q[i] > 0.0) || !std::isfinite(q[i]))
+      throw std::domain_error("parameter " + params_.names()[static_cast<std::size_t>(i)] + " left the positive range");
+  params_.coefficients(q, s.c, s.dcdq);
+  s.ops = assemble(model_, s.c);
+  return s;
+}
+
+SecondOrderSolver::Forcing Objective::state_forcing(const Setup& s) const {
+  const auto& loads = s.ops.loads;
+  const int n = model_.ndof;
+  return [this, &loads, n](double t, double* F) {
+    Eigen::Map<VectorXd> Fm(F, n);
+    for (std::size_t i = 0; i < loads.size(); ++i) {
+      const double fi = inputs_[i](t);
+      if (fi != 0.0) Fm += fi * loads[i];
+    }
+  };
+}
+
+VectorXd Objective::output_at(const Setup& s, const SecondOrderSolver& solver, double t, const VectorXd& x,
+                              const VectorXd& v, VectorXd* a) const {
+  if (C1_.size() == 0) return C_ * x;
+  VectorXd y = C_ * x + C1_ * v;
+  if (accelerations_) {
+    const int n = model_.ndof;
+    VectorXd F = VectorXd::Zero(n), acc(n);
+    for (std::size_t i = 0; i < s.ops.loads.size(); ++i) {
+      const double fi = inputs_[i](t);
+      if (fi != 0.0) F += fi * s.ops.loads[i];
+    }
+    solver.acceleration(F.data(), x.data(), v.data(), acc.data());
+    y += C2_ * acc;
+    if (a) *a = acc;
+  }
+  return y;
+}
+
+VectorXd Objective::tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
+                                      const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const {
+  if (C1_.size() == 0) return C_ * si;
+  VectorXd y = C_ * si + C1_ * svi;
+  if (accelerations_) {
+    // S̈ from the sensitivity equation M S̈ + D Ṡ + K S = −(∂M ü + ∂D u̇ + ∂K u − ∂b f).
+    const int n = model_.ndof;
+    VectorXd G = -(d.dM * a + d.dD * v + d.dK * x), acc(n);
+    for (std::size_t k = 0; k < d.db.size(); ++k) {
+      const double fk = inputs_[k](t);
+      if (fk != 0.0) G += fk * d.db[k];
+    }
+    solver.acceleration(G.data(), si.data(), svi.data(), acc.data());
+    y += C2_ * acc;
+  }
+  return y;
+}
+
+Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s, double t_end) {
+  const auto t0 = Clock::now();
+  SolverSummary sum;
+  Trajectory u = solver.solve(data_.t.front(), t_end, state_forcing(s), breakpoints_, &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.forward_seconds += since(t0);
+  return u;
+}
+
+std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const {
+  std::vector<double> g;
+  for (const auto* s : sets) g.insert(g.end(), s->begin(), s->end());
+  g.insert(g.end(), data_.t.begin(), data_.t.end());
+  g.push_back(t_end);
+  std::sort(g.begin(), g.end());
+  g.erase(std::unique(g.begin(), g.end()), g.end());
+  const double t0 = data_.t.front();
+  g.erase(std::remove_if(g.begin(), g.end(), [&](double t) { return t < t0 || t > t_end; }), g.end());
+  return g;
+}
+
+double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const {
+  const int n = model_.ndof, ns = data_.sensors();
+  const auto grid = union_grid({&u.times()}, T_);
+  VectorXd x(n), v(n), z(ns);
+  double J = 0.0;
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int g = 0; g < 3; ++g) {
+      const double t = grid[k] + kGx[g] * h;
+      u.eval(t, x.data(), v.data());
+      data_.eval(t, z.data());
+      const VectorXd r = output_at(s, solver, t, x, v) - z;
+      double e = 0.0;
+      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+      J += 0.5 * kGw[g] * h * e;
+    }
+  }
+  return J;
+}
+
+Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,
+                                                  const Trajectory& u) const {
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t_end = data_.t.back();
+  const auto grid = union_grid({&u.times()}, t_end);
+  VectorXd x(n), v(n), z(ns), rr = VectorXd::Zero(ns), zz = VectorXd::Zero(ns);
+  MisfitProfile prof;
+  std::size_t next = 1;  // next sample time to report
+  auto report = [&](double t) {
+    while (next < data_.t.size() && data_.t[next] <= t) {
+      double m = 0.0;
+      for (int k = 0; k < ns; ++k) m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
+      prof.t.push_back(data_.t[next]);
+      prof.misfit.push_back(m / ns);
+      ++next;
+    }
+  };
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int g = 0; g < 3; ++g) {
+      const double t = grid[k] + kGx[g] * h;
+      u.eval(t, x.data(), v.data());
+      data_.eval(t, z.data());
+      const VectorXd r = output_at(s, solver, t, x, v) - z;
+      rr += kGw[g] * h * r.cwiseAbs2();
+      zz += kGw[g] * h * z.cwiseAbs2();
+    }
+    report(grid[k + 1]);
+  }
+  return prof;
+}
+
+double Objective::cost(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const Trajectory u = forward(solver, s, T_);
+  const auto t0 = Clock::now();
+  const double J = cost_of(s, solver, u);
+  counters_.quadrature_seconds += since(t0);
+  return J;
+}
+
+double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
+  if (C1_.size() != 0) {
+    // Velocity and acceleration sensors: the gradient from the forward sensitivities (the exact
+    // derivative of the discrete cost, P extra solves) until the costate carries their forcing.
+    MatrixXd H;
+    return gauss_newton(q, gradient, H);
+  }
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const Trajectory u = forward(solver, s, T_);
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t0 = data_.t.front();
+
+  // Costate backward: P(τ) = p(T − τ), τ ∈ [0, T − t0].
+  auto tc = Clock::now();
+  VectorXd xb(n), vb(n), zb(ns), rb(ns);
+  const MatrixXd CtR = C_.transpose() * Eigen::Map<const VectorXd>(R_.data(), ns).asDiagonal();
+  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
+    const double t = T_ - tau;
+    u.eval(t, xb.data(), vb.data());
+    data_.eval(t, zb.data());
+    rb = C_ * xb - zb;
+    Eigen::Map<VectorXd>(F, n) = -CtR * rb;
+  };
+  std::vector<double> bp_tau;
+  for (double b : breakpoints_)
+    if (b < T_) bp_tau.push_back(T_ - b);
+  std::sort(bp_tau.begin(), bp_tau.end());
+  SolverSummary sum;
+  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.costate_solves;
+  counters_.costate_seconds += since(tc);
+
+  // Quadratures: cost and coefficient gradients.
+  const auto tq = Clock::now();
+  std::vector<double> ptimes;
+  ptimes.reserve(P.size());
+  for (double tau : P.times()) ptimes.push_back(T_ - tau);
+  const auto grid = union_grid({&u.times(), &ptimes}, T_);
+  VectorXd x(n), v(n), p(n), pd(n), z(ns), gc = VectorXd::Zero(model_.ncoef), w(n);
+  double J = 0.0;
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int gq = 0; gq < 3; ++gq) {
+      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
+      u.eval(t, x.data(), v.data());
+      P.eval(T_ - t, p.data(), pd.data());
+      pd = -pd;  // ṗ(t) = −P'(T − t)
+      data_.eval(t, z.data());
+      const VectorXd r = C_ * x - z;
+      double e = 0.0;
+      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+      J += 0.5 * wt * e;
+      // Mass term by parts: −ṗᵀ M_j u̇; damping pᵀ D_j u̇; stiffness pᵀ K_j u.
+      for (const auto& e : terms_) {
+        const double* left = e.kind == 0 ? pd.data() : p.data();
+        const double* right = e.kind == 2 ? x.data() : v.data();
+        double acc = 0.0;
+        for (std::size_t m = 0; m < e.value.size(); ++m) acc += left[e.row[m]] * e.value[m] * right[e.col[m]];
+        gc[e.coefficient] += (e.kind == 0 ? -wt : wt) * acc;
+      }
+      for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
+        const int ci = model_.inputs[i].coefficient;
+        if (ci >= 0) gc[ci] -= wt * inputs_[i](t) * p.dot(model_.inputs[i].vector);
+      }
+    }
+  }
+  gradient = s.dcdq.transpose() * gc;
+  ++counters_.gradient_evaluations;
+  counters_.quadrature_seconds += since(tq);
+  return J;
+}
+
+Objective::Derivative Objective::derivative(const Setup& s, int i) const {
+  const int n = model_.ndof;
+  const VectorXd dcol = s.dcdq.col(i);
+  // Constant terms (coefficient −1) do not enter the derivative.
+  auto only_coef = [&](const std::vector<OperatorTerm>& terms) {
+    SparseMatrix A(n, n);
+    for (const auto& t : terms)
+      if (t.coefficient >= 0 && dcol[t.coefficient] != 0.0) A += dcol[t.coefficient] * t.matrix;
+    return A;
+  };
+  Derivative d{only_coef(model_.mass), only_coef(model_.damping), only_coef(model_.stiffness), {}};
+  for (const auto& in : model_.inputs)
+    d.db.push_back(in.coefficient >= 0 ? VectorXd(dcol[in.coefficient] * in.vector) : VectorXd(VectorXd::Zero(n)));
+  return d;
+}
+
+Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i,
+                                  double t_end) const {
+  const int n = model_.ndof;
+  const Derivative d = derivative(s, i);
+  VectorXd x(n), v(n), a(n), Fe(n);
+  SecondOrderSolver::Forcing f = [&](double t, double* F) {
+    u.eval(t, x.data(), v.data());
+    Fe.setZero();
+    for (std::size_t k = 0; k < s.ops.loads.size(); ++k) Fe += inputs_[k](t) * s.ops.loads[k];
+    solver.acceleration(Fe.data(), x.data(), v.data(), a.data());
+    Eigen::Map<VectorXd> Fm(F, n);
+    Fm = -(d.dM * a + d.dD * v + d.dK * x);
+    for (std::size_t k = 0; k < d.db.size(); ++k) Fm += inputs_[k](t) * d.db[k];
+  };
+  return solver.solve(data_.t.front(), t_end, f, breakpoints_, nullptr);
+}
+
+std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s,
+                                                            double state_end, double tangent_end, Trajectory& u) {
+  const int P = size(), n = model_.ndof;
+  const auto ts = Clock::now();
+  std::vector<Trajectory> S;
+  if (solver.has_tangent_solve()) {
+    std::vector<Derivative> d;
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    std::vector<double> f(inputs_.size());
+    SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* v, const double* a, double* Gp) {
+      const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
+      for (std::size_t k = 0; k < inputs_.size(); ++k) f[k] = inputs_[k](t);
+      for (int i = 0; i < P; ++i) {
+        Eigen::Map<VectorXd> Gi(Gp + static_cast<std::size_t>(i) * n, n);
+        const Derivative& di = d[static_cast<std::size_t>(i)];
+        Gi.noalias() -= di.dM * A;
+        Gi.noalias() -= di.dD * V;
+        Gi.noalias() -= di.dK * X;
+        for (std::size_t k = 0; k < f.size(); ++k)
+          if (f[k] != 0.0) Gi += f[k] * di.db[k];
+      }
+    };
+    SolverSummary sum;
+    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), P, G, tangent_end, breakpoints_, &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    u = std::move(sol.state);
+    S = std::move(sol.tangents);
+  } else {
+    u = forward(solver, s, state_end);
+    for (int i = 0; i < P; ++i) S.push_back(sensitivity(solver, s, u, i, tangent_end));
+  }
+  counters_.sensitivity_solves += P;
+  counters_.sensitivity_seconds += since(ts);
+  return S;
+}
+
+double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const int P = size(), n = model_.ndof, ns = data_.sensors();
+  Trajectory u;
+  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, profile ? data_.t.back() : T_, T_, u);
+
+  const auto tq = Clock::now();
+  const auto grid = union_grid({&u.times()}, T_);
+  VectorXd x(n), v(n), a(n), z(ns), si(n), sv(n);
+  MatrixXd CS(ns, P);
+  std::vector<Derivative> d;
+  if (accelerations_)
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+  gradient = VectorXd::Zero(P);
+  H = MatrixXd::Zero(P, P);
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  double J = 0.0;
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int gq = 0; gq < 3; ++gq) {
+      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
+      u.eval(t, x.data(), v.data());
+      data_.eval(t, z.data());
+      const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
+      for (int i = 0; i < P; ++i) {
+        S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
+        CS.col(i) = accelerations_ ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
+                                   : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
+      }
+      const MatrixXd RCS = Rv.asDiagonal() * CS;
+      J += 0.5 * wt * r.dot(Rv.cwiseProduct(r));
+      gradient += wt * RCS.transpose() * r;
+      H += wt * CS.transpose() * RCS;
+    }
+  }
+  if (profile) *profile = misfit_profile(s, solver, u);
+  counters_.quadrature_seconds += since(tq);
+  return J;
+}
+
+Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const Trajectory u = forward(solver, s, data_.t.back());
+  const auto t0 = Clock::now();
+  MisfitProfile p = misfit_profile(s, solver, u);
+  counters_.quadrature_seconds += since(t0);
+  return p;
+}
+
+VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {
+  VectorXd g(q.size());
+  for (int i = 0; i < q.size(); ++i) {
+    VectorXd qp = q, qm = q;
+    const double d = h * q[i];
+    qp[i] += d;
+    qm[i] -= d;
+    g[i] = (cost(qp) - cost(qm)) / (2.0 * d);
+  }
+  return g;
+}
+
+MatrixXd Objective::predict(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const Trajectory u = forward(solver, s, data_.t.back());
+  const int n = model_.ndof;
+  MatrixXd Y(static_cast<Eigen::Index>(data_.t.size()), data_.sensors());
+  VectorXd x(n), v(n);
+  for (std::size_t k = 0; k < data_.t.size(); ++k) {
+    u.eval(data_.t[k], x.data(), v.data());
+    Y.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
+  }
+  return Y;
+}
+
+MatrixXd Objective::output_sensitivities(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const int P = size(), n = model_.ndof, ns = data_.sensors();
+  Trajectory u;
+  const double t_end = data_.t.back();
+  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, t_end, t_end, u);
+  MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
+  VectorXd x(n), v(n), a(n), ux(n), uv(n);
+  for (int i = 0; i < P; ++i) {
+    const Derivative d = accelerations_ ? derivative(s, i) : Derivative{};
+    for (std::size_t k = 0; k < data_.t.size(); ++k) {
+      const double t = data_.t[k];
+      S[static_cast<std::size_t>(i)].eval(t, x.data(), v.data());
+      if (accelerations_) {
+        u.eval(t, ux.data(), uv.data());
+        output_at(s, solver, t, ux, uv, &a);
+      }
+      G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) = tangent_output_at(solver, d, t, ux, uv, a, x, v);
+    }
+  }
+  return G;
+}
+
+}  // namespace scoleid::identify

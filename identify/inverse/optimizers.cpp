@@ -1,0 +1,351 @@
+#include "scoleid/identify/inverse/optimizers.h"
+
+#include "scoleid/identify/inverse/gauss_newton_step.h"
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <sstream>
+
+namespace scoleid::identify {
+
+bool OptimizerOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (method != "gauss-newton" && method != "lbfgs" && method != "steepest-descent")
+    return bad("method must be gauss-newton, lbfgs or steepest-descent");
+  if (max_iterations < 0) return bad("max_iterations must be >= 0");
+  if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
+  for (double w : steepest_weights)
+    if (!(w > 0)) return bad("steepest_weights must be > 0");
+  if (!(trust_radius > 0) || !(max_trust_radius >= trust_radius)) return bad("need 0 < trust_radius <= max_trust_radius");
+  if (!(continuation_misfit > 0)) return bad("continuation_misfit must be > 0");
+  if (!(short_horizon_floor >= 0)) return bad("short_horizon_floor must be >= 0");
+  if (!(cost_stall >= 0)) return bad("cost_stall must be >= 0");
+  if (!(continuation_min_fraction > 0 && continuation_min_fraction <= 1)) return bad("continuation_min_fraction must be in (0, 1]");
+  return true;
+}
+
+const char* to_string(OptimizerSummary::Termination t) {
+  using T = OptimizerSummary::Termination;
+  switch (t) {
+    case T::StepTolerance: return "step_tolerance";
+    case T::GradientTolerance: return "gradient_tolerance";
+    case T::CostFloor: return "cost_floor";
+    case T::CostStalled: return "cost_stalled";
+    case T::MaxIterations: return "max_iterations";
+    case T::LineSearchFailed: return "line_search_failed";
+  }
+  return "?";
+}
+
+std::string OptimizerSummary::BriefReport() const {
+  std::ostringstream os;
+  os << to_string(termination) << " after " << iterations_done << " iterations, J = " << cost << ", "
+     << wall_seconds << " s";
+  if (!message.empty()) os << " (" << message << ")";
+  return os.str();
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using T = OptimizerSummary::Termination;
+
+struct Run {
+  Objective& obj;
+  const OptimizerOptions& opt;
+  const std::function<void(const IterationRecord&)>& cb;
+  OptimizerSummary sum;
+
+  void record(int k, double J, const VectorXd& q, const VectorXd& gx) {
+    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0, obj.horizon()};
+    sum.iterations.push_back(r);
+    if (cb) cb(r);
+  }
+  bool small_gradient(const VectorXd& gx, double J) const {
+    return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
+  }
+  // Evaluate J and ∂J/∂x at x, or return false if the point is outside the model's domain.
+  bool eval_grad(const VectorXd& x, double& J, VectorXd& gx) {
+    try {
+      const VectorXd q = x.array().exp();
+      VectorXd gq;
+      J = obj.cost_and_gradient(q, gq);
+      gx = q.cwiseProduct(gq);
+      return std::isfinite(J);
+    } catch (const std::domain_error&) {
+      return false;
+    } catch (const std::runtime_error&) {
+      return false;  // integrator failure at an extreme trial point: treat as infeasible
+    }
+  }
+};
+
+void gauss_newton(Run& r, VectorXd x) {
+  Objective& obj = r.obj;
+  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const double t_min = t0 + r.opt.continuation_min_fraction * (t_end - t0);
+  // Horizon from a misfit profile: the longest T >= t_min up to which the misfit stays within
+  // the bound (never shorter than the current one).
+  auto choose_horizon = [&](const Objective::MisfitProfile& p, double current) {
+    double T = t_min;
+    for (std::size_t i = 0; i < p.t.size(); ++i) {
+      if (p.t[i] <= t_min) continue;
+      if (!(p.misfit[i] <= r.opt.continuation_misfit)) break;
+      T = p.t[i];
+    }
+    T = std::max(T, current);
+    return T >= t_end - 1e-9 * (t_end - t0) ? t_end : T;
+  };
+  const bool continuation = r.opt.continuation;
+  auto full = [&]() { return obj.horizon() >= t_end; };
+
+  Objective::MisfitProfile prof;
+  auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx, bool with_profile) {
+    try {
+      const VectorXd q = xx.array().exp();
+      VectorXd g;
+      MatrixXd H;
+      J = obj.gauss_newton(q, g, H, with_profile ? &prof : nullptr);
+      gx = q.cwiseProduct(g);
+      Hx = q.asDiagonal() * H * q.asDiagonal();
+      return std::isfinite(J) && gx.allFinite() && Hx.allFinite();
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  auto fail_start = [&]() {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.sum.q = x.array().exp();
+  };
+  obj.set_horizon(t_end);
+  if (continuation) {
+    try {
+      obj.set_horizon(choose_horizon(obj.misfit_profile(x.array().exp()), t0));
+    } catch (const std::exception&) {
+      return fail_start();
+    }
+  }
+  double J;
+  VectorXd gx;
+  MatrixXd Hx;
+  if (!gn_at(x, J, gx, Hx, false)) return fail_start();
+  r.record(0, J, x.array().exp(), gx);
+  double radius = r.opt.trust_radius;
+  int k = 0;
+  r.sum.termination = T::MaxIterations;
+  // On a short horizon a termination test lengthens the horizon instead; true if it did.
+  auto extend = [&](double T_new) {
+    if (full() || !(T_new > obj.horizon())) return false;
+    obj.set_horizon(T_new);
+    if (!gn_at(x, J, gx, Hx, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    return true;
+  };
+  try {
+    while (true) {
+      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
+        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
+        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+        break;
+      }
+      if (k >= r.opt.max_iterations) break;
+      const TrustRegionStep st = trust_region_step(Hx, gx, radius, full() ? 0.0 : r.opt.short_horizon_floor * J);
+      double Jn;
+      VectorXd gn;
+      MatrixXd Hn;
+      const bool profile = continuation && !full();
+      const bool ok = gn_at(x + st.delta, Jn, gn, Hn, profile) && Jn < J;
+      const double rho = ok && st.predicted > 0 ? (J - Jn) / st.predicted : -1.0;
+      radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
+      if (!ok) {
+        if (radius < r.opt.step_tolerance) {
+          if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) {
+            radius = r.opt.trust_radius;
+            continue;
+          }
+          r.sum.termination = T::StepTolerance;
+          r.sum.message = "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
+          break;
+        }
+        continue;
+      }
+      // The cost fell by clearly more than the Gauss–Newton model predicted: the minimum along δ
+      // lies further out (the model's curvature along δ is too large — a curved valley, a large
+      // residual). Try 2δ, 4δ, … with one state solve each while the cost keeps falling.
+      VectorXd delta = st.delta;
+      if (rho > r.opt.extrapolation_ratio) {
+        double best = 1.0, Jb = Jn;
+        for (double a = 2.0; a <= r.opt.max_extrapolation && a * st.delta.norm() <= r.opt.max_trust_radius; a *= 2.0) {
+          double Ja = 0.0;
+          try {
+            Ja = obj.cost((x + a * st.delta).array().exp());
+          } catch (const std::exception&) {
+            break;
+          }
+          if (!(Ja < Jb)) break;
+          best = a;
+          Jb = Ja;
+        }
+        if (best > 1.0) {
+          VectorXd g2;
+          MatrixXd H2;
+          double J2;
+          if (gn_at(x + best * st.delta, J2, g2, H2, profile) && J2 < Jn) {
+            delta = best * st.delta;
+            Jn = J2;
+            gn = g2;
+            Hn = H2;
+            radius = std::max(radius, std::min(delta.norm(), r.opt.max_trust_radius));
+          } else if (profile) {
+            gn_at(x + st.delta, Jn, gn, Hn, profile);  // restore the profile of the accepted point
+          }
+        }
+      }
+      x += delta;
+      const double step = delta.cwiseAbs().maxCoeff();
+      const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
+      const bool stalled = J - Jn <= stall * J;
+      J = Jn;
+      gx = gn;
+      Hx = Hn;
+      ++k;
+      // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
+      // with its cost on the horizon the next step is taken on.
+      const bool extended = profile && extend(choose_horizon(prof, obj.horizon()));
+      r.record(k, J, x.array().exp(), gx);
+      if (extended) continue;
+      if (step < r.opt.step_tolerance || stalled) {
+        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
+        r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+        break;
+      }
+    }
+  } catch (const std::runtime_error& e) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = e.what();
+  }
+  r.sum.iterations_done = k;
+  r.sum.q = x.array().exp();
+  r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
+  obj.set_horizon(t_end);
+}
+
+void lbfgs(Run& r, VectorXd x, bool steepest) {
+  double J;
+  VectorXd gx;
+  if (!r.eval_grad(x, J, gx)) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.sum.q = x.array().exp();
+    return;
+  }
+  r.record(0, J, x.array().exp(), gx);
+  std::deque<std::pair<VectorXd, VectorXd>> mem;  // (s, y)
+  const int m = 8;
+  double alpha0 = 1.0;
+  const bool fixed_weights = steepest && !r.opt.steepest_weights.empty();
+  VectorXd w;
+  if (fixed_weights) {
+    w = Eigen::Map<const VectorXd>(r.opt.steepest_weights.data(), static_cast<Eigen::Index>(r.opt.steepest_weights.size()));
+    if (w.size() != x.size()) throw std::invalid_argument("steepest_weights: one weight per parameter");
+  }
+  int k = 0;
+  r.sum.termination = T::MaxIterations;
+  while (true) {
+    if (J <= r.opt.cost_floor) { r.sum.termination = T::CostFloor; break; }
+    if (r.small_gradient(gx, J)) { r.sum.termination = T::GradientTolerance; break; }
+    if (k >= r.opt.max_iterations) break;
+    VectorXd d;
+    if (fixed_weights) {
+      // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
+      const VectorXd q = x.array().exp();
+      d = -(w.array() * (gx.array() / q.array()) / q.array()).matrix();
+    } else if (steepest || mem.empty()) {
+      d = -gx;
+      if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
+      if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
+    } else {
+      // two-loop recursion
+      VectorXd qv = gx;
+      std::vector<double> al(mem.size());
+      for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
+        const auto& [s, y] = mem[static_cast<std::size_t>(i)];
+        al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
+        qv -= al[static_cast<std::size_t>(i)] * y;
+      }
+      const auto& [sl, yl] = mem.back();
+      qv *= sl.dot(yl) / yl.dot(yl);
+      for (std::size_t i = 0; i < mem.size(); ++i) {
+        const auto& [s, y] = mem[i];
+        const double b = y.dot(qv) / y.dot(s);
+        qv += (al[i] - b) * s;
+      }
+      d = -qv;
+    }
+    if (gx.dot(d) >= 0) {
+      mem.clear();
+      d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
+    }
+    const double mx = d.cwiseAbs().maxCoeff();
+    if (mx > 1.0) d *= 1.0 / mx;
+    double a = 1.0, Jn = 0.0;
+    VectorXd gn;
+    bool ok = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      if (r.eval_grad(x + a * d, Jn, gn) && Jn <= J + 1e-4 * a * gx.dot(d) && Jn <= J) {
+        ok = true;
+        break;
+      }
+      a *= 0.5;
+    }
+    if (!ok) {
+      r.sum.termination = T::LineSearchFailed;
+      r.sum.message = "no decrease along the search direction";
+      break;
+    }
+    const VectorXd s = a * d, y = gn - gx;
+    const bool stalled = J - Jn <= (r.opt.cost_stall > 0 ? r.opt.cost_stall : 1e-5) * J;
+    x += s;
+    J = Jn;
+    gx = gn;
+    if (!steepest && y.dot(s) > 1e-300) {
+      mem.emplace_back(s, y);
+      if (static_cast<int>(mem.size()) > m) mem.pop_front();
+    }
+    if (steepest && !fixed_weights) alpha0 = std::min(1e3, a * 2.0 * alpha0);
+    ++k;
+    r.record(k, J, x.array().exp(), gx);
+    if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance) {
+      r.sum.termination = T::StepTolerance;
+      break;
+    }
+    if (stalled && !steepest) {
+      r.sum.termination = T::CostStalled;
+      break;
+    }
+  }
+  r.sum.iterations_done = k;
+  r.sum.q = x.array().exp();
+  r.sum.cost = J;
+}
+
+}  // namespace
+
+OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const OptimizerOptions& options,
+                          const std::function<void(const IterationRecord&)>& on_iteration) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("OptimizerOptions: " + why);
+  const auto t0 = Clock::now();
+  Run r{objective, options, on_iteration, {}};
+  const VectorXd x0 = q0.array().log();
+  if (options.method == "gauss-newton") gauss_newton(r, x0);
+  else lbfgs(r, x0, options.method == "steepest-descent");
+  r.sum.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return r.sum;
+}
+
+}  // namespace scoleid::identify

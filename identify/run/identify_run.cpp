@@ -1,0 +1,228 @@
+#include "scoleid/identify/run/identify_run.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "scoleid/io/data_files.h"
+#include "scoleid/identify/run/fit_plot.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+// Paper-style iteration table: iteration, parameters, physical values, cost.
+class Table {
+public:
+  Table(const Parameterization& p, bool physical_columns) : p_(p), phys_(physical_columns) {}
+  void header() const {
+    std::printf("%5s", "iter");
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
+    if (p_.size() > kMaxCols) std::printf(" %5s", "...");
+    if (phys_)
+      for (const char* n : {"rho_A", "EI", "zeta"}) std::printf(" %13s", n);
+    std::printf(" %13s %8s\n", "cost", "horizon");
+  }
+  void row(const IterationRecord& r) const {
+    std::printf("%5d", r.k);
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13.6g", r.q[i]);
+    if (p_.size() > kMaxCols) std::printf(" %5s", "");
+    if (phys_) {
+      const auto ph = p_.physical(r.q);
+      for (const char* n : {"rho_A", "EI", "zeta"}) {
+        const auto it = ph.find(n);
+        std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
+      }
+    }
+    std::printf(" %13.6e %8.4g\n", r.cost, r.horizon);
+    std::fflush(stdout);
+  }
+
+private:
+  static constexpr int kMaxCols = 8;
+  const Parameterization& p_;
+  bool phys_;
+};
+
+double safe(double v) { return std::isfinite(v) ? v : 0.0; }
+
+const char* integrator_name(SolverOptions::Integrator i) {
+  switch (i) {
+    case SolverOptions::Integrator::Esdirk: return "esdirk324l2sa";
+    case SolverOptions::Integrator::EsdirkArkode: return "arkode-esdirk324l2sa";
+    case SolverOptions::Integrator::Bdf: return "cvodes-bdf";
+  }
+  return "?";
+}
+
+}  // namespace
+
+RunResult run_identification(Problem& p, const RunOptions& ro) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RunResult r;
+  r.scenario = p.scenario.name;
+  r.names = p.params->names();
+  r.initial = p.params->initial();
+  r.truth = p.true_values;
+  std::string method = ro.method.empty() ? p.scenario.identification.method : ro.method;
+  if (method == "auto") method = p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
+  r.method = method;
+
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+  OptimizerOptions oo;
+  oo.method = method;
+  oo.max_iterations = ro.max_iterations.value_or(p.scenario.identification.max_iterations);
+  oo.gradient_tolerance = p.scenario.identification.gradient_tolerance;
+  oo.step_tolerance = p.scenario.identification.step_tolerance;
+  oo.steepest_weights = p.scenario.identification.steepest_weights;
+  oo.continuation = p.scenario.identification.continuation_misfit > 0;
+  if (oo.continuation) oo.continuation_misfit = p.scenario.identification.continuation_misfit;
+  if (!oo.steepest_weights.empty() && static_cast<int>(oo.steepest_weights.size()) != p.params->size())
+    io::fail_field(p.scenario.source, "identification.steepest_weights",
+                   "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
+                   std::to_string(oo.steepest_weights.size()) + " values");
+  Table table(*p.params, p.params->names().size() <= 3 && p.params->paper_form());
+  if (ro.verbose) table.header();
+  r.summary = minimize(obj, r.initial, oo, [&](const IterationRecord& rec) {
+    io::check_interrupt();
+    if (ro.verbose) table.row(rec);
+  });
+  r.estimate = r.summary.q;
+  if (ro.compute_std) {
+    const auto ti = std::chrono::steady_clock::now();
+    // Each sensor's stated noise level: the scenario's, else truth.json's (make_problem).
+    std::vector<io::SensorSpec> sensors = p.scenario.sensors;
+    for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
+    r.ident = analyse_identifiability(obj, sensors, r.estimate);
+    if (r.ident.noise_source == "scenario") {
+      std::string origin;
+      for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
+      r.ident.noise_source = origin;
+    }
+    r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
+  }
+  r.counters = obj.counters();
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+nlohmann::json RunResult::to_json(const Problem& p) const {
+  using nlohmann::json;
+  json params = json::array();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    json e{{"name", names[i]}, {"initial", initial[static_cast<Eigen::Index>(i)]},
+           {"estimate", estimate[static_cast<Eigen::Index>(i)]}};
+    const auto it = truth.find(names[i]);
+    if (it != truth.end()) {
+      e["truth"] = it->second;
+      e["relative_error"] = estimate[static_cast<Eigen::Index>(i)] / it->second - 1.0;
+    }
+    if (ident.std.size() > static_cast<Eigen::Index>(i)) {
+      // A flagged parameter has no standard deviation worth the name: null, with the reason.
+      const bool ok = ident.identifiable[i];
+      const double sd = ident.std[static_cast<Eigen::Index>(i)], res = ident.resolution[static_cast<Eigen::Index>(i)];
+      e["std"] = ok && std::isfinite(sd) ? json(sd) : json(nullptr);
+      e["resolution"] = ok && std::isfinite(res) ? json(res) : json(nullptr);
+      e["identifiable"] = ok;
+      if (!ok && i < ident.reason.size()) e["not_identifiable_because"] = ident.reason[i];
+    } else {
+      // --no-std: not assessed, which is not the same as identifiable.
+      e["std"] = nullptr;
+      e["resolution"] = nullptr;
+      e["identifiable"] = nullptr;
+    }
+    params.push_back(e);
+  }
+  json iters = json::array();
+  for (const auto& it : summary.iterations) {
+    json values = json::object();
+    for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = it.q[static_cast<Eigen::Index>(i)];
+    iters.push_back({{"k", it.k}, {"cost", it.cost}, {"values", values}, {"physical", p.params->physical(it.q)},
+                     {"gradient_norm", it.gradient_norm}, {"horizon", it.horizon}});
+  }
+  json out{{"scenario", scenario},
+           {"method", method},
+           {"parameters", params},
+           {"physical_estimate", p.params->physical(estimate)},
+           {"iterations", iters},
+           {"termination", to_string(summary.termination)},
+           {"termination_message", summary.message},
+           {"converged", summary.converged()},
+           {"cost", summary.cost},
+           {"gradient_evaluations", counters.gradient_evaluations},
+           {"forward_solves", counters.forward_solves},
+           {"costate_solves", counters.costate_solves},
+           {"sensitivity_solves", counters.sensitivity_solves},
+           {"wall_seconds", wall_seconds},
+           {"timing_seconds",
+            {{"forward", counters.forward_seconds},
+             {"costate", counters.costate_seconds},
+             {"sensitivity", counters.sensitivity_seconds},
+             {"quadrature", counters.quadrature_seconds},
+             {"optimizer_total", summary.wall_seconds},
+             {"identifiability", identifiability_seconds}}},
+           {"integrator",
+            {{"name", integrator_name(p.objective_options.solver.integrator)},
+             {"step", p.objective_options.solver.step},
+             {"rtol", p.objective_options.solver.rtol},
+             {"steps", counters.solver.steps}}},
+           {"data_source", p.data_source},
+           {"elements", p.structure->elements()},
+           {"settings", io::to_json(p.scenario)}};
+  if (ident.std.size() > 0) {
+    out["identifiability"] = {{"assessed", true},
+                              {"condition_number", safe(ident.condition_number)},
+                              {"noise_std", ident.noise_std},
+                              {"noise_source", ident.noise_source},
+                              {"chi2", ident.chi2},
+                              {"data_values", ident.data_values}};
+  } else {
+    out["identifiability"] = {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
+  }
+  if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0)
+    out["data_columns"] = {{"sensors", p.columns.sensors},
+                           {"inputs_from_data", p.columns.inputs_from_data},
+                           {"inputs_from_scenario", p.columns.inputs_from_scenario},
+                           {"unused", p.columns.unused}};
+  return out;
+}
+
+void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
+  // fit.csv: measured, predicted and residual per sensor at the sample times.
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+  const MatrixXd Y = obj.predict(r.estimate);
+  io::DataTable tab;
+  tab.t = p.data.t;
+  for (int k = 0; k < p.data.sensors(); ++k) {
+    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+    tab.names.push_back(n + "_measured");
+    tab.names.push_back(n + "_predicted");
+    tab.names.push_back(n + "_residual");
+    std::vector<double> m(p.data.t.size()), y(p.data.t.size()), e(p.data.t.size());
+    for (std::size_t i = 0; i < p.data.t.size(); ++i) {
+      m[i] = p.data.z(static_cast<Eigen::Index>(i), k);
+      y[i] = Y(static_cast<Eigen::Index>(i), k);
+      e[i] = y[i] - m[i];
+    }
+    tab.columns.push_back(m);
+    tab.columns.push_back(y);
+    tab.columns.push_back(e);
+  }
+  io::write_csv(dir.path("fit.csv"), tab);
+  // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
+  std::vector<std::pair<int, double>> cost;
+  for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
+  io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost));
+  switch (render_gnuplot(dir.staging(), "fit.gp")) {
+    case RenderStatus::Rendered: break;
+    case RenderStatus::NoGnuplot: std::fprintf(stderr, "scole-identify: note: gnuplot is not installed; no fit.png\n"); break;
+    case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n"); break;
+  }
+  io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,294 @@
+#include "scoleid/identify/run/problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/fe/scole_model.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
+#include "scoleid/io/structure_parameters.h"
+
+namespace scoleid::identify {
+
+using io::fail_field;
+using io::InputError;
+
+namespace {
+
+std::vector<io::Signal> scenario_signals(const io::Scenario& sc) {
+  std::vector<io::Signal> s;
+  for (const auto& in : sc.inputs) s.push_back(in.signal);
+  return s;
+}
+
+std::vector<double> sample_times(const io::Scenario& sc) {
+  std::vector<double> t;
+  const double dt = sc.simulation.sample_interval, T = sc.simulation.duration;
+  const long n = static_cast<long>(std::floor(T / dt + 1e-9));
+  for (long k = 0; k <= n; ++k) t.push_back(k * dt);
+  if (T - t.back() > 1e-9 * dt) t.push_back(T);
+  return t;
+}
+
+// The structure's FE model on `elements` elements, with the structure's own sections (not the
+// identifier's), and its coefficients at the scenario's values.
+std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elements) {
+  io::Scenario own = sc;
+  own.identification.sections = 0;
+  const auto st = make_structure(own, elements);
+  return {st->model(), st->coefficients(own)};
+}
+
+}  // namespace
+
+double resolved_frequency(const StructuralModel& model, const Parameterization& params) {
+  VectorXd c;
+  MatrixXd dcdq;
+  params.coefficients(params.initial(), c, dcdq);
+  const AssembledModel ops = assemble(model, c);
+  const std::vector<double> w = natural_frequencies(ops.M, ops.K);
+  const double wmax = w.empty() ? 0.0 : w.back();
+  std::vector<double> flexible;
+  for (double x : w)
+    if (x > 1e-6 * wmax) flexible.push_back(x);
+  if (flexible.empty()) return 0.0;
+  const std::size_t r = std::min(flexible.size(), static_cast<std::size_t>(params.size() + 2)) - 1;
+  return flexible[r];
+}
+
+double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
+  if (sc.identification.time_step > 0) return sc.identification.time_step;
+  // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
+  // an L-stable step damps what it does not resolve, and P parameters are fixed mostly by the
+  // first P modes' frequencies and shapes.
+  const double w = resolved_frequency(model, params);
+  double h = sc.simulation.sample_interval;
+  if (w > 0) h = std::min(h, 0.3 / w);
+  return h;
+}
+
+namespace {
+// Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
+// scenario that does not resolve the modes the parameters live in (ω_{P+2} h > 1: the L-stable
+// step would damp them away and the fit would absorb that into the parameters), and trajectory
+// storage beyond io::limits (state, costate and, for Gauss–Newton or the standard deviations,
+// one sensitivity trajectory per parameter; synthetic data on its finer mesh and step).
+void check_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params, double h,
+                bool synthetic) {
+  const auto& id = sc.identification;
+  const double T = sc.simulation.duration;
+  const std::string field = id.time_step > 0 ? "identification.time_step" : "identification.elements";
+  const std::string got = id.time_step > 0 ? io::format_value(id.time_step) : std::to_string(id.elements);
+  if (id.time_step > 0 && id.integrator != "bdf") {
+    const double w = resolved_frequency(model, params);
+    if (w * h > 1.0)
+      fail_field(sc.source, "identification.time_step",
+                 "must resolve flexible mode " + std::to_string(params.size() + 2) + " (" +
+                     io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
+                     io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
+                     io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
+                 io::format_value(h));
+  }
+  const double steps = T / h;
+  const double trajectories = 2.0 + params.size();
+  const double bytes = (steps + 1.0) * model.ndof * 3.0 * 8.0 * trajectories;
+  if (!(steps <= io::limits::kMaxSteps) || !(bytes <= io::limits::kMaxTrajectoryBytes))
+    fail_field(sc.source, field,
+               "gives " + io::format_value(std::ceil(steps)) + " steps of " + std::to_string(model.ndof) + " DOF (about " +
+                   io::format_value(std::ceil(bytes / 1048576.0)) + " MiB of trajectories); the limits are " +
+                   io::format_value(io::limits::kMaxSteps) + " steps and " +
+                   io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
+               got);
+  if (synthetic) {
+    const int de = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
+    const double dsteps = 4.0 * steps;
+    const double dbytes = (dsteps + 1.0) * model.ndof * (static_cast<double>(de) / id.elements) * 3.0 * 8.0;
+    if (!(dsteps <= io::limits::kMaxSteps) || !(dbytes <= io::limits::kMaxTrajectoryBytes))
+      fail_field(sc.source, field,
+                 "makes the synthetic data (" + std::to_string(de) + " elements, step h/4) take " +
+                     io::format_value(std::ceil(dsteps)) + " steps (about " + io::format_value(std::ceil(dbytes / 1048576.0)) +
+                     " MiB); the limits are " + io::format_value(io::limits::kMaxSteps) + " steps and " +
+                     io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
+                 got);
+  }
+}
+}  // namespace
+
+Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
+  const auto [model, coefficients] = true_model(sc, elements);
+  const AssembledModel ops = assemble(model, coefficients);
+  SolverOptions so;
+  so.rtol = rtol;
+  so.step = step;
+  SecondOrderSolver solver(ops.M, ops.D, ops.K, model.dof_group, so);
+  const auto signals = scenario_signals(sc);
+  const int n = model.ndof;
+  SecondOrderSolver::Forcing f = [&](double t, double* F) {
+    Eigen::Map<VectorXd> Fm(F, n);
+    for (std::size_t i = 0; i < signals.size(); ++i) Fm += signals[i](t) * ops.loads[i];
+  };
+  std::vector<double> bps;
+  for (const auto& s : signals)
+    for (double b : s.breakpoints()) bps.push_back(b);
+  const auto times = sample_times(sc);
+  const Trajectory u = solver.solve(0.0, times.back(), f, bps);
+  Measurements m;
+  m.t = times;
+  // y = C_0 u + C_1 u̇ + C_2 ü, ü from the equation of motion at the sample time.
+  const MatrixXd C = model.output_matrix(0), C1 = model.output_matrix(1), C2 = model.output_matrix(2);
+  const bool rates = model.has_rate_outputs();
+  m.z.resize(static_cast<Eigen::Index>(times.size()), C.rows());
+  VectorXd x(n), v(n), a(n), F(n);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    u.eval(times[k], x.data(), v.data());
+    VectorXd y = C * x;
+    if (rates) {
+      F.setZero();
+      f(times[k], F.data());
+      solver.acceleration(F.data(), x.data(), v.data(), a.data());
+      y += C1 * v + C2 * a;
+    }
+    m.z.row(static_cast<Eigen::Index>(k)) = y.transpose();
+  }
+  for (const auto& s : sc.sensors) m.names.push_back(s.name);
+  if (add_noise) {
+    std::mt19937_64 rng(sc.simulation.seed);
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+      const double sd = sc.sensors[j].noise_std;
+      if (sd <= 0) continue;
+      std::normal_distribution<double> N(0.0, sd);
+      for (Eigen::Index k = 0; k < m.z.rows(); ++k) m.z(k, static_cast<Eigen::Index>(j)) += N(rng);
+    }
+  }
+  return m;
+}
+
+std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
+  if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
+  if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
+  auto p = std::make_unique<Problem>();
+  p->scenario = sc;
+  const auto& id = sc.identification;
+  p->structure = make_structure(sc, id.elements);
+  p->params = p->structure->parameterize(sc);
+  // True values of the estimated parameters for a structure (the truth's), translated to this
+  // parameterization.
+  const auto set_true_values = [&](const io::Scenario& truth_sc) {
+    const VectorXd tv = p->structure->parameterize(truth_sc)->truth();
+    for (int i = 0; i < tv.size(); ++i)
+      if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
+  };
+  p->signals = scenario_signals(sc);
+
+  p->noise_std.assign(sc.sensors.size(), 0.0);
+  p->noise_origin.assign(sc.sensors.size(), "");
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+    if (sc.sensors[j].noise_std > 0) {
+      p->noise_std[j] = sc.sensors[j].noise_std;
+      p->noise_origin[j] = "scenario";
+    }
+  if (data_csv) {
+    const io::DataTable tab = io::read_csv(*data_csv);
+    // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
+    const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
+    std::map<std::string, double> meta_truth;
+    if (std::filesystem::exists(meta_path)) {
+      const io::TruthMeta meta = io::read_truth_meta(meta_path.string());
+      meta_truth = meta.true_parameters;
+      // The two files must come from one run: the same columns.
+      std::vector<std::string> described;
+      for (const auto& c : meta.columns) described.push_back(c.name);
+      for (const auto& n : tab.names)
+        if (std::find(described.begin(), described.end(), n) == described.end())
+          throw InputError(meta_path.string() + ": does not describe column '" + n + "' of data file '" + *data_csv +
+                           "'; the two files are not from the same run");
+      for (const auto& n : described)
+        if (tab.find(n) < 0)
+          throw InputError(meta_path.string() + ": describes column '" + n + "', which data file '" + *data_csv +
+                           "' lacks; the two files are not from the same run");
+      for (const auto& c : meta.columns) {
+        for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+          const auto& s = sc.sensors[j];
+          if (s.name != c.name) continue;
+          if (c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
+            throw InputError(meta_path.string() + ": column '" + c.name + "' is a " + c.quantity +
+                             " but the scenario's sensor is a " + s.kind);
+          if (p->noise_std[j] <= 0 && c.noise_std > 0) {
+            p->noise_std[j] = c.noise_std;
+            p->noise_origin[j] = "truth.json";
+          }
+        }
+      }
+    }
+    p->data.t = tab.t;
+    p->data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+      const int col = tab.find(sc.sensors[j].name);
+      if (col < 0)
+        throw InputError("data file '" + *data_csv + "': no column for sensor '" + sc.sensors[j].name +
+                         "' (sensors[" + std::to_string(j) + "] of " + sc.source + ")");
+      for (std::size_t k = 0; k < tab.t.size(); ++k)
+        p->data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
+      p->data.names.push_back(sc.sensors[j].name);
+    }
+    std::vector<bool> used(tab.names.size(), false);
+    for (const auto& s : sc.sensors) {
+      used[static_cast<std::size_t>(tab.find(s.name))] = true;
+      p->columns.sensors.push_back(s.name);
+    }
+    for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+      const auto& in = sc.inputs[i];
+      const int col = tab.find(in.name);
+      const std::string field = "inputs[" + std::to_string(i) + "]";
+      if (in.signal_from == "data" && col < 0)
+        throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' (" + field +
+                         ".signal_from is data, in " + sc.source + ")");
+      if (in.signal_from != "scenario" && col >= 0) {
+        p->signals[i] = io::Signal::table(tab.t, tab.columns[static_cast<std::size_t>(col)]);
+        used[static_cast<std::size_t>(col)] = true;
+        p->columns.inputs_from_data.push_back(in.name);
+      } else {
+        if (in.signal.terms().empty())
+          throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' and " + field +
+                           " of " + sc.source + " gives no signal");
+        p->columns.inputs_from_scenario.push_back(in.name);
+      }
+    }
+    for (std::size_t c = 0; c < tab.names.size(); ++c)
+      if (!used[c]) p->columns.unused.push_back(tab.names[c]);
+    if (tab.t.front() < 0.0)
+      throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
+    p->data_source = *data_csv;
+    // True values from the metadata, translated to this parameterization.
+    if (!meta_truth.empty()) {
+      io::Scenario truth_sc = sc;
+      io::set_structure_parameters(truth_sc, meta_truth);
+      set_true_values(truth_sc);
+    }
+  } else {
+    const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
+    if (data_elements < 2 * id.elements)
+      fail_field(sc.source, "identification.data_elements",
+                 "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
+                 std::to_string(data_elements));
+    check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), true);
+    // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
+    // 4x finer than the identifier's.
+    const io::Scenario truth_sc = io::truth_scenario(sc);
+    p->data = synthesize(truth_sc, data_elements, id.rtol, identifier_step(sc, p->model(), *p->params) / 4.0, true);
+    p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
+    set_true_values(truth_sc);
+  }
+  if (data_csv) check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), false);
+  p->objective_options.solver.rtol = id.rtol;
+  p->objective_options.solver.step = identifier_step(sc, p->model(), *p->params);
+  p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
+                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
+                                                                              : SolverOptions::Integrator::Esdirk;
+  return p;
+}
+
+}  // namespace scoleid::identify

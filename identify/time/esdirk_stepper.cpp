@@ -1,0 +1,215 @@
+#include "scoleid/identify/time/esdirk_stepper.h"
+
+#include <arkode/arkode_butcher_dirk.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace scoleid::identify {
+
+bool ButcherTable::explicit_first_stage() const {
+  if (stages < 1 || c[0] != 0.0) return false;
+  for (int j = 0; j < stages; ++j)
+    if (a(0, j) != 0.0) return false;
+  return true;
+}
+
+bool ButcherTable::stiffly_accurate() const {
+  if (stages < 1 || c[static_cast<std::size_t>(stages - 1)] != 1.0) return false;
+  for (int j = 0; j < stages; ++j)
+    if (b[static_cast<std::size_t>(j)] != a(stages - 1, j)) return false;
+  return true;
+}
+
+ButcherTable ButcherTable::arkode_dirk(int id) {
+  const auto tid = id < 0 ? ARKODE_ESDIRK324L2SA_4_2_3 : static_cast<ARKODE_DIRKTableID>(id);
+  ARKodeButcherTable B = ARKodeButcherTable_LoadDIRK(tid);
+  if (!B) throw std::invalid_argument("unknown ARKODE DIRK table id " + std::to_string(id));
+  ButcherTable t;
+  t.stages = B->stages;
+  const auto s = static_cast<std::size_t>(t.stages);
+  t.A.resize(s * s);
+  t.b.resize(s);
+  t.c.resize(s);
+  for (std::size_t i = 0; i < s; ++i) {
+    for (std::size_t j = 0; j < s; ++j) t.A[i * s + j] = B->A[i][j];
+    t.b[i] = B->b[i];
+    t.c[i] = B->c[i];
+  }
+  ARKodeButcherTable_Free(B);
+  for (int i = 0; i < t.stages; ++i)
+    for (int j = i + 1; j < t.stages; ++j)
+      if (t.a(i, j) != 0.0) throw std::invalid_argument("ARKODE table " + std::to_string(id) + " is not diagonally implicit");
+  return t;
+}
+
+EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
+                             NewtonMatrix& newton, ButcherTable table)
+    : M_(M), D_(D), K_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
+  explicit_first_ = tab_.explicit_first_stage();
+  stiffly_accurate_ = tab_.stiffly_accurate();
+  for (int i = 0; i < tab_.stages; ++i)
+    if (tab_.a(i, i) < 0.0) throw std::invalid_argument("EsdirkStepper: negative diagonal coefficient");
+}
+
+EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const std::vector<double>& stops_in,
+                                         const Forcing& forcing, int P, const TangentForcing* tangent,
+                                         double tangent_end) const {
+  if (!(h > 0.0)) throw std::invalid_argument("EsdirkStepper: step must be > 0");
+  if (!(t1 > t0)) throw std::invalid_argument("EsdirkStepper: t1 must exceed t0");
+  if (P < 0 || (P > 0 && !tangent)) throw std::invalid_argument("EsdirkStepper: tangents need their forcing");
+  const int n = static_cast<int>(M_.rows()), s = tab_.stages;
+  std::vector<double> stops;
+  for (double b : stops_in)
+    if (b > t0 && b < t1) stops.push_back(b);
+  std::sort(stops.begin(), stops.end());
+  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
+  stops.push_back(t1);
+
+  int m = 1 + P;
+  MatrixXd x = MatrixXd::Zero(n, m), v = MatrixXd::Zero(n, m), a(n, m), xt(n, m), vt(n, m), w(n, m), r(n, m);
+  std::vector<MatrixXd> Vs(static_cast<std::size_t>(s), MatrixXd(n, m)), As(static_cast<std::size_t>(s), MatrixXd(n, m));
+  MatrixXd G(n, std::max(P, 1));
+  VectorXd F(n), X0(n);
+
+  Result res;
+  res.state = Trajectory(n);
+  res.tangents.assign(static_cast<std::size_t>(P), Trajectory(n));
+  // Recorded points: one per step and two per breakpoint, plus the start.
+  auto points = [&](double t_end) {
+    return static_cast<std::size_t>(std::ceil((std::min(t_end, t1) - t0) / h)) + 3 * stops.size() + 4;
+  };
+  res.state.reserve(points(t1));
+  for (auto& tr : res.tangents) tr.reserve(points(tangent_end + h));
+  StepperCounters& cnt = res.counters;
+
+  // Tangent forcing of every tangent column from column 0 at (t, x0, v0, a0), into r's columns 1..P
+  // (less D ṽ + K w, the parts the caller sets up).
+  auto tangent_forcing = [&](double t, const double* x0, const double* v0, const double* a0) {
+    G.setZero();
+    (*tangent)(t, x0, v0, a0, G.data());
+  };
+  // Accelerations of every column at the current (x, v), forcing evaluated at tf.
+  auto accelerate = [&](double tf) {
+    F.setZero();
+    forcing(tf, F.data());
+    ++cnt.stage_forcings;
+    a.col(0) = F;
+    a.col(0).noalias() -= D_ * v.col(0);
+    a.col(0).noalias() -= K_ * x.col(0);
+    mass_.solve_in_place(a.col(0).data());
+    ++cnt.linear_solves;
+    if (m > 1) {
+      tangent_forcing(tf, x.col(0).data(), v.col(0).data(), a.col(0).data());
+      a.rightCols(P) = G.leftCols(P);
+      a.rightCols(P).noalias() -= D_ * v.rightCols(P);
+      a.rightCols(P).noalias() -= K_ * x.rightCols(P);
+      for (int j = 1; j < m; ++j) mass_.solve_in_place(a.col(j).data());
+      cnt.linear_solves += P;
+    }
+  };
+  auto record = [&](double t) {
+    res.state.push(t, x.col(0).data(), v.col(0).data(), a.col(0).data());
+    for (int i = 1; i < m; ++i)
+      res.tangents[static_cast<std::size_t>(i - 1)].push(t, x.col(i).data(), v.col(i).data(), a.col(i).data());
+  };
+  auto drop_tangents = [&]() {
+    m = 1;
+    for (MatrixXd* A : {&x, &v, &a, &xt, &vt, &w, &r}) A->conservativeResize(n, 1);
+    for (auto& A : Vs) A.conservativeResize(n, 1);
+    for (auto& A : As) A.conservativeResize(n, 1);
+  };
+
+  auto step = [&](double tn, double hs) {
+    for (int i = 0; i < s; ++i) {
+      const auto si = static_cast<std::size_t>(i);
+      if (i == 0 && explicit_first_) {
+        Vs[0] = v;
+        As[0] = a;
+        continue;
+      }
+      xt = x;
+      vt = v;
+      for (int j = 0; j < i; ++j) {
+        const double c = hs * tab_.a(i, j);
+        if (c == 0.0) continue;
+        xt.noalias() += c * Vs[static_cast<std::size_t>(j)];
+        vt.noalias() += c * As[static_cast<std::size_t>(j)];
+      }
+      const double g = hs * tab_.a(i, i);
+      const double ti = tn + tab_.c[si] * hs;
+      const BandedCholesky& S = g > 0.0 ? newton_.factor(g) : mass_;
+      // (M + g D + g² K) A_i = F − D ṽ − K (x̃ + g ṽ);  V_i = ṽ + g A_i;  X_i = x̃ + g ṽ + g² A_i.
+      w = xt;
+      w.noalias() += g * vt;
+      F.setZero();
+      forcing(ti, F.data());
+      ++cnt.stage_forcings;
+      r.col(0) = F;
+      r.col(0).noalias() -= D_ * vt.col(0);
+      r.col(0).noalias() -= K_ * w.col(0);
+      S.solve_in_place(r.col(0).data());
+      ++cnt.linear_solves;
+      As[si].col(0) = r.col(0);
+      Vs[si].col(0) = vt.col(0) + g * r.col(0);
+      if (m > 1) {
+        X0 = w.col(0) + (g * g) * r.col(0);
+        tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), As[si].col(0).data());
+        r.rightCols(P) = G.leftCols(P);
+        r.rightCols(P).noalias() -= D_ * vt.rightCols(P);
+        r.rightCols(P).noalias() -= K_ * w.rightCols(P);
+        for (int j = 1; j < m; ++j) S.solve_in_place(r.col(j).data());
+        cnt.linear_solves += P;
+        As[si].rightCols(P) = r.rightCols(P);
+        Vs[si].rightCols(P) = vt.rightCols(P) + g * r.rightCols(P);
+      }
+    }
+    for (int j = 0; j < s; ++j) {
+      const double c = hs * tab_.b[static_cast<std::size_t>(j)];
+      if (c == 0.0) continue;
+      x.noalias() += c * Vs[static_cast<std::size_t>(j)];
+      v.noalias() += c * As[static_cast<std::size_t>(j)];
+    }
+    if (stiffly_accurate_) a = As[static_cast<std::size_t>(s - 1)];
+    else accelerate(tn + hs);
+  };
+
+  accelerate(t0);
+  record(t0);
+  bool tangents_on = m > 1;
+  if (tangents_on && t0 >= tangent_end) {
+    drop_tangents();
+    tangents_on = false;
+  }
+  double t = t0;
+  for (std::size_t seg = 0; seg < stops.size(); ++seg) {
+    const double stop = stops[seg];
+    const double start = t;
+    const double snap = 1e-12 * std::max(1.0, std::abs(stop));
+    long k = 0;
+    while (t < stop) {
+      double tnext = start + static_cast<double>(k + 1) * h;
+      if (tnext > stop - snap) tnext = stop;  // land on the stop (no micro-step)
+      step(t, tnext - t);
+      t = tnext;
+      ++k;
+      ++cnt.steps;
+      const bool at_break = t == stop && seg + 1 < stops.size();
+      if (at_break) accelerate(std::nextafter(t, -std::numeric_limits<double>::infinity()));  // left limit
+      record(t);
+      if (tangents_on && t >= tangent_end) {
+        drop_tangents();
+        tangents_on = false;
+      }
+      if (at_break) {
+        accelerate(t);  // right limit: restart from it
+        record(t);
+      }
+    }
+  }
+  return res;
+}
+
+}  // namespace scoleid::identify
