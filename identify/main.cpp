@@ -60,8 +60,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (list) {
-      for (const auto& n : io::builtin_scenario_names())
-        std::printf("%-16s %s\n", n.c_str(), io::builtin_scenario_description(n).c_str());
+      std::fputs(io::builtin_scenario_listing().c_str(), stdout);
       return 0;
     }
     io::Scenario sc = io::load_scenario(scenario);

@@ -1,4 +1,7 @@
 #include "scoleid/io/builtin.h"
+
+#include <cstdio>
+
 #include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
 
@@ -16,6 +19,16 @@ std::vector<std::string> builtin_scenario_names() {
   std::vector<std::string> names;
   for (const auto& s : all_builtins()) names.push_back(s.name);
   return names;
+}
+
+std::string builtin_scenario_listing() {
+  std::string out;
+  for (const auto& n : builtin_scenario_names()) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%-16s ", n.c_str());
+    out += buf + builtin_scenario_description(n) + "\n";
+  }
+  return out;
 }
 
 std::string builtin_scenario_text(const std::string& name) {

@@ -107,7 +107,8 @@ struct SimulationSpec {
 };
 
 struct IdentificationSpec {
-  // "physical": parameters are rho_A, EI, zeta, EI_k (k = 1..N), c (damping coefficient).
+  // "physical": the structure's quantities by name (beam: rho_A, EI, EI_k (k = 1..N), zeta;
+  //             SCOLE: rho_A, EI, EI_roll, EI_pitch, GJ, rho_I_psi, zeta, m_reflector).
   // "paper":    the beam equation divided by rho_A: q1 = EI/rho_A, q2 = 1/rho_A,
   //             q3 = 2 zeta sqrt(EI/rho_A) (then q1_k on sections).
   std::string parameterization = "physical";
@@ -172,6 +173,8 @@ std::vector<std::string> builtin_scenario_names();
 std::string builtin_scenario_yaml(const std::string& name);  // "" if unknown
 // The same, or InputError naming the built-ins (--print-scenario).
 std::string builtin_scenario_text(const std::string& name);
+// One line per built-in: name and description (--list-scenarios).
+std::string builtin_scenario_listing();
 std::string builtin_scenario_description(const std::string& name);
 
 // Every field, defaults included: the settings a run actually used, echoed into its outputs.

@@ -3,7 +3,8 @@
 // structural_model.h:
 //
 //   ρA w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = Σ_i f_i(t) δ(s − s_i)   (or δ′ for moments)
-//   c(s) = 2 ζ sqrt(ρA EI(s))   (Kelvin–Voigt; ζ is the first-mode damping ratio of a uniform beam)
+//   c(s) = 2 ζ sqrt(ρA EI(s))   (Kelvin–Voigt; mode k of a uniform beam has damping ratio ζ β_k²,
+//                                 docs/theory.md §2.2)
 //
 // Hermite cubic elements on a uniform mesh; EI piecewise constant on N equal sections;
 // ends pinned (w = 0), clamped (w = w_s = 0) or free (natural conditions); optional rigid tip
