@@ -18,7 +18,7 @@ void check(int flag, const char* what) {
 
 struct Data {
   int n = 0, P = 0, ns = 0;
-  MatrixXd M, D, K, Minv, C;
+  MatrixXd M, D, K, Minv, C0, C1, C2;  // output rows on x, v and a = ẍ (C1, C2 empty without rate sensors)
   std::vector<MatrixXd> dM, dD, dK;
   std::vector<VectorXd> loads;
   std::vector<std::vector<VectorXd>> dloads;  // [param][input]
@@ -30,10 +30,23 @@ struct Data {
     for (std::size_t i = 0; i < loads.size(); ++i) F += obj->input(static_cast<int>(i), t) * loads[i];
     return F;
   }
+  // a = M⁻¹(B f − D v − K x)
+  VectorXd acceleration(double t, const double* y) const {
+    Eigen::Map<const VectorXd> x(y, n), v(y + n, n);
+    return Minv * (force(t) - D * v - K * x);
+  }
+  // r = C0 x + C1 v + C2 a − z̃
   VectorXd residual(double t, const double* y) const {
     VectorXd z(ns);
     obj->data().eval(t, z.data());
-    return C * Eigen::Map<const VectorXd>(y, n) - z;
+    VectorXd r = C0 * Eigen::Map<const VectorXd>(y, n) - z;
+    if (C1.size() != 0) r += C1 * Eigen::Map<const VectorXd>(y + n, n) + C2 * acceleration(t, y);
+    return r;
+  }
+  // ν = M⁻¹ C2ᵀ R r (zero without acceleration rows): a's share of g_y and g_q.
+  VectorXd nu(const VectorXd& r) const {
+    if (C2.size() == 0) return VectorXd::Zero(n);
+    return Minv * (C2.transpose() * R.cwiseProduct(r));
   }
 };
 
@@ -61,10 +74,12 @@ int rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
   double* ld = N_VGetArrayPointer(yBdot);
   Eigen::Map<const VectorXd> lx(l, d.n), lv(l + d.n, d.n);
   const VectorXd w = d.Minv * lv;  // M⁻¹ λ_v (M symmetric)
-  const VectorXd r = d.residual(t, y);
-  // λ̇ = −f_yᵀ λ − g_yᵀ
-  Eigen::Map<VectorXd>(ld, d.n) = d.K * w - d.C.transpose() * d.R.cwiseProduct(r);
-  Eigen::Map<VectorXd>(ld + d.n, d.n) = -lx + d.D * w;
+  const VectorXd r = d.residual(t, y), Rr = d.R.cwiseProduct(r), nu = d.nu(r);
+  // λ̇ = −f_yᵀ λ − g_yᵀ,  g_yᵀ = [C0ᵀRr − Kν; C1ᵀRr − Dν]
+  Eigen::Map<VectorXd> ldx(ld, d.n), ldv(ld + d.n, d.n);
+  ldx = d.K * (w + nu) - d.C0.transpose() * Rr;
+  ldv = -lx + d.D * (w + nu);
+  if (d.C1.size() != 0) ldv -= d.C1.transpose() * Rr;
   return 0;
 }
 
@@ -75,12 +90,14 @@ int rhsQB(realtype t, N_Vector yv, N_Vector yB, N_Vector qBdot, void* ud) {
   Eigen::Map<const VectorXd> x(y, d.n), v(y + d.n, d.n), lv(l + d.n, d.n);
   const VectorXd F = d.force(t);
   const VectorXd a = d.Minv * (F - d.D * v - d.K * x);
-  const VectorXd w = d.Minv * lv;
+  // λᵀ ∂f/∂q_i + g_{q_i} = (M⁻¹λ_v + ν)ᵀ h_i
+  VectorXd w = d.Minv * lv;
+  if (d.C2.size() != 0) w += d.nu(d.residual(t, y));
   double* qd = N_VGetArrayPointer(qBdot);
   for (int i = 0; i < d.P; ++i) {
     VectorXd h = -(d.dD[static_cast<std::size_t>(i)] * v + d.dK[static_cast<std::size_t>(i)] * x + d.dM[static_cast<std::size_t>(i)] * a);
     for (std::size_t k = 0; k < d.loads.size(); ++k) h += d.obj->input(static_cast<int>(k), t) * d.dloads[static_cast<std::size_t>(i)][k];
-    qd[i] = w.dot(h);  // λᵀ ∂f/∂q_i
+    qd[i] = w.dot(h);
   }
   return 0;
 }
@@ -102,9 +119,11 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
   d.D = MatrixXd(ops.D);
   d.K = MatrixXd(ops.K);
   d.Minv = d.M.inverse();
-  if (m.has_rate_outputs())
-    throw std::invalid_argument("cvodes_adjoint_gradient: velocity and acceleration sensors are not supported by the reference");
-  d.C = m.output_matrix();
+  d.C0 = m.output_matrix(0);
+  if (m.has_rate_outputs()) {
+    d.C1 = m.output_matrix(1);
+    d.C2 = m.output_matrix(2);
+  }
   d.loads = ops.loads;
   d.R = Eigen::Map<const VectorXd>(obj.weights().data(), d.ns);
   for (int i = 0; i < d.P; ++i) {

@@ -240,46 +240,127 @@ double Objective::cost(const VectorXd& q) {
 }
 
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
-  if (C1_.size() != 0) {
-    // Velocity and acceleration sensors: the gradient from the forward sensitivities (the exact
-    // derivative of the discrete cost, P extra solves) until the costate carries their forcing.
-    MatrixXd H;
-    return gauss_newton(q, gradient, H);
-  }
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const Trajectory u = forward(solver, s, T_);
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
+  const bool rates = C1_.size() != 0;
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  const SecondOrderSolver::Forcing force = state_forcing(s);
 
-  // Costate backward: P(τ) = p(T − τ), τ ∈ [0, T − t0].
-  auto tc = Clock::now();
-  VectorXd xb(n), vb(n), zb(ns), rb(ns);
-  const MatrixXd CtR = C_.transpose() * Eigen::Map<const VectorXd>(R_.data(), ns).asDiagonal();
-  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
-    const double t = T_ - tau;
-    u.eval(t, xb.data(), vb.data());
-    data_.eval(t, zb.data());
-    rb = C_ * xb - zb;
-    Eigen::Map<VectorXd>(F, n) = -CtR * rb;
-  };
   std::vector<double> bp_tau;
   for (double b : breakpoints_)
     if (b < T_) bp_tau.push_back(T_ - b);
   std::sort(bp_tau.begin(), bp_tau.end());
+
+  // Rate sensors (docs/theory.md §6.1a): with ü = M⁻¹(f − D u̇ − K u) the residual is
+  //   r = A₀ u + A₁ u̇ + Σ_i f_i G_i − z̃,   A₀ = C₀ − C₂M⁻¹K,  A₁ = C₁ − C₂M⁻¹D,  G_i = C₂M⁻¹b_i,
+  // dense ns × n, and μ = M⁻¹C₂ᵀ R r = (M⁻¹C₂ᵀ) R r (M symmetric): ns mass solves per gradient, none
+  // per forcing evaluation.
+  MatrixXd A0, A1, MinvC2t, G;
+  if (rates) {
+    MinvC2t = MatrixXd::Zero(n, ns);
+    if (accelerations_) {
+      const VectorXd zero = VectorXd::Zero(n);
+      for (int k = 0; k < ns; ++k) {
+        const VectorXd c = C2_.row(k).transpose();
+        solver.acceleration(c.data(), zero.data(), zero.data(), MinvC2t.col(k).data());
+      }
+    }
+    A0 = C_ - MinvC2t.transpose() * s.ops.K;
+    A1 = C1_ - MinvC2t.transpose() * s.ops.D;
+    G = MatrixXd::Zero(ns, static_cast<Eigen::Index>(s.ops.loads.size()));
+    for (std::size_t i = 0; i < s.ops.loads.size(); ++i) G.col(static_cast<Eigen::Index>(i)) = MinvC2t.transpose() * s.ops.loads[i];
+  }
+
+  // Backward solves in reversed time τ = T − t (docs/theory.md §6.2):
+  //   P(τ) = p₀(T − τ),  M P'' + D P' + K P = −w₀(T − τ)
+  //   Y(τ) = y(T − τ),   M Y'' + D Y' + K Y = −w₁(T − τ)   (velocity and acceleration sensors only)
+  // with w₀ = C₀ᵀRr − Kμ, w₁ = C₁ᵀRr − Dμ, μ = M⁻¹C₂ᵀRr (§6.1a; w₀ = CᵀRr without rate sensors).
+  auto tc = Clock::now();
+  Trajectory P, Y;
   SolverSummary sum;
-  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
-  counters_.solver.Accumulate(sum);
-  ++counters_.costate_solves;
+  if (!rates) {
+    VectorXd xb(n), vb(n), zb(ns), rb(ns);
+    const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
+    SecondOrderSolver::Forcing g = [&](double tau, double* F) {
+      const double t = T_ - tau;
+      u.eval(t, xb.data(), vb.data());
+      data_.eval(t, zb.data());
+      rb = C_ * xb - zb;
+      Eigen::Map<VectorXd>(F, n) = -CtR * rb;
+    };
+    P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.costate_solves;
+  } else {
+    // With an acceleration output r jumps where the input does. The stepper asks for the right
+    // limit in τ at τ_b = T − t_b, which is the left limit in t (the signals are right-continuous).
+    auto backward_time = [&](double tau) {
+      const double t = T_ - tau;
+      for (double tb : breakpoints_)
+        if (std::abs(t - tb) <= 1e-12 * std::max(1.0, std::abs(tb)))
+          return tau >= T_ - tb ? std::nextafter(tb, -std::numeric_limits<double>::infinity()) : tb;
+      return t;
+    };
+    // w₀ = A₀ᵀ R r and w₁ = A₁ᵀ R r at τ, kept for the second forcing evaluated at the same τ.
+    double tau_last = std::numeric_limits<double>::quiet_NaN();
+    VectorXd xb(n), vb(n), zb(ns), rb(ns), w0(n), w1(n);
+    auto weights_at = [&](double tau) {
+      if (tau == tau_last) return;
+      tau_last = tau;
+      const double t = backward_time(tau);
+      u.eval(t, xb.data(), vb.data());
+      data_.eval(t, zb.data());
+      rb.noalias() = A0 * xb;
+      rb.noalias() += A1 * vb;
+      rb -= zb;
+      for (std::size_t i = 0; i < inputs_.size(); ++i) {
+        const double fi = inputs_[i](t);
+        if (fi != 0.0) rb += fi * G.col(static_cast<Eigen::Index>(i));
+      }
+      rb = Rv.cwiseProduct(rb);
+      w0.noalias() = A0.transpose() * rb;
+      w1.noalias() = A1.transpose() * rb;
+    };
+    SecondOrderSolver::Forcing g0 = [&](double tau, double* F) {
+      weights_at(tau);
+      Eigen::Map<VectorXd>(F, n) = -w0;
+    };
+    if (solver.has_tangent_solve()) {
+      // Y stepped with P on P's stages, sharing the factorisations and the forcing evaluations.
+      SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*, double* F) {
+        weights_at(tau);
+        Eigen::Map<VectorXd>(F, n) = -w1;
+      };
+      auto sol = solver.solve_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, &sum);
+      counters_.solver.Accumulate(sum);
+      P = std::move(sol.state);
+      Y = std::move(sol.tangents.front());
+    } else {
+      SecondOrderSolver::Forcing g1 = [&](double tau, double* F) {
+        weights_at(tau);
+        Eigen::Map<VectorXd>(F, n) = -w1;
+      };
+      P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum);
+      counters_.solver.Accumulate(sum);
+      Y = solver.solve(0.0, T_ - t0, g1, bp_tau, &sum);
+      counters_.solver.Accumulate(sum);
+    }
+    counters_.costate_solves += 2;
+  }
   counters_.costate_seconds += since(tc);
 
   // Quadratures: cost and coefficient gradients.
   const auto tq = Clock::now();
-  std::vector<double> ptimes;
+  std::vector<double> ptimes, ytimes;
   ptimes.reserve(P.size());
   for (double tau : P.times()) ptimes.push_back(T_ - tau);
-  const auto grid = union_grid({&u.times(), &ptimes}, T_);
-  VectorXd x(n), v(n), p(n), pd(n), z(ns), gc = VectorXd::Zero(model_.ncoef), w(n);
+  if (rates)
+    for (double tau : Y.times()) ytimes.push_back(T_ - tau);
+  const auto grid = union_grid({&u.times(), &ptimes, &ytimes}, T_);
+  VectorXd x(n), v(n), a(n), F(n), p(n), pd(n), yx(n), yd(n), z(ns), r(ns), gc = VectorXd::Zero(model_.ncoef);
   double J = 0.0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
@@ -289,17 +370,31 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
       P.eval(T_ - t, p.data(), pd.data());
       pd = -pd;  // ṗ(t) = −P'(T − t)
       data_.eval(t, z.data());
-      const VectorXd r = C_ * x - z;
+      if (!rates) {
+        r = C_ * x - z;
+      } else {
+        F.setZero();
+        force(t, F.data());
+        solver.acceleration(F.data(), x.data(), v.data(), a.data());  // ü from the equation of motion
+        r = C_ * x + C1_ * v - z;
+        if (accelerations_) r += C2_ * a;
+        // Multiplier of §6.1a: p = p₀ − ẏ − μ, ẏ(t) = −Y'(T − t).
+        Y.eval(T_ - t, yx.data(), yd.data());
+        p += yd;
+        if (accelerations_) p.noalias() -= MinvC2t * Rv.cwiseProduct(r);  // μ
+      }
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
       J += 0.5 * wt * e;
-      // Mass term by parts: −ṗᵀ M_j u̇; damping pᵀ D_j u̇; stiffness pᵀ K_j u.
+      // Without rate sensors the mass term is taken by parts, −ṗᵀ M_j u̇ (p(T) = 0); with them p(T) ≠ 0
+      // and it is pᵀ M_j ü. Damping pᵀ D_j u̇, stiffness pᵀ K_j u.
       for (const auto& e : terms_) {
-        const double* left = e.kind == 0 ? pd.data() : p.data();
-        const double* right = e.kind == 2 ? x.data() : v.data();
+        const bool by_parts = e.kind == 0 && !rates;
+        const double* left = by_parts ? pd.data() : p.data();
+        const double* right = e.kind == 2 ? x.data() : (e.kind == 0 && rates ? a.data() : v.data());
         double acc = 0.0;
-        for (std::size_t m = 0; m < e.value.size(); ++m) acc += left[e.row[m]] * e.value[m] * right[e.col[m]];
-        gc[e.coefficient] += (e.kind == 0 ? -wt : wt) * acc;
+        for (std::size_t mm = 0; mm < e.value.size(); ++mm) acc += left[e.row[mm]] * e.value[mm] * right[e.col[mm]];
+        gc[e.coefficient] += (by_parts ? -wt : wt) * acc;
       }
       for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
         const int ci = model_.inputs[i].coefficient;
@@ -414,7 +509,9 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
                                    : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
       }
       const MatrixXd RCS = Rv.asDiagonal() * CS;
-      J += 0.5 * wt * r.dot(Rv.cwiseProduct(r));
+      double e = 0.0;
+      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+      J += 0.5 * wt * e;
       gradient += wt * RCS.transpose() * r;
       H += wt * CS.transpose() * RCS;
     }

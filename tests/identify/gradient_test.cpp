@@ -3,8 +3,10 @@
 // and a Taylor test showing second-order decay of the remainder.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 
 #include "test_support.h"
 #include "scoleid/identify/inverse/cvodes_adjoint.h"
@@ -87,8 +89,10 @@ TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
 // Velocity and acceleration sensors (rows on u̇ and ü; ü from the equation of motion). Their
 // Gauss–Newton gradient is the exact derivative of the discrete cost (the sensitivities are
 // stepped with the state, S̈ comes from the sensitivity equation), so it must match central
-// differences of the cost (measured: 1.8e-6 beam, 5.9e-6 SCOLE), and the
-// Taylor remainder must fall at second order. (The CVODES adjoint reference has no such outputs.)
+// differences of the cost. The costate gradient (docs/theory.md §6.1a: multiplier p₀ − ẏ − μ) is
+// the gradient of the continuous functional, so it agrees with both to the time-discretisation
+// error, like the displacement-only costate above; with BDF at rtol 1e-10 it must agree with the
+// CVODES adjoint, whose outputs on v and a = ẍ are just more rows of g(t, y, q).
 namespace {
 const char* kRatesBeam = R"(name: grad-rates-beam
 beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
@@ -112,8 +116,23 @@ simulation: {duration: 2, sample_interval: 0.01}
 identification: {parameterization: physical, estimate: [EI, rho_A, GJ, m_reflector],
   initial: {EI: 3.8e7, rho_A: 0.09, GJ: 3.6e7, m_reflector: 11.5}, elements: 4}
 )";
+// A pulse input: the acceleration outputs jump at its two breakpoints, and so do r and the costate forcing.
+const char* kRatesPulse = R"(name: grad-rates-pulse
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05}
+inputs: [{name: P, location: 6.3, signal: {type: pulse, amplitude: 10, t0: 0.3, width: 0.4}}]
+sensors: [{name: a_tip, kind: acceleration, location: 10}, {name: v_tip, kind: velocity, location: 10}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+)";
 
-void check_rates(const char* yaml) {
+struct RateBounds {
+  double costate_fd;          // ESDIRK: costate vs central differences and vs Gauss–Newton
+  double costate_bdf_cvodes;  // BDF at rtol 1e-10: costate vs the CVODES adjoint
+  bool taylor;                // the Taylor test (needs the gradient consistent with the discrete cost)
+};
+
+void check_rates(const char* yaml, const RateBounds& bound) {
+  // (1) Same integrator (ESDIRK, fixed step): Gauss–Newton and costate gradients vs central FD.
   Case e = make_case(yaml, false);
   const VectorXd q = e.p->params->initial();
   VectorXd g_gn, g_cg;
@@ -131,19 +150,100 @@ void check_rates(const char* yaml) {
     };
     g_fd[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
   }
-  std::printf("  Gauss-Newton gradient vs FD %.2e\n", max_rel(g_gn, g_fd));
+  std::printf("  esdirk: Gauss-Newton vs FD %.2e, costate vs FD %.2e, costate vs Gauss-Newton %.2e\n",
+              max_rel(g_gn, g_fd), max_rel(g_cg, g_fd), max_rel(g_cg, g_gn));
   for (int i = 0; i < q.size(); ++i)
-    std::printf("    %-12s gauss-newton %+.10e  fd %+.10e\n", e.p->params->names()[static_cast<std::size_t>(i)].c_str(), g_gn[i],
-                g_fd[i]);
+    std::printf("    %-12s costate %+.10e  gauss-newton %+.10e  fd %+.10e\n",
+                e.p->params->names()[static_cast<std::size_t>(i)].c_str(), g_cg[i], g_gn[i], g_fd[i]);
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-5);  // the bound the displacement-sensor tests hold it to
-  EXPECT_EQ(max_rel(g_cg, g_gn), 0.0);
-  const std::vector<double> R = test_support::taylor_remainders(*e.obj, q, 5);
-  for (std::size_t k = 1; k < 5; ++k) {
-    EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-    EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
+  EXPECT_LT(max_rel(g_cg, g_fd), bound.costate_fd);
+  EXPECT_LT(max_rel(g_cg, g_gn), bound.costate_fd);
+  // (2) The costate gradient passes the Taylor test (the remainder falls at second order).
+  if (bound.taylor) {
+    const std::vector<double> R = test_support::taylor_remainders(*e.obj, q, 5);
+    for (std::size_t k = 1; k < 5; ++k) {
+      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
+      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
+    }
   }
+  // (3) Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint (CVodeF/CVodeB).
+  Case b = make_case(yaml, true);
+  VectorXd g_b;
+  const double Jb = b.obj->cost_and_gradient(q, g_b);
+  const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
+  std::printf("  bdf: costate vs CVODES adjoint %.2e, costate vs FD(esdirk) %.2e (J %.10e vs %.10e)\n",
+              max_rel(g_b, ref.gradient), max_rel(g_b, g_fd), Jb, ref.cost);
+  for (int i = 0; i < q.size(); ++i)
+    std::printf("    %-12s costate %+.10e  cvodes %+.10e\n", e.p->params->names()[static_cast<std::size_t>(i)].c_str(), g_b[i],
+                ref.gradient[i]);
+  EXPECT_LT(max_rel(g_b, ref.gradient), bound.costate_bdf_cvodes);
+  EXPECT_NEAR(Jb, ref.cost, 1e-6 * ref.cost);
 }
 }  // namespace
 
-TEST(Gradient, VelocityAndAccelerationSensorsBeam) { check_rates(kRatesBeam); }
-TEST(Gradient, VelocityAndAccelerationSensorsScole) { check_rates(kRatesScole); }
+// Bounds from the measured agreements (esdirk; bdf vs CVODES):
+// beam 1.3e-4; 2.5e-7. The costate is the continuous gradient, so it differs from the discrete one
+//   by the time error, third order in h (RateSensorCostateConvergesWithTheStep); 2× margin.
+//   CVODES: both at rtol 1e-10, the difference is at the tolerance level; 4× margin.
+TEST(Gradient, VelocityAndAccelerationSensorsBeam) { check_rates(kRatesBeam, {3e-4, 1e-6, true}); }
+// SCOLE 1.6e-3; 1.2e-6. The same time error, also third order (measured 1.6e-3, 1.7e-4, 4.0e-5,
+//   4.4e-6 as the step is halved); 2.5× margin. CVODES: its tolerance-level error, 4× margin.
+TEST(Gradient, VelocityAndAccelerationSensorsScole) { check_rates(kRatesScole, {4e-3, 5e-6, true}); }
+// Pulse 8.2e-2; 1.0e-6. The input jumps excite every mode of the mesh in the acceleration output;
+//   the L-stable step damps those it does not resolve (docs/theory.md §5.2), so the discrete cost
+//   is not a consistent approximation of the continuous one there and the two gradients approach
+//   each other only at first order in h. The adaptive BDF resolves them: the CVODES adjoint agrees
+//   to its tolerance (5× margin), which checks the jump handling of the costate forcing. 0.15 is
+//   the measured 8.2e-2 with 2× margin; no Taylor test (the first-order error shows at small ε).
+TEST(Gradient, VelocityAndAccelerationSensorsPulseInput) { check_rates(kRatesPulse, {0.15, 5e-6, false}); }
+
+// The costate gradient with rate sensors differs from the exact gradient of the discrete cost by the
+// time-discretisation error: with a smooth input it falls at third order as the step is halved
+// (measured ratios 8.1 and 5.9 per halving; bound 4, i.e. faster than second order).
+TEST(Gradient, RateSensorCostateConvergesWithTheStep) {
+  const double h0 = make_case(kRatesBeam, false).p->objective_options.solver.step;
+  std::vector<double> diff;
+  for (double f : {1.0, 0.5, 0.25}) {
+    Case e = make_case(kRatesBeam, false, h0 * f);
+    const VectorXd q = e.p->params->initial();
+    VectorXd g_gn, g_cg;
+    MatrixXd H;
+    e.obj->gauss_newton(q, g_gn, H);
+    e.obj->cost_and_gradient(q, g_cg);
+    diff.push_back(max_rel(g_cg, g_gn));
+    std::printf("  h %.4e: costate vs Gauss-Newton %.3e\n", h0 * f, diff.back());
+  }
+  for (std::size_t k = 1; k < diff.size(); ++k) EXPECT_GT(diff[k - 1] / diff[k], 4.0) << "halving " << k;
+}
+
+// With rate sensors cost_and_gradient takes the costate: no sensitivity solve, its cost
+// independent of the number of parameters. Side by side, the time of the Gauss–Newton
+// (sensitivity) gradient it replaced.
+TEST(Gradient, RateSensorsCostateDoesNoSensitivitySolves) {
+  Case e = make_case(kRatesScole, false);
+  const VectorXd q = e.p->params->initial();
+  VectorXd g;
+  MatrixXd H;
+  e.obj->cost_and_gradient(q, g);  // warm-up (allocations, trajectory pool)
+  e.obj->reset_counters();
+  e.obj->cost_and_gradient(q, g);
+  const ObjectiveCounters c = e.obj->counters();
+  EXPECT_EQ(c.sensitivity_solves, 0);
+  EXPECT_GE(c.costate_solves, 1);
+  EXPECT_EQ(c.forward_solves, 1);
+  EXPECT_EQ(c.gradient_evaluations, 1);
+
+  using Clock = std::chrono::steady_clock;
+  const int reps = 5;
+  double t_cg = 0.0, t_gn = 0.0;
+  for (int k = 0; k < reps; ++k) {
+    auto t0 = Clock::now();
+    e.obj->cost_and_gradient(q, g);
+    t_cg += std::chrono::duration<double>(Clock::now() - t0).count();
+    t0 = Clock::now();
+    e.obj->gauss_newton(q, g, H);
+    t_gn += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  std::cout << "  SCOLE, rate sensors, P = " << q.size() << ": costate gradient " << 1e3 * t_cg / reps
+            << " ms, sensitivity (Gauss-Newton) gradient " << 1e3 * t_gn / reps << " ms, ratio " << t_gn / t_cg << "\n";
+}

@@ -2,17 +2,22 @@
 // The identification functional and its derivatives (docs/theory.md §6, paper Eqs. 18–25).
 //
 //   state     M ü + D u̇ + K u = Σ_i γ_i b_i f_i(t),           u(0) = u̇(0) = 0
-//   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C u − z̃(t)   (displacement-type sensors; velocity and
-//             acceleration sensors add C_1 u̇ + C_2 ü, ü from the equation of motion at each
-//             quadrature point, and their Gauss–Newton rows C_1 Ṡ + C_2 S̈ likewise. With them the
-//             gradient is taken from the forward sensitivities: the costate below has no forcing
-//             for u̇ and ü outputs yet.)
-//   costate   M p̈ − D ṗ + K p = −Cᵀ R r,                      p(T) = ṗ(T) = 0   (Eqs. 23–24)
-//             integrated backward as P(τ) = p(T − τ):  M P'' + D P' + K P = −Cᵀ R r(T − τ)
+//   cost      J(q) = ½ ∫₀ᵀ rᵀ R r dt,   r = C₀ u + C₁ u̇ + C₂ ü − z̃(t)   (rows on displacements,
+//             velocities and accelerations; ü = M⁻¹(f − D u̇ − K u) from the equation of motion at
+//             each quadrature point, so r = (C₀ − C₂M⁻¹K) u + (C₁ − C₂M⁻¹D) u̇ + C₂M⁻¹f − z̃)
+//   costate   M p̈₀ − D ṗ₀ + K p₀ = −w₀,   w₀ = C₀ᵀ R r − K μ,   p₀(T) = ṗ₀(T) = 0   (Eqs. 23–24)
+//             M ÿ − D ẏ + K y = −w₁,      w₁ = C₁ᵀ R r − D μ,   y(T) = ẏ(T) = 0
+//             μ = M⁻¹ C₂ᵀ R r;  multiplier p = p₀ − ẏ − μ   (docs/theory.md §6.1a; y and μ only with
+//             velocity or acceleration sensors, otherwise p = p₀, w₀ = C₀ᵀ R r).
+//             Both integrated backward as P(τ) = p₀(T − τ), Y(τ) = y(T − τ):
+//             M P'' + D P' + K P = −w₀(T − τ), likewise Y; −ẏ(t) = Y'(T − t). With the esdirk
+//             integrator Y is stepped with P on P's stages (one pass, shared factorisations).
 //   gradient  ∂J/∂q_i = ∫₀ᵀ pᵀ (∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) dt                (Eq. 25)
-//             evaluated per model coefficient c_j and chained through ∂c/∂q; the mass term is
-//             integrated by parts, ∫ pᵀ M_j ü dt = −∫ ṗᵀ M_j u̇ dt (p(T) = 0, u̇(0) = 0), so only
-//             displacements and velocities of the two recorded solutions enter.
+//             evaluated per model coefficient c_j and chained through ∂c/∂q. Without rate sensors
+//             the mass term is integrated by parts, ∫ pᵀ M_j ü dt = −∫ ṗᵀ M_j u̇ dt (p(T) = 0,
+//             u̇(0) = 0), so only displacements and velocities of the two recorded solutions
+//             enter; with them p(T) = −μ(T) ≠ 0 and ü is taken from the equation of motion.
+//             Either way the cost is one forward and one backward pass, independent of P.
 //   Gauss–Newton: sensitivities S_i = ∂u/∂q_i from
 //             M S̈_i + D Ṡ_i + K S_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f),
 //             H = ∫ (C S)ᵀ R (C S) dt,  g = ∫ (C S)ᵀ R r dt.
@@ -85,7 +90,8 @@ public:
 
   // J(q): one forward solve.
   double cost(const VectorXd& q);
-  // J and ∂J/∂q by the costate: one forward and one backward solve.
+  // J and ∂J/∂q by the costate: one forward and one backward solve (two backward equations with
+  // velocity or acceleration sensors, stepped together by esdirk), whatever the number of parameters.
   double cost_and_gradient(const VectorXd& q, VectorXd& gradient);
   // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
   // the state is integrated over the whole data span and its misfit profile returned.
