@@ -21,6 +21,14 @@
 namespace scoleid::io {
 
 namespace {
+// None of these scenarios drives the proof-mass actuators. Their free proof masses stay where they
+// are while the structure's rigid motion carries the mast past them, so each scenario states a
+// stroke beyond that drift (measured over its record) instead of the default travel of a driven
+// actuator; the guard stays armed against a runaway (docs/truth-guards.md).
+constexpr const char* kPassiveActuators = R"(# Passive proof masses: the roll the reflector pulses leave (0.016 rad at 20 s) carries the mast
+# 1.3 ft past the outer one over the record; the stroke leaves about four times that.
+scole: {actuator_stroke: 5}
+)";
 constexpr const char* kExcitation = R"(inputs:
   - {name: F_x, at: reflector, kind: force, direction: x, unit: lb, signal: {type: haversine, amplitude: 10, t0: 0, width: 1.5}}
   - {name: F_y, at: reflector, kind: force, direction: y, unit: lb, signal: {type: haversine, amplitude: 10, t0: 0.5, width: 1.5}}
@@ -35,7 +43,7 @@ std::vector<BuiltinScenario> scole_builtin_scenarios() {
        std::string(R"(name: paper-scole-1
 description: "Paper SCOLE Case I: q1 = EI/rho_A, q2 = 1/rho_A; force and moment pulses at the reflector"
 structure: scole
-)") + kExcitation + R"(sensors:
+)") + kPassiveActuators + kExcitation + R"(sensors:
   - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
   - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x, unit: ft}
   - {name: yaw_tip, at: reflector, kind: rotation, direction: z, unit: rad}
@@ -52,7 +60,7 @@ truth: {segments: 40}
        std::string(R"(name: paper-scole-2
 description: "Paper SCOLE Case II: EI, rho_A, rho_I_psi, zeta; force and moment pulses at the reflector"
 structure: scole
-)") + kExcitation + R"(sensors:
+)") + kPassiveActuators + kExcitation + R"(sensors:
   - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
   - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x, unit: ft}
   - {name: yaw_tip, at: reflector, kind: rotation, direction: z, unit: rad}
@@ -74,6 +82,9 @@ description: "20 deg rest-to-rest shuttle roll slew (bang-bang moment), nonlinea
 structure: scole
 # Rest-to-rest rigid slew: theta = A w^2 / (4 I_roll). With I_roll = 1.204413e6 slug ft^2 (the
 # whole SCOLE about the roll axis through the system CM), A = 16817 lb ft and w = 10 s give 20 deg.
+# Passive proof masses: the mast sweeps past them through the slew, up to 36 ft at the outer one
+# over the record; the stroke leaves about three times that.
+scole: {actuator_stroke: 100}
 inputs:
   - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16817, t0: 0, width: 10}}
 sensors:
@@ -89,7 +100,8 @@ identification:
   estimate: [EI, rho_A]
   initial: {EI: 3.6e7, rho_A: 0.085}
   elements: 10
-truth: {segments: 40}
+# A large-motion study: the shuttle turns 0.35 rad, beyond the small-rotation bound.
+truth: {segments: 40, large_motion: true}
 )"},
   };
 }

@@ -80,6 +80,16 @@ public:
     if (!n.IsScalar()) fail_field(source_, field(key), "must be a string", "a " + kind(n));
     return n.as<std::string>();
   }
+  bool boolean(const std::string& key, bool dflt) {
+    if (!has(key)) return dflt;
+    const YAML::Node n = node_[key];
+    if (n.IsScalar()) {  // YAML 1.2 core schema booleans only (a "yes" or "1" is refused)
+      const std::string v = n.Scalar();
+      if (v == "true" || v == "True" || v == "TRUE") return true;
+      if (v == "false" || v == "False" || v == "FALSE") return false;
+    }
+    fail_field(source_, field(key), "must be true or false", n.IsScalar() ? kind(n) : "a " + kind(n));
+  }
   std::string choice(const std::string& key, const std::string& dflt,
                      const std::vector<std::string>& allowed) {
     const std::string v = str(key, dflt);
@@ -338,6 +348,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
                  "must lie inside the mast (0, " + format_value(s.length) + ")", format_value(a));
   }
   s.actuator_mass = r.positive("actuator_mass", s.actuator_mass);
+  s.actuator_stroke = r.positive("actuator_stroke", s.actuator_stroke);
 }
 
 double structure_length(const Scenario& sc) {
@@ -436,6 +447,7 @@ void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
   t.accuracy = r.positive("accuracy", t.accuracy);
   if (!(t.accuracy < 1)) fail_field(source, "truth.accuracy", "must be < 1", format_value(t.accuracy));
   t.output_interval = r.nonneg("output_interval", t.output_interval);
+  t.large_motion = r.boolean("large_motion", t.large_motion);
   if (r.has("overrides")) {
     // Kept as text and applied on demand (truth_scenario), onto whatever the structure section
     // holds then; applied once here so that its errors surface while parsing.
@@ -565,7 +577,8 @@ nlohmann::json to_json(const Scenario& s) {
                 {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}, {"shuttle", rigid(c.shuttle)},
                 {"reflector", rigid(c.reflector)}, {"reflector_rx", c.reflector_rx},
                 {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
-                {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass}};
+                {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass},
+                {"actuator_stroke", c.actuator_stroke}};
   };
   // The structure section, and the truth's overrides as the fields whose values differ from it.
   json structure, truth_structure;
@@ -610,7 +623,8 @@ nlohmann::json to_json(const Scenario& s) {
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol}};
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
-                {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval}};
+                {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval},
+                {"large_motion", s.truth.large_motion}};
   if (!overrides.empty()) j["truth"]["overrides"] = {{s.structure, overrides}};
   return j;
 }

@@ -2,8 +2,10 @@
 //   scole-truth --scenario NAME|FILE --out DIR   writes DIR/truth.csv and DIR/truth.json
 //   scole-truth --list-scenarios
 //   scole-truth                                  the default SCOLE scenario into ./run/
-// Exit codes: 0 success, 1 run failed, 2 bad usage or bad input, 130/143 interrupted; one line on
-// stderr on failure, and then no output (truth.csv and truth.json appear together or not at all).
+// Exit codes: 0 success, 1 run failed (the integration, or a plausibility guard: a proof mass
+// beyond its stroke, a rotation beyond the small-rotation bound; docs/truth-guards.md), 2 bad usage
+// or bad input, 130/143 interrupted; one line on stderr on failure, and then no output (truth.csv
+// and truth.json appear together or not at all).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -50,7 +52,10 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress or summary on stderr");
   app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");
   app.footer(
-      "Exit codes: 0 success; 1 the run failed; 2 bad usage or bad input; 130/143 interrupted by SIGINT/SIGTERM. "
+      "Exit codes: 0 success; 1 the run failed (integration failure, or the motion left the identifier's linear "
+      "range: a proof mass beyond scole.actuator_stroke, a rotation beyond " +
+      io::format_value(model::kSmallRotationBound) + " rad without truth.large_motion); "
+      "2 bad usage or bad input; 130/143 interrupted by SIGINT/SIGTERM. "
       "On any failure nothing is written: truth.csv and truth.json are staged beside --out and moved into place "
       "together at the end.");
   try {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <unistd.h>
 #include <random>
@@ -135,6 +136,16 @@ void sample_loop(const SimulateOptions& opt, double t_start, Clock::time_point w
   const int K = static_cast<int>(std::floor(opt.final_time / opt.sample_interval + 1e-9));
   double next_progress = 2.0;
   std::size_t ib = 0;
+  // A failure mid-run (a guard, the integrator) ends the progress line first, so that its
+  // message is a line of its own (an interrupt's message starts its own line: model/main.cpp).
+  struct EndProgressLine {
+    const SimulateOptions& opt;
+    const double& next_progress;
+    ~EndProgressLine() {
+      if (std::uncaught_exceptions() > 0 && io::interrupt_signal() == 0 && opt.progress && next_progress > 2.0)
+        std::fprintf(stderr, "\n");
+    }
+  } end_progress_line{opt, next_progress};
   for (int k = 0; k <= K; ++k) {
     const double tk = std::min(t_start + k * opt.sample_interval, opt.final_time);
     const double eps = 1e-12 * std::max(1.0, std::abs(tk));
@@ -255,6 +266,80 @@ Array_<String> visualizer_search_path() {
 }
 }  // namespace
 
+namespace {
+// A measured value or a sample time in a message: six significant digits (a sample time k dt
+// carries rounding noise in its last bits).
+std::string g6(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// The plausibility guards of run_truth (truth_run.h, docs/truth-guards.md), read off each sample.
+class PlausibilityGuard {
+public:
+  PlausibilityGuard(const io::Scenario& scenario, const io::Scenario& truth, const Structure& st)
+      : matter_(st.matter()), source_(truth.source) {
+    if (st.kind() == "scole") {
+      stroke_ = truth.scole.actuator_stroke;
+      stroke_field_ = truth.scole.actuator_stroke != scenario.scole.actuator_stroke
+                          ? "truth.overrides.scole.actuator_stroke" : "scole.actuator_stroke";
+      for (std::size_t k = 1; k <= truth.scole.actuator_locations.size(); ++k)
+        for (int axis = 0; axis < 2; ++axis) {
+          const MobilizedBodyIndex b = st.actuator_slider(static_cast<int>(k), axis);
+          if (b.isValid()) sliders_.push_back({b, "actuator" + std::to_string(k), axis == 0 ? "x" : "y"});
+        }
+    }
+    if (truth.truth.large_motion) return;
+    const bool scole = st.kind() == "scole";
+    const MobilizedBodyIndex ref = st.reference_body();
+    const std::string rel = scole ? "relative to the shuttle" : "relative to ground";
+    if (ref != GroundIndex) rotations_.push_back({ref, GroundIndex, "shuttle attitude (relative to the inertial frame)"});
+    const int n = st.segments();
+    const double h = st.length() / n;
+    for (int i = 0; i < n; ++i)
+      rotations_.push_back({st.segment_bodies()[static_cast<std::size_t>(i)], ref,
+                            std::string(scole ? "mast" : "beam") + " segment " + std::to_string(i + 1) + " of " +
+                                std::to_string(n) + " (s = " + g6(i * h) + " to " + g6((i + 1) * h) + ") " + rel});
+    if (st.tip_body().isValid())
+      rotations_.push_back({st.tip_body(), ref, std::string(scole ? "reflector " : "tip body ") + rel});
+  }
+
+  // Throws PlausibilityError at the first slider beyond the stroke or rotation beyond the bound.
+  void check(const State& s) const {
+    for (const auto& sl : sliders_) {
+      const double q = matter_.getMobilizedBody(sl.body).getOneQ(s, 0);
+      if (std::abs(q) > stroke_)
+        throw PlausibilityError(source_ + ": " + sl.actuator + " proof mass displaced " + g6(q) +
+                                " along " + sl.axis + " relative to the mast at t = " + g6(s.getTime()) +
+                                " s, beyond its stroke " + stroke_field_ + " = " + io::format_value(stroke_) +
+                                " (docs/truth-guards.md)");
+    }
+    for (const auto& r : rotations_) {
+      const Rotation R = matter_.getMobilizedBody(r.body).findBodyRotationInAnotherBody(
+          s, matter_.getMobilizedBody(r.relative_to));
+      const double angle = R.convertRotationToAngleAxis()[0];  // in [0, pi]
+      if (angle > kSmallRotationBound)
+        throw PlausibilityError(source_ + ": " + r.what + " rotated " + g6(angle) + " rad at t = " +
+                                g6(s.getTime()) + " s, beyond the small-rotation bound " +
+                                io::format_value(kSmallRotationBound) +
+                                " rad of the identifier's linear model; a large-motion study sets "
+                                "truth.large_motion: true (docs/truth-guards.md)");
+    }
+  }
+
+private:
+  struct Slider { MobilizedBodyIndex body; std::string actuator, axis; };
+  struct Rotating { MobilizedBodyIndex body, relative_to; std::string what; };
+  const SimbodyMatterSubsystem& matter_;
+  std::string source_;
+  double stroke_ = 0.0;
+  std::string stroke_field_;
+  std::vector<Slider> sliders_;
+  std::vector<Rotating> rotations_;
+};
+}  // namespace
+
 bool TruthOptions::IsValid(std::string* why) const {
   auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
   if (segments < 0 || segments > io::limits::kMaxSegments)
@@ -336,7 +421,9 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   for (const auto& se : sc.sensors) tab.names.push_back(se.name);
   tab.columns.assign(tab.names.size(), {});
   const auto& matter = structure->matter();
+  const PlausibilityGuard guard(scenario, sc, *structure);
   res.summary = simulate(structure->system(), state, so, [&](const State& s) {
+    guard.check(s);
     tab.t.push_back(s.getTime());
     std::size_t j = 0;
     for (const auto& in : sc.inputs) tab.columns[j++].push_back(in.signal(s.getTime()));

@@ -139,3 +139,45 @@ TEST(TruthOverrides, UnknownFieldsOrTheOtherStructureAreRefused) {
             std::string::npos);
   EXPECT_NE(error_of("name: m\ntruth: {overrides: {plate: {}}}\n").find("truth.overrides.plate"), std::string::npos);
 }
+
+// The plausibility guards' fields (docs/truth-guards.md): scole.actuator_stroke (> 0, default
+// 0.5) and truth.large_motion (a boolean, default false), parsed, checked, echoed, overridable.
+TEST(Scenario, GuardFieldsAreParsedCheckedAndEchoed) {
+  const Scenario d = parse_scenario("name: d\nstructure: scole\n", "s");
+  EXPECT_DOUBLE_EQ(d.scole.actuator_stroke, 0.5);
+  EXPECT_FALSE(d.truth.large_motion);
+  const auto jd = to_json(d);
+  EXPECT_EQ(jd["scole"]["actuator_stroke"], 0.5);
+  EXPECT_EQ(jd["truth"]["large_motion"], false);
+
+  const Scenario s = parse_scenario(
+      "name: g\nstructure: scole\nscole: {actuator_stroke: 0.25}\ntruth: {large_motion: true}\n", "s");
+  EXPECT_DOUBLE_EQ(s.scole.actuator_stroke, 0.25);
+  EXPECT_TRUE(s.truth.large_motion);
+  EXPECT_EQ(to_json(s)["scole"]["actuator_stroke"], 0.25);
+  EXPECT_EQ(to_json(s)["truth"]["large_motion"], true);
+
+  EXPECT_EQ(error_of("name: g\nstructure: scole\nscole: {actuator_stroke: 0}\n"),
+            "scenario 'x.yaml': scole.actuator_stroke must be > 0, got 0");
+  EXPECT_EQ(error_of("name: g\nstructure: scole\nscole: {actuator_stroke: -0.5}\n"),
+            "scenario 'x.yaml': scole.actuator_stroke must be > 0, got -0.5");
+  EXPECT_EQ(error_of("name: g\ntruth: {large_motion: yes}\n"),
+            "scenario 'x.yaml': truth.large_motion must be true or false, got 'yes'");
+  EXPECT_EQ(error_of("name: g\ntruth: {large_motion: [true]}\n"),
+            "scenario 'x.yaml': truth.large_motion must be true or false, got a list");
+
+  // Set for the truth alone: the identifier's scenario keeps the default, the echo names the override.
+  const Scenario o = parse_scenario(
+      "name: o\nstructure: scole\ntruth:\n  overrides:\n    scole: {actuator_stroke: 0.3}\n", "s");
+  EXPECT_DOUBLE_EQ(o.scole.actuator_stroke, 0.5);
+  EXPECT_DOUBLE_EQ(truth_scenario(o).scole.actuator_stroke, 0.3);
+  EXPECT_EQ(to_json(o)["truth"]["overrides"]["scole"], (nlohmann::json{{"actuator_stroke", 0.3}}));
+  EXPECT_NE(error_of("name: o\nstructure: scole\ntruth: {overrides: {scole: {actuator_stroke: -1}}}\n")
+                .find("truth.overrides.scole.actuator_stroke must be > 0, got -1"),
+            std::string::npos);
+}
+
+TEST(Scenario, OnlyTheSlewIsALargeMotionStudy) {
+  for (const auto& name : builtin_scenario_names())
+    EXPECT_EQ(load_scenario(name).truth.large_motion, name == "scole-slew") << name;
+}

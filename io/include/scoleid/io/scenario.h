@@ -14,9 +14,14 @@
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
 //   simulation:{ duration, sample_interval, seed }
 //   identification: { parameterization, estimate, initial, elements, data_elements, method, ... }
-//   truth:     { segments, integrator, accuracy, ..., overrides: {beam: {...}} | {scole: {...}} }
+//   truth:     { segments, integrator, accuracy, ..., large_motion,
+//                overrides: {beam: {...}} | {scole: {...}} }
 //              (the Simbody generator's settings; overrides: structure fields in which the truth
 //              differs from the identifier's model — how a model-mismatch scenario is written)
+//
+// Plausibility guards (docs/truth-guards.md): the truth refuses a run whose motion leaves the
+// range the identifier's linear model describes — a proof mass beyond scole.actuator_stroke, a
+// rotation beyond the small-rotation bound unless truth.large_motion is set.
 #include <map>
 #include <string>
 #include <vector>
@@ -67,6 +72,14 @@ struct ScoleSpec {
   std::vector<double> mast_root = {0.0, 0.0, 0.0};
   std::vector<double> actuator_locations = {130.0 / 3.0, 260.0 / 3.0};
   double actuator_mass = 0.2;
+  // Travel of each proof mass on each of its two sliders, either way from the centre (|q| <= stroke),
+  // one value for all actuators, in the scenario's length unit. The truth refuses a run in which a
+  // proof mass goes beyond it (docs/truth-guards.md). 0.5 ft (±6 in) is a reasoned default, not a
+  // sourced figure: the SCOLE design challenge gives the actuators' stations and mass but no
+  // travel, and linear proof-mass actuators for structural control move a few inches to about a
+  // foot either way. A scenario whose actuators are passive states more (the built-ins do): its
+  // free proof masses stay put while the structure's rigid motion carries the mast past them.
+  double actuator_stroke = 0.5;
 };
 
 // A point input. `at` names the body it acts on: "beam" or "mast" (then `location` is s),
@@ -143,6 +156,9 @@ struct TruthModelSpec {
   // the scenario's structure for the truth only (truth_scenario). The identifier never reads it.
   std::string overrides;
   std::string overrides_source;   // where it was read, for messages
+  // A large-motion study (e.g. scole-slew): the truth does not refuse rotations beyond the
+  // small-rotation bound of the identifier's linear model (docs/truth-guards.md).
+  bool large_motion = false;
 };
 
 struct Scenario {

@@ -10,8 +10,14 @@
 // Sensor noise: N(0, noise_std^2), one std::mt19937_64 seeded with simulation.seed, drawn
 // column by column (sensors in scenario order, samples in time order) for sensors with
 // noise_std > 0; inputs are never noisy.
+//
+// Plausibility guards (docs/truth-guards.md), checked at every sample: the identifier's model is
+// linear, so a truth that leaves its range is refused rather than written. A proof mass further
+// than scole.actuator_stroke from the centre of either slider, or (unless truth.large_motion) a
+// rotation beyond kSmallRotationBound, ends the run with PlausibilityError.
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -84,6 +90,20 @@ SimulateSummary simulate(const SimTK::MultibodySystem& system, const SimTK::Stat
                          const SimulateOptions& options,
                          const std::function<void(const SimTK::State&)>& on_sample);
 
+// The truth left the range of the identifier's linear model (docs/truth-guards.md): one line
+// naming the scenario, the body or actuator, the quantity, the bound and the time. scole-truth
+// maps it, like every run failure, to exit code 1; nothing is written.
+class PlausibilityError : public std::runtime_error {
+public:
+  explicit PlausibilityError(const std::string& what) : std::runtime_error(what) {}
+};
+
+// The small-rotation bound (rad) on the shuttle's attitude (relative to the inertial frame), on
+// every mast segment and the reflector relative to the shuttle, and on every beam segment and tip
+// body relative to ground. At 0.1 rad sin θ = θ to 0.17 % and the second-order terms a linear
+// model drops (1 − cos θ ≈ θ²/2 against θ) are 5 % of the first-order ones (docs/truth-guards.md).
+inline constexpr double kSmallRotationBound = 0.1;
+
 struct TruthOptions {
   int segments = 0;            // 0 = scenario truth.segments
   std::string integrator;      // "" = scenario truth.integrator
@@ -101,7 +121,8 @@ struct TruthResult {
 
 // Simulates io::truth_scenario(scenario): the structure with truth.overrides applied; truth.json's
 // true_parameters are the values it used. Throws io::InputError for a scenario the truth cannot
-// represent, std::runtime_error when the integration fails.
+// represent, PlausibilityError when the motion leaves the identifier's linear range (a guard
+// above), std::runtime_error when the integration fails.
 TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& options = {});
 // truth.csv and truth.json into the run directory's staging area; the caller commits them as one
 // unit (io/run_directory.h), so the two files always come from the same run.
