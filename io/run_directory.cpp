@@ -33,7 +33,8 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
     std::vector<std::string> foreign;
     for (const auto& e : fs::directory_iterator(t, ec)) {
       const std::string n = e.path().filename().string();
-      if (std::find(owned_.begin(), owned_.end(), n) != owned_.end() && e.is_regular_file()) continue;
+      if (std::find(owned_.begin(), owned_.end(), n) != owned_.end() && (e.is_regular_file() || e.is_directory()))
+        continue;
       if (n.find(".tmp.") != std::string::npos) continue;  // temporary file of an older version
       foreign.push_back(n);
     }
@@ -71,6 +72,25 @@ RunDirectory::~RunDirectory() {
 }
 
 std::string RunDirectory::path(const std::string& name) const { return (fs::path(staging_) / name).string(); }
+
+void RunDirectory::keep_earlier_outputs() {
+  std::error_code ec;
+  if (!fs::is_directory(target_, ec)) return;
+  for (const auto& e : fs::directory_iterator(target_, ec)) {
+    const fs::path name = e.path().filename();
+    if (std::find(owned_.begin(), owned_.end(), name.string()) == owned_.end()) continue;
+    const fs::path dest = fs::path(staging_) / name;
+    if (fs::exists(dest)) continue;  // rewritten by this run
+    std::error_code cec;
+    fs::copy(e.path(), dest, fs::copy_options::recursive | fs::copy_options::create_hard_links, cec);
+    if (cec) {
+      fs::remove_all(dest, cec);
+      fs::copy(e.path(), dest, fs::copy_options::recursive, cec);
+    }
+    if (cec)
+      throw std::runtime_error("cannot keep '" + e.path().string() + "' of the earlier run: " + cec.message());
+  }
+}
 
 void RunDirectory::commit() {
   if (committed_) return;

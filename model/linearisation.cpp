@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -66,12 +68,19 @@ Eigen::MatrixXd state_jacobian(const MultibodySystem& system, const State& eq, c
 }
 
 std::vector<Mode> modes_of(const Eigen::MatrixXd& A, double zero_tolerance) {
+  // Rigid-body and constraint directions have |lambda| = 0 up to the round-off of the differenced
+  // accelerations, about sqrt(eps max |du_dot/d delta|_jj); a fine chain's stiff joints make that
+  // level grow with n (1.7e-3 rad/s for SCOLE at 160 segments), so the floor follows it.
+  const int nu = static_cast<int>(A.rows()) / 2;
+  double kmax = 0.0;
+  for (int j = 0; j < nu; ++j) kmax = std::max(kmax, std::abs(A(nu + j, j)));
+  const double floor = std::max(zero_tolerance, 30.0 * std::sqrt(std::numeric_limits<double>::epsilon() * kmax));
   Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
   std::vector<Mode> modes;
   for (int i = 0; i < es.eigenvalues().size(); ++i) {
     const std::complex<double> l = es.eigenvalues()[i];
     const double w = std::abs(l);
-    if (l.imag() <= 0.0 || w <= zero_tolerance) continue;
+    if (l.imag() <= 0.0 || w <= floor) continue;
     modes.push_back({w / (2 * Pi), w, -l.real() / w});
   }
   std::sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) { return a.omega < b.omega; });
@@ -80,6 +89,88 @@ std::vector<Mode> modes_of(const Eigen::MatrixXd& A, double zero_tolerance) {
 
 std::vector<Mode> natural_modes(const MultibodySystem& system, const State& eq, const LinearisationOptions& opt) {
   return modes_of(state_jacobian(system, eq, opt), opt.zero_tolerance);
+}
+
+ModeShapes undamped_modes(const MultibodySystem& system, const State& eq, const OutputFunction& outputs,
+                          const LinearisationOptions& opt) {
+  std::string why;
+  if (!opt.IsValid(&why)) throw std::invalid_argument("undamped_modes: " + why);
+  const int nu = eq.getNU();
+  State base = eq;
+  base.updU() = 0.0;
+  system.realize(base, Stage::Position);
+  const Eigen::VectorXd y0 = outputs(base);
+  const int ny = static_cast<int>(y0.size());
+  Eigen::MatrixXd K(nu, nu), Cy(ny, nu);
+  State s = base;
+  const double h = opt.step;
+  for (int j = 0; j < nu; ++j) {
+    Vector delta(nu, 0.0);
+    delta[j] = h;
+    displace(system, base, delta, s);
+    const Eigen::VectorXd ap = generalized_accelerations(system, s);
+    const Eigen::VectorXd yp = outputs(s);
+    delta[j] = -h;
+    displace(system, base, delta, s);
+    const Eigen::VectorXd am = generalized_accelerations(system, s);
+    const Eigen::VectorXd ym = outputs(s);
+    K.col(j) = -(ap - am) / (2 * h);
+    Cy.col(j) = (yp - ym) / (2 * h);
+  }
+  // Rigid-body and constraint directions have omega^2 = 0 up to the round-off of the differenced
+  // accelerations, about eps * max K_ii (the largest terms cancel); 30 times that is the floor.
+  double kmax = opt.zero_tolerance * opt.zero_tolerance;
+  for (int j = 0; j < nu; ++j) kmax = std::max(kmax, std::abs(K(j, j)));
+  const double floor = std::max(opt.zero_tolerance, 30.0 * std::sqrt(std::numeric_limits<double>::epsilon() * kmax));
+  std::vector<std::pair<double, int>> order;
+  Eigen::MatrixXd vectors;
+  if (system.getMatterSubsystem().getNumConstraints() == 0) {
+    // Unconstrained: M (du_dot/d delta) is minus the Hessian of the potential at the equilibrium,
+    // symmetric, so the problem is the symmetric-definite K_s phi = omega^2 M phi (several times
+    // faster than the general eigenproblem, and real by construction).
+    Matrix Ms;
+    system.getMatterSubsystem().calcM(base, Ms);
+    Eigen::MatrixXd M(nu, nu);
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nu; ++j) M(i, j) = Ms(i, j);
+    Eigen::MatrixXd Ks = M * K;
+    Ks = 0.5 * (Ks + Ks.transpose()).eval();
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Ks, M, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    for (int i = 0; i < nu; ++i)
+      if (es.eigenvalues()[i] > floor * floor) order.push_back({std::sqrt(es.eigenvalues()[i]), i});
+    vectors = es.eigenvectors();
+  } else {
+    Eigen::EigenSolver<Eigen::MatrixXd> es(K, true);
+    vectors.resize(nu, nu);
+    for (int i = 0; i < nu; ++i) {
+      const std::complex<double> l = es.eigenvalues()[i];
+      const Eigen::VectorXcd v = es.eigenvectors().col(i);
+      // Real shape: rotate by the phase of the largest entry.
+      Eigen::Index imax = 0;
+      v.cwiseAbs().maxCoeff(&imax);
+      vectors.col(i) = (v * std::conj(v[imax]) / std::abs(v[imax])).real();
+      // Flexible modes: omega^2 real and positive. A complex pair (|Im| not small) would mean a
+      // non-conservative linearisation; it is not a natural mode and is skipped.
+      if (l.real() > floor * floor && std::abs(l.imag()) <= 1e-6 * l.real()) order.push_back({std::sqrt(l.real()), i});
+    }
+  }
+  std::sort(order.begin(), order.end());
+  ModeShapes m;
+  m.omega.resize(static_cast<Eigen::Index>(order.size()));
+  m.shapes.resize(ny, static_cast<Eigen::Index>(order.size()));
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    Eigen::VectorXd y = Cy * vectors.col(order[k].second);
+    const double norm = y.norm();
+    if (norm > 0) {
+      Eigen::Index ymax = 0;
+      y.cwiseAbs().maxCoeff(&ymax);
+      y *= (y[ymax] < 0 ? -1.0 : 1.0) / norm;
+    }
+    const auto col = static_cast<Eigen::Index>(k);
+    m.omega[col] = order[k].first;
+    m.shapes.col(col) = y;
+  }
+  return m;
 }
 
 double solve_static_equilibrium(const MultibodySystem& system, State& state, const std::vector<int>& mob,

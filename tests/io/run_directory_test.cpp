@@ -133,3 +133,33 @@ TEST_F(RunDirectoryTest, QuotesAndSemicolonsInTheNameAreJustCharacters) {
   EXPECT_EQ(slurp(out / "a.csv"), "a\n");
   EXPECT_FALSE(fs::exists(root_ / "pwned"));
 }
+
+TEST_F(RunDirectoryTest, KeepEarlierOutputsReplacesOnlyWhatThisRunWrote) {
+  // Commands sharing one output directory (scole-crosscheck's verbs): each replaces its own
+  // outputs and keeps the others', owned directories included.
+  const fs::path out = root_ / "run";
+  const std::vector<std::string> owned{"a.csv", "b.json", "sub"};
+  fs::create_directories(out / "sub");
+  write_text_atomic((out / "a.csv").string(), "old a\n");
+  write_text_atomic((out / "b.json").string(), "old b\n");
+  write_text_atomic((out / "sub" / "c.csv").string(), "old c\n");
+  {
+    RunDirectory d(out.string(), owned, "test");
+    write_text_atomic(d.path("a.csv"), "new a\n");
+    d.keep_earlier_outputs();
+    d.commit();
+  }
+  EXPECT_EQ(slurp(out / "a.csv"), "new a\n");
+  EXPECT_EQ(slurp(out / "b.json"), "old b\n");
+  EXPECT_EQ(slurp(out / "sub" / "c.csv"), "old c\n");
+  EXPECT_TRUE(leftovers("run").empty());
+  // Without keep_earlier_outputs the earlier run is replaced whole, as before.
+  {
+    RunDirectory d(out.string(), owned, "test");
+    write_text_atomic(d.path("b.json"), "newer b\n");
+    d.commit();
+  }
+  EXPECT_FALSE(fs::exists(out / "a.csv"));
+  EXPECT_FALSE(fs::exists(out / "sub"));
+  EXPECT_EQ(slurp(out / "b.json"), "newer b\n");
+}

@@ -9,7 +9,7 @@
 // destructor removes the staging directory and the target is left exactly as it was.
 //
 // The target may be new, empty, or hold an earlier run of the same program (only files from
-// `owned`). Anything else in it is refused up front, so no user file is ever replaced. The
+// `owned`; an owned name may be a file or a directory). Anything else in it is refused up front, so no user file is ever replaced. The
 // constructor also proves the parent is writable, before any work is done.
 #include <string>
 #include <vector>
@@ -29,6 +29,10 @@ public:
   std::string path(const std::string& name) const;
   const std::string& staging() const { return staging_; }
   const std::string& target() const { return target_; }
+  // Programs whose commands each write part of a shared output directory: before commit(), the
+  // earlier run's entries that this run did not write are carried into the staging area (hard
+  // links, or copies across file systems), so committing replaces only what this run produced.
+  void keep_earlier_outputs();
   // Puts the staged outputs in place as one unit. Checks for an interrupt first (then nothing is
   // committed). Throws std::runtime_error if the file system refuses.
   void commit();

@@ -9,8 +9,11 @@
 // is formed by central differences with step `step` in every delta and u. Its eigenvalues
 // lambda give the natural frequencies |lambda| / 2 pi and damping ratios -Re(lambda)/|lambda|.
 // Constraint-violating directions and rigid-body motions give (near-)zero eigenvalues; modes
-// with |lambda| <= zero_tolerance or Im(lambda) <= 0 are not reported. Central differences make
+// with Im(lambda) <= 0 or |lambda| below max(zero_tolerance, 30 sqrt(eps max_j |du_dot_j/d delta_j|))
+// (the round-off level of the differenced accelerations, which grows with a chain's stiffness)
+// are not reported. Central differences make
 // the error O(step^2) in the nonlinearity plus O(eps/step) round-off.
+#include <functional>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -41,6 +44,24 @@ Eigen::MatrixXd state_jacobian(const SimTK::MultibodySystem& system, const SimTK
 std::vector<Mode> natural_modes(const SimTK::MultibodySystem& system, const SimTK::State& equilibrium,
                                 const LinearisationOptions& options = {});
 std::vector<Mode> modes_of(const Eigen::MatrixXd& A, double zero_tolerance);
+
+// Undamped modes with their shapes. At an equilibrium with u = 0 the velocity-dependent forces
+// (dampers) do not enter du_dot/d delta, so the undamped eigenproblem is
+//     -(du_dot/d delta) phi = omega^2 phi,
+// whose eigenvalues are real and >= 0 (M^-1 K in the coordinates delta); without constraints it is
+// solved as the symmetric-definite (M K_delta) phi = omega^2 M phi. Rigid-body motions and
+// constraint-violating directions (omega below max(zero_tolerance, 30 sqrt(eps max K_ii)), the
+// round-off level of the differenced accelerations) are dropped. A mode's shape is
+// reported through `outputs` (any read-out of a position-realized state, e.g. sensor values):
+// the column (dy/d delta) phi, by central differences, normalised to unit 2-norm with its largest
+// entry positive.
+struct ModeShapes {
+  Eigen::VectorXd omega;   // rad/s, ascending
+  Eigen::MatrixXd shapes;  // outputs x modes
+};
+using OutputFunction = std::function<Eigen::VectorXd(const SimTK::State&)>;
+ModeShapes undamped_modes(const SimTK::MultibodySystem& system, const SimTK::State& equilibrium,
+                          const OutputFunction& outputs, const LinearisationOptions& options = {});
 
 // Newton iteration for a static equilibrium udot = 0, u = 0 over the listed mobilities (others
 // held at their values): q = q0 + N delta, delta restricted to `mobilities`. Returns the final

@@ -1,0 +1,24 @@
+#pragma once
+// One table, three renderings: aligned text for the terminal, CSV for other tools, and Markdown
+// for report.md. Cells are already-formatted strings; numbers are formatted by `number`.
+#include <string>
+#include <vector>
+
+namespace scoleid::crosscheck {
+
+struct Table {
+  std::string title;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+
+  std::string text() const;
+  std::string csv() const;
+  std::string markdown() const;
+};
+
+// %.*g with `digits` significant digits; NaN and infinities as "nan", "inf" (CSV readers
+// understand them); `percent` multiplies by 100 and appends nothing (the header says %).
+std::string number(double v, int digits = 6);
+std::string percent(double v, int digits = 3);
+
+}  // namespace scoleid::crosscheck

@@ -1,0 +1,192 @@
+// scole-crosscheck: the Simbody truth against the FE identifier (docs/theory.md §11).
+//   scole-crosscheck modes        --scenario X [--out DIR]   natural modes side by side, MAC
+//   scole-crosscheck trajectories --scenario X [--out DIR]   the same inputs through both models
+//   scole-crosscheck identify     --scenario X [--out DIR]   identification on the truth, extrapolated in n
+//   scole-crosscheck report       [--scenario X] [--out DIR] report.md and plots from the above
+//   scole-crosscheck all          --scenario X [--out DIR]   the four, then the one-screen summary
+// DIR defaults to run/<scenario>/crosscheck. Each verb replaces only its own files there, as one
+// unit (io/run_directory.h). Exit codes: 0 success; 1 a run failed or an identification did not
+// converge (its outputs are written and say so); 2 bad usage or bad input (nothing written);
+// 130/143 interrupted (nothing written).
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+
+#include "scoleid/crosscheck/identify_study.h"
+#include "scoleid/crosscheck/modes.h"
+#include "scoleid/crosscheck/report.h"
+#include "scoleid/crosscheck/trajectories.h"
+#include "scoleid/identify/run/fit_plot.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/run_directory.h"
+#include "scoleid/io/validation.h"
+
+using namespace scoleid;
+namespace fs = std::filesystem;
+
+namespace {
+const std::vector<std::string> kOutputs = {
+    "modes.csv",   "mac.csv",   "modes.json",   "trajectories.csv", "trajectories.json",   "overlay.csv",
+    "identify.csv", "identify.json", "report.md", "modes_convergence.csv", "identify_convergence.csv",
+    "modes.gp",    "modes.png", "overlay.gp",   "overlay.png",      "identify.gp",         "identify.png",
+    "truths"};
+
+void print(const crosscheck::Table& t, bool quiet) {
+  if (!quiet) std::fputs((t.text() + "\n").c_str(), stdout);
+}
+
+// Report files into the staging area; gnuplot is run there (it reads the CSVs beside it).
+void write_report(io::RunDirectory& dir, const crosscheck::ReportInputs& in, bool quiet) {
+  const bool overlay = fs::exists(dir.path("overlay.csv"));
+  const crosscheck::ReportFiles rf = crosscheck::make_report(in, overlay);
+  // Carried-over plots are hard links to the earlier run's files: unlink them, so that gnuplot
+  // writes new files instead of rewriting the earlier run's in place.
+  for (const char* png : {"modes.png", "overlay.png", "identify.png"}) fs::remove(dir.path(png));
+  for (const auto& [name, text] : rf.files) io::write_text_atomic(dir.path(name), text);
+  int missing = 0;
+  for (const auto& s : rf.scripts) {
+    const auto st = identify::render_gnuplot(dir.staging(), s);
+    if (st == identify::RenderStatus::NoGnuplot) ++missing;
+    else if (st == identify::RenderStatus::Failed && !quiet)
+      std::fprintf(stderr, "scole-crosscheck: gnuplot failed on %s (the CSV and the script are written)\n", s.c_str());
+  }
+  if (missing && !quiet)
+    std::fprintf(stderr, "scole-crosscheck: gnuplot is not installed: plots not drawn (the .gp scripts are written)\n");
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "scole-crosscheck: the Simbody truth (a chain of n rigid segments) against the finite-element identifier\n"
+      "(N elements), on the same scenario: natural modes, trajectories, and identification on the truth with the\n"
+      "chain's lumping bias extrapolated away. Tables on stdout; CSV and JSON beside them in --out\n"
+      "(default run/<scenario>/crosscheck); `report` adds report.md and PNG plots (gnuplot)."};
+  app.require_subcommand(1, 1);
+  app.footer(
+      "Exit codes: 0 success; 1 a run failed or an identification did not converge (outputs written, marked); 2 bad "
+      "usage or bad input (nothing written); 130/143 interrupted (nothing written). Each verb replaces only its own "
+      "files in the output directory, all at once.");
+  std::string scenario = "paper-scole-1", out;
+  bool quiet = false;
+  crosscheck::ModesOptions mo;
+  crosscheck::TrajectoryOptions to;
+  crosscheck::IdentifyStudyOptions io_;
+  auto common = [&](CLI::App* c) {
+    c->add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
+    c->add_option("-o,--out", out, "output directory (default: run/<scenario>/crosscheck)");
+    c->add_flag("-q,--quiet", quiet, "no tables on stdout, no progress on stderr");
+  };
+  auto* modes = app.add_subcommand(
+      "modes", "natural frequencies and mode shapes: the Simbody chain linearised at rest at n, 2n, 4n segments against "
+               "the FE model at N, 2N, 4N elements and the analytic values where they exist; observed rates, Richardson "
+               "extrapolation of the chain, MAC matrix. Writes modes.csv, mac.csv, modes.json");
+  common(modes);
+  modes->add_option("--segments", mo.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  modes->add_option("--elements", mo.elements, "first FE resolution N (default: the scenario's identification.elements)");
+  modes->add_option("--count", mo.count, "flexible modes compared")->capture_default_str();
+  modes->add_option("--levels", mo.levels, "resolutions per side (n, 2n, 4n: 3)")->capture_default_str();
+  auto* traj = app.add_subcommand(
+      "trajectories", "the scenario's inputs through both models at the truth's parameters: relative RMS difference "
+                      "per sensor at n, 2n, 4n segments and its rate. Writes trajectories.csv, trajectories.json, "
+                      "overlay.csv, truths/");
+  common(traj);
+  traj->add_option("--segments", to.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  traj->add_option("--elements", to.elements, "FE elements (default: 4 x identification.elements)");
+  traj->add_option("--fe-step", to.fe_step, "FE time step (default: resolve the first 5 flexible modes with omega h <= 0.03)");
+  traj->add_option("--levels", to.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
+  auto* ident = app.add_subcommand(
+      "identify", "the identifier on the Simbody truth at n, 2n, 4n segments, the estimates' errors against the "
+                  "truth's values, their extrapolation in n, and the FE-on-FE result beside them. Writes identify.csv, "
+                  "identify.json, truths/");
+  common(ident);
+  ident->add_option("--segments", io_.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  ident->add_option("--levels", io_.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
+  ident->add_flag("--with-noise", io_.with_noise, "keep the scenario's sensor noise in the truths (default: noise-free)");
+  auto* report = app.add_subcommand("report", "report.md with every table, a CSV behind each, and PNG plots, from the "
+                                              "JSON the other verbs left in --out");
+  common(report);
+  auto* all = app.add_subcommand("all", "modes, trajectories, identify and report, then the one-screen summary");
+  common(all);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "scole-crosscheck: %s (see --help)\n", io::one_line(e.what()).c_str());
+    return 2;
+  }
+  io::install_interrupt_handlers();
+  try {
+    const io::Scenario sc = io::load_scenario(scenario);
+    io::validate_scenario(sc);
+    if (out.empty()) out = "run/" + sc.name + "/crosscheck";
+    std::string why;
+    if (!mo.IsValid(&why) || !to.IsValid(&why) || !io_.IsValid(&why)) throw io::InputError("command line: " + why);
+    to.progress = io_.progress = !quiet;
+    io::RunDirectory dir(out, kOutputs, "scole-crosscheck");
+    const bool do_modes = modes->parsed() || all->parsed();
+    const bool do_traj = traj->parsed() || all->parsed();
+    const bool do_ident = ident->parsed() || all->parsed();
+    const bool do_report = report->parsed() || all->parsed();
+    bool converged = true;
+    const std::string truths = dir.path("truths");
+    if (do_modes) {
+      if (!quiet) std::fprintf(stderr, "scole-crosscheck: modes of %s\n", sc.name.c_str());
+      const auto r = crosscheck::compare_modes(sc, mo);
+      const auto t = crosscheck::modes_table(r), m = crosscheck::mac_table(r);
+      print(t, quiet);
+      print(m, quiet);
+      io::write_text_atomic(dir.path("modes.csv"), t.csv());
+      io::write_text_atomic(dir.path("mac.csv"), m.csv());
+      io::write_json_atomic(dir.path("modes.json"), crosscheck::to_json(r));
+    }
+    if (do_traj) {
+      const auto r = crosscheck::compare_trajectories(sc, to, truths);
+      const auto t = crosscheck::trajectories_table(r);
+      print(t, quiet);
+      io::write_text_atomic(dir.path("trajectories.csv"), t.csv());
+      io::write_text_atomic(dir.path("overlay.csv"), crosscheck::overlay_table(r).csv());
+      io::write_json_atomic(dir.path("trajectories.json"), crosscheck::to_json(r));
+    }
+    if (do_ident) {
+      if (do_traj) fs::remove_all(truths);  // the identify verb writes its own truths (noise as it says)
+      const auto s = crosscheck::identify_study(sc, io_, truths);
+      const auto t = crosscheck::identify_table(s);
+      print(t, quiet);
+      io::write_text_atomic(dir.path("identify.csv"), t.csv());
+      io::write_json_atomic(dir.path("identify.json"), crosscheck::to_json(s));
+      converged = s.all_converged();
+      if (!converged)
+        std::fprintf(stderr, "scole-crosscheck: not every identification converged (identify.json: runs)\n");
+    }
+    dir.keep_earlier_outputs();
+    if (do_report) {
+      const crosscheck::ReportInputs in = crosscheck::read_report_inputs(dir.staging());
+      if (in.modes.is_null() && in.trajectories.is_null() && in.identify.is_null())
+        throw io::InputError("output directory '" + out + "': no modes.json, trajectories.json or identify.json to report on");
+      write_report(dir, in, quiet);
+      if (all->parsed() || !quiet) {
+        std::printf("Cross-check of %s\n", sc.name.c_str());
+        for (const auto& l : crosscheck::summary_lines(in)) std::printf("  %s\n", l.c_str());
+      }
+    }
+    dir.commit();
+    if (!quiet) std::fprintf(stderr, "scole-crosscheck: wrote %s\n", out.c_str());
+    return converged ? 0 : 1;
+  } catch (const io::InputError& e) {
+    std::fprintf(stderr, "scole-crosscheck: %s\n", io::one_line(e.what()).c_str());
+    return 2;
+  } catch (const io::Interrupted& e) {
+    std::fprintf(stderr, "\nscole-crosscheck: %s\n", e.what());
+    return e.exit_code();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "scole-crosscheck: run failed: %s\n", io::one_line(e.what()).c_str());
+    return 1;
+  }
+}

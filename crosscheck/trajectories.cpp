@@ -1,0 +1,201 @@
+#include "scoleid/crosscheck/trajectories.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/run/problem.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
+
+namespace scoleid::crosscheck {
+
+namespace {
+// The reference FE run resolves the first kResolvedModes flexible modes with ω h <= kPhaseStep:
+// the ESDIRK scheme's relative phase error per step is O((ω h)³), so over the ~10³ periods of a
+// record it stays near 1e-6 on those modes (the chain's differences are 1e-4 and up).
+constexpr int kResolvedModes = 5;
+constexpr double kPhaseStep = 0.03;
+}  // namespace
+
+bool TrajectoryOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) { if (why) *why = m; return false; };
+  if (segments < 0 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
+  if (elements < 0 || elements > io::limits::kMaxElements) return fail("elements must be in [1, " + std::to_string(io::limits::kMaxElements) + "] (0 = 4 x the identifier's)");
+  if (levels < 1 || levels > 4) return fail("levels must be in [1, 4]");
+  if (!(fe_step >= 0 && fe_step < 1e6)) return fail("fe_step must be >= 0 (0 = automatic)");
+  return true;
+}
+
+double fe_reference_step(const identify::Problem& p) {
+  const auto& names = p.params->names();
+  identify::VectorXd q(static_cast<Eigen::Index>(names.size()));
+  for (std::size_t i = 0; i < names.size(); ++i) q[static_cast<Eigen::Index>(i)] = p.true_values.at(names[i]);
+  identify::VectorXd c;
+  identify::MatrixXd dcdq;
+  p.params->coefficients(q, c, dcdq);
+  const identify::AssembledModel ops = identify::assemble(p.model(), c);
+  const identify::NaturalModes nm = identify::natural_modes(ops.M, ops.K);
+  double w = 0.0;
+  int flexible = 0;
+  for (int i = 0; i < nm.omega.size() && flexible < kResolvedModes; ++i)
+    if (nm.omega[i] > nm.floor && std::isfinite(nm.omega[i])) {
+      w = nm.omega[i];
+      ++flexible;
+    }
+  const double h = p.scenario.simulation.sample_interval / 4.0;
+  return w > 0 ? std::min(h, kPhaseStep / w) : h;
+}
+
+FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
+  io::Scenario sc = io::truth_scenario(scenario);
+  sc.truth.overrides.clear();
+  sc.identification.elements = elements;
+  sc.identification.time_step = 0.0;
+  for (auto& in : sc.inputs) in.signal_from = "scenario";
+  auto p = identify::make_problem(sc, csv);
+  const auto& names = p->params->names();
+  identify::VectorXd q(static_cast<Eigen::Index>(names.size()));
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto it = p->true_values.find(names[i]);
+    if (it == p->true_values.end())
+      throw io::InputError("truth file '" + csv + "': no true value for parameter '" + names[i] + "'");
+    q[static_cast<Eigen::Index>(i)] = it->second;
+  }
+  auto& so = p->objective_options.solver;
+  so.integrator = identify::SolverOptions::Integrator::Esdirk;
+  so.step = step > 0 ? step : fe_reference_step(*p);
+  identify::Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  FeResponse r;
+  r.t = p->data.t;
+  r.fe = obj.predict(q);
+  r.measured = p->data.z;
+  for (const auto& s : p->model().sensors) {
+    r.sensors.push_back(s.name);
+    r.kinds.push_back(s.kind);
+  }
+  return r;
+}
+
+TrajectoryReport compare_trajectories(const io::Scenario& scenario, const TrajectoryOptions& opt,
+                                      const std::string& truth_root) {
+  std::string why;
+  if (!opt.IsValid(&why)) throw io::InputError("trajectories: " + why);
+  const auto t0 = std::chrono::steady_clock::now();
+  TrajectoryReport rep;
+  rep.scenario = scenario.name;
+  rep.truth_overrides = io::has_truth_overrides(scenario);
+  rep.elements = opt.elements > 0 ? opt.elements : 4 * scenario.identification.elements;
+  if (rep.elements > io::limits::kMaxElements) rep.elements = io::limits::kMaxElements;
+  for (const auto& in : scenario.inputs) rep.input_kinds.push_back(in.at + " " + in.kind);
+  rep.segments = refinement(opt.segments > 0 ? opt.segments : scenario.truth.segments, opt.levels,
+                            io::limits::kMaxSegments, "segments");
+  rep.truths = run_truth_levels(scenario, rep.segments, truth_root, true, opt.progress);
+  const auto tf = std::chrono::steady_clock::now();
+  // The FE response does not depend on the level: computed once, on the first level's times.
+  const FeResponse fe = fe_response(scenario, rep.truths.front().csv, rep.elements, opt.fe_step);
+  rep.fe_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
+  const int ns = static_cast<int>(fe.sensors.size());
+  for (int k = 0; k < ns; ++k) rep.sensors.push_back({fe.sensors[static_cast<std::size_t>(k)], fe.kinds[static_cast<std::size_t>(k)], {}, std::numeric_limits<double>::quiet_NaN()});
+  for (std::size_t l = 0; l < rep.truths.size(); ++l) {
+    // The FE part does not depend on the level; each level contributes its measured columns.
+    Eigen::MatrixXd measured = fe.measured;
+    if (l > 0) {
+      const io::DataTable tab = io::read_csv(rep.truths[l].csv);
+      if (tab.t.size() != fe.t.size())
+        throw std::runtime_error("truth levels sampled differently (" + std::to_string(tab.t.size()) + " vs " +
+                                 std::to_string(fe.t.size()) + " samples)");
+      for (int k = 0; k < ns; ++k) {
+        const int c = tab.find(fe.sensors[static_cast<std::size_t>(k)]);
+        if (c < 0) throw std::runtime_error("truth file '" + tab.source + "': no column " + fe.sensors[static_cast<std::size_t>(k)]);
+        for (std::size_t i = 0; i < tab.t.size(); ++i)
+          measured(static_cast<Eigen::Index>(i), k) = tab.columns[static_cast<std::size_t>(c)][i];
+      }
+    }
+    for (int k = 0; k < ns; ++k) {
+      const double num = (measured.col(k) - fe.fe.col(k)).norm(), den = measured.col(k).norm();
+      rep.sensors[static_cast<std::size_t>(k)].relative_rms.push_back(den > 0 ? num / den : std::numeric_limits<double>::quiet_NaN());
+    }
+    if (l + 1 == rep.truths.size()) {
+      rep.t = fe.t;
+      rep.chain = measured;
+      rep.fe = fe.fe;
+    }
+  }
+  for (auto& s : rep.sensors) {
+    const auto L = s.relative_rms.size();
+    if (L >= 2) s.rate = std::log2(s.relative_rms[L - 2] / s.relative_rms[L - 1]);
+  }
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return rep;
+}
+
+Table trajectories_table(const TrajectoryReport& r) {
+  Table t;
+  t.title = "Trajectory agreement, " + r.scenario + ": relative RMS difference Simbody chain - FE (N=" +
+            std::to_string(r.elements) + "), %";
+  t.header = {"sensor", "kind"};
+  for (int n : r.segments) t.header.push_back("n=" + std::to_string(n));
+  t.header.push_back("rate");
+  for (const auto& s : r.sensors) {
+    std::vector<std::string> row{s.name, s.kind};
+    for (double d : s.relative_rms) row.push_back(percent(d, 3));
+    row.push_back(number(s.rate, 3));
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+Table overlay_table(const TrajectoryReport& r) {
+  Table t;
+  t.header.push_back("t");
+  for (const auto& s : r.sensors) {
+    t.header.push_back(s.name + "_chain");
+    t.header.push_back(s.name + "_fe");
+    t.header.push_back(s.name + "_residual");
+  }
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    std::vector<std::string> row{number(r.t[i], 10)};
+    const auto ii = static_cast<Eigen::Index>(i);
+    for (int k = 0; k < static_cast<int>(r.sensors.size()); ++k) {
+      row.push_back(number(r.chain(ii, k), 10));
+      row.push_back(number(r.fe(ii, k), 10));
+      row.push_back(number(r.chain(ii, k) - r.fe(ii, k), 6));
+    }
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+nlohmann::json to_json(const TrajectoryReport& r) {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json j;
+  j["scenario"] = r.scenario;
+  j["truth_overrides"] = r.truth_overrides;
+  j["elements"] = r.elements;
+  j["segments"] = r.segments;
+  j["inputs"] = r.input_kinds;
+  j["sensors"] = nlohmann::json::array();
+  for (const auto& s : r.sensors) {
+    nlohmann::json e;
+    e["name"] = s.name;
+    e["kind"] = s.kind;
+    nlohmann::json d = nlohmann::json::array();
+    for (double v : s.relative_rms) d.push_back(num(v));
+    e["relative_rms"] = d;
+    e["rate"] = num(s.rate);
+    j["sensors"].push_back(e);
+  }
+  nlohmann::json tr = nlohmann::json::array();
+  for (const auto& l : r.truths)
+    tr.push_back({{"segments", l.segments}, {"file", "truths/n" + std::to_string(l.segments) + "/truth.csv"}, {"seconds", l.seconds}, {"integrator", l.summary.integrator}});
+  j["truths"] = tr;
+  j["fe_seconds"] = r.fe_seconds;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+}  // namespace scoleid::crosscheck
