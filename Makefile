@@ -10,10 +10,12 @@ FUZZ_BUILD   ?= build-fuzz
 ASAN_BUILD   ?= build-asan
 FUZZ_SECONDS ?= 60
 
-# Main job: a Simbody truth trajectory, then the FE identifier on that data file.
+# Main job: a Simbody truth trajectory, the FE identifier on that data file, then the cross-check
+# of the two (modes, trajectories, identification at n, 2n, 4n segments) and its summary.
 run: build
 	$(BUILD)/model/scole-truth --scenario $(SCENARIO) --out $(OUT)/$(SCENARIO)/truth
 	$(BUILD)/identify/scole-identify --scenario $(SCENARIO) --data $(OUT)/$(SCENARIO)/truth/truth.csv --out $(OUT)/$(SCENARIO)/identify
+	$(BUILD)/crosscheck/scole-crosscheck all --scenario $(SCENARIO) --out $(OUT)/$(SCENARIO)/crosscheck
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
@@ -23,6 +25,7 @@ slow: build
 
 bench: build
 	$(BUILD)/identify/scole-identify-bench
+	$(BUILD)/crosscheck/scole-crosscheck-bench
 
 deps:
 	bash .ci/install-deps

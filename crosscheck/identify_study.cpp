@@ -46,7 +46,8 @@ LevelRun run_one(identify::Problem& p, int segments, identify::RunResult& result
 }
 }  // namespace
 
-IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOptions& opt, const std::string& truth_root) {
+IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOptions& opt, const std::string& truth_root,
+                             const std::vector<TruthLevel>& reuse) {
   std::string why;
   if (!opt.IsValid(&why)) throw io::InputError("identify: " + why);
   if (scenario.identification.integrator != "esdirk")
@@ -61,7 +62,9 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
   st.data_kind = opt.with_noise ? "Simbody truth with the scenario's sensor noise" : "Simbody truth, noise-free";
   st.segments = refinement(opt.segments > 0 ? opt.segments : scenario.truth.segments, opt.levels,
                            io::limits::kMaxSegments, "segments");
-  st.truths = run_truth_levels(scenario, st.segments, truth_root, !opt.with_noise, opt.progress);
+  bool same = !reuse.empty() && !opt.with_noise && reuse.size() == st.segments.size();
+  for (std::size_t l = 0; same && l < reuse.size(); ++l) same = reuse[l].segments == st.segments[l];
+  st.truths = same ? reuse : run_truth_levels(scenario, st.segments, truth_root, !opt.with_noise, opt.progress);
   for (std::size_t l = 0; l < st.truths.size(); ++l) {
     if (opt.progress) std::fprintf(stderr, "scole-crosscheck: identifying from the %d-segment truth\n", st.segments[l]);
     auto p = identify::make_problem(scenario, st.truths[l].csv);

@@ -146,8 +146,10 @@ int main(int argc, char** argv) {
       io::write_text_atomic(dir.path("mac.csv"), m.csv());
       io::write_json_atomic(dir.path("modes.json"), crosscheck::to_json(r));
     }
+    std::vector<crosscheck::TruthLevel> noise_free_truths;
     if (do_traj) {
       const auto r = crosscheck::compare_trajectories(sc, to, truths);
+      noise_free_truths = r.truths;
       const auto t = crosscheck::trajectories_table(r);
       print(t, quiet);
       io::write_text_atomic(dir.path("trajectories.csv"), t.csv());
@@ -155,8 +157,9 @@ int main(int argc, char** argv) {
       io::write_json_atomic(dir.path("trajectories.json"), crosscheck::to_json(r));
     }
     if (do_ident) {
-      if (do_traj) fs::remove_all(truths);  // the identify verb writes its own truths (noise as it says)
-      const auto s = crosscheck::identify_study(sc, io_, truths);
+      // The trajectories' noise-free truths serve the identification when the levels match; the
+      // study runs its own otherwise (replacing them: truths/ then holds what identify.json used).
+      const auto s = crosscheck::identify_study(sc, io_, truths, noise_free_truths);
       const auto t = crosscheck::identify_table(s);
       print(t, quiet);
       io::write_text_atomic(dir.path("identify.csv"), t.csv());

@@ -55,6 +55,9 @@ FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int
   sc.truth.overrides.clear();
   sc.identification.elements = elements;
   sc.identification.time_step = 0.0;
+  // Every quantity at the truth's value: the parameters by the truth file's true values (below),
+  // the others from the structure, not from the identifier's starting guesses.
+  sc.identification.initial.clear();
   for (auto& in : sc.inputs) in.signal_from = "scenario";
   auto p = identify::make_problem(sc, csv);
   const auto& names = p->params->names();

@@ -67,8 +67,10 @@ struct IdentifyStudy {
   bool all_converged() const;
 };
 
+// `reuse`: truths already run for this scenario at these levels (e.g. by the trajectories verb,
+// noise-free); empty = run them into `truth_root`.
 IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOptions& options,
-                             const std::string& truth_root);
+                             const std::string& truth_root, const std::vector<TruthLevel>& reuse = {});
 
 Table identify_table(const IdentifyStudy& s);
 nlohmann::json to_json(const IdentifyStudy& s);
