@@ -61,6 +61,7 @@ void write_report(io::RunDirectory& dir, const crosscheck::ReportInputs& in, boo
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables and progress interleave in order in a log
   CLI::App app{
       "scole-crosscheck: the Simbody truth (a chain of n rigid segments) against the finite-element identifier\n"
       "(N elements), on the same scenario: natural modes, trajectories, and identification on the truth with the\n"

@@ -54,7 +54,7 @@ std::vector<std::string> summary_lines(const ReportInputs& in) {
     const auto& seg = in.modes["segments"];
     out.push_back("modes         first " + std::to_string(k) + " flexible frequencies: chain (n = " +
                   std::to_string(seg.front().get<int>()) + ".." + std::to_string(seg.back().get<int>()) +
-                  ", extrapolated) and FE agree to " + pct(worst) + "; MAC diagonal >= " + number(mac, 4));
+                  ", extrapolated) and FE agree to " + pct(worst) + "; MAC diagonal >= " + number(mac, 6));
   }
   if (!in.trajectories.is_null()) {
     double worst = 0.0;

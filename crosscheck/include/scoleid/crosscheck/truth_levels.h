@@ -19,7 +19,8 @@ struct TruthLevel {
 
 // Runs io::truth_scenario(scenario) with segments[k] segments and writes the pair into
 // `root`/n<segments>/ (a RunDirectory each: complete or absent). `noise_free` drops every
-// sensor's noise (for comparisons of the models themselves).
+// sensor's noise (for comparisons of the models themselves). The levels run concurrently, one
+// per hardware thread; the first failure (in level order) is rethrown after all have stopped.
 std::vector<TruthLevel> run_truth_levels(const io::Scenario& scenario, const std::vector<int>& segments,
                                          const std::string& root, bool noise_free, bool progress);
 
