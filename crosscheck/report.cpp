@@ -118,12 +118,13 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
     }
     for (const auto& e : m["modes"])
       t.rows.push_back({std::to_string(e["index"].get<int>()), number(num(e["chain_extrapolated_hz"]), 7),
-                        number(num(e["fe_hz"].back()), 7), number(num(e["analytic_hz"]), 7),
+                        number(num(e["fe_hz"].back()), 7),
+                        std::isfinite(num(e["analytic_hz"])) ? number(num(e["analytic_hz"]), 7) : "-",
                         percent(num(e["extrapolated_vs_fe"]), 3), number(num(e["chain_rate"]), 3),
-                        number(num(e["fe_rate"]), 3), number(num(e["mac"]), 4)});
+                        number(num(e["fe_rate"]), 3), number(num(e["mac"]), 6)});
     rf.files.push_back({"modes_convergence.csv", conv.csv()});
-    std::string gp = "set terminal pngcairo size 900,600\nset output 'modes.png'\nset datafile separator ','\n"
-                     "set logscale xy\nset key outside right\nset grid\nset xlabel 'chain segments n'\n"
+    std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'modes.png'\nset datafile separator ','\n"
+                     "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'chain segments n'\n"
                      "set ylabel '|f_chain(n) / f_FE - 1|'\nset title " +
                      gnuplot_quote("Natural frequencies, " + m["scenario"].get<std::string>() + ": chain against the finest FE") +
                      "\nplot ";
@@ -155,7 +156,7 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
     if (overlay_csv_present) {
       const auto& sensors = tr["sensors"];
       const std::size_t k = std::min<std::size_t>(4, sensors.size());
-      std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * k) +
+      std::string gp = "set terminal pngcairo noenhanced size 1000," + std::to_string(300 * k) +
                        "\nset output 'overlay.png'\nset datafile separator ','\nset key autotitle columnhead\n"
                        "set multiplot layout " + std::to_string(k) + ",1\nset grid\nset y2tics\nset ytics nomirror\n";
       for (std::size_t i = 0; i < k; ++i) {
@@ -197,8 +198,8 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
       t.rows.push_back(row);
     }
     rf.files.push_back({"identify_convergence.csv", conv.csv()});
-    std::string gp = "set terminal pngcairo size 900,600\nset output 'identify.png'\nset datafile separator ','\n"
-                     "set logscale xy\nset key outside right\nset grid\nset xlabel 'truth chain segments n'\n"
+    std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'identify.png'\nset datafile separator ','\n"
+                     "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'truth chain segments n'\n"
                      "set ylabel '|estimate / truth - 1|'\nset title " +
                      gnuplot_quote("Identification on the Simbody truth, " + id["scenario"].get<std::string>()) + "\nplot ";
     int col = 2;
