@@ -134,7 +134,7 @@ Table identify_table(const IdentifyStudy& s) {
 }
 
 nlohmann::json to_json(const IdentifyStudy& s) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto num = json_number;
   auto nums = [&](const std::vector<double>& v) {
     nlohmann::json a = nlohmann::json::array();
     for (double x : v) a.push_back(num(x));

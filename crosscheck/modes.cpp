@@ -276,7 +276,7 @@ Table mac_table(const ModesReport& r) {
 }
 
 nlohmann::json to_json(const ModesReport& r) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto num = json_number;
   nlohmann::json j;
   j["scenario"] = r.scenario;
   j["structure"] = r.structure;

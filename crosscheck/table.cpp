@@ -74,4 +74,6 @@ std::string number(double v, int digits) {
 
 std::string percent(double v, int digits) { return number(100.0 * v, digits); }
 
+nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
 }  // namespace scoleid::crosscheck

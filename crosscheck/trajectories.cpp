@@ -174,7 +174,7 @@ Table overlay_table(const TrajectoryReport& r) {
 }
 
 nlohmann::json to_json(const TrajectoryReport& r) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto num = json_number;
   nlohmann::json j;
   j["scenario"] = r.scenario;
   j["truth_overrides"] = r.truth_overrides;

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace scoleid::crosscheck {
 
 struct Table {
@@ -20,5 +22,7 @@ struct Table {
 // understand them); `percent` multiplies by 100 and appends nothing (the header says %).
 std::string number(double v, int digits = 6);
 std::string percent(double v, int digits = 3);
+// A number for JSON: NaN and infinities (not representable there) become null.
+nlohmann::json json_number(double v);
 
 }  // namespace scoleid::crosscheck
