@@ -14,13 +14,44 @@ int BandedCholesky::bandwidth(const Eigen::SparseMatrix<double>& A) {
   return b;
 }
 
-void BandedCholesky::resize(int n, int b) {
-  n_ = n;
-  b_ = b;
-  band_.assign(static_cast<std::size_t>(n) * (b + 1), 0.0);
+BandedCholesky::Shape BandedCholesky::shape(const Eigen::SparseMatrix<double>& A, int max_border) {
+  const int n = static_cast<int>(A.rows());
+  // reach[i]: the farthest coupling to the left of row i (symmetric pattern: either triangle).
+  std::vector<int> reach(static_cast<std::size_t>(n), 0);
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, k); it; ++it) {
+      const int i = static_cast<int>(std::max(it.row(), it.col())), j = static_cast<int>(std::min(it.row(), it.col()));
+      reach[static_cast<std::size_t>(i)] = std::max(reach[static_cast<std::size_t>(i)], i - j);
+    }
+  // prefix[m] = half bandwidth of the leading m rows.
+  std::vector<int> prefix(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i) prefix[static_cast<std::size_t>(i) + 1] = std::max(prefix[static_cast<std::size_t>(i)], reach[static_cast<std::size_t>(i)]);
+  Shape best{prefix[static_cast<std::size_t>(n)], 0};
+  auto cost = [n](int b, int k) {
+    const double m = n - k;
+    return m * (b + 1.0) * (b + 1.0) + k * m * (b + 1.0) + static_cast<double>(k) * k * n;
+  };
+  double best_cost = cost(best.band, 0);
+  for (int k = 1; k <= std::min(max_border, n - 1); ++k) {
+    const int b = prefix[static_cast<std::size_t>(n - k)];
+    const double c = cost(b, k);
+    if (c < 0.999 * best_cost) {
+      best = {b, k};
+      best_cost = c;
+    }
+  }
+  return best;
 }
 
-void BandedCholesky::set_zero() { std::fill(band_.begin(), band_.end(), 0.0); }
+void BandedCholesky::resize(int n, int b, int border) {
+  if (border < 0 || border > n) throw std::invalid_argument("BandedCholesky: border outside [0, n]");
+  n_ = n;
+  b_ = b;
+  nb_ = n - border;
+  data_.assign(static_cast<std::size_t>(nb_) * (b + 1) + static_cast<std::size_t>(border) * n, 0.0);
+}
+
+void BandedCholesky::set_zero() { std::fill(data_.begin(), data_.end(), 0.0); }
 
 void BandedCholesky::assign(const Eigen::SparseMatrix<double>& A) {
   set_zero();
@@ -28,15 +59,16 @@ void BandedCholesky::assign(const Eigen::SparseMatrix<double>& A) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(A, k); it; ++it) {
       const int i = static_cast<int>(it.row()), j = static_cast<int>(it.col());
       if (j > i) continue;
-      if (i - j > b_) throw std::logic_error("BandedCholesky::assign: entry outside the band");
+      if (!fits(i, j)) throw std::logic_error("BandedCholesky::assign: entry outside band and border");
       at(i, j) = it.value();
     }
 }
 
 bool BandedCholesky::factorize() {
   const int w = b_ + 1;
-  double* L = band_.data();
-  for (int i = 0; i < n_; ++i) {
+  double* L = data_.data();
+  // Band rows: L_ij for j ∈ [i − b, i] only depends on band rows.
+  for (int i = 0; i < nb_; ++i) {
     const int j0 = std::max(0, i - b_);
     for (int j = j0; j <= i; ++j) {
       double s = L[i * w + (j - i + b_)];
@@ -50,22 +82,54 @@ bool BandedCholesky::factorize() {
       }
     }
   }
+  // Border rows: dense; against a band row j only its band [j − b, j) contributes.
+  for (int i = nb_; i < n_; ++i) {
+    double* Li = L + offset(i, 0);
+    for (int j = 0; j <= i; ++j) {
+      double s = Li[j];
+      if (j < nb_) {
+        const double* Lj = L + static_cast<std::size_t>(j) * w;
+        for (int k = std::max(0, j - b_); k < j; ++k) s -= Li[k] * Lj[k - j + b_];
+        Li[j] = s / Lj[b_];
+      } else {
+        const double* Lj = L + offset(j, 0);
+        for (int k = 0; k < j; ++k) s -= Li[k] * Lj[k];
+        if (i == j) {
+          if (!(s > 0.0)) return false;
+          Li[j] = std::sqrt(s);
+        } else {
+          Li[j] = s / Lj[j];
+        }
+      }
+    }
+  }
   return true;
 }
 
 void BandedCholesky::solve_in_place(double* x) const {
-  // Both sweeps read L by rows, which are contiguous in the band storage: L y = r by dot
-  // products with row i, Lᵀ x = y by axpys with row i (column-oriented back substitution).
+  // Both sweeps read L by rows, which are contiguous in storage: L y = r by dot products with
+  // row i, Lᵀ x = y by axpys with row i (column-oriented back substitution).
   const int w = b_ + 1;
-  const double* L = band_.data();
-  for (int i = 0; i < n_; ++i) {
+  const double* L = data_.data();
+  for (int i = 0; i < nb_; ++i) {
     const int k0 = std::max(0, i - b_);
     const double* Li = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
     double s = x[i];
     for (int k = k0; k < i; ++k) s -= *Li++ * x[k];
     x[i] = s / *Li;
   }
-  for (int i = n_ - 1; i >= 0; --i) {
+  for (int i = nb_; i < n_; ++i) {
+    const double* Li = L + offset(i, 0);
+    double s = x[i];
+    for (int k = 0; k < i; ++k) s -= Li[k] * x[k];
+    x[i] = s / Li[i];
+  }
+  for (int i = n_ - 1; i >= nb_; --i) {
+    const double* Li = L + offset(i, 0);
+    const double xi = (x[i] /= Li[i]);
+    for (int k = 0; k < i; ++k) x[k] -= Li[k] * xi;
+  }
+  for (int i = nb_ - 1; i >= 0; --i) {
     const double* Li = L + static_cast<std::size_t>(i) * w;
     const double xi = (x[i] /= Li[b_]);
     const int k0 = std::max(0, i - b_);

@@ -4,18 +4,20 @@
 
 namespace scoleid::identify {
 
-NewtonMatrix::NewtonMatrix(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, int half_bandwidth)
-    : M_(M), D_(D), K_(K), n_(static_cast<int>(M.rows())), b_(half_bandwidth) {
+NewtonMatrix::NewtonMatrix(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, BandedCholesky::Shape shape)
+    : M_(M), D_(D), K_(K), n_(static_cast<int>(M.rows())), shape_(shape) {
   cache_.reserve(kCache);  // references handed out stay valid
   if (M.nonZeros() != D.nonZeros() || M.nonZeros() != K.nonZeros())
     throw std::invalid_argument("NewtonMatrix: M, D and K must share one sparsity pattern");
   lower_slot_.assign(static_cast<std::size_t>(M.nonZeros()), -1);
+  const BandedCholesky layout(n_, shape_.band, shape_.border);
   int idx = 0;
   for (int k = 0; k < M.outerSize(); ++k)
     for (SparseMatrix::InnerIterator it(M, k); it; ++it, ++idx)
       if (it.col() <= it.row()) {
-        if (it.row() - it.col() > b_) throw std::invalid_argument("NewtonMatrix: entry outside the half bandwidth");
-        lower_slot_[static_cast<std::size_t>(idx)] = static_cast<int>(it.row()) * (b_ + 1) + static_cast<int>(it.col() - it.row()) + b_;
+        const int i = static_cast<int>(it.row()), j = static_cast<int>(it.col());
+        if (!layout.fits(i, j)) throw std::invalid_argument("NewtonMatrix: entry outside band and border");
+        lower_slot_[static_cast<std::size_t>(idx)] = static_cast<long>(layout.offset(i, j));
       }
 }
 
@@ -31,7 +33,7 @@ const BandedCholesky& NewtonMatrix::factor(double gamma) {
   if (cache_.size() < kCache) {
     cache_.emplace_back();
     slot = &cache_.back();
-    slot->chol.resize(n_, b_);
+    slot->chol.resize(n_, shape_);
   } else {
     slot = &cache_.front();
     for (auto& e : cache_)
@@ -45,9 +47,9 @@ const BandedCholesky& NewtonMatrix::factor(double gamma) {
   const double* d = D_.valuePtr();
   const double* k = K_.valuePtr();
   const double g2 = gamma * gamma;
-  double* band = &c.at(0, 0) - b_;
+  double* band = c.data();
   for (int i = 0; i < nnz; ++i) {
-    const int s = lower_slot_[static_cast<std::size_t>(i)];
+    const long s = lower_slot_[static_cast<std::size_t>(i)];
     if (s >= 0) band[s] = m[i] + gamma * d[i] + g2 * k[i];
   }
   if (!c.factorize()) throw std::runtime_error("Newton matrix M + gD + g^2 K is not positive definite");

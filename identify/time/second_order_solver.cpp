@@ -247,11 +247,11 @@ SecondOrderSolver::SecondOrderSolver(const SparseMatrix& M, const SparseMatrix& 
   s.K = on_pattern(K, pattern);
   s.group = dof_group.empty() ? std::vector<int>(static_cast<std::size_t>(s.n), 0) : std::move(dof_group);
   s.ngroups = 1 + *std::max_element(s.group.begin(), s.group.end());
-  const int b = BandedCholesky::bandwidth(pattern);
-  s.mass_chol.resize(s.n, b);
+  const BandedCholesky::Shape shape = BandedCholesky::shape(pattern);
+  s.mass_chol.resize(s.n, shape);
   s.mass_chol.assign(M);
   if (!s.mass_chol.factorize()) throw std::runtime_error("mass matrix is not positive definite");
-  s.newton = std::make_unique<NewtonMatrix>(s.M, s.D, s.K, b);
+  s.newton = std::make_unique<NewtonMatrix>(s.M, s.D, s.K, shape);
   if (s.opt.integrator == SolverOptions::Integrator::Esdirk)
     s.stepper = std::make_unique<EsdirkStepper>(s.M, s.D, s.K, s.mass_chol, *s.newton, ButcherTable::arkode_dirk(s.opt.dirk_table));
   s.F.resize(s.n);

@@ -5,9 +5,9 @@
 //
 // In first-order form y = (x, v) the stage system (I − γJ) y = r, J = [0 I; −M⁻¹K −M⁻¹D],
 // reduces to one solve with S(γ) (second_order_solver.h, esdirk_stepper.h). S(γ) is symmetric
-// positive definite when M is and D, K are positive semidefinite, and banded in the FE DOF order,
-// so it is factored by banded Cholesky, written straight into the band from the common sparsity
-// pattern of M, D and K.
+// positive definite when M is and D, K are positive semidefinite, and banded (with a dense border
+// of a few rigid-body DOFs) in the FE DOF order, so it is factored by banded Cholesky, written
+// straight into band and border from the common sparsity pattern of M, D and K.
 //
 // A fixed-step integrator needs one factorisation per distinct γ: the regular step, and the
 // shortened steps that land on forcing breakpoints. The last few are kept, so a solve that
@@ -22,8 +22,9 @@ namespace scoleid::identify {
 class NewtonMatrix {
 public:
   // M, D, K must share one compressed sparsity pattern (values aligned entry by entry);
-  // half_bandwidth bounds |i − j| over that pattern. The matrices are referenced, not copied.
-  NewtonMatrix(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, int half_bandwidth);
+  // `shape` (BandedCholesky::shape of that pattern) holds every entry. The matrices are referenced,
+  // not copied.
+  NewtonMatrix(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, BandedCholesky::Shape shape);
 
   // The Cholesky factor of S(γ); throws std::runtime_error if S(γ) is not positive definite.
   const BandedCholesky& factor(double gamma);
@@ -37,8 +38,9 @@ private:
     BandedCholesky chol;
   };
   const SparseMatrix &M_, &D_, &K_;
-  int n_ = 0, b_ = 0;
-  std::vector<int> lower_slot_;  // per stored nonzero: its place in the band, or −1 (upper triangle)
+  int n_ = 0;
+  BandedCholesky::Shape shape_;
+  std::vector<long> lower_slot_;  // per stored nonzero: its storage offset, or −1 (upper triangle)
   std::vector<Entry> cache_;
   long uses_ = 0, factorizations_ = 0;
 };
