@@ -66,9 +66,29 @@ void normalise(Eigen::VectorXd& y) {
 struct SideModes {
   std::vector<double> hz;
   Eigen::MatrixXd shapes;
+  std::vector<double> zeta;  // modal damping ratio per mode (when asked for), NaN if none matched
 };
 
-SideModes chain_modes(const io::Scenario& shape_sc, const std::vector<double>& scale, int segments, int count) {
+// The damping ratio of the damped mode nearest in frequency to each undamped one (light damping:
+// |λ| is the undamped frequency to O(ζ²)); NaN where none lies within 1 % of it.
+std::vector<double> match_damping(const std::vector<double>& hz, const std::vector<double>& damped_hz,
+                                  const std::vector<double>& damped_zeta) {
+  std::vector<double> z(hz.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < hz.size(); ++i) {
+    double best = 0.01;
+    for (std::size_t k = 0; k < damped_hz.size(); ++k) {
+      const double d = std::abs(damped_hz[k] / hz[i] - 1.0);
+      if (d < best) {
+        best = d;
+        z[i] = damped_zeta[k];
+      }
+    }
+  }
+  return z;
+}
+
+SideModes chain_modes(const io::Scenario& shape_sc, const std::vector<double>& scale, int segments, int count,
+                      bool damping) {
   auto structure = model::prepare_structure(shape_sc, segments);
   const auto sensors = model::resolve_sensors(shape_sc, *structure);
   const auto& matter = structure->matter();
@@ -87,10 +107,20 @@ SideModes chain_modes(const io::Scenario& shape_sc, const std::vector<double>& s
   const int k = std::min<int>(count, static_cast<int>(ms.omega.size()));
   for (int i = 0; i < k; ++i) out.hz.push_back(ms.omega[i] / kTwoPi);
   out.shapes = ms.shapes.leftCols(k);
+  if (damping) {
+    // The damped modes from the full state Jacobian (dampers included), matched by frequency.
+    std::vector<double> dhz, dz;
+    for (const auto& m : model::natural_modes(system, state)) {
+      dhz.push_back(m.omega / kTwoPi);
+      dz.push_back(m.damping_ratio);
+    }
+    out.zeta = match_damping(out.hz, dhz, dz);
+  }
   return out;
 }
 
-SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scale, int elements, int count) {
+SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scale, int elements, int count,
+                   bool damping) {
   const auto fe = identify::make_structure(shape_sc, elements);
   const auto& model = fe->model();
   const identify::AssembledModel ops = identify::assemble(model, fe->coefficients(shape_sc));
@@ -108,6 +138,14 @@ SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scal
   }
   out.shapes.resize(C.rows(), static_cast<Eigen::Index>(cols.size()));
   for (std::size_t j = 0; j < cols.size(); ++j) out.shapes.col(static_cast<Eigen::Index>(j)) = cols[j];
+  if (damping) {
+    std::vector<double> dhz, dz;
+    for (const auto& m : identify::damped_modes(Eigen::MatrixXd(ops.M), Eigen::MatrixXd(ops.D), Eigen::MatrixXd(ops.K))) {
+      dhz.push_back(m.omega / kTwoPi);
+      dz.push_back(m.zeta);
+    }
+    out.zeta = match_damping(out.hz, dhz, dz);
+  }
   return out;
 }
 
@@ -199,8 +237,9 @@ ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& opt)
   for (int l = 0; l < opt.levels; ++l) {
     rep.segments.push_back(n0 << l);
     rep.elements.push_back(N0 << l);
-    chain.push_back(chain_modes(shape_sc, scale, rep.segments.back(), opt.count));
-    fe.push_back(fe_modes(shape_sc, scale, rep.elements.back(), opt.count));
+    // Damping ratios on the coarsest level of each side (the one the MAC compares).
+    chain.push_back(chain_modes(shape_sc, scale, rep.segments.back(), opt.count, l == 0));
+    fe.push_back(fe_modes(shape_sc, scale, rep.elements.back(), opt.count, l == 0));
   }
   std::size_t count = static_cast<std::size_t>(opt.count);
   for (const auto& c : chain) count = std::min(count, c.hz.size());
@@ -226,6 +265,8 @@ ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& opt)
     Eigen::Index best = 0;
     rep.mac.row(ii).maxCoeff(&best);
     m.best_fe = static_cast<int>(best) + 1;
+    m.chain_zeta = chain.front().zeta[i];
+    m.fe_zeta = fe.front().zeta[i];
     rep.modes.push_back(m);
   }
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -245,6 +286,8 @@ Table modes_table(const ModesReport& r) {
   t.header.push_back("chain/FE-1 % (n, N)");
   t.header.push_back("extrap./FE-1 %");
   t.header.push_back("MAC");
+  t.header.push_back("zeta chain (n)");
+  t.header.push_back("zeta FE (N)");
   for (const auto& m : r.modes) {
     std::vector<std::string> row{std::to_string(m.index)};
     for (double f : m.chain_hz) row.push_back(number(f, 7));
@@ -256,6 +299,8 @@ Table modes_table(const ModesReport& r) {
     row.push_back(percent(m.raw_difference(), 3));
     row.push_back(percent(m.extrapolated_difference(), 3));
     row.push_back(number(m.mac, 4) + (m.best_fe != m.index ? " (best FE " + std::to_string(m.best_fe) + ")" : ""));
+    row.push_back(std::isnan(m.chain_zeta) ? "-" : number(m.chain_zeta, 5));
+    row.push_back(std::isnan(m.fe_zeta) ? "-" : number(m.fe_zeta, 5));
     t.rows.push_back(row);
   }
   return t;
@@ -300,6 +345,8 @@ nlohmann::json to_json(const ModesReport& r) {
     e["extrapolated_vs_fe"] = num(m.extrapolated_difference());
     e["mac"] = num(m.mac);
     e["best_fe_mode"] = m.best_fe;
+    e["chain_damping_ratio"] = num(m.chain_zeta);
+    e["fe_damping_ratio"] = num(m.fe_zeta);
     j["modes"].push_back(e);
   }
   nlohmann::json mac = nlohmann::json::array();

@@ -312,6 +312,7 @@ void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, con
       fail_field(source, b.EI.size() == 1 ? r.field("EI") : r.field("EI") + "[" + std::to_string(i) + "]",
                  "must be > 0", format_value(b.EI[i]));
   b.zeta = r.nonneg("zeta", b.zeta);
+  b.c_kv = r.nonneg("c_kv", b.c_kv);
   b.tip_mass = r.nonneg("tip_mass", b.tip_mass);
   b.tip_inertia = r.nonneg("tip_inertia", b.tip_inertia);
   if (b.left == EndCondition::Free && b.right == EndCondition::Free) {
@@ -330,6 +331,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   s.GJ = r.positive("GJ", s.GJ);
   s.rho_I_psi = r.positive("rho_I_psi", s.rho_I_psi);
   s.zeta = r.nonneg("zeta", s.zeta);
+  s.bending_rotary_inertia = r.boolean("bending_rotary_inertia", s.bending_rotary_inertia);
   if (r.has("shuttle")) parse_rigid(r.child("shuttle"), source, r.field("shuttle"), s.shuttle);
   if (r.has("reflector")) parse_rigid(r.child("reflector"), source, r.field("reflector"), s.reflector);
   s.reflector_rx = r.num("reflector_rx", s.reflector_rx);
@@ -349,6 +351,8 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   }
   s.actuator_mass = r.positive("actuator_mass", s.actuator_mass);
   s.actuator_stroke = r.positive("actuator_stroke", s.actuator_stroke);
+  s.actuator_stiffness = r.nonneg("actuator_stiffness", s.actuator_stiffness);
+  s.actuator_damping = r.nonneg("actuator_damping", s.actuator_damping);
 }
 
 double structure_length(const Scenario& sc) {
@@ -569,16 +573,18 @@ nlohmann::json to_json(const Scenario& s) {
   j["structure"] = s.structure;
   auto beam = [](const BeamSpec& b) {
     return json{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
-                {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta},
+                {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta}, {"c_kv", b.c_kv},
                 {"tip_mass", b.tip_mass}, {"tip_inertia", b.tip_inertia}};
   };
   auto scole = [&](const ScoleSpec& c) {
     return json{{"length", c.length}, {"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch},
-                {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta}, {"shuttle", rigid(c.shuttle)},
+                {"GJ", c.GJ}, {"rho_I_psi", c.rho_I_psi}, {"zeta", c.zeta},
+                {"bending_rotary_inertia", c.bending_rotary_inertia}, {"shuttle", rigid(c.shuttle)},
                 {"reflector", rigid(c.reflector)}, {"reflector_rx", c.reflector_rx},
                 {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
                 {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass},
-                {"actuator_stroke", c.actuator_stroke}};
+                {"actuator_stroke", c.actuator_stroke}, {"actuator_stiffness", c.actuator_stiffness},
+                {"actuator_damping", c.actuator_damping}};
   };
   // The structure section, and the truth's overrides as the fields whose values differ from it.
   json structure, truth_structure;

@@ -22,14 +22,21 @@ std::vector<Row> rows(const Scenario& sc) {
          {{"GJ", "mast torsional stiffness", "force·length²"}, [](Scenario& s) -> double& { return s.scole.GJ; }},
          {{"rho_I_psi", "mast torsional inertia per unit length", "mass·length"},
           [](Scenario& s) -> double& { return s.scole.rho_I_psi; }},
-         {{"zeta", "mast damping parameter ζ (docs/theory.md §3.3)", "see §3.3"},
+         {{"zeta", "mast damping ratio ζ (Chen–Russell bending, Kelvin–Voigt torsion; docs/theory.md §3.3)",
+           "dimensionless"},
           [](Scenario& s) -> double& { return s.scole.zeta; }},
-         {{"m_reflector", "reflector mass", "mass"}, [](Scenario& s) -> double& { return s.scole.reflector.mass; }}};
+         {{"m_reflector", "reflector mass", "mass"}, [](Scenario& s) -> double& { return s.scole.reflector.mass; }},
+         {{"k_actuator", "proof-mass actuator centering spring (docs/theory.md §3.7)", "force/length"},
+          [](Scenario& s) -> double& { return s.scole.actuator_stiffness; }},
+         {{"c_actuator", "proof-mass actuator damper (docs/theory.md §3.7)", "force·time/length"},
+          [](Scenario& s) -> double& { return s.scole.actuator_damping; }}};
     return r;
   }
   r = {{{"rho_A", "mass per unit length", "mass/length"}, [](Scenario& s) -> double& { return s.beam.rho_A; }},
-       {{"zeta", "Kelvin–Voigt damping parameter ζ (docs/theory.md §2.2)", "see §2.2"},
-        [](Scenario& s) -> double& { return s.beam.zeta; }}};
+       {{"zeta", "square-root (Chen–Russell) damping ratio ζ, d = 2ζ√(ρA·EI) (docs/theory.md §2.2)", "dimensionless"},
+        [](Scenario& s) -> double& { return s.beam.zeta; }},
+       {{"c_kv", "Kelvin–Voigt (strain-rate) damping coefficient (docs/theory.md §2.2)", "force·length²·time"},
+        [](Scenario& s) -> double& { return s.beam.c_kv; }}};
   if (sc.beam.EI.size() == 1) {
     r.push_back({{"EI", "bending stiffness", "force·length²"}, [](Scenario& s) -> double& { return s.beam.EI[0]; }});
   } else {

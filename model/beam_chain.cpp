@@ -1,5 +1,6 @@
 #include "scoleid/model/beam_chain.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "scoleid/model/joint_forces.h"
@@ -13,11 +14,24 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
   root_R_ = Vec3(0);
   axis_B_ = axis_R_ = Vec3(1, 0, 0);
 
+  // Kelvin–Voigt: c_kv (one value) lumps into the joint dampers the way EI lumps into the joint
+  // springs (hencky.h, docs/theory.md §9.1).
   PiecewiseField EI{beam.length, beam.EI};
-  PiecewiseField c{beam.length, beam.EI};
-  for (auto& v : c.values) v = 2.0 * beam.zeta * std::sqrt(beam.rho_A * v);
+  PiecewiseField c{beam.length, {beam.c_kv}};
   lumping_ = hencky_lumping(n, EI, c);
   const double h = lumping_.h;
+  // Chen–Russell: bar i on [i h, (i+1) h] dissipates 1/2 D_i omega_i^2, D_i = integral of
+  // d(s) = 2 zeta sqrt(rho_A EI(s)) over the bar (docs/theory.md §9.2).
+  const auto chen_russell = [&](double a, double b) {
+    const int m = static_cast<int>(beam.EI.size());
+    const double w = beam.length / m;
+    double sum = 0.0;
+    for (int k = 0; k < m; ++k) {
+      const double lo = std::max(a, k * w), hi = std::min(b, (k + 1) * w);
+      if (hi > lo) sum += (hi - lo) * 2.0 * beam.zeta * std::sqrt(beam.rho_A * beam.EI[static_cast<std::size_t>(k)]);
+    }
+    return sum;
+  };
 
   // Thin rigid bar along its x axis: no inertia about its own axis.
   const double m = beam.rho_A * h;
@@ -53,6 +67,7 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     if (i > 0) joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
     if (i == 0 && beam.left == io::EndCondition::Clamped)
       joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[0], lumping_.damping[0]});
+    if (beam.zeta > 0.0) anchors.push_back({seg.getMobilizedBodyIndex(), 0.0, chen_russell(i * h, (i + 1) * h)});
     segment_bodies_.push_back(seg.getMobilizedBodyIndex());
     parent = seg;
   }

@@ -7,8 +7,8 @@ namespace scoleid::model {
 using namespace SimTK;
 
 JointForces::JointForces(const SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
-                         std::vector<AnchorSpring> anchors)
-    : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)) {}
+                         std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative)
+    : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)), relative_(std::move(relative)) {}
 
 namespace {
 double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB[1][0], R_GB[0][0]); }
@@ -26,6 +26,15 @@ void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces
     const Real theta = planar_angle(b.getBodyRotation(state));
     const Real omega = b.getBodyAngularVelocity(state)[2];
     b.applyBodyTorque(state, Vec3(0, 0, -a.k * theta - a.c * omega), body_forces);
+  }
+  for (const auto& d : relative_) {
+    const MobilizedBody& b = matter_.getMobilizedBody(d.body);
+    const MobilizedBody& r = matter_.getMobilizedBody(d.reference);
+    const Rotation& R_GR = r.getBodyRotation(state);
+    const Vec3 w_R = ~R_GR * (b.getBodyAngularVelocity(state) - r.getBodyAngularVelocity(state));
+    const Vec3 torque = R_GR * Vec3(-d.c[0] * w_R[0], -d.c[1] * w_R[1], -d.c[2] * w_R[2]);
+    b.applyBodyTorque(state, torque, body_forces);
+    r.applyBodyTorque(state, -torque, body_forces);
   }
 }
 

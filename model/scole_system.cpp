@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "scoleid/model/joint_forces.h"
 
@@ -22,10 +23,19 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
 
   const double L = sc.length;
   auto uniform = [L](double v) { return PiecewiseField{L, {v}}; };
-  const HenckyLumping roll = hencky_lumping(n, uniform(sc.EI_roll), uniform(2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_roll)));
-  const HenckyLumping pitch = hencky_lumping(n, uniform(sc.EI_pitch), uniform(2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_pitch)));
-  const HenckyLumping torsion = hencky_lumping(n, uniform(sc.GJ), uniform(2 * sc.zeta * std::sqrt(sc.rho_I_psi * sc.GJ)));
+  if (!sc.bending_rotary_inertia)
+    throw std::invalid_argument(
+        "ScoleSystem: a chain of rigid segments always carries the section's bending rotary inertia");
+  // Bending is damped per segment relative to the shuttle (square-root damping), not at the
+  // joints; torsion at the joints (Kelvin–Voigt, c_psi = 2 zeta sqrt(rho_I_psi GJ) 2L/pi).
+  const HenckyLumping roll = hencky_lumping(n, uniform(sc.EI_roll), uniform(0.0));
+  const HenckyLumping pitch = hencky_lumping(n, uniform(sc.EI_pitch), uniform(0.0));
+  const HenckyLumping torsion =
+      hencky_lumping(n, uniform(sc.GJ), uniform(4.0 * L / Pi * sc.zeta * std::sqrt(sc.rho_I_psi * sc.GJ)));
   const double h = roll.h;
+  const Vec3 slope_damping(2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_roll) * h,
+                           2 * sc.zeta * std::sqrt(sc.rho_A * sc.EI_pitch) * h, 0.0);
+  std::vector<RelativeDamper> dampers;
 
   // Decorations are for the visualizer only: shuttle-sized box, mast tube, reflector dish.
   Body::Rigid shuttle_body(MassProperties(sc.shuttle.mass, Vec3(0), inertia_of(sc.shuttle)));
@@ -50,6 +60,7 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
     joints.push_back({seg.getMobilizedBodyIndex(), 0, roll.stiffness[j], roll.damping[j]});
     joints.push_back({seg.getMobilizedBodyIndex(), 1, pitch.stiffness[j], pitch.damping[j]});
     joints.push_back({seg.getMobilizedBodyIndex(), 2, torsion.stiffness[j], torsion.damping[j]});
+    if (sc.zeta > 0.0) dampers.push_back({seg.getMobilizedBodyIndex(), shuttle_, slope_damping});
     segment_bodies_.push_back(seg.getMobilizedBodyIndex());
     parent = seg;
   }
@@ -83,9 +94,13 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
                                 Transform(x_to_y));
     sliders_.push_back(carriage.getMobilizedBodyIndex());
     sliders_.push_back(proof.getMobilizedBodyIndex());
+    // Centering spring and damper on each slider (docs/theory.md §3.7).
+    if (sc.actuator_stiffness > 0.0 || sc.actuator_damping > 0.0)
+      for (MobilizedBodyIndex b : {carriage.getMobilizedBodyIndex(), proof.getMobilizedBodyIndex()})
+        joints.push_back({b, 0, sc.actuator_stiffness, sc.actuator_damping});
   }
   joint_springs_ = joints;
-  Force::Custom(forces_, new JointForces(matter_, std::move(joints), {}));
+  Force::Custom(forces_, new JointForces(matter_, std::move(joints), {}, std::move(dampers)));
 }
 
 Station ScoleSystem::named_station(const std::string& at) const {

@@ -80,6 +80,11 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Syste
 }
 
 std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
+  if (sc.structure == "scole" && !sc.scole.bending_rotary_inertia)
+    io::fail_field(sc.source, "scole.bending_rotary_inertia",
+                   "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "
+                   "inertia (a body with polar inertia J has Ixx + Iyy >= J); drop it on the identifier's side only",
+                   "false");
   if (sc.structure == "scole") return std::make_unique<ScoleSystem>(sc.scole, segments);
   return std::make_unique<BeamChain>(sc.beam, segments);
 }

@@ -66,10 +66,11 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
 
   StructuralModel& m = fe.model;
   m.ndof = n;
-  m.ncoef = 1 + 2 * sections;
+  m.ncoef = 2 + 2 * sections;
   m.coefficient_names.push_back("rho_A");
   for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("EI_" + std::to_string(s + 1));
-  for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("c_" + std::to_string(s + 1));
+  for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("d_" + std::to_string(s + 1));
+  m.coefficient_names.push_back("c_kv");
   m.dof_group.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < nfull; ++i) {
     const int r = fe.full_to_reduced[static_cast<std::size_t>(i)];
@@ -80,7 +81,7 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   const double h = beam.length / elements;
   const double hs = beam.length / sections;
   std::vector<Trip> mass;
-  std::vector<std::vector<Trip>> stiff(static_cast<std::size_t>(sections));
+  std::vector<std::vector<Trip>> stiff(static_cast<std::size_t>(sections)), slopes(static_cast<std::size_t>(sections));
   auto scatter = [&](std::vector<Trip>& out, int e, const hermite::Mat4& k) {
     for (int a = 0; a < 4; ++a) {
       const int ra = fe.full_to_reduced[static_cast<std::size_t>(2 * e + a)];
@@ -93,13 +94,17 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   };
   for (int e = 0; e < elements; ++e) {
     scatter(mass, e, hermite::mass(h, 0.0, h));
-    // Split the element at section boundaries so EI jumps are integrated exactly.
+    // Split the element at section boundaries so jumps of EI (and of d = 2ζ√(ρA EI)) are
+    // integrated exactly.
     const double sa = e * h, sb = (e + 1) * h;
     int s = std::min(sections - 1, static_cast<int>(std::floor(sa / hs + 1e-12)));
     double lo = sa;
     while (lo < sb - 1e-12 * h) {
       const double hi = std::min(sb, (s + 1) * hs);
-      if (hi > lo + 1e-12 * h) scatter(stiff[static_cast<std::size_t>(s)], e, hermite::stiffness(h, lo - sa, hi - sa));
+      if (hi > lo + 1e-12 * h) {
+        scatter(stiff[static_cast<std::size_t>(s)], e, hermite::stiffness(h, lo - sa, hi - sa));
+        scatter(slopes[static_cast<std::size_t>(s)], e, hermite::slope_product(h, lo - sa, hi - sa));
+      }
       lo = hi;
       s = std::min(sections - 1, s + 1);
       if (hi >= sb) break;
@@ -112,11 +117,16 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     return A;
   };
   m.mass.push_back({to_sparse(mass), fe.coef_rho_A()});
+  // K = Σ EI_k K_k; D = Σ d_k G_k (Chen–Russell) + c_kv Σ K_k (Kelvin–Voigt, one coefficient for
+  // the whole beam: the unit-EI stiffness summed over the sections). docs/theory.md §2.2.
+  SparseMatrix Kunit(n, n);
   for (int s = 0; s < sections; ++s) {
     const SparseMatrix Ks = to_sparse(stiff[static_cast<std::size_t>(s)]);
     m.stiffness.push_back({Ks, fe.coef_EI(s)});
-    m.damping.push_back({Ks, fe.coef_damping(s)});
+    Kunit += Ks;
   }
+  for (int s = 0; s < sections; ++s) m.damping.push_back({to_sparse(slopes[static_cast<std::size_t>(s)]), fe.coef_chen_russell(s)});
+  m.damping.push_back({Kunit, fe.coef_kelvin_voigt()});
   if (beam.tip_mass > 0.0 || beam.tip_inertia > 0.0) {
     std::vector<Trip> tip;
     const int rw = fe.full_to_reduced[static_cast<std::size_t>(2 * elements)];
@@ -159,14 +169,15 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   return fe;
 }
 
-VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta) {
+VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta, double c_kv) {
   VectorXd c(fe.model.ncoef);
   c[fe.coef_rho_A()] = rho_A;
   for (int s = 0; s < fe.sections; ++s) {
     const double ei = EI.size() == 1 ? EI[0] : EI.at(static_cast<std::size_t>(s));
     c[fe.coef_EI(s)] = ei;
-    c[fe.coef_damping(s)] = 2.0 * zeta * std::sqrt(rho_A * ei);
+    c[fe.coef_chen_russell(s)] = 2.0 * zeta * std::sqrt(rho_A * ei);
   }
+  c[fe.coef_kelvin_voigt()] = c_kv;
   return c;
 }
 
@@ -208,20 +219,25 @@ ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) 
   sp.quantities.push_back("zeta");
   sp.value.push_back(beam.zeta);
   sp.true_value.push_back(true);
+  sp.quantities.push_back("c_kv");
+  sp.value.push_back(beam.c_kv);
+  sp.true_value.push_back(true);
   sp.groups.push_back(ei);
   sp.rho_A = 0;
-  sp.zeta = N + 1;
+  sp.q3_quantity = N + 2;
   sp.has_q3 = true;
   if (N > 1) sp.paper_requirement = "needs a uniform beam (one EI section), not " + std::to_string(N) + " sections";
   sp.ncoef = fe.model.ncoef;
-  // c = [ρA, EI_1..EI_N, c_1..c_N], c_k = 2ζ√(ρA EI_k) (Kelvin–Voigt, docs/theory.md §2.2).
+  // φ = [ρA, EI_1..EI_N, ζ, c_kv] → c = [ρA, EI_1..EI_N, d_1..d_N, c_kv], d_k = 2ζ√(ρA EI_k)
+  // (Chen–Russell), c_kv as is (Kelvin–Voigt); docs/theory.md §2.2.
   sp.coefficients = [N](const std::vector<ParameterSpace::Cd>& f) {
-    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(1 + 2 * N));
+    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(2 + 2 * N));
     c[0] = f[0];
     for (int k = 0; k < N; ++k) {
       c[static_cast<std::size_t>(1 + k)] = f[static_cast<std::size_t>(1 + k)];
       c[static_cast<std::size_t>(1 + N + k)] = 2.0 * f[static_cast<std::size_t>(N + 1)] * std::sqrt(f[0] * f[static_cast<std::size_t>(1 + k)]);
     }
+    c[static_cast<std::size_t>(1 + 2 * N)] = f[static_cast<std::size_t>(N + 2)];
     return c;
   };
   return sp;

@@ -46,4 +46,15 @@ Mat4 stiffness(double h, double a, double b) {
   return k;
 }
 
+Mat4 slope_product(double h, double a, double b) {
+  // N' N'ᵀ is of degree 4: the 4-point rule is exact.
+  Mat4 m = Mat4::Zero();
+  for (int g = 0; g < 4; ++g) {
+    const double s = a + (b - a) * kX[g];
+    const Vec4 d = slope(s / h, h);
+    m += (b - a) * kW[g] * d * d.transpose();
+  }
+  return m;
+}
+
 }  // namespace scoleid::identify::hermite

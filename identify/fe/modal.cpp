@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
 
 namespace scoleid::identify {
@@ -37,6 +38,63 @@ NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K) {
   }
   m.floor = 1e-4 * std::sqrt(sigma);
   return m;
+}
+
+std::vector<DampedMode> damped_modes(const MatrixXd& M, const MatrixXd& D, const MatrixXd& K) {
+  const Eigen::Index n = M.rows();
+  std::vector<DampedMode> out;
+  if (n == 0) return out;
+  const auto symmetric = [](const MatrixXd& A) {
+    return (A - A.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * std::max(A.cwiseAbs().maxCoeff(), 1e-300);
+  };
+  MatrixXd A = MatrixXd::Zero(2 * n, 2 * n);
+  double omega_max = 0.0;
+  bool modal = false;
+  if (symmetric(M) && symmetric(K)) {
+    // Undamped modes from the shifted problem M φ = μ (K + σM) φ, μ = 1/(ω² + σ), as in
+    // natural_modes: the low modes come out to relative accuracy ~ε (ω² + σ)/ω², not ε ω_max²/ω².
+    double ratio = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (M(i, i) > 0) ratio = std::max(ratio, K(i, i) / M(i, i));
+    const double sigma = ratio > 0 ? 1e-6 * ratio : 1.0;
+    const MatrixXd B = K + sigma * M;
+    if (Eigen::LLT<MatrixXd>(B).info() == Eigen::Success) {
+      const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> es(M, B, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+      const VectorXd mu = es.eigenvalues();
+      if (es.info() == Eigen::Success && mu.minCoeff() > 0.0) {
+        // φᵀ B φ = 1, so φᵀ M φ = μ: Φ = φ/√μ is M-orthonormal, Φᵀ K Φ = Λ = 1/μ − σ.
+        const MatrixXd Phi = es.eigenvectors() * mu.cwiseSqrt().cwiseInverse().asDiagonal();
+        const MatrixXd Dq = Phi.transpose() * D * Phi;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double lam = 1.0 / mu[i] - sigma, w = std::sqrt(std::abs(lam));
+          omega_max = std::max(omega_max, w);
+          A(i, n + i) = w;
+          A(n + i, i) = lam >= 0.0 ? -w : w;
+        }
+        A.bottomRightCorner(n, n) = -Dq;
+        modal = true;
+      }
+    }
+  }
+  if (!modal) {
+    const Eigen::PartialPivLU<MatrixXd> lu(M);
+    const MatrixXd MK = lu.solve(K), MD = lu.solve(D);
+    A.topRightCorner(n, n).setIdentity();
+    A.bottomLeftCorner(n, n) = -MK;
+    A.bottomRightCorner(n, n) = -MD;
+    const Eigen::EigenSolver<MatrixXd> ek(MK, false);
+    omega_max = std::sqrt(ek.eigenvalues().cwiseAbs().maxCoeff());
+  }
+  const Eigen::EigenSolver<MatrixXd> es(A, false);
+  const double floor = 1e-6 * omega_max;
+  for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) {
+    const std::complex<double> l = es.eigenvalues()[i];
+    const double r = std::abs(l);
+    if (!(r >= floor) || r == 0.0 || l.imag() < 0.0) continue;
+    out.push_back({r, -l.real() / r, l.imag()});
+  }
+  std::sort(out.begin(), out.end(), [](const DampedMode& a, const DampedMode& b) { return a.omega < b.omega; });
+  return out;
 }
 
 }  // namespace scoleid::identify

@@ -182,9 +182,8 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   const double L = sc.length, h = L / ne;
   fe.nfull = 6 + kNodeDofs * (ne + 1) + 2 * nact;
 
-  // Reduced order: X, Y, θx, θy, θz | nodes 1..n (proof masses after their nearest node) | Z.
+  // Reduced order: nodes 1..n (proof masses after their nearest node) | X, Y, Z, θx, θy, θz.
   std::vector<int> order;  // full index of each reduced DOF
-  for (int i : {kX, kY, kTx, kTy, kTz}) order.push_back(i);
   std::vector<std::vector<int>> after(static_cast<std::size_t>(ne + 1));
   for (int k = 0; k < nact; ++k) {
     const int node = std::clamp(static_cast<int>(std::lround(sc.actuator_locations[static_cast<std::size_t>(k)] / h)), 1, ne);
@@ -195,7 +194,7 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     for (int k : after[static_cast<std::size_t>(n)])
       for (int ax = 0; ax < 2; ++ax) order.push_back(full_proof(ne, k, ax));
   }
-  order.push_back(kZ);
+  for (int i : {kX, kY, kZ, kTx, kTy, kTz}) order.push_back(i);
   const int n = static_cast<int>(order.size());
   std::vector<int> reduced_of(static_cast<std::size_t>(fe.nfull), -1);
   for (int r = 0; r < n; ++r) reduced_of[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] = r;
@@ -228,7 +227,8 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   StructuralModel& m = fe.model;
   m.ndof = n;
   m.ncoef = ScoleFE::kCount;
-  m.coefficient_names = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "c_roll", "c_pitch", "c_tors", "m_reflector"};
+  m.coefficient_names = {"rho_A",  "EI_roll", "EI_pitch",    "GJ",         "rho_I_psi", "d_roll",
+                         "d_pitch", "c_tors", "m_reflector", "k_actuator", "c_actuator"};
   m.dof_group.assign(static_cast<std::size_t>(n), 0);  // 0: displacements [ft], 1: rotations [rad]
   for (int i : {kTx, kTy, kTz}) m.dof_group[static_cast<std::size_t>(fe.shuttle_dof(i))] = 1;
   for (int nd = 1; nd <= ne; ++nd)
@@ -237,7 +237,13 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
 
   // Element operators on the full vector.
   std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const, mass_refl;
+  std::vector<Trip> damp_roll, damp_pitch, act_spring;
   const hermite::Mat4 Me = hermite::mass(h, 0.0, h), Ke = hermite::stiffness(h, 0.0, h);
+  const FullRows fr(sc, ne, fe.nfull);
+  // Three-point Gauss rule on [0, 1]: exact for the quadratic-times-quadratic slope products.
+  const double g = 0.5 * std::sqrt(0.6);
+  const double gauss_x[3] = {0.5 - g, 0.5, 0.5 + g}, gauss_w[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  const MatrixXd shuttle_rot = fr.shuttle_rotation();
   for (int e = 0; e < ne; ++e) {
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) {
@@ -255,8 +261,19 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
         mass_tors.emplace_back(pa, pb, h / 6.0 * (a == b ? 2.0 : 1.0));
         stiff_tors.emplace_back(pa, pb, (a == b ? 1.0 : -1.0) / h);
       }
+    // Slope quadratic forms (docs/theory.md §3.3, §4.3): G_roll = ∫ (Θx − θx)², G_pitch =
+    // ∫ (Θy − θy)² on the cross-section rotation relative to the shuttle (the damping's
+    // dissipation), and ½ ∫ (Θx² + Θy²) on the absolute one (the section's bending rotary
+    // inertia ρI_ψ/2 per plane).
+    for (int q = 0; q < 3; ++q) {
+      const MatrixXd rot = fr.rotation((e + gauss_x[q]) * h);
+      const MatrixXd rel = rot - shuttle_rot;
+      const double w = gauss_w[q] * h;
+      add_quadratic(damp_roll, rel.row(0), MatrixXd::Constant(1, 1, w));
+      add_quadratic(damp_pitch, rel.row(1), MatrixXd::Constant(1, 1, w));
+      if (sc.bending_rotary_inertia) add_quadratic(mass_tors, rot.topRows(2), 0.5 * w * MatrixXd::Identity(2, 2));
+    }
   }
-  const FullRows fr(sc, ne, fe.nfull);
   // The mast's rigid axial motion: ρA L w².
   add_quadratic(mass_bend, fr.axial(), MatrixXd::Constant(1, 1, L));
   // Shuttle.
@@ -269,13 +286,16 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   // Reflector: translation of its CM and rotation of the tip section.
   add_quadratic(mass_refl, fr.reflector(), MatrixXd::Identity(3, 3));  // × m_reflector
   add_quadratic(mass_const, fr.rotation(L), inertia_matrix(sc.reflector));
-  // Proof masses: free laterally, axially with the mast.
+  // Proof masses: laterally on their sliders (centering spring and damper on the stroke
+  // ξ − u(s_k), §3.7), axially with the mast.
   for (int k = 0; k < nact; ++k) {
     MatrixXd p = fr.zero();
     p(0, full_proof(ne, k, 0)) = 1.0;
     p(1, full_proof(ne, k, 1)) = 1.0;
     p.row(2) = fr.axial();
     add_quadratic(mass_const, p, sc.actuator_mass * MatrixXd::Identity(3, 3));
+    MatrixXd stroke = p - fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
+    add_quadratic(act_spring, stroke.topRows(2), MatrixXd::Identity(2, 2));
   }
 
   auto reduce = [&](const std::vector<Trip>& t) {
@@ -287,12 +307,17 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     return R;
   };
   const SparseMatrix Kr = reduce(stiff_roll), Kp = reduce(stiff_pitch), Kt = reduce(stiff_tors);
+  const SparseMatrix Ka = reduce(act_spring);
   m.mass = {{reduce(mass_bend), ScoleFE::kRhoA},
             {reduce(mass_tors), ScoleFE::kRhoIPsi},
             {reduce(mass_refl), ScoleFE::kMReflector},
             {reduce(mass_const), -1}};
   m.stiffness = {{Kr, ScoleFE::kEIRoll}, {Kp, ScoleFE::kEIPitch}, {Kt, ScoleFE::kGJ}};
-  m.damping = {{Kr, ScoleFE::kCRoll}, {Kp, ScoleFE::kCPitch}, {Kt, ScoleFE::kCTors}};
+  m.damping = {{reduce(damp_roll), ScoleFE::kDRoll}, {reduce(damp_pitch), ScoleFE::kDPitch}, {Kt, ScoleFE::kCTors}};
+  if (nact > 0) {
+    m.stiffness.push_back({Ka, ScoleFE::kKActuator});
+    m.damping.push_back({Ka, ScoleFE::kCActuator});
+  }
 
   auto direction = [&](const std::vector<double>& d, const std::string& field) {
     const Vector3d v = vec3(d);
@@ -402,10 +427,17 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   return fe;
 }
 
+namespace {
+// Torsion's Kelvin–Voigt coefficient per unit ζ·√(ρI_ψ GJ): 2 · 2L/π, so that the first
+// clamped–free torsion mode of the uniform mast has damping ratio ζ (docs/theory.md §3.3).
+double torsion_scale(double L) { return 4.0 * L / M_PI; }
+}  // namespace
+
 VectorXd scole_coefficients(const io::ScoleSpec& s) {
   VectorXd c(ScoleFE::kCount);
   c << s.rho_A, s.EI_roll, s.EI_pitch, s.GJ, s.rho_I_psi, 2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_roll),
-      2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_pitch), 2.0 * s.zeta * std::sqrt(s.rho_I_psi * s.GJ), s.reflector.mass;
+      2.0 * s.zeta * std::sqrt(s.rho_A * s.EI_pitch), torsion_scale(s.length) * s.zeta * std::sqrt(s.rho_I_psi * s.GJ),
+      s.reflector.mass, s.actuator_stiffness, s.actuator_damping;
   return c;
 }
 
@@ -414,19 +446,23 @@ VectorXd scole_coefficients(const io::ScoleSpec& s) {
 ParameterSpace scole_parameter_space(const io::ScoleSpec& sc) {
   ParameterSpace sp;
   sp.structure = "SCOLE";
-  sp.quantities = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta", "m_reflector"};
-  sp.value = {sc.rho_A, sc.EI_roll, sc.EI_pitch, sc.GJ, sc.rho_I_psi, sc.zeta, sc.reflector.mass};
+  sp.quantities = {"rho_A", "EI_roll", "EI_pitch", "GJ", "rho_I_psi", "zeta", "m_reflector", "k_actuator", "c_actuator"};
+  sp.value = {sc.rho_A, sc.EI_roll, sc.EI_pitch, sc.GJ, sc.rho_I_psi, sc.zeta, sc.reflector.mass,
+              sc.actuator_stiffness, sc.actuator_damping};
   sp.true_value.assign(sp.quantities.size(), true);
   sp.groups = {{"EI", {1, 2}, true}};
   sp.rho_A = 0;
-  sp.zeta = 5;
+  sp.q3_quantity = -1;  // no q3 (has_q3 = false)
   sp.has_q3 = false;
   sp.ncoef = ScoleFE::kCount;
-  // c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors, m_reflector] (scole_model.h).
-  sp.coefficients = [](const std::vector<ParameterSpace::Cd>& f) {
+  // c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, d_roll, d_pitch, c_tors, m_reflector, k_actuator,
+  // c_actuator] (scole_model.h).
+  const double tors = torsion_scale(sc.length);
+  sp.coefficients = [tors](const std::vector<ParameterSpace::Cd>& f) {
     const auto two = ParameterSpace::Cd(2.0);
     return std::vector<ParameterSpace::Cd>{f[0], f[1], f[2], f[3], f[4], two * f[5] * std::sqrt(f[0] * f[1]),
-                                           two * f[5] * std::sqrt(f[0] * f[2]), two * f[5] * std::sqrt(f[4] * f[3]), f[6]};
+                                           two * f[5] * std::sqrt(f[0] * f[2]), tors * f[5] * std::sqrt(f[4] * f[3]),
+                                           f[6], f[7], f[8]};
   };
   return sp;
 }

@@ -22,7 +22,7 @@ public:
     return std::make_unique<PhysicalParameterization>(beam_parameter_space(fe_, sc.beam), sc.identification, sc.source);
   }
   VectorXd coefficients(const io::Scenario& sc) const override {
-    return beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta);
+    return beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta, sc.beam.c_kv);
   }
 
 private:

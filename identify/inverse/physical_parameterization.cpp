@@ -69,7 +69,7 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
       fail_field(source, "identification.initial." + key, "is not a parameter of this " + space_.structure, format_value(v));
 
   // Starting φ: the scenario's values, overridden by identification.initial — groups first, then
-  // single quantities, then the paper's q2 (ρA), q1 (EI = q1 ρA) and q3 (ζ).
+  // single quantities, then the paper's q2 (ρA), q1 (EI = q1 ρA) and q3 (X = q3 ρA).
   start_ = space_.value;
   const auto& ini = id.initial;
   for (const auto& g : space_.groups)
@@ -81,13 +81,12 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
   if (space_.rho_A >= 0 && ini.count("q2")) start_[static_cast<std::size_t>(space_.rho_A)] = 1.0 / ini.at("q2");
   if (ei && space_.rho_A >= 0 && ini.count("q1"))
     for (int m : ei->members) start_[static_cast<std::size_t>(m)] = ini.at("q1") * start_[static_cast<std::size_t>(space_.rho_A)];
-  if (ei && space_.zeta >= 0 && ini.count("q3"))
-    start_[static_cast<std::size_t>(space_.zeta)] =
-        ini.at("q3") / (2.0 * std::sqrt(start_[static_cast<std::size_t>(ei->members[0])] / start_[static_cast<std::size_t>(space_.rho_A)]));
+  if (space_.rho_A >= 0 && space_.q3_quantity >= 0 && ini.count("q3"))
+    start_[static_cast<std::size_t>(space_.q3_quantity)] = ini.at("q3") * start_[static_cast<std::size_t>(space_.rho_A)];
 
   // A group estimated as one value must start as one value.
   for (const auto& n : names_) {
-    const auto* g = group(n == "q1" || n == "q3" ? space_.EI_group : n);
+    const auto* g = group(n == "q1" ? space_.EI_group : n);
     if (!g) continue;
     for (int m : g->members)
       if (start_[static_cast<std::size_t>(m)] != start_[static_cast<std::size_t>(g->members[0])])
@@ -130,7 +129,7 @@ VectorXd PhysicalParameterization::parameters_of(const std::vector<double>& phi,
       const double rho = value(space_.rho_A), EI = ei ? group_value(*ei) : nan;
       if (n == "q1") v = EI / rho;
       else if (n == "q2") v = 1.0 / rho;
-      else v = 2.0 * value(space_.zeta) * std::sqrt(EI / rho);
+      else v = value(space_.q3_quantity) / rho;
     } else if (const auto* g = group(n)) {
       v = group_value(*g);
     } else {
@@ -147,11 +146,11 @@ std::vector<PhysicalParameterization::Cd> PhysicalParameterization::phi(const st
     // The equation divided by ρA; q's not estimated keep their starting values.
     const auto* ei = group(space_.EI_group);
     const auto rho0 = start_[static_cast<std::size_t>(space_.rho_A)], EI0 = start_[static_cast<std::size_t>(ei->members[0])];
-    Cd q1 = EI0 / rho0, q2 = 1.0 / rho0, q3 = space_.has_q3 ? 2.0 * start_[static_cast<std::size_t>(space_.zeta)] * std::sqrt(EI0 / rho0) : 0.0;
+    Cd q1 = EI0 / rho0, q2 = 1.0 / rho0, q3 = space_.has_q3 ? start_[static_cast<std::size_t>(space_.q3_quantity)] / rho0 : 0.0;
     for (std::size_t i = 0; i < names_.size(); ++i) (names_[i] == "q1" ? q1 : names_[i] == "q2" ? q2 : q3) = q[i];
     f[static_cast<std::size_t>(space_.rho_A)] = Cd(1.0) / q2;
     for (int m : ei->members) f[static_cast<std::size_t>(m)] = q1 / q2;
-    if (space_.has_q3) f[static_cast<std::size_t>(space_.zeta)] = q3 / (Cd(2.0) * std::sqrt(q1));
+    if (space_.has_q3) f[static_cast<std::size_t>(space_.q3_quantity)] = q3 / q2;
     return f;
   }
   for (std::size_t i = 0; i < names_.size(); ++i) {

@@ -1,5 +1,6 @@
 #include "scoleid/identify/run/identify_run.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,14 +17,18 @@ namespace {
 // Paper-style iteration table: iteration, parameters, physical values, cost.
 class Table {
 public:
-  Table(const Parameterization& p, bool physical_columns) : p_(p), phys_(physical_columns) {}
+  // The physical columns of the paper form: rho_A, EI and what q3 stands for (the beam's
+  // Kelvin–Voigt c_kv; zeta where there is no q3).
+  Table(const Parameterization& p, bool physical_columns)
+      : p_(p), phys_(physical_columns),
+        columns_{"rho_A", "EI", physical_columns && p.physical(p.initial()).count("c_kv") ? "c_kv" : "zeta"} {}
   void header() const {
     std::printf("%5s", "iter");
     const int P = std::min(p_.size(), kMaxCols);
     for (int i = 0; i < P; ++i) std::printf(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
     if (p_.size() > kMaxCols) std::printf(" %5s", "...");
     if (phys_)
-      for (const char* n : {"rho_A", "EI", "zeta"}) std::printf(" %13s", n);
+      for (const char* n : columns_) std::printf(" %13s", n);
     std::printf(" %13s %8s\n", "cost", "horizon");
   }
   void row(const IterationRecord& r) const {
@@ -33,7 +38,7 @@ public:
     if (p_.size() > kMaxCols) std::printf(" %5s", "");
     if (phys_) {
       const auto ph = p_.physical(r.q);
-      for (const char* n : {"rho_A", "EI", "zeta"}) {
+      for (const char* n : columns_) {
         const auto it = ph.find(n);
         std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
       }
@@ -46,6 +51,7 @@ private:
   static constexpr int kMaxCols = 8;
   const Parameterization& p_;
   bool phys_;
+  std::array<const char*, 3> columns_;
 };
 
 double safe(double v) { return std::isfinite(v) ? v : 0.0; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <filesystem>
 #include <random>
 
@@ -59,6 +60,53 @@ double resolved_frequency(const StructuralModel& model, const Parameterization& 
   return flexible[r];
 }
 
+double numerical_damping_ratio(const ButcherTable& t, double x) {
+  // One step of y' = i ω y multiplies y by R(z) = 1 + z bᵀ (I − zA)⁻¹ 1 at z = i x; the
+  // amplitude decays as exp(−ζ ω h) per step.
+  const int s = t.stages;
+  const std::complex<double> z(0.0, x);
+  Eigen::MatrixXcd IA = Eigen::MatrixXcd::Identity(s, s);
+  for (int i = 0; i < s; ++i)
+    for (int j = 0; j < s; ++j) IA(i, j) -= z * t.a(i, j);
+  const Eigen::VectorXcd k = IA.partialPivLu().solve(Eigen::VectorXcd::Ones(s));
+  std::complex<double> R = 1.0;
+  for (int i = 0; i < s; ++i) R += z * t.b[static_cast<std::size_t>(i)] * k[i];
+  return -std::log(std::abs(R)) / x;
+}
+
+namespace {
+// Whether a parameter moves a coefficient of the damping operator (at the starting values).
+bool estimates_damping(const StructuralModel& model, const Parameterization& params) {
+  VectorXd c;
+  MatrixXd dcdq;
+  params.coefficients(params.initial(), c, dcdq);
+  for (const auto& term : model.damping)
+    if (term.coefficient >= 0 && dcdq.row(term.coefficient).cwiseAbs().maxCoeff() > 0.0) return true;
+  return false;
+}
+
+// The smallest positive modal damping ratio φᵀDφ / (2ω) (M-orthonormal φ) over the flexible
+// modes 1 … P + 2 at the starting parameters; 0 if none is damped.
+double smallest_modal_damping(const StructuralModel& model, const Parameterization& params) {
+  VectorXd c;
+  MatrixXd dcdq;
+  params.coefficients(params.initial(), c, dcdq);
+  const AssembledModel ops = assemble(model, c);
+  const NaturalModes m = natural_modes(ops.M, ops.K);
+  const MatrixXd D(ops.D);
+  double smallest = 0.0;
+  int counted = 0;
+  for (Eigen::Index k = 0; k < m.omega.size() && counted < params.size() + 2; ++k) {
+    if (!(m.omega[k] > m.floor)) continue;
+    ++counted;
+    const VectorXd phi = m.vectors.col(k);
+    const double z = phi.dot(D * phi) / (2.0 * m.omega[k]);
+    if (z > 0.0 && (smallest == 0.0 || z < smallest)) smallest = z;
+  }
+  return smallest;
+}
+}  // namespace
+
 double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
   if (sc.identification.time_step > 0) return sc.identification.time_step;
   // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
@@ -67,6 +115,21 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   const double w = resolved_frequency(model, params);
   double h = sc.simulation.sample_interval;
   if (w > 0) h = std::min(h, 0.3 / w);
+  // A damping parameter is read from decay rates: the step's own damping in that band must be
+  // small against the physical one, ζ_num(ω_{P+2} h) <= 1 % of the smallest modal damping ratio
+  // there (docs/theory.md §5.2), or the fit absorbs the integrator's damping into the estimate.
+  if (w > 0 && estimates_damping(model, params)) {
+    const double target = 0.01 * smallest_modal_damping(model, params);
+    const ButcherTable table = ButcherTable::arkode_dirk(SolverOptions{}.dirk_table);
+    if (target > 0.0 && numerical_damping_ratio(table, w * h) > target) {
+      double lo = 0.0, hi = w * h;  // ζ_num grows with x = ω h on (0, 0.3]
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (numerical_damping_ratio(table, mid) > target ? hi : lo) = mid;
+      }
+      h = lo / w;
+    }
+  }
   return h;
 }
 

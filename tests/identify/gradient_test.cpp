@@ -21,25 +21,25 @@ namespace {
 
 // Small meshes and a 2 s horizon keep the dense CVODES reference cheap.
 const char* kPaper = R"(name: grad-paper
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
 inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
 sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
 simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
 )";
 const char* kPhysical = R"(name: grad-physical
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05}
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211}
 inputs: [{name: P, location: 6.3, signal: {type: step, amplitude: 10, t0: 0}}]
 sensors: [{name: w, location: 10}]
 simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
 )";
 const char* kSections = R"(name: grad-sections
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 30000, 26000, 35000], zeta: 0.02}
+beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 30000, 26000, 35000], c_kv: 49.65480843}
 inputs: [{name: P, location: 3.3, signal: {type: pulse, amplitude: 50, t0: 0.1, width: 0.2}}]
 sensors: [{name: a, location: 2.5}, {name: b, location: 7.5}]
 simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI_1, EI_2, EI_3, EI_4, rho_A, zeta], initial: {EI: 28000, rho_A: 70, zeta: 0.03}, elements: 8}
+identification: {parameterization: physical, estimate: [EI_1, EI_2, EI_3, EI_4, rho_A, c_kv], initial: {EI: 28000, rho_A: 70, c_kv: 84}, elements: 8}
 )";
 
 void check_kind(const char* yaml) {
@@ -95,11 +95,11 @@ TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
 // CVODES adjoint, whose outputs on v and a = ẍ are just more rows of g(t, y, q).
 namespace {
 const char* kRatesBeam = R"(name: grad-rates-beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
 inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
 sensors: [{name: a_tip, kind: acceleration, location: 10}, {name: v_mid, kind: velocity, location: 6}, {name: w, location: 8}]
 simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
 )";
 const char* kRatesScole = R"(name: grad-rates-scole
 structure: scole
@@ -118,11 +118,11 @@ identification: {parameterization: physical, estimate: [EI, rho_A, GJ, m_reflect
 )";
 // A pulse input: the acceleration outputs jump at its two breakpoints, and so do r and the costate forcing.
 const char* kRatesPulse = R"(name: grad-rates-pulse
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05}
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211}
 inputs: [{name: P, location: 6.3, signal: {type: pulse, amplitude: 10, t0: 0.3, width: 0.4}}]
 sensors: [{name: a_tip, kind: acceleration, location: 10}, {name: v_tip, kind: velocity, location: 10}]
 simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
 )";
 
 struct RateBounds {

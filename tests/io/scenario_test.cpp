@@ -76,6 +76,23 @@ TEST(Scenario, NegativeStiffnessNamesFieldAndValue) {
   EXPECT_EQ(error_of("beam: {rho_A: -1}"), "scenario 'x.yaml': beam.rho_A must be > 0, got -1");
 }
 
+TEST(Scenario, ScoleDampingAndActuatorHardwareAreChecked) {
+  EXPECT_EQ(error_of("structure: scole\nscole: {zeta: -0.1}"), "scenario 'x.yaml': scole.zeta must be >= 0, got -0.1");
+  EXPECT_EQ(error_of("structure: scole\nscole: {actuator_stiffness: -2}"),
+            "scenario 'x.yaml': scole.actuator_stiffness must be >= 0, got -2");
+  EXPECT_EQ(error_of("structure: scole\nscole: {actuator_damping: -0.5}"),
+            "scenario 'x.yaml': scole.actuator_damping must be >= 0, got -0.5");
+  EXPECT_EQ(error_of("structure: scole\nscole: {actuator_stroke: 0}"),
+            "scenario 'x.yaml': scole.actuator_stroke must be > 0, got 0");
+  EXPECT_NE(error_of("structure: scole\nscole: {bending_rotary_inertia: maybe}").find("scole.bending_rotary_inertia"),
+            std::string::npos);
+  // The defaults: the section's rotary inertia on, free sliders.
+  const Scenario sc = parse_scenario("structure: scole\n", "x");
+  EXPECT_TRUE(sc.scole.bending_rotary_inertia);
+  EXPECT_EQ(sc.scole.actuator_stiffness, 0.0);
+  EXPECT_EQ(sc.scole.actuator_damping, 0.0);
+}
+
 TEST(Scenario, NanAndTextAreRejected) {
   EXPECT_EQ(error_of("beam: {EI: .nan}"), "scenario 'x.yaml': beam.EI must be a finite number, got '.nan'");
   EXPECT_EQ(error_of("beam: {length: ten}"), "scenario 'x.yaml': beam.length must be a number, got 'ten'");

@@ -142,7 +142,7 @@ TEST(TruthMeta, NegativeNoiseOrTrueValuesAndDuplicateColumnsAreRefused) {
     return nlohmann::json::parse(R"({"scenario": "x", "columns": [)" + cols + R"(], "true_parameters": {)" + truth + "}}");
   };
   const std::string w = R"({"name": "w", "kind": "output", "noise_std": 0.001})";
-  EXPECT_NO_THROW(truth_meta_from_json(meta(w, R"("EI": 23000, "zeta": 0)"), "truth.json"));
+  EXPECT_NO_THROW(truth_meta_from_json(meta(w, R"("EI": 23000, "zeta": 0, "c_kv": 0)"), "truth.json"));
   try {
     truth_meta_from_json(meta(R"({"name": "w", "kind": "output", "noise_std": -1})", R"("EI": 1)"), "truth.json");
     ADD_FAILURE() << "negative noise accepted";

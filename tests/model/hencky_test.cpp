@@ -29,6 +29,7 @@ io::BeamSpec beam(io::EndCondition left, io::EndCondition right, double tip_mass
   b.rho_A = kRhoA;
   b.EI = {kEI};
   b.zeta = 0.0;
+  b.c_kv = 0.0;
   b.tip_mass = tip_mass;
   b.tip_inertia = tip_inertia;
   return b;

@@ -219,7 +219,7 @@ TEST_F(PlausibilityGuard, BeamSegmentRotationRelativeToGroundIsBounded) {
   auto beam = [](const std::string& truth_extra) {
     return io::parse_scenario(R"(name: guard-beam
 structure: beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.1}
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 248.2740421}
 inputs:
   - {name: P, at: beam, kind: force, location: 10, unit: N, signal: {type: step, amplitude: 100, t0: 0}}
 sensors:

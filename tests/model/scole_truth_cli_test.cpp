@@ -87,6 +87,25 @@ TEST_F(ScoleTruthCli, BadFieldValueExits2WithOneLineAndNoOutput) {
   EXPECT_FALSE(fs::exists(out / "truth.json"));
 }
 
+TEST_F(ScoleTruthCli, EulerBernoulliMastIsRefusedByTheChain) {
+  // Rigid segments always carry the section's bending rotary inertia (docs/theory.md §3.3).
+  const std::string file = write("eb.yaml", R"(name: cli-eb
+structure: scole
+scole: {bending_rotary_inertia: false}
+sensors:
+  - {name: tip, at: mast, kind: displacement, location: 130, direction: y}
+simulation: {duration: 1, sample_interval: 0.01}
+truth: {segments: 10}
+)");
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("--scenario " + file + " --out " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("scole.bending_rotary_inertia"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("false"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(ScoleTruthCli, InputTheStructureCannotTakeExits2) {
   std::string yaml = kBeam;
   yaml.replace(yaml.find("at: beam, kind: force"), 8, "at: shuttle");
@@ -157,6 +176,7 @@ TEST_F(ScoleTruthCli, StepLoadPeaksAtTwiceTheStaticDeflection) {
   EXPECT_EQ(meta.true_parameters.at("EI"), 23000.0);
   EXPECT_EQ(meta.true_parameters.at("rho_A"), 67.0);
   EXPECT_EQ(meta.true_parameters.at("zeta"), 0.0);
+  EXPECT_EQ(meta.true_parameters.at("c_kv"), 0.0);
 }
 
 // ------------------------------------------------------------------------------- hardening

@@ -80,7 +80,7 @@ TEST(TruthRun, MetadataCopiesTheScenario) {
   EXPECT_EQ(m.settings.at("beam").at("EI").size(), 2u);
 }
 
-// Kelvin–Voigt damping (paper-beam-2, zeta = 0.1) overdamps the chain's top modes: "auto" takes
+// Kelvin–Voigt damping (paper-beam-2, c_kv = 2·0.1·√(ρA·EI)) overdamps the chain's top modes: "auto" takes
 // BDF. SCOLE's zeta leaves them ringing: the trapezoidal rule. Simple supports are constraints,
 // which the trapezoidal rule does not project onto: explicit RK (paper-beam-1, -3).
 TEST(TruthRun, AutoIntegratorFollowsTheSpectrum) {

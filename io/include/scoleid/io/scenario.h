@@ -8,7 +8,7 @@
 //
 //   name, description
 //   structure: beam | scole
-//   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, tip_mass, tip_inertia }
+//   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, c_kv, tip_mass, tip_inertia }
 //   scole:     see ScoleSpec
 //   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
@@ -35,16 +35,21 @@ namespace scoleid::io {
 enum class EndCondition { Pinned, Clamped, Free };
 const char* to_string(EndCondition e);
 
-// Euler–Bernoulli beam on s in [0, length]:
-//   rho_A w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = loads,  c = 2 zeta sqrt(rho_A EI)
-// EI holds one value (uniform) or N values on N equal-length sections.
+// Euler–Bernoulli beam on s in [0, length] (docs/theory.md §2.1, §2.2):
+//   rho_A w_tt - (d(s) w_st)_s + (c_kv w_sst)_ss + (EI(s) w_ss)_ss = loads,  d = 2 zeta sqrt(rho_A EI)
+// EI holds one value (uniform) or N values on N equal-length sections. Two damping laws, either or
+// both: zeta, the dimensionless square-root (Chen–Russell) damping ratio (every mode of a uniform
+// pinned–pinned beam has damping ratio exactly zeta; d follows EI section by section), and c_kv,
+// the Kelvin–Voigt (strain-rate) coefficient in units of EI × time (N·m²·s), one value for the
+// whole beam. Both >= 0.
 struct BeamSpec {
   double length = 10.0;
   EndCondition left = EndCondition::Pinned;
   EndCondition right = EndCondition::Pinned;
   double rho_A = 67.0;
   std::vector<double> EI = {23000.0};
-  double zeta = 0.0;
+  double zeta = 0.0;   // Chen–Russell damping ratio (dimensionless)
+  double c_kv = 0.0;   // Kelvin–Voigt coefficient (EI × time)
   double tip_mass = 0.0;     // rigid mass at s = length
   double tip_inertia = 0.0;  // its rotary inertia about the bending axis
 };
@@ -64,7 +69,15 @@ struct ScoleSpec {
   double EI_pitch = 4.0e7;
   double GJ = 4.0e7;
   double rho_I_psi = 0.9089;
+  // Damping ratio, dimensionless (docs/theory.md §3.3): square-root (Chen–Russell) damping
+  // 2ζ√(ρA·EI) on the bending slope rate relative to the shuttle frame, and Kelvin–Voigt torsion
+  // c_ψ = 2ζ√(ρI_ψ·GJ)·2L/π (ratio ζ in the first clamped–free torsion mode).
   double zeta = 0.003;
+  // Rotary inertia of the mast cross-section in bending (Rayleigh beam): ρI_b = ρI_ψ/2 per plane,
+  // as for any axisymmetric section (polar = twice the bending moment of inertia). The Simbody
+  // chain's segments are rigid bodies and always carry it (Ixx + Iyy >= Izz), so a truth refuses
+  // `false`; the identifier's FE model can drop it (the Euler–Bernoulli mast of the paper).
+  bool bending_rotary_inertia = true;
   RigidBodySpec shuttle{6366.0, 905443.0, 6789100.0, 7086601.0, 0.0, 0.0, 0.0};
   RigidBodySpec reflector{12.42, 4969.0, 4969.0, 9938.0, 0.0, 0.0, 0.0};
   double reflector_rx = 18.75;   // reflector CM offset from the mast tip, shuttle x
@@ -80,6 +93,11 @@ struct ScoleSpec {
   // foot either way. A scenario whose actuators are passive states more (the built-ins do): its
   // free proof masses stay put while the structure's rigid motion carries the mast past them.
   double actuator_stroke = 0.5;
+  // Proof-mass actuator hardware (docs/theory.md §3.7), the same for every actuator and both
+  // sliders: a centering spring [lb/ft] and a damper [lb·s/ft] between the proof mass and the
+  // mast. Zero for both is the free slider (an ideal force source on a free mass).
+  double actuator_stiffness = 0.0;
+  double actuator_damping = 0.0;
 };
 
 // A point input. `at` names the body it acts on: "beam" or "mast" (then `location` is s),
@@ -120,13 +138,13 @@ struct SimulationSpec {
 };
 
 struct IdentificationSpec {
-  // "physical": the structure's quantities by name (beam: rho_A, EI, EI_k (k = 1..N), zeta;
+  // "physical": the structure's quantities by name (beam: rho_A, EI, EI_k (k = 1..N), zeta, c_kv;
   //             SCOLE: rho_A, EI, EI_roll, EI_pitch, GJ, rho_I_psi, zeta, m_reflector).
   // "paper":    the beam equation divided by rho_A: q1 = EI/rho_A, q2 = 1/rho_A,
-  //             q3 = 2 zeta sqrt(EI/rho_A) (then q1_k on sections).
+  //             q3 = c_kv/rho_A (then q1_k on sections).
   std::string parameterization = "physical";
   std::vector<std::string> estimate;
-  // Starting point: physical values (rho_A, EI, zeta, EI_k) and/or parameter values by name.
+  // Starting point: physical values (rho_A, EI, zeta, c_kv, EI_k) and/or parameter values by name.
   std::map<std::string, double> initial;
   int elements = 10;          // identifier mesh
   int sections = 0;           // equal sections carrying EI_k in the identifier (0 = the beam's own)

@@ -1,13 +1,20 @@
 #pragma once
 // A planar Euler–Bernoulli beam as a Hencky bar chain in Simbody (docs/theory.md §2, §9).
 //
-//   rho_A w_tt + (c w_sst)_ss + (EI(s) w_ss)_ss = loads,  c = 2 zeta sqrt(rho_A EI),  s in [0, L]
+//   rho_A w_tt - (d(s) w_st)_s + (c_kv w_sst)_ss + (EI(s) w_ss)_ss = loads,  s in [0, L]
+//   d(s) = 2 zeta sqrt(rho_A EI(s))   square-root (Chen–Russell) damping, zeta dimensionless
+//   c_kv                              Kelvin–Voigt coefficient, one value for the whole beam
 //
 // The beam lies along ground x from the origin and deflects along ground y (w > 0 along +y, the
 // way a positive force pushes); rotations are about ground z (slope w_s > 0 counter-clockwise).
 // n rigid segments of length h = L/n, each carrying mass rho_A h at its centre and rotary
 // inertia rho_A h^3/12, are joined by Pin mobilizers with the Hencky joint spring-dampers of
-// hencky.h. Ends:
+// hencky.h (joint springs from EI, joint dampers from c_kv). Chen–Russell damping: the dissipation
+// 1/2 integral d w_st^2 ds, with each bar's slope its rotation angle theta_i, is 1/2 D_i omega_i^2
+// per bar, D_i = integral of d(s) over the bar (exact for piecewise EI: the bar's share of each
+// section it overlaps); each bar gets the torque -D_i omega_i about ground z (omega_i its absolute
+// angular velocity; the beam is grounded), an AnchorSpring with k = 0. A tip body is not a bar
+// and gets none. The lumping error of both laws is O(h^2) (docs/theory.md §9.2). Ends:
 //   left  pinned: Pin to ground, no spring; clamped: Pin to ground with the end spring (2EI/h);
 //         free: Planar mobilizer (x, y, rotation) to ground.
 //   right pinned: roller, Constraint::PointInPlane (tip stays on y = 0, slides along x);

@@ -13,8 +13,9 @@
 // EI/h at interior joints and 2EI/h at a clamped end joint (the half cell is the mirror-image
 // "ghost point" of the clamped boundary); pinned and free ends carry no spring. Piecewise EI is
 // handled by the same integral (series compliance), so section boundaries need not fall on
-// joints. The Kelvin–Voigt term (c w_sst)_ss, c = 2 zeta sqrt(rho_A EI), lumps the same way into
-// joint dampers c_j. The torsion rod GJ psi_ss is the second-order analogue: segment polar inertia
+// joints. The Kelvin–Voigt term (c w_sst)_ss (for the beam c = c_kv, one value) lumps the same
+// way into joint dampers c_j = 1 / integral over the cell of ds / c(s). (The beam's square-root
+// damping -(d w_st)_s acts on the bars' rotations, not on the joints: beam_chain.h.) The torsion rod GJ psi_ss is the second-order analogue: segment polar inertia
 // rho_I_psi h, joint springs GJ/h, 2GJ/h at a clamped end.
 //
 // The result is the central-difference analogue of the PDE: natural frequencies converge

@@ -6,7 +6,10 @@
 // forces are internal: they act equally and oppositely on the two bodies of the joint, so they
 // conserve the system's linear and angular momentum. An AnchorSpring ties a planar body's
 // absolute rotation about ground z to zero (a clamped end that is not the chain's root):
-// torque -k theta - c omega_z on the body.
+// torque -k theta - c omega_z on the body. A RelativeDamper damps a body's angular velocity
+// relative to a reference body, per axis of the reference frame: torque -R_GR diag(c) R_GR^T
+// (omega_B - omega_R) on the body and its opposite on the reference (a torque pair: momentum
+// conserved; docs/theory.md §9.3 uses it for the mast's square-root damping).
 #include <vector>
 
 #include <Simbody.h>
@@ -21,10 +24,15 @@ struct AnchorSpring {
   double c = 0.0;
 };
 
+struct RelativeDamper {
+  SimTK::MobilizedBodyIndex body, reference;
+  SimTK::Vec3 c{0.0};  // about the reference frame's x, y, z axes
+};
+
 class JointForces : public SimTK::Force::Custom::Implementation {
 public:
   JointForces(const SimTK::SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
-              std::vector<AnchorSpring> anchors);
+              std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative = {});
   void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
                  SimTK::Vector_<SimTK::Vec3>& particle_forces,
                  SimTK::Vector& mobility_forces) const override;
@@ -34,6 +42,7 @@ private:
   const SimTK::SimbodyMatterSubsystem& matter_;
   std::vector<JointSpring> joints_;
   std::vector<AnchorSpring> anchors_;
+  std::vector<RelativeDamper> relative_;
 };
 
 }  // namespace scoleid::model

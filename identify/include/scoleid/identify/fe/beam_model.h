@@ -2,14 +2,20 @@
 // Finite-element model of the Euler–Bernoulli beam of docs/theory.md §2, in the form of
 // structural_model.h:
 //
-//   ρA w_tt + (c(s) w_sst)_ss + (EI(s) w_ss)_ss = Σ_i f_i(t) δ(s − s_i)   (or δ′ for moments)
-//   c(s) = 2 ζ sqrt(ρA EI(s))   (Kelvin–Voigt; mode k of a uniform beam has damping ratio ζ β_k²,
-//                                 docs/theory.md §2.2)
+//   ρA w_tt − (d(s) w_st)_s + (c_kv w_sst)_ss + (EI(s) w_ss)_ss = Σ_i f_i(t) δ(s − s_i)   (or δ′ for moments)
+//
+//   d(s) = 2 ζ sqrt(ρA EI(s))   square-root (Chen–Russell) damping, ζ dimensionless: every mode of a
+//                               uniform pinned–pinned beam has damping ratio exactly ζ
+//                               (docs/theory.md §2.2); d follows EI section by section.
+//   c_kv                        Kelvin–Voigt (strain-rate) coefficient [EI × time], one value for
+//                               the whole beam, also when EI has sections (docs/theory.md §2.2).
 //
 // Hermite cubic elements on a uniform mesh; EI piecewise constant on N equal sections;
 // ends pinned (w = 0), clamped (w = w_s = 0) or free (natural conditions); optional rigid tip
 // mass and rotary inertia at s = L. Constrained DOFs are eliminated.
-// Coefficients: c = [ρA, EI_1..EI_N, c_1..c_N]. Loads and sensors anywhere on the beam, through
+// Coefficients: c = [ρA, EI_1..EI_N, d_1..d_N, c_kv]. Operators: M = ρA M_1 (+ tip body),
+// K = Σ_k EI_k K_k, D = Σ_k d_k G_k + c_kv Σ_k K_k, with K_k = ∫_{section k} N″N″ᵀ ds and
+// G_k = ∫_{section k} N′N′ᵀ ds (hermite_beam.h). Loads and sensors anywhere on the beam, through
 // the shape functions (a sensor between nodes reads the interpolated field).
 #include <string>
 #include <vector>
@@ -29,7 +35,8 @@ struct BeamFE {
 
   int coef_rho_A() const { return 0; }
   int coef_EI(int s) const { return 1 + s; }
-  int coef_damping(int s) const { return 1 + sections + s; }
+  int coef_chen_russell(int s) const { return 1 + sections + s; }  // d_s
+  int coef_kelvin_voigt() const { return 1 + 2 * sections; }        // c_kv
 
   // Rows acting on the reduced DOF vector.
   Eigen::RowVectorXd displacement_row(double s) const;
@@ -42,13 +49,14 @@ struct BeamFE {
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
                   const std::vector<io::SensorSpec>& sensors, const std::string& source);
 
-// Coefficients c for a physical state (ρA, EI per section, ζ).
-VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta);
+// Coefficients c for a physical state (ρA, EI per section, ζ, c_kv); EI holds one value or one
+// per model section.
+VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta, double c_kv = 0.0);
 
 // The beam's parameter space (physical_parameterization.h): φ = [ρA, EI_1..EI_N (the model's N
-// sections), ζ], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
-// q3 = 2ζ√(EI/ρA) (uniform beams only). φ's values: the scenario's beam (sections expanded to
-// the model's; a model section's true EI is known when it lies inside one scenario section).
+// sections), ζ, c_kv], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
+// q3 = c_kv/ρA (uniform beams only; ζ is held). φ's values: the scenario's beam (sections expanded
+// to the model's; a model section's true EI is known when it lies inside one scenario section).
 ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam);
 
 }  // namespace scoleid::identify

@@ -5,6 +5,9 @@
 // Weak forms integrated over [s_a, s_b] ⊂ element with a coefficient constant on that piece:
 //   mass      ∫ N Nᵀ ds              (consistent; × ρA)
 //   stiffness ∫ N'' N''ᵀ ds          (× EI; the Kelvin–Voigt damping uses the same matrix)
+//   slope     ∫ N' N'ᵀ ds            (× d; the square-root (Chen–Russell) damping, docs/theory.md §2.2;
+//                                     on a whole element (1/(30h)) [[36, 3h, −36, 3h], [3h, 4h², −3h, −h²],
+//                                     [−36, −3h, 36, −3h], [3h, −h², −3h, 4h²]], the "geometric stiffness")
 // Integration is by Gauss–Legendre, exact for these polynomial degrees, so a coefficient that
 // jumps inside an element (sections not aligned with the mesh) is integrated exactly too.
 // Frequencies converge as O(h⁴) (verified in tests/identify/hermite_beam_test.cpp).
@@ -23,5 +26,7 @@ Vec4 curvature(double xi, double h); // d²N/ds²
 // (a, b measured from the element's left end, 0 <= a < b <= h).
 Mat4 mass(double h, double a, double b);
 Mat4 stiffness(double h, double a, double b);
+// ∫_{a}^{b} N' N'ᵀ ds over the same piece.
+Mat4 slope_product(double h, double a, double b);
 
 }  // namespace scoleid::identify::hermite

@@ -15,31 +15,39 @@
 //              u_x(0) = X + θy r0_z − θz r0_y,  u_x'(0) = −θy,
 //              u_y(0) = Y + θz r0_x − θx r0_z,  u_y'(0) = θx,   ψ(0) = θz.
 //              The root DOFs are eliminated by u_full = T u (M = Tᵀ M_full T, …).
-//   energies   T = ½ ρA ∫ (u̇_x² + u̇_y² + ẇ²) ds + ½ ρI_ψ ∫ ψ̇² ds  (Euler–Bernoulli: no bending
-//              rotary inertia), V = ½ EI_pitch ∫ u_x''² + ½ EI_roll ∫ u_y''² + ½ GJ ∫ ψ'².
+//   energies   T = ½ ρA ∫ (u̇_x² + u̇_y² + ẇ²) ds + ½ ρI_ψ ∫ ψ̇² ds
+//                  + ¼ ρI_ψ ∫ (Θ̇x² + Θ̇y²) ds   (the section's bending rotary inertia ρI_ψ/2 per
+//                  plane, Rayleigh beam; only with scole.bending_rotary_inertia),
+//              V = ½ EI_pitch ∫ u_x''² + ½ EI_roll ∫ u_y''² + ½ GJ ∫ ψ'².
 //              Curvatures and twist rate of the absolute fields are those of the deformation
 //              relative to the shuttle (rigid motions are linear in s for u, constant for ψ), so
 //              K has the six rigid-body modes of the free-floating system in its null space.
 //              Roll bending is u_y (EI_roll), pitch bending u_x (EI_pitch).
-//   damping    Kelvin–Voigt on the three fields: D = c_roll K1_y + c_pitch K1_x + c_tors K1_ψ,
-//              c_roll = 2ζ√(ρA EI_roll), c_pitch = 2ζ√(ρA EI_pitch), c_tors = 2ζ√(ρI_ψ GJ).
+//   damping    ζ dimensionless (docs/theory.md §3.3). Bending: square-root (Chen–Russell) damping on
+//              the slope rate relative to the shuttle, dissipation ½ d_roll ∫ (Θ̇x − θ̇x)² +
+//              ½ d_pitch ∫ (Θ̇y − θ̇y)², d = 2ζ√(ρA EI) (the PDE term −2ζ√(ρA·EI) u_sst: ratio ζ in
+//              every mode of a uniform pinned beam; rigid motion undamped). Torsion: Kelvin–Voigt
+//              c_tors K1_ψ, c_tors = 2ζ√(ρI_ψ GJ)·2L/π (ratio ζ in the first clamped–free mode).
 //   reflector  rigid, welded at s = L, CM at r = (r_x, r_y, 0) from the tip (shuttle axes):
 //              CM displacement  u_R = u(L) + Θ(L) × r,  rotation Θ(L);
 //              KE ½ m4 |u̇_R|² + ½ Θ̇ᵀ I4 Θ̇ (I4 about its CM): a constant mass term coupling
 //              torsion to both bending planes (docs/theory.md §3.2: f_φ,4 = −m4 (ü_y(L) + r_x ψ̈(L)) + F_y).
-//   proof mass k at s_k (massless carriage on a slider along x, the mass on a slider along y, no
-//              slider spring — model/scole_system.cpp): DOFs are its absolute lateral position
-//              ξ_k = (ξx, ξy); axially it moves with the mast. KE ½ m_k (ξ̇x² + ξ̇y² + ẇ²). With no
-//              slider stiffness these DOFs are free: K has 6 + 2·(actuators) zero eigenvalues,
-//              and an unforced proof mass does not load the mast laterally.
-// Coefficients c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, c_roll, c_pitch, c_tors, m_reflector]; the
+//   proof mass k at s_k (massless carriage on a slider along x, the mass on a slider along y —
+//              model/scole_system.cpp): DOFs are its absolute lateral position ξ_k = (ξx, ξy);
+//              axially it moves with the mast. KE ½ m_k (ξ̇x² + ξ̇y² + ẇ²); on each slider a
+//              centering spring k_a and damper c_a act on the stroke ξ − u(s_k) (§3.7):
+//              V += ½ k_a |ξ − u(s_k)|², dissipation ½ c_a |ξ̇ − u̇(s_k)|². With k_a = 0 (the free
+//              slider) K has 6 + 2·(actuators) zero eigenvalues and an unforced proof mass does not
+//              load the mast laterally.
+// Coefficients c = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, d_roll, d_pitch, c_tors, m_reflector,
+// k_actuator, c_actuator]; the
 // reflector's translational mass is its own term (so m_reflector can be estimated); the shuttle,
 // the reflector's rotary inertia and the proof masses are constant terms (coefficient −1).
 //
-// DOF order (keeps M + γD + γ²K banded): X, Y, θx, θy, θz; then nodes 1..n, each
-// (u_x, u_x', u_y, u_y', ψ), the proof masses' (ξx, ξy) right after the node nearest them;
-// Z last (it couples to the tip slopes through the reflector offset; to the shuttle rotations
-// only when the root is off the z axis).
+// DOF order (M + γD + γ²K banded with a dense border, time/banded_cholesky.h): nodes 1..n,
+// each (u_x, u_x', u_y, u_y', ψ), the proof masses' (ξx, ξy) right after the node nearest them;
+// then the shuttle's X, Y, Z, θx, θy, θz, which couple to the first node (root), to the tip
+// (reflector offset, the bending damping's relative slopes) and to each other.
 //
 // Inputs (model/inputs.cpp resolve_inputs/InputForces: f(t) d, d a unit direction in S; the
 // linearisation drops R_GS ≈ I + θ×, second order with f):
@@ -70,7 +78,9 @@ struct ScoleFE {
   io::ScoleSpec spec;
   int elements = 0;
 
-  enum Coefficient { kRhoA = 0, kEIRoll, kEIPitch, kGJ, kRhoIPsi, kCRoll, kCPitch, kCTors, kMReflector, kCount };
+  enum Coefficient {
+    kRhoA = 0, kEIRoll, kEIPitch, kGJ, kRhoIPsi, kDRoll, kDPitch, kCTors, kMReflector, kKActuator, kCActuator, kCount
+  };
   // Field of a mast node DOF.
   enum Field { kUx = 0, kUxSlope, kUy, kUySlope, kPsi };
 
@@ -107,7 +117,7 @@ ScoleFE build_scole(const io::ScoleSpec& scole, int elements, const std::vector<
 VectorXd scole_coefficients(const io::ScoleSpec& s);
 
 // SCOLE's parameter space (physical_parameterization.h): φ = [ρA, EI_roll, EI_pitch, GJ, ρI_ψ, ζ,
-// m_reflector], the group EI (both bending planes), the paper form q1 = EI/ρA, q2 = 1/ρA (the
+// m_reflector, k_actuator, c_actuator], the group EI (both bending planes), the paper form q1 = EI/ρA, q2 = 1/ρA (the
 // bending equations divided by ρA).
 ParameterSpace scole_parameter_space(const io::ScoleSpec& scole);
 

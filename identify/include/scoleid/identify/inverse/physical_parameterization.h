@@ -7,7 +7,7 @@
 //   - a quantity by name (rho_A, EI_2, GJ, m_reflector, ...),
 //   - a group name that sets several quantities to one value (EI: every section, both planes),
 //   - or, in the paper's form (the equation divided by ρA), q1 = EI/ρA, q2 = 1/ρA and, where the
-//     structure has it, q3 = 2ζ√(EI/ρA) (EI the group; ζ follows q3 then).
+//     structure has it, q3 = c_kv/ρA (EI the group, c_kv the Kelvin–Voigt coefficient; c_kv = q3/q2).
 // Quantities not estimated keep their starting values: the scenario's, overridden by
 // identification.initial (keys: quantity, group and q names). ∂c/∂q by complex step: exact to
 // rounding, no step-size choice.
@@ -33,8 +33,9 @@ struct ParameterSpace {
     bool report_when_equal = true;       // physical() shows the group name when all members agree
   };
   std::vector<Group> groups;
-  // Paper form: the quantities behind q1, q2 (, q3): ρA, the EI group, ζ; q3 only if has_q3.
-  int rho_A = -1, zeta = -1;
+  // Paper form: the quantities behind q1, q2 (, q3): ρA, the EI group and the quantity X with
+  // q3 = X/ρA (the beam's Kelvin–Voigt coefficient c_kv); q3 only if has_q3.
+  int rho_A = -1, q3_quantity = -1;
   std::string EI_group = "EI";
   bool has_q3 = false;
   std::string paper_requirement;          // non-empty: the paper form is refused with this reason

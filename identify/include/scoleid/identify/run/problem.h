@@ -16,6 +16,7 @@
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/measurements.h"
 #include "scoleid/identify/inverse/objective.h"
+#include "scoleid/identify/time/esdirk_stepper.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/scenario.h"
 
@@ -51,10 +52,14 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
 // The identifier's fixed time step: identification.time_step if set, else
 // min(sample interval, 0.3 / ω_{P+2}) with ω_{P+2} the FE frequency of flexible mode P + 2 at the
-// starting parameters (P = number of estimated parameters). make_problem refuses a given step
+// starting parameters (P = number of estimated parameters), shortened when a damping parameter is
+// estimated until the method's numerical damping ratio at ω_{P+2} h is at most 1 % of the
+// smallest modal damping ratio of modes 1 … P + 2 (docs/theory.md §5.2). make_problem refuses a given step
 // with ω_{P+2} h > 1 and any step whose trajectories exceed io/limits.h.
 // ω_{P+2} (rad/s) at the starting parameters, or 0 for a structure without flexible modes.
 double resolved_frequency(const StructuralModel& model, const Parameterization& params);
 double identifier_step(const io::Scenario& scenario, const StructuralModel& model, const Parameterization& params);
+// Numerical damping ratio −ln|R(i x)| / x of one step of a Runge–Kutta table at x = ω h.
+double numerical_damping_ratio(const ButcherTable& table, double x);
 
 }  // namespace scoleid::identify
