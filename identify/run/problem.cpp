@@ -253,6 +253,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       p->noise_std[j] = sc.sensors[j].noise_std;
       p->noise_origin[j] = "scenario";
     }
+  // The identifier's step (each call solves an eigenproblem): once.
+  const double step = identifier_step(sc, p->model(), *p->params);
   if (data_csv) {
     const io::DataTable tab = io::read_csv(*data_csv);
     // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
@@ -337,17 +339,17 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       fail_field(sc.source, "identification.data_elements",
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
-    check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), true);
+    check_step(sc, p->model(), *p->params, step, true);
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
-    p->data = synthesize(truth_sc, data_elements, id.rtol, identifier_step(sc, p->model(), *p->params) / 4.0, true);
+    p->data = synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     set_true_values(truth_sc);
   }
-  if (data_csv) check_step(sc, p->model(), *p->params, identifier_step(sc, p->model(), *p->params), false);
+  if (data_csv) check_step(sc, p->model(), *p->params, step, false);
   p->objective_options.solver.rtol = id.rtol;
-  p->objective_options.solver.step = identifier_step(sc, p->model(), *p->params);
+  p->objective_options.solver.step = step;
   p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                            : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                               : SolverOptions::Integrator::Esdirk;

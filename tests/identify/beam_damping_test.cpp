@@ -4,8 +4,8 @@
 //      mode has damping ratio ζ and damped frequency ω_k√(1−ζ²); Kelvin–Voigt adds c_kv ω_k/(2EI).
 //   2. The slope-product element matrix G = ∫ N′N′ᵀ ds against its closed form, and the
 //      assembled G against ∫ w′² ds of a sine.
-//   3. Costate and CVODES-adjoint gradients for ζ, c_kv and the paper's q3 = c_kv/ρA.
-//   4. Negative zeta or c_kv is refused naming the field and the value.
+//   3. Negative zeta or c_kv is refused naming the field and the value.
+// (Their gradients, against FD and the CVODES adjoint: tests/identify/gradient_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,15 +17,11 @@
 #include "scoleid/identify/fe/beam_model.h"
 #include "scoleid/identify/fe/hermite_beam.h"
 #include "scoleid/identify/fe/modal.h"
-#include "scoleid/identify/inverse/cvodes_adjoint.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/error.h"
 
 using namespace scoleid;
 using namespace scoleid::identify;
-using test_support::Case;
-using test_support::make_case;
-using test_support::max_rel;
 
 namespace {
 
@@ -179,91 +175,7 @@ TEST(BeamDamping, AssembledSlopeMatrixIntegratesTheSlopeSquared) {
   for (std::size_t i = 1; i < err.size(); ++i) EXPECT_GT(err[i - 1] / err[i], 12.0) << "halving " << i;
 }
 
-// ------------------------------------------------------------------------------ 3. gradients
-
-namespace {
-
-// Chen–Russell ζ estimated with ρA and EI (cantilever with a tip body).
-const char* kChenRussell = R"(name: grad-chen-russell
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
-)";
-// The paper's q1, q2, q3 = c_kv/ρA, with Chen–Russell damping present (held at its ζ).
-const char* kPaperQ3 = R"(name: grad-paper-q3
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.02, c_kv: 124.1370211}
-inputs: [{name: P, location: 6.3, signal: {type: step, amplitude: 10, t0: 0}}]
-sensors: [{name: w, location: 10}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
-// Both laws on a sectional beam, d_k = 2ζ√(ρA·EI_k) per section; the section boundary at 5 m
-// falls inside an element of the 7-element mesh.
-const char* kBothSections = R"(name: grad-both-sections
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 35000], zeta: 0.03, c_kv: 50}
-inputs: [{name: P, location: 3.3, signal: {type: pulse, amplitude: 50, t0: 0.1, width: 0.2}}]
-sensors: [{name: a, location: 2.5}, {name: b, location: 7.5}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI_1, EI_2, rho_A, zeta, c_kv],
-  initial: {EI: 28000, rho_A: 70, zeta: 0.04, c_kv: 80}, elements: 7}
-)";
-
-void check_gradient(const char* yaml) {
-  // (1) ESDIRK, fixed step: costate vs central differences vs the Gauss–Newton gradient.
-  Case e = make_case(yaml, false);
-  const VectorXd q = e.p->params->initial();
-  VectorXd g_adj, g_gn;
-  MatrixXd H;
-  e.obj->cost_and_gradient(q, g_adj);
-  e.obj->gauss_newton(q, g_gn, H);
-  const VectorXd g_fd = e.obj->finite_difference_gradient(q, 1e-5);
-  std::printf("  esdirk: costate vs FD %.2e, Gauss-Newton vs FD %.2e\n", max_rel(g_adj, g_fd), max_rel(g_gn, g_fd));
-  EXPECT_LT(max_rel(g_adj, g_fd), 1e-4);
-  EXPECT_LT(max_rel(g_gn, g_fd), 1e-4);
-  // (2) Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint.
-  Case b = make_case(yaml, true);
-  VectorXd g_b;
-  const double Jb = b.obj->cost_and_gradient(q, g_b);
-  const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
-  std::printf("  bdf: costate vs CVODES adjoint %.2e\n", max_rel(g_b, ref.gradient));
-  for (int i = 0; i < q.size(); ++i)
-    std::printf("    %-6s costate %+.10e  cvodes %+.10e  fd(esdirk) %+.10e\n",
-                e.p->params->names()[static_cast<std::size_t>(i)].c_str(), g_b[i], ref.gradient[i], g_fd[i]);
-  EXPECT_LT(max_rel(g_b, ref.gradient), 1e-5);
-  EXPECT_NEAR(Jb, ref.cost, 1e-6 * ref.cost);
-}
-
-}  // namespace
-
-TEST(BeamDampingGradient, ChenRussellZeta) { check_gradient(kChenRussell); }
-TEST(BeamDampingGradient, PaperQ3IsKelvinVoigtOverRhoA) { check_gradient(kPaperQ3); }
-TEST(BeamDampingGradient, BothLawsOnSections) { check_gradient(kBothSections); }
-
-TEST(BeamDampingGradient, TaylorRemainderFallsAtSecondOrder) {
-  for (const char* yaml : {kChenRussell, kPaperQ3}) {
-    Case e = make_case(yaml, false);
-    const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
-    for (std::size_t k = 1; k < 5; ++k) {
-      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
-    }
-  }
-}
-
-TEST(BeamDampingGradient, PaperQ3MapsToKelvinVoigt) {
-  // q3 = c_kv/ρA: the starting q3 from identification.initial, c_kv = q3/q2 back; ζ held.
-  Case e = make_case(kPaperQ3, false);
-  const VectorXd q = e.p->params->initial();
-  EXPECT_DOUBLE_EQ(q[2], 175.2712184 / 60.0);
-  const auto ph = e.p->params->physical(q);
-  EXPECT_NEAR(ph.at("c_kv"), 175.2712184, 1e-9);
-  EXPECT_DOUBLE_EQ(ph.at("zeta"), 0.02);
-  EXPECT_NEAR(e.p->params->truth()[2], 124.1370211 / 67.0, 1e-14);
-}
-
-// --------------------------------------------------------------------------------- 4. input
+// --------------------------------------------------------------------------------- 3. input
 
 TEST(BeamDamping, NegativeZetaOrKelvinVoigtIsRefused) {
   const auto error_of = [](const std::string& yaml) -> std::string {

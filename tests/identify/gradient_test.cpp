@@ -73,6 +73,64 @@ TEST(Gradient, PaperParametersWithTipBody) { check_kind(kPaper); }
 TEST(Gradient, PhysicalParameters) { check_kind(kPhysical); }
 TEST(Gradient, SectionalStiffnessMassAndDamping) { check_kind(kSections); }
 
+// The beam's two damping laws (docs/theory.md §2.2): square-root ζ and Kelvin–Voigt c_kv.
+namespace {
+// Chen–Russell ζ estimated with ρA and EI (cantilever with a tip body).
+const char* kChenRussell = R"(name: grad-chen-russell
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
+inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
+sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+)";
+// The paper's q1, q2, q3 = c_kv/ρA, with Chen–Russell damping present (held at its ζ).
+const char* kPaperQ3 = R"(name: grad-paper-q3
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.02, c_kv: 124.1370211}
+inputs: [{name: P, location: 6.3, signal: {type: step, amplitude: 10, t0: 0}}]
+sensors: [{name: w, location: 10}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
+)";
+// Both laws on a sectional beam, d_k = 2ζ√(ρA·EI_k) per section; the section boundary at 5 m
+// falls inside an element of the 7-element mesh.
+const char* kBothSections = R"(name: grad-both-sections
+beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 35000], zeta: 0.03, c_kv: 50}
+inputs: [{name: P, location: 3.3, signal: {type: pulse, amplitude: 50, t0: 0.1, width: 0.2}}]
+sensors: [{name: a, location: 2.5}, {name: b, location: 7.5}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: physical, estimate: [EI_1, EI_2, rho_A, zeta, c_kv],
+  initial: {EI: 28000, rho_A: 70, zeta: 0.04, c_kv: 80}, elements: 7}
+)";
+
+}  // namespace
+
+TEST(BeamDampingGradient, ChenRussellZeta) { check_kind(kChenRussell); }
+TEST(BeamDampingGradient, PaperQ3IsKelvinVoigtOverRhoA) { check_kind(kPaperQ3); }
+TEST(BeamDampingGradient, BothLawsOnSections) { check_kind(kBothSections); }
+
+TEST(BeamDampingGradient, TaylorRemainderFallsAtSecondOrder) {
+  for (const char* yaml : {kChenRussell, kPaperQ3}) {
+    Case e = make_case(yaml, false);
+    const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
+    for (std::size_t k = 1; k < 5; ++k) {
+      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
+      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
+    }
+  }
+}
+
+TEST(BeamDampingGradient, PaperQ3MapsToKelvinVoigt) {
+  // q3 = c_kv/ρA: the starting q3 from identification.initial, c_kv = q3/q2 back; ζ held.
+  Case e = make_case(kPaperQ3, false);
+  const VectorXd q = e.p->params->initial();
+  EXPECT_DOUBLE_EQ(q[2], 175.2712184 / 60.0);
+  const auto ph = e.p->params->physical(q);
+  EXPECT_NEAR(ph.at("c_kv"), 175.2712184, 1e-9);
+  EXPECT_DOUBLE_EQ(ph.at("zeta"), 0.02);
+  EXPECT_NEAR(e.p->params->truth()[2], 124.1370211 / 67.0, 1e-14);
+}
+
+
 TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
   for (const char* yaml : {kPaper, kSections}) {

@@ -10,7 +10,6 @@
 #include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
-#include <complex>
 #include <cstdio>
 
 #include "scoleid/identify/time/esdirk_stepper.h"
@@ -21,27 +20,6 @@
 using namespace scoleid::identify;
 using test_support::first_within;
 using test_support::max_rel_error;
-
-namespace {
-
-// Damping ratio the integrator adds to an undamped mode of frequency ω at step h:
-// |R(iωh)| = exp(−ζ_num ω h), R(z) = 1 + z bᵀ (I − z A)⁻¹ 1 the table's stability function.
-double numerical_damping(const ButcherTable& B, double wh) {
-  const int s = B.stages;
-  Eigen::MatrixXcd A(s, s);
-  Eigen::VectorXcd b(s);
-  for (int i = 0; i < s; ++i) {
-    b[i] = B.b[static_cast<std::size_t>(i)];
-    for (int j = 0; j < s; ++j) A(i, j) = B.a(i, j);
-  }
-  const std::complex<double> z(0.0, wh);
-  const Eigen::MatrixXcd I = Eigen::MatrixXcd::Identity(s, s);
-  const Eigen::VectorXcd y = (I - z * A).partialPivLu().solve(Eigen::VectorXcd::Ones(s));
-  const std::complex<double> R = 1.0 + z * (b.transpose() * y)(0);
-  return -std::log(std::abs(R)) / wh;
-}
-
-}  // namespace
 
 TEST(ScoleIdentification, CaseOneReachesOneInTenThousandWithinHalfThePaperIterations) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -115,7 +93,7 @@ TEST(ScoleIdentification, CaseTwoZetaIsResolvedAndTheStepDampsLessThanOnePercent
     const double om = std::sqrt(w2);
     const VectorXd phi = es.eigenvectors().col(i);
     const double z = phi.dot(a.D * phi) / (2.0 * om * phi.dot(a.M * phi));
-    const double zh = numerical_damping(table, om * h);
+    const double zh = numerical_damping_ratio(table, om * h);
     std::printf("  %4d %9.4f %11.3e %13.3e %9.2e\n", ++shown, om / (2 * M_PI), z, zh, zh / z);
     EXPECT_GT(z, 0.1 * sc.scole.zeta) << "mode " << shown;
     EXPECT_LT(z, 1.1 * sc.scole.zeta) << "mode " << shown;
