@@ -95,8 +95,8 @@ int main(int argc, char** argv) {
     identify::write_outputs(run_dir, *problem, r);
     run_dir.commit();
     // Summary against the truth where known.
-    std::printf("\n%-10s %14s %14s %14s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth", "rel.error", "std",
-                "resolution");
+    std::printf("\n%-10s %14s %14s %14s %12s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth", "rel.error",
+                "std", "resolution", "± interval");
     for (std::size_t i = 0; i < r.names.size(); ++i) {
       const auto it = r.truth.find(r.names[i]);
       const auto e = static_cast<Eigen::Index>(i);
@@ -108,13 +108,14 @@ int main(int argc, char** argv) {
       };
       const bool flagged = r.ident.identifiable.size() && !r.ident.identifiable[i];
       const char* flag = flagged ? "  NOT IDENTIFIABLE" : r.ident.identifiable.empty() ? "  (not assessed)" : "";
-      const std::string sd = flagged ? "-" : cell(r.ident.std), res = flagged ? "-" : cell(r.ident.resolution);
+      const std::string sd = flagged ? "-" : cell(r.ident.std), res = flagged ? "-" : cell(r.ident.resolution),
+                        hw = flagged ? "-" : cell(r.interval.half_width);
       if (it != r.truth.end())
-        std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, it->second,
-                    est / it->second - 1.0, sd.c_str(), res.c_str(), flag);
+        std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est,
+                    it->second, est / it->second - 1.0, sd.c_str(), res.c_str(), hw.c_str(), flag);
       else
-        std::printf("%-10s %14.7g %14.7g %14s %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, "-", "-", sd.c_str(),
-                    res.c_str(), flag);
+        std::printf("%-10s %14.7g %14.7g %14s %12s %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, "-", "-",
+                    sd.c_str(), res.c_str(), hw.c_str(), flag);
     }
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);

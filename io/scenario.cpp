@@ -1,7 +1,9 @@
 #include "scoleid/io/scenario.h"
+#include "scoleid/io/scenario_fields.h"
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -353,17 +355,20 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   s.actuator_stroke = r.positive("actuator_stroke", s.actuator_stroke);
   s.actuator_stiffness = r.nonneg("actuator_stiffness", s.actuator_stiffness);
   s.actuator_damping = r.nonneg("actuator_damping", s.actuator_damping);
+  s.actuator_lag = r.nonneg("actuator_lag", s.actuator_lag);
 }
 
 double structure_length(const Scenario& sc) {
   return sc.structure == "scole" ? sc.scole.length : sc.beam.length;
 }
 
-void check_location(const Scenario& sc, const std::string& field, const std::string& at, double loc) {
+void check_location(const Scenario& sc, const std::string& field, const std::string& at, double loc,
+                    const std::string& source = "") {
   if (at != "beam" && at != "mast") return;
   const double L = structure_length(sc);
   if (!(loc >= 0.0 && loc <= L))
-    fail_field(sc.source, field, "must lie on the " + at + " [0, " + format_value(L) + "]", format_value(loc));
+    fail_field(source.empty() ? sc.source : source, field, "must lie on the " + at + " [0, " + format_value(L) + "]",
+               format_value(loc));
 }
 
 void parse_inputs(const YAML::Node& n, Scenario& sc) {
@@ -407,6 +412,14 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.direction = parse_direction(r, "direction");
     s.unit = r.str("unit", "");
     s.noise_std = r.nonneg("noise_std", 0.0);
+    // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
+    // cannot explain, so they belong to the truth's side of a mismatch study only.
+    for (const char* key : {"bias", "drift"})
+      if (r.has(key))
+        fail_field(sc.source, r.field(key),
+                   "is refused here: bias and drift describe the truth's sensor errors: set them under "
+                   "truth.overrides.sensors",
+                   Reader::kind(r.child(key)));
     sc.sensors.push_back(std::move(s));
   }
 }
@@ -441,6 +454,25 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
   id.time_step = r.nonneg("time_step", id.time_step);
   id.rtol = r.positive("rtol", id.rtol);
+  if (r.has("uncertain")) {
+    // Paths are checked against the whole scenario once it is read (parse_scenario).
+    const YAML::Node m = r.child("uncertain");
+    if (!m.IsMap()) fail_field(source, "identification.uncertain", "must be a map field: tolerance", Reader::kind(m));
+    for (const auto& kv : m) {
+      UncertainSpec u;
+      u.field = kv.first.as<std::string>();
+      const std::string field = "identification.uncertain." + u.field;
+      const std::string text = kv.second.IsScalar() ? kv.second.Scalar() : "";
+      if (text == "true" || text == "false") {
+        u.is_switch = true;
+        u.alternative = text == "true";
+      } else {
+        u.tolerance = r.as_number(kv.second, field);
+        if (!(u.tolerance > 0.0) || !std::isfinite(u.tolerance)) fail_field(source, field, "must be a tolerance > 0", format_value(u.tolerance));
+      }
+      id.uncertain.push_back(u);
+    }
+  }
 }
 
 void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
@@ -460,6 +492,45 @@ void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
     t.overrides = e.c_str();
     t.overrides_source = source;
     truth_scenario(sc);
+  }
+}
+
+// truth.overrides.sensors: a list of partial sensor entries, each naming a sensor of the scenario,
+// applied onto t.sensors (the truth's). location and direction are read as in the main section
+// (a direction is normalised, so a misaligned sensor is written as the vector it measures along);
+// bias and drift are the truth's sensor errors (SensorSpec).
+void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scenario& t) {
+  if (!n.IsSequence()) fail_field(source, "truth.overrides.sensors", "must be a list", Reader::kind(n));
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string path = "truth.overrides.sensors[" + std::to_string(i) + "]";
+    Reader r(n[i], source, path);
+    if (!r.has("name")) fail_field(source, r.field("name"), "must name a sensor of the scenario", "none");
+    const std::string name = r.str("name", "");
+    auto it = std::find_if(t.sensors.begin(), t.sensors.end(), [&](const SensorSpec& x) { return x.name == name; });
+    if (it == t.sensors.end()) {
+      std::string list;
+      for (const auto& x : t.sensors) list += (list.empty() ? "" : ", ") + x.name;
+      fail_field(source, r.field("name"), "must name a sensor of the scenario (" + (list.empty() ? "none" : list) + ")",
+                 "'" + name + "'");
+    }
+    if (!names.insert(name).second) fail_field(source, r.field("name"), "must be unique", "'" + name + "'");
+    SensorSpec& se = *it;
+    if (r.has("location")) {
+      if (se.at != "beam" && se.at != "mast")
+        fail_field(source, r.field("location"), "applies to beam and mast sensors only (sensor '" + name + "' is at " + se.at + ")",
+                   format_value(r.num("location", 0.0)));
+      se.location = r.num("location", se.location);
+      check_location(t, r.field("location"), se.at, se.location, source);
+    }
+    if (r.has("direction")) {
+      if (t.structure == "beam")
+        fail_field(source, r.field("direction"), "does not apply to a beam sensor (it measures w or w_s)",
+                   Reader::kind(r.child("direction")));
+      se.direction = parse_direction(r, "direction");
+    }
+    se.bias = r.num("bias", se.bias);
+    se.drift = r.num("drift", se.drift);
   }
 }
 
@@ -500,6 +571,20 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     parse_sensors(r.child("sensors"), sc);
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
+    for (const auto& u : sc.identification.uncertain) {
+      const std::string field = "identification.uncertain." + u.field;
+      if (u.is_switch) {
+        const bool* b = bool_field(sc, u.field);
+        if (!b) fail_field(source, field, "names no switch of this scenario (switches: scole.bending_rotary_inertia)", "'" + u.field + "'");
+        if (*b == u.alternative)
+          fail_field(source, field, "must name the alternative to the model's setting", u.alternative ? "true" : "false");
+      } else if (!numeric_field(sc, u.field)) {
+        std::string known;
+        for (const auto& p : field_paths(sc))
+          if (p != "scole.bending_rotary_inertia") known += (known.empty() ? "" : ", ") + p;
+        fail_field(source, field, "names no number of this scenario (known: " + known + ")", "'" + u.field + "'");
+      }
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
@@ -521,6 +606,8 @@ Scenario truth_scenario(const Scenario& s) {
       if (s.structure != "scole") fail_field(source, "truth.overrides.scole", "must match the structure", "'" + s.structure + "'");
       parse_scole(o.child("scole"), source, t.scole, "truth.overrides.scole");
     }
+    // After the structure: a location is checked against the length the truth simulates.
+    if (o.has("sensors")) parse_sensor_overrides(o.child("sensors"), source, t);
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": truth.overrides: malformed YAML: " + e.msg);
   }
@@ -584,7 +671,7 @@ nlohmann::json to_json(const Scenario& s) {
                 {"reflector_ry", c.reflector_ry}, {"mast_root", c.mast_root},
                 {"actuator_locations", c.actuator_locations}, {"actuator_mass", c.actuator_mass},
                 {"actuator_stroke", c.actuator_stroke}, {"actuator_stiffness", c.actuator_stiffness},
-                {"actuator_damping", c.actuator_damping}};
+                {"actuator_damping", c.actuator_damping}, {"actuator_lag", c.actuator_lag}};
   };
   // The structure section, and the truth's overrides as the fields whose values differ from it.
   json structure, truth_structure;
@@ -628,10 +715,30 @@ nlohmann::json to_json(const Scenario& s) {
                          {"continuation_misfit", id.continuation_misfit},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol}};
+  if (!id.uncertain.empty()) {
+    json u = json::object();
+    for (const auto& x : id.uncertain) u[x.field] = x.is_switch ? json(x.alternative) : json(x.tolerance);
+    j["identification"]["uncertain"] = u;
+  }
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
                 {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval},
                 {"large_motion", s.truth.large_motion}};
-  if (!overrides.empty()) j["truth"]["overrides"] = {{s.structure, overrides}};
+  // Sensor overrides: per sensor, its name and the fields in which the truth's sensor differs.
+  json sensor_overrides = json::array();
+  auto sensor_fields = [](const SensorSpec& se) {
+    return json{{"location", se.location}, {"direction", se.direction}, {"bias", se.bias}, {"drift", se.drift}};
+  };
+  for (std::size_t i = 0; i < s.sensors.size() && i < ts.sensors.size(); ++i) {
+    const json base = sensor_fields(s.sensors[i]), truth = sensor_fields(ts.sensors[i]);
+    json diff{{"name", s.sensors[i].name}};
+    for (const auto& [k, v] : truth.items())
+      if (v != base[k]) diff[k] = v;
+    if (diff.size() > 1) sensor_overrides.push_back(diff);
+  }
+  json truth_overrides = json::object();
+  if (!overrides.empty()) truth_overrides[s.structure] = overrides;
+  if (!sensor_overrides.empty()) truth_overrides["sensors"] = sensor_overrides;
+  if (!truth_overrides.empty()) j["truth"]["overrides"] = truth_overrides;
   return j;
 }
 

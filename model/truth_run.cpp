@@ -432,7 +432,9 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
     tab.t.push_back(s.getTime());
     std::size_t j = 0;
     for (const auto& in : sc.inputs) tab.columns[j++].push_back(in.signal(s.getTime()));
-    for (const auto& se : sensors) tab.columns[j++].push_back(read_sensor(matter, s, se));
+    // The ideal read-out plus the sensor's own error (truth.overrides.sensors); noise below.
+    for (std::size_t i = 0; i < sensors.size(); ++i)
+      tab.columns[j++].push_back(read_sensor(matter, s, sensors[i]) + sensor_error(sc.sensors[i], s.getTime()));
     if (viz && s.getTime() >= next_frame) {
       viz->report(s);
       next_frame = s.getTime() + frame;

@@ -174,6 +174,12 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
   if (sc.mast_root.size() != 3)
     fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(sc.mast_root.size()) + " values");
+  // The actuator force enters the FE equations as commanded: there is no servo state to lag it.
+  if (sc.actuator_lag > 0)
+    fail_field(source, "scole.actuator_lag",
+               "must be 0: the finite-element model has no servo lag: set it under truth.overrides.scole to study the "
+               "mismatch",
+               format_value(sc.actuator_lag));
   ScoleFE fe;
   fe.spec = sc;
   fe.elements = elements;

@@ -39,8 +39,10 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
       id.chi2 += w * r * r;
     }
   id.data_values = static_cast<long>(N) * ns;
-  // Residual energy counted as model error: beyond what the stated noise explains, or all of it.
-  const double systematic = from_scenario ? std::max(0.0, id.chi2 - static_cast<double>(id.data_values)) : id.chi2;
+  // Residual energy counted as model error: beyond the upper end of the χ² band of the stated noise
+  // (N ± 2√(2N): white noise alone reaches it one time in forty), or all of it with no stated noise.
+  const double Nd = static_cast<double>(id.data_values);
+  const double systematic = from_scenario ? std::max(0.0, id.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd)) : id.chi2;
 
   const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
   Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);

@@ -9,6 +9,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/scenario_fields.h"
 
 namespace scoleid::identify {
 
@@ -65,6 +66,82 @@ const char* integrator_name(SolverOptions::Integrator i) {
   return "?";
 }
 
+// Consider terms (interval.h): for each declared tolerance, the shift of the least-squares
+// estimate that the quantity's change would cause, −F⁻¹ Gᵀ W G_θ Δθ with G_θ Δθ the central
+// difference of the model's outputs at q̂ (or the difference to the alternative model form), over
+// the parameters the Fisher test kept.
+std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const Identifiability& id, const VectorXd& q) {
+  std::vector<ConsiderTerm> terms;
+  const auto& uncertain = p.scenario.identification.uncertain;
+  if (uncertain.empty()) return terms;
+  const MatrixXd G = obj.output_sensitivities(q);
+  const MatrixXd Y0 = obj.predict(q);
+  const int P = static_cast<int>(q.size()), ns = static_cast<int>(Y0.cols());
+  std::vector<int> keep;
+  for (int i = 0; i < P; ++i)
+    if (std::isfinite(id.std[i])) keep.push_back(i);
+  const auto K = static_cast<Eigen::Index>(keep.size());
+  MatrixXd Gk(G.rows(), K);
+  for (Eigen::Index a = 0; a < K; ++a) Gk.col(a) = G.col(keep[static_cast<std::size_t>(a)]);
+  VectorXd w(G.rows());
+  for (Eigen::Index r = 0; r < G.rows(); ++r) {
+    const double sd = id.noise_std[static_cast<std::size_t>(r % ns)];
+    w[r] = 1.0 / (sd * sd);
+  }
+  const MatrixXd F = Gk.transpose() * w.asDiagonal() * Gk;
+  const Eigen::LDLT<MatrixXd> ldlt(F);
+  auto flat = [&](const MatrixXd& Y) {  // row i*ns + k, as G
+    VectorXd v(Y.size());
+    for (Eigen::Index i = 0; i < Y.rows(); ++i)
+      for (Eigen::Index k = 0; k < Y.cols(); ++k) v[i * ns + k] = Y(i, k);
+    return v;
+  };
+  // The model's outputs at q̂ with the scenario changed (the same data, inputs and time step).
+  auto outputs = [&](const io::Scenario& sc) {
+    const auto st = make_structure(sc, sc.identification.elements);
+    const auto params = st->parameterize(sc);
+    Objective o(st->model(), *params, p.signals, p.data, p.objective_options);
+    return flat(o.predict(q));
+  };
+  for (const auto& u : uncertain) {
+    ConsiderTerm t;
+    t.field = u.field;
+    io::Scenario hi = p.scenario, lo = p.scenario;
+    VectorXd d;
+    if (u.is_switch) {
+      *io::bool_field(hi, u.field) = u.alternative;
+      t.value = *io::bool_field(lo, u.field) ? 1.0 : 0.0;
+      t.delta = 1.0;
+      d = outputs(hi) - flat(Y0);
+    } else {
+      double* vh = io::numeric_field(hi, u.field);
+      double* vl = io::numeric_field(lo, u.field);
+      t.value = *vh;
+      t.delta = u.tolerance;
+      *vh += u.tolerance;
+      *vl -= u.tolerance;
+      // Central where both sides are valid scenarios; one-sided at the edge of the valid range (a
+      // sensor at the tip of the mast cannot move beyond it).
+      std::optional<VectorXd> yh, yl;
+      try { yh = outputs(hi); } catch (const io::InputError&) {}
+      // A quantity that cannot be negative (a stiffness, a mass) is not moved through zero.
+      const bool lo_valid = io::signed_field(u.field) || (t.value > 0 ? *vl > 0 : *vl >= 0);
+      if (lo_valid) try { yl = outputs(lo); } catch (const io::InputError&) {}
+      if (yh && yl) d = 0.5 * (*yh - *yl);
+      else if (yh) d = *yh - flat(Y0);
+      else if (yl) d = flat(Y0) - *yl;
+      else
+        io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
+                       "moves the scenario out of its valid range on both sides", io::format_value(u.tolerance));
+    }
+    const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
+    t.shift = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
+    terms.push_back(t);
+  }
+  return terms;
+}
+
 }  // namespace
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
@@ -109,6 +186,34 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
       for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
       r.ident.noise_source = origin;
     }
+    // The half-record refit (interval.h): the same fit on the first half of the record, from q̂.
+    IntervalInputs ii;
+    ii.estimate = r.estimate;
+    {
+      Measurements first = p.data;
+      const double t_half = first.t.front() + 0.5 * (first.t.back() - first.t.front());
+      std::size_t n = 0;
+      while (n < first.t.size() && first.t[n] <= t_half) ++n;
+      first.t.resize(n);
+      first.z.conservativeResize(static_cast<Eigen::Index>(n), Eigen::NoChange);
+      Objective half(p.model(), *p.params, p.signals, first, p.objective_options);
+      OptimizerOptions oh = oo;
+      oh.continuation = false;
+      const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+      r.half_record_estimate = ii.half_record_estimate = s.q;
+      r.half_record_converged = ii.half_record_converged = s.converged();
+    }
+    ii.consider = consider_terms(p, obj, r.ident, r.estimate);
+    r.interval = uncertainty_interval(r.ident, ii);
+    for (std::size_t i = 0; i < r.names.size(); ++i)
+      if (r.ident.identifiable[i] && r.interval.too_wide[i]) {
+        r.ident.identifiable[i] = false;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "uncertainty interval ±%.3g is %.3g of the estimate: above 0.5",
+                      r.interval.half_width[static_cast<Eigen::Index>(i)],
+                      r.interval.half_width[static_cast<Eigen::Index>(i)] / std::abs(r.estimate[static_cast<Eigen::Index>(i)]));
+        r.ident.reason[i] = buf;
+      }
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();
@@ -135,11 +240,27 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
       e["resolution"] = ok && std::isfinite(res) ? json(res) : json(nullptr);
       e["identifiable"] = ok;
       if (!ok && i < ident.reason.size()) e["not_identifiable_because"] = ident.reason[i];
+      // The interval (interval.h): ±half_width about the estimate, and what it is made of.
+      const auto ie = static_cast<Eigen::Index>(i);
+      const double hw = interval.half_width.size() > ie ? interval.half_width[ie] : std::nan("");
+      if (ok && std::isfinite(hw)) {
+        json comp{{"noise_2std", interval.noise[ie]},
+                  {"residual_2resolution", interval.residual[ie]},
+                  {"half_record_shift", interval.half_record_shift[ie]},
+                  {"consider", interval.consider[ie]}};
+        e["interval"] = {{"half_width", hw}, {"low", estimate[ie] - hw}, {"high", estimate[ie] + hw},
+                         {"relative_half_width", hw / std::abs(estimate[ie])}, {"components", comp}};
+        if (it != truth.end()) e["interval"]["covers_truth"] = std::abs(estimate[ie] - it->second) <= hw;
+      } else {
+        e["interval"] = nullptr;
+      }
+      if (half_record_estimate.size() > ie) e["half_record_estimate"] = half_record_estimate[ie];
     } else {
       // --no-std: not assessed, which is not the same as identifiable.
       e["std"] = nullptr;
       e["resolution"] = nullptr;
       e["identifiable"] = nullptr;
+      e["interval"] = nullptr;
     }
     params.push_back(e);
   }
@@ -185,7 +306,19 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                               {"noise_std", ident.noise_std},
                               {"noise_source", ident.noise_source},
                               {"chi2", ident.chi2},
-                              {"data_values", ident.data_values}};
+                              {"data_values", ident.data_values},
+                              {"half_record_refit_converged", half_record_converged},
+                              {"consider", [&] {
+                                 json c = json::array();
+                                 for (const auto& t : interval.terms) {
+                                   json sh = json::object();
+                                   for (std::size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < t.shift.size(); ++i)
+                                     sh[names[i]] = t.shift[static_cast<Eigen::Index>(i)];
+                                   c.push_back({{"field", t.field}, {"value", t.value}, {"tolerance", t.delta}, {"shift", sh}});
+                                 }
+                                 return c;
+                               }()},
+                              {"interval_note", interval.note}};
   } else {
     out["identifiability"] = {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
   }

@@ -217,6 +217,10 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
     m.z.row(static_cast<Eigen::Index>(k)) = y.transpose();
   }
   for (const auto& s : sc.sensors) m.names.push_back(s.name);
+  // Sensor errors of the truth's sensors (truth.overrides.sensors), as the Simbody truth adds them.
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+    for (Eigen::Index k = 0; k < m.z.rows(); ++k)
+      m.z(k, static_cast<Eigen::Index>(j)) += sc.sensors[j].bias + sc.sensors[j].drift * times[static_cast<std::size_t>(k)];
   if (add_noise) {
     std::mt19937_64 rng(sc.simulation.seed);
     for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
@@ -343,6 +347,11 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
+    if (truth_sc.structure == "scole" && truth_sc.scole.actuator_lag > 0)
+      fail_field(sc.source, "truth.overrides.scole.actuator_lag",
+                 "is a servo lag of the Simbody truth only: the finite-element synthesis cannot produce it (generate the "
+                 "data with scole-truth and pass them with --data)",
+                 io::format_value(truth_sc.scole.actuator_lag));
     p->data = synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     set_true_values(truth_sc);

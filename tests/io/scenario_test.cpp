@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/scenario_fields.h"
 
 using namespace scoleid::io;
 
@@ -157,6 +160,110 @@ TEST(TruthOverrides, UnknownFieldsOrTheOtherStructureAreRefused) {
   EXPECT_NE(error_of("name: m\ntruth: {overrides: {plate: {}}}\n").find("truth.overrides.plate"), std::string::npos);
 }
 
+// truth.overrides.sensors: partial entries named after the scenario's sensors (location,
+// direction, bias, drift) for the truth alone; echoed as overrides.sensors = [{name, fields that
+// differ}], which alone make has_truth_overrides true.
+TEST(TruthOverrides, SensorEntriesChangeTheTruthsSensorsOnlyAndAreEchoed) {
+  const std::string head = R"(name: sensors
+structure: scole
+sensors:
+  - {name: roll_tip, at: mast, location: 130, direction: y}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
+  - {name: roll_mid, at: mast, location: 65, direction: y}
+truth:
+  overrides:
+    sensors:
+)";
+  const Scenario s = parse_scenario(head + R"(      - {name: roll_tip, direction: [0, 0.99985, 0.01745], bias: 1.0e-3}
+      - {name: roll_mid, location: 80, drift: -2.0e-4}
+)", "scenario 'm.yaml'");
+  EXPECT_EQ(s.sensors[0].direction, (std::vector<double>{0, 1, 0}));  // the identifier's sensors
+  EXPECT_EQ(s.sensors[0].bias, 0.0);
+  EXPECT_EQ(s.sensors[2].location, 65.0);
+  const Scenario t = truth_scenario(s);
+  const auto& d = t.sensors[0].direction;
+  const double n = std::hypot(0.99985, 0.01745);
+  EXPECT_EQ(d, (std::vector<double>{0, 0.99985 / n, 0.01745 / n}));  // normalised
+  EXPECT_EQ(t.sensors[0].bias, 1.0e-3);
+  EXPECT_EQ(t.sensors[0].drift, 0.0);
+  EXPECT_EQ(t.sensors[2].location, 80.0);
+  EXPECT_EQ(t.sensors[2].drift, -2.0e-4);
+  EXPECT_EQ(t.sensors[1].direction, s.sensors[1].direction);  // untouched sensor
+  EXPECT_EQ(t.scole.EI_roll, s.scole.EI_roll);
+  EXPECT_TRUE(has_truth_overrides(s));
+  const nlohmann::json j = to_json(s)["truth"]["overrides"];
+  EXPECT_EQ(j, (nlohmann::json{{"sensors",
+                                {{{"name", "roll_tip"}, {"direction", d}, {"bias", 1.0e-3}},
+                                 {{"name", "roll_mid"}, {"location", 80.0}, {"drift", -2.0e-4}}}}}));
+  // An entry that changes nothing is no override.
+  EXPECT_FALSE(has_truth_overrides(parse_scenario(head + "      - {name: roll_mid, location: 65, bias: 0}\n", "s")));
+}
+
+TEST(TruthOverrides, SensorEntryErrorsNameTheField) {
+  const std::string head = R"(name: sensors
+structure: scole
+sensors:
+  - {name: roll_tip, at: mast, location: 130, direction: y}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
+truth:
+  overrides:
+    sensors:
+)";
+  EXPECT_EQ(error_of(head + "      - {name: roll_tpi, bias: 1}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario (roll_tip, yaw_tip), "
+            "got 'roll_tpi'");
+  EXPECT_EQ(error_of(head + "      - {bias: 1}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario, got none");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, bias: 1}\n      - {name: roll_tip, drift: 1}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[1].name must be unique, got 'roll_tip'");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, drift: .nan}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].drift must be a finite number, got '.nan'");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, bias: -.inf}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].bias must be a finite number, got '-.inf'");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, location: 131}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].location must lie on the mast [0, 130], got 131");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, direction: [0, 0, 0]}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].direction must be non-zero, got [0, 0, 0]");
+  EXPECT_EQ(error_of(head + "      - {name: yaw_tip, location: 100}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].location applies to beam and mast sensors only (sensor "
+            "'yaw_tip' is at reflector), got 100");
+  EXPECT_EQ(error_of(head + "      - {name: roll_tip, noise_std: 1}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].noise_std is not a known field, got 'noise_std'");
+  EXPECT_EQ(error_of(head + "      {name: roll_tip}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors must be a list, got map");
+  // The main section refuses them: the identifier models an ideal sensor plus noise.
+  EXPECT_EQ(error_of("name: b\nsensors:\n  - {name: w, location: 5, bias: 0.001}\n"),
+            "scenario 'x.yaml': sensors[0].bias is refused here: bias and drift describe the truth's sensor errors: "
+            "set them under truth.overrides.sensors, got '0.001'");
+  EXPECT_NE(error_of("name: b\nsensors:\n  - {name: w, location: 5, drift: 0}\n").find("sensors[0].drift is refused here"),
+            std::string::npos);
+  // A beam's sensors measure w or w_s: a direction would be ignored, so it is refused.
+  EXPECT_EQ(error_of("name: b\nsensors:\n  - {name: w, location: 5}\ntruth:\n  overrides:\n    sensors:\n"
+                     "      - {name: w, direction: y}\n"),
+            "scenario 'x.yaml': truth.overrides.sensors[0].direction does not apply to a beam sensor (it measures w or "
+            "w_s), got 'y'");
+}
+
+// scole.actuator_lag: seconds, >= 0 and finite, default 0; echoed; overridable for the truth.
+TEST(Scenario, ActuatorLagIsParsedCheckedAndEchoed) {
+  EXPECT_EQ(parse_scenario("name: d\nstructure: scole\n", "s").scole.actuator_lag, 0.0);
+  const Scenario s = parse_scenario("name: l\nstructure: scole\nscole: {actuator_lag: 0.05}\n", "s");
+  EXPECT_EQ(s.scole.actuator_lag, 0.05);
+  EXPECT_EQ(to_json(s)["scole"]["actuator_lag"], 0.05);
+  EXPECT_EQ(error_of("name: l\nstructure: scole\nscole: {actuator_lag: -0.1}\n"),
+            "scenario 'x.yaml': scole.actuator_lag must be >= 0, got -0.1");
+  EXPECT_EQ(error_of("name: l\nstructure: scole\nscole: {actuator_lag: .nan}\n"),
+            "scenario 'x.yaml': scole.actuator_lag must be a finite number, got '.nan'");
+  EXPECT_EQ(error_of("name: l\nstructure: scole\nscole: {actuator_lag: .inf}\n"),
+            "scenario 'x.yaml': scole.actuator_lag must be a finite number, got '.inf'");
+  const Scenario o = parse_scenario("name: o\nstructure: scole\ntruth:\n  overrides:\n    scole: {actuator_lag: 0.02}\n", "s");
+  EXPECT_EQ(o.scole.actuator_lag, 0.0);
+  EXPECT_EQ(truth_scenario(o).scole.actuator_lag, 0.02);
+  EXPECT_EQ(to_json(o)["truth"]["overrides"], (nlohmann::json{{"scole", {{"actuator_lag", 0.02}}}}));
+  EXPECT_EQ(error_of("name: o\nstructure: scole\ntruth: {overrides: {scole: {actuator_lag: -1}}}\n"),
+            "scenario 'x.yaml': truth.overrides.scole.actuator_lag must be >= 0, got -1");
+}
+
 // The plausibility guards' fields (docs/truth-guards.md): scole.actuator_stroke (> 0, default
 // 0.5) and truth.large_motion (a boolean, default false), parsed, checked, echoed, overridable.
 TEST(Scenario, GuardFieldsAreParsedCheckedAndEchoed) {
@@ -197,4 +304,39 @@ TEST(Scenario, GuardFieldsAreParsedCheckedAndEchoed) {
 TEST(Scenario, OnlyTheSlewIsALargeMotionStudy) {
   for (const auto& name : builtin_scenario_names())
     EXPECT_EQ(load_scenario(name).truth.large_motion, name == "scole-slew") << name;
+}
+
+// identification.uncertain: declared tolerances name a scenario quantity by path; the parsed
+// values reach the spec, and a path that names nothing, a tolerance that is not > 0, or a switch
+// set to the model's own setting is one line naming the field.
+TEST(Scenario, UncertainToleranceNamesAQuantityOfTheScenario) {
+  const std::string head = R"(structure: scole
+inputs:
+  - {name: F, at: reflector, kind: force, direction: x, signal: {type: step, amplitude: 1}}
+sensors:
+  - {name: roll_tip, at: mast, location: 130, direction: y}
+identification:
+  estimate: [EI]
+  uncertain: )";
+  const Scenario sc = parse_scenario(head + "{scole.reflector.mass: 0.6, sensors.roll_tip.location: 1.3, scole.bending_rotary_inertia: false}\n",
+                                     "scenario 'x.yaml'");
+  ASSERT_EQ(sc.identification.uncertain.size(), 3u);
+  EXPECT_EQ(sc.identification.uncertain[0].field, "scole.reflector.mass");
+  EXPECT_DOUBLE_EQ(sc.identification.uncertain[0].tolerance, 0.6);
+  EXPECT_EQ(sc.identification.uncertain[1].field, "sensors.roll_tip.location");
+  EXPECT_TRUE(sc.identification.uncertain[2].is_switch);
+  EXPECT_FALSE(sc.identification.uncertain[2].alternative);
+  Scenario copy = sc;
+  ASSERT_NE(numeric_field(copy, "scole.reflector.mass"), nullptr);
+  EXPECT_DOUBLE_EQ(*numeric_field(copy, "scole.reflector.mass"), 12.42);
+  EXPECT_EQ(to_json(sc)["identification"]["uncertain"]["sensors.roll_tip.location"].get<double>(), 1.3);
+  EXPECT_NE(error_of(head + "{scole.reflector.weight: 1}\n").find("identification.uncertain.scole.reflector.weight names no number"),
+            std::string::npos);
+  EXPECT_NE(error_of(head + "{sensors.nobody.location: 1}\n").find("names no number"), std::string::npos);
+  EXPECT_EQ(error_of(head + "{scole.GJ: -1}\n"),
+            "scenario 'x.yaml': identification.uncertain.scole.GJ must be a tolerance > 0, got -1");
+  EXPECT_EQ(error_of(head + "{scole.bending_rotary_inertia: true}\n"),
+            "scenario 'x.yaml': identification.uncertain.scole.bending_rotary_inertia must name the alternative to the "
+            "model's setting, got true");
+  EXPECT_NE(error_of(head + "[1, 2]\n").find("identification.uncertain must be a map"), std::string::npos);
 }

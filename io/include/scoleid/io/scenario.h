@@ -13,11 +13,14 @@
 //   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
 //   simulation:{ duration, sample_interval, seed }
-//   identification: { parameterization, estimate, initial, elements, data_elements, method, ... }
+//   identification: { parameterization, estimate, initial, elements, data_elements, method, ...,
+//                      uncertain: {field path: tolerance | alternative switch setting} }
 //   truth:     { segments, integrator, accuracy, ..., large_motion,
-//                overrides: {beam: {...}} | {scole: {...}} }
-//              (the Simbody generator's settings; overrides: structure fields in which the truth
-//              differs from the identifier's model — how a model-mismatch scenario is written)
+//                overrides: { beam: {...} | scole: {...},
+//                             sensors: [ { name, location, direction, bias, drift } ] } }
+//              (the Simbody generator's settings; overrides: structure and sensor fields in which
+//              the truth differs from the identifier's model — how a model-mismatch scenario is
+//              written)
 //
 // Plausibility guards (docs/truth-guards.md): the truth refuses a run whose motion leaves the
 // range the identifier's linear model describes — a proof mass beyond scole.actuator_stroke, a
@@ -98,6 +101,16 @@ struct ScoleSpec {
   // mast. Zero for both is the free slider (an ideal force source on a free mass).
   double actuator_stiffness = 0.0;
   double actuator_damping = 0.0;
+  // Servo lag [s] of every actuator (>= 0; 0 = none): the commanded force f_cmd(t) of an
+  // `at: actuatorK` input reaches the proof mass as f(t), the output of the first-order lag
+  //   τ ḟ + f = f_cmd(t),   f(0) = f_cmd(0).
+  // (A command that jumps at t = 0 therefore reaches the mass at once; one that starts later lags.)
+  // The Simbody truth models it without an extra state: f_cmd is a known function of time, so f
+  // is computed once at setup, by exact exponential integration across a grid on which f_cmd is
+  // replaced by quadratics (to ~1e-8 of its amplitude), and evaluated between nodes by the same
+  // formula (model/inputs.h, LaggedSignal). The identifier's FE model has no lag and refuses
+  // τ > 0: a mismatch study sets it under truth.overrides.scole.
+  double actuator_lag = 0.0;
 };
 
 // A point input. `at` names the body it acts on: "beam" or "mast" (then `location` is s),
@@ -129,12 +142,30 @@ struct SensorSpec {
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;
   double noise_std = 0.0;
+  // The sensor's own error in the truth, in its unit: the truth writes
+  //   y(t) = y_ideal(t) + bias + drift·t + noise,
+  // bias a constant offset, drift a rate [unit/s]. Set only under truth.overrides.sensors (the
+  // identifier models neither; the main sensors section refuses them), so both are 0 in the
+  // scenario the identifier reads.
+  double bias = 0.0;
+  double drift = 0.0;
 };
 
 struct SimulationSpec {
   double duration = 10.0;
   double sample_interval = 0.01;
   unsigned seed = 1;
+};
+
+// A quantity the identifier's model holds fixed but knows only to a tolerance
+// (identification.uncertain: {path: tolerance}); it widens the reported uncertainty interval by its
+// consider term (docs/theory.md §8.2). `field` is a path of io/scenario_fields.h. A number is a ± tolerance
+// in the field's unit; a switch (scole.bending_rotary_inertia) names the alternative model form.
+struct UncertainSpec {
+  std::string field;
+  double tolerance = 0.0;      // numbers: ± this
+  bool is_switch = false;
+  bool alternative = false;    // switches: the other setting to consider
 };
 
 struct IdentificationSpec {
@@ -161,6 +192,7 @@ struct IdentificationSpec {
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (resolves modes up to number P + 2)
   double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
+  std::vector<UncertainSpec> uncertain;  // declared tolerances of fixed quantities (consider terms)
 };
 
 struct TruthModelSpec {
@@ -171,7 +203,9 @@ struct TruthModelSpec {
   double accuracy = 1e-9;
   double output_interval = 0.0;   // 0 = simulation.sample_interval
   // truth.overrides as YAML text ("" = none): a partial beam: or scole: section applied on top of
-  // the scenario's structure for the truth only (truth_scenario). The identifier never reads it.
+  // the scenario's structure, and `sensors:`, partial sensor entries identified by name (location,
+  // direction, bias, drift), applied on top of the scenario's sensors, for the truth only
+  // (truth_scenario). The identifier never reads it.
   std::string overrides;
   std::string overrides_source;   // where it was read, for messages
   // A large-motion study (e.g. scole-slew): the truth does not refuse rotations beyond the
@@ -193,9 +227,10 @@ struct Scenario {
   TruthModelSpec truth;
 };
 
-// The scenario as the truth sees it: truth.overrides applied to its structure section.
+// The scenario as the truth sees it: truth.overrides applied to its structure section and its
+// sensors.
 Scenario truth_scenario(const Scenario& scenario);
-// Whether truth.overrides changes any structure field.
+// Whether truth.overrides changes any structure or sensor field.
 bool has_truth_overrides(const Scenario& scenario);
 
 // NAME (a built-in) or a path to a YAML file. Throws InputError.

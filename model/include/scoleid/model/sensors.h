@@ -16,6 +16,11 @@
 //                  (the feed-to-reflector line) has turned in R: (u0 x u) . d, u unit vectors.
 // Shuttle sensors ("at: shuttle") measure the shuttle itself in ground: CM displacement and the
 // attitude rotation vector relative to its initial orientation.
+// d need not be an axis: every read-out is linear in d (a projection onto it, or the rotation
+// vector's component along it), so a misaligned sensor (truth.overrides.sensors direction) reads
+// d_x y_x + d_y y_y + d_z y_z of the axis read-outs.
+// The truth's sensor errors (truth.overrides.sensors bias, drift) are not part of the read-out
+// (which stays the ideal, noise-free quantity): run_truth adds sensor_error() to it, before noise.
 // Every read-out needs the state realized to Stage::Acceleration (for acceleration) or Velocity.
 #include <string>
 #include <vector>
@@ -44,5 +49,8 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& scenario, const 
 // accelerometer, else Velocity).
 double read_sensor(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::State& state,
                    const ResolvedSensor& sensor);
+
+// The truth's error of sensor `s` at time t, in its unit: bias + drift·t (io::SensorSpec).
+inline double sensor_error(const io::SensorSpec& s, double t) { return s.bias + s.drift * t; }
 
 }  // namespace scoleid::model

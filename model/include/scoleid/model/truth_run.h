@@ -7,6 +7,7 @@
 // Integration stops at every input breakpoint (io::Signal::breakpoints) and restarts there,
 // so no step straddles a jump in f or f'. Samples are taken at k * dt, k = 0..floor(T/dt),
 // dt = truth.output_interval or simulation.sample_interval, by the integrator's interpolant.
+// Sensor errors (truth.overrides.sensors): bias + drift·t added to each noise-free read-out.
 // Sensor noise: N(0, noise_std^2), one std::mt19937_64 seeded with simulation.seed, drawn
 // column by column (sensors in scenario order, samples in time order) for sensors with
 // noise_std > 0; inputs are never noisy.

@@ -56,6 +56,8 @@
 //   mast     force at station s: b = (∂(u_x, u_y, w)(s)/∂u)ᵀ d;  moment: (∂Θ(s)/∂u)ᵀ d
 //   actuatorK (force only, d in the x–y plane): slider generalized forces f d_x, f d_y on the
 //            relative coordinates ξ − u(s_k): b = d_x (e_ξx − ∂u_x(s_k)/∂u) + d_y (e_ξy − ∂u_y(s_k)/∂u).
+//            f is the commanded force itself: the model has no servo lag (build_scole refuses
+//            scole.actuator_lag > 0; the truth models it under truth.overrides.scole).
 // Sensors (model/sensors.cpp read_sensor, reference body R = shuttle):
 //   displacement  (p_RP − p_RP0)·d, linearised: (δp_P − X − θ × p_P0)·d  (mast station or reflector CM)
 //   rotation      θ_RB·d = (Θ_B − θ)·d, Θ_B = Θ(s) on the mast, Θ(L) for the reflector

@@ -13,8 +13,8 @@
 // up, equals the whole (systematic) residual is
 //     resolution_i = std_i · ‖e‖_W     (‖W^½ G F⁻¹ e_i‖ = std_i),
 // the shift a model error of the residual's size could cause at most (Cauchy–Schwarz on
-// δq = F⁻¹ Gᵀ W e). ‖e‖_W² is the residual's χ² = Σ r²/σ² less the N values white noise of the
-// stated level accounts for; with no stated level (σ from the residual) nothing can be told apart
+// δq = F⁻¹ Gᵀ W e). ‖e‖_W² is the residual's χ² = Σ r²/σ² less the upper end N + 2√(2N) of the
+// band white noise of the stated level stays in; with no stated level (σ from the residual) nothing can be told apart
 // from noise and the whole χ² is counted. It is a limit of what the data resolve, not a bound on
 // the error: at the estimate the residual is orthogonal to the sensitivities, so model error that
 // mimics a parameter change (a chain's stiffness error looks like an EI change) has already been

@@ -3,7 +3,9 @@
 // identifiability, written as identify.json (docs/theory.md §10) and fit.csv (t, measured, predicted).
 //
 // Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
-// estimate.
+// estimate; the uncertainty interval (interval.h) from them, a refit on the first half of the
+// record, and the consider shifts of the scenario's declared uncertainties
+// (identification.uncertain).
 #include <functional>
 #include <map>
 #include <optional>
@@ -13,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scoleid/identify/inverse/identifiability.h"
+#include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/run_directory.h"
@@ -22,7 +25,7 @@ namespace scoleid::identify {
 struct RunOptions {
   std::optional<std::string> data_csv;
   std::string method;          // empty = the scenario's (auto → gauss-newton for ≤ 16 parameters, else lbfgs)
-  bool compute_std = true;
+  bool compute_std = true;     // identifiability and the uncertainty interval
   bool verbose = true;         // print the iteration table on stdout as it goes
   std::optional<int> max_iterations;
 };
@@ -36,6 +39,9 @@ struct RunResult {
   OptimizerSummary summary;
   ObjectiveCounters counters;
   Identifiability ident;
+  UncertaintyInterval interval;
+  VectorXd half_record_estimate;
+  bool half_record_converged = false;
   double wall_seconds = 0;
   double identifiability_seconds = 0;
   nlohmann::json to_json(const Problem& p) const;
