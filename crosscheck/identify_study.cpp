@@ -23,6 +23,11 @@ bool ParameterStudy::covered(std::size_t level) const {
   return std::isfinite(s) && std::abs(estimate[level] - truth) <= 2.0 * s;
 }
 
+bool ParameterStudy::interval_covered(std::size_t level) const {
+  const double h = half_width[level];
+  return std::isfinite(h) && std::abs(estimate[level] - truth) <= h;
+}
+
 bool IdentifyStudy::all_converged() const {
   for (const auto& r : runs)
     if (!r.converged) return false;
@@ -84,6 +89,9 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
       const auto ii = static_cast<Eigen::Index>(i);
       st.parameters[i].estimate.push_back(res.estimate[ii]);
       st.parameters[i].std.push_back(res.ident.std.size() > ii ? res.ident.std[ii] : ParameterStudy::nan);
+      const bool ok = res.ident.identifiable.size() > i && res.ident.identifiable[i];
+      st.parameters[i].half_width.push_back(ok && res.interval.half_width.size() > ii ? res.interval.half_width[ii]
+                                                                                      : ParameterStudy::nan);
     }
   }
   for (auto& ps : st.parameters) {
@@ -120,6 +128,8 @@ Table identify_table(const IdentifyStudy& s) {
   t.header.push_back("FE-on-FE");
   t.header.push_back("2 std n=" + std::to_string(s.segments.front()));
   t.header.push_back("covered");
+  t.header.push_back("± interval");
+  t.header.push_back("covered");
   for (const auto& p : s.parameters) {
     std::vector<std::string> row{p.name, number(p.truth, 7)};
     for (std::size_t l = 0; l < p.estimate.size(); ++l) row.push_back(percent(p.error(l), 3));
@@ -128,6 +138,8 @@ Table identify_table(const IdentifyStudy& s) {
     row.push_back(percent(p.fe_on_fe_error(), 3));
     row.push_back(percent(2.0 * p.std.front() / std::abs(p.truth), 3));
     row.push_back(std::isfinite(p.std.front()) ? (p.covered(0) ? "yes" : "no") : "no std");
+    row.push_back(percent(p.half_width.front() / std::abs(p.truth), 3));
+    row.push_back(std::isfinite(p.half_width.front()) ? (p.interval_covered(0) ? "yes" : "no") : "flagged");
     t.rows.push_back(row);
   }
   return t;
@@ -157,11 +169,14 @@ nlohmann::json to_json(const IdentifyStudy& s) {
     e["estimate"] = nums(p.estimate);
     e["std"] = nums(p.std);
     std::vector<double> err;
-    nlohmann::json cov = nlohmann::json::array();
+    nlohmann::json cov = nlohmann::json::array(), icov = nlohmann::json::array();
     for (std::size_t l = 0; l < p.estimate.size(); ++l) {
       err.push_back(p.error(l));
       cov.push_back(p.covered(l));
+      icov.push_back(p.interval_covered(l));
     }
+    e["half_width"] = nums(p.half_width);
+    e["covered_by_interval"] = icov;
     e["relative_error"] = nums(err);
     e["covered_by_2std"] = cov;
     e["extrapolated"] = num(p.extrapolated);

@@ -4,18 +4,22 @@
 //   scole-crosscheck identify     --scenario X [--out DIR]   identification on the truth, extrapolated in n
 //   scole-crosscheck report       [--scenario X] [--out DIR] report.md and plots from the above
 //   scole-crosscheck all          --scenario X [--out DIR]   the four, then the one-screen summary
+//   scole-crosscheck suite        [--only F] [--out DIR]     the mismatch suite (crosscheck/mismatch/*.yaml):
+//                                 errors, reported intervals, coverage, sharpness; report.md
 // DIR defaults to run/<scenario>/crosscheck. Each verb replaces only its own files there, as one
 // unit (io/run_directory.h). Exit codes: 0 success; 1 a run failed or an identification did not
 // converge (its outputs are written and say so); 2 bad usage or bad input (nothing written);
 // 130/143 interrupted (nothing written).
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 
 #include "scoleid/crosscheck/identify_study.h"
+#include "scoleid/crosscheck/mismatch_suite.h"
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/crosscheck/report.h"
 #include "scoleid/crosscheck/trajectories.h"
@@ -57,6 +61,100 @@ void write_report(io::RunDirectory& dir, const crosscheck::ReportInputs& in, boo
   }
   if (missing && !quiet)
     std::fprintf(stderr, "scole-crosscheck: gnuplot is not installed: plots not drawn (the .gp scripts are written)\n");
+}
+// Runs a verb; what escapes it becomes the exit code of the footer (2 bad input, 130/143
+// interrupted, 1 a failed run), with one line on stderr.
+int guarded(const std::function<int()>& verb) {
+  try {
+    return verb();
+  } catch (const io::InputError& e) {
+    std::fprintf(stderr, "scole-crosscheck: %s\n", io::one_line(e.what()).c_str());
+    return 2;
+  } catch (const io::Interrupted& e) {
+    std::fprintf(stderr, "\nscole-crosscheck: %s\n", e.what());
+    return e.exit_code();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "scole-crosscheck: run failed: %s\n", io::one_line(e.what()).c_str());
+    return 1;
+  }
+}
+
+// scole-crosscheck suite: see --help.
+int run_suite(const std::vector<std::string>& only, const std::string& suite_dir, const std::string& out, bool collect,
+              crosscheck::SuiteOptions so, bool quiet) {
+  so.progress = !quiet;
+  return guarded([&] {
+    // Every file is read and checked before anything runs: bad input costs nothing.
+    std::vector<crosscheck::SuiteFile> files;
+    if (!collect || !only.empty()) {
+      std::vector<std::string> paths;
+      if (only.empty()) paths = crosscheck::suite_files(suite_dir);
+      for (const auto& o : only) {
+        if (fs::exists(o)) { paths.push_back(o); continue; }
+        const fs::path p = fs::path(suite_dir) / (o + ".yaml");
+        bool found = fs::exists(p);
+        if (found) paths.push_back(p.string());
+        else
+          for (const auto& f : crosscheck::suite_files(suite_dir))
+            if (crosscheck::load_suite_file(f).family == o) { paths.push_back(f); found = true; }
+        if (!found) throw io::InputError("--only: '" + o + "' is neither a suite file nor a family in " + suite_dir);
+      }
+      if (paths.empty()) throw io::InputError("suite directory '" + suite_dir + "': no *.yaml family files");
+      for (const auto& p : paths) {
+        files.push_back(crosscheck::load_suite_file(p));
+        for (std::size_t k = 0; k < files.back().cases.size(); ++k) crosscheck::case_scenario(files.back(), k);
+      }
+    }
+    fs::create_directories(fs::path(out) / "results");
+    bool ok = true;
+    for (const auto& f : files) {
+      const auto r = crosscheck::run_suite_file(f, out, so);
+      io::write_json_atomic((fs::path(out) / "results" / (f.family + ".json")).string(), r);
+      ok = ok && r["expectations_met"].get<bool>();
+      if (!quiet)
+        for (const auto& c : r["checks"])
+          if (!c["held"].get<bool>())
+            std::fprintf(stderr, "scole-crosscheck suite: %s: expectation failed: %s (measured %s)\n", f.family.c_str(),
+                         c["what"].get<std::string>().c_str(), c["measured"].get<std::string>().c_str());
+    }
+    if (!only.empty() && !collect) {
+      if (!quiet) std::fprintf(stderr, "scole-crosscheck suite: wrote %s/results; %s\n", out.c_str(), ok ? "expectations held" : "NOT every expectation held");
+      return ok ? 0 : 1;
+    }
+    std::vector<nlohmann::json> results;
+    // One result per family of the suite directory (a family without one has not been run: that
+    // is an incomplete suite, not a smaller one).
+    std::vector<std::string> missing;
+    for (const auto& p : only.empty() ? crosscheck::suite_files(suite_dir) : std::vector<std::string>{}) {
+      const std::string fam = crosscheck::load_suite_file(p).family;
+      const fs::path r = fs::path(out) / "results" / (fam + ".json");
+      if (fs::exists(r)) results.push_back(io::read_json(r.string()));
+      else missing.push_back(fam);
+    }
+    for (const auto& f : files)
+      if (!only.empty()) results.push_back(io::read_json((fs::path(out) / "results" / (f.family + ".json")).string()));
+    if (!missing.empty()) {
+      std::string m;
+      for (const auto& f : missing) m += (m.empty() ? "" : ", ") + f;
+      std::fprintf(stderr, "scole-crosscheck suite: no results in %s/results for: %s (run them first)\n", out.c_str(), m.c_str());
+      return 1;
+    }
+    if (results.empty()) throw io::InputError("output directory '" + out + "': no results/*.json to summarise");
+    const auto s = crosscheck::summarise_suite(results);
+    for (const auto& [name, text] : crosscheck::suite_report(results, s))
+      io::write_text_atomic((fs::path(out) / name).string(), text);
+    if (identify::render_gnuplot(out, "suite.gp") == identify::RenderStatus::NoGnuplot && !quiet)
+      std::fprintf(stderr, "scole-crosscheck: gnuplot is not installed: suite.png not drawn (suite.gp is written)\n");
+    std::printf("Mismatch suite: %zu families, %d estimates\n", results.size(), s.cases);
+    std::printf("  coverage  %d of %d = %.1f %% (target >= 90 %%)\n", s.covered, s.cases, 100.0 * s.coverage);
+    std::printf("  sharpness median half-width %.3g / median error %.3g = %.2f (target <= 10)\n", s.median_relative_half_width,
+                s.median_relative_error, s.sharpness);
+    std::printf("  expectations of the family files: %s\n", s.expectations_met ? "all held" : "NOT all held");
+    for (const auto& f : s.failures) std::printf("    failed: %s\n", f.c_str());
+    std::printf("  report: %s/report.md\n", out.c_str());
+    const bool targets = s.coverage >= 0.9 && s.sharpness <= 10.0;
+    return ok && s.expectations_met && targets ? 0 : 1;
+  });
 }
 }  // namespace
 
@@ -113,6 +211,24 @@ int main(int argc, char** argv) {
   common(report);
   auto* all = app.add_subcommand("all", "modes, trajectories, identify and report, then the one-screen summary");
   common(all);
+  std::vector<std::string> suite_only;
+  std::string suite_dir = SCOLEID_MISMATCH_DIR, suite_out = "run/mismatch-suite";
+  bool suite_collect = false;
+  crosscheck::SuiteOptions so;
+  auto* suite = app.add_subcommand(
+      "suite", "the mismatch suite: each family file (truth differing from the identifier's model by a stated mismatch) "
+               "runs the truth and the identifier; per family <family>.json under --out/results with each case's errors, "
+               "reported intervals and the file's expectations; then report.md, suite.csv, suite.json and suite.png "
+               "(error and interval against mismatch size) with the coverage (truth inside the interval, target >= 90 %) "
+               "and the sharpness (median interval / median error, target <= 10). Exit 1 when an expectation or a "
+               "target fails (outputs written, marked).");
+  suite->add_option("--only", suite_only, "run only these families (file path or family name); no report unless --collect follows")
+      ->take_all();
+  suite->add_option("--suite-dir", suite_dir, "directory of the family files")->capture_default_str();
+  suite->add_option("-o,--out", suite_out, "output directory")->capture_default_str();
+  suite->add_option("--seeds", so.seeds, "noise seeds per noise case (default: the file's)");
+  suite->add_flag("--collect", suite_collect, "only summarise the results already in --out/results: report, coverage, sharpness");
+  suite->add_flag("-q,--quiet", quiet, "no progress on stderr");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -123,7 +239,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   io::install_interrupt_handlers();
-  try {
+  if (suite->parsed()) return run_suite(suite_only, suite_dir, suite_out, suite_collect, so, quiet);
+  return guarded([&] {
     const io::Scenario sc = io::load_scenario(scenario);
     io::validate_scenario(sc);
     if (out.empty()) out = "run/" + sc.name + "/crosscheck";
@@ -183,14 +300,5 @@ int main(int argc, char** argv) {
     dir.commit();
     if (!quiet) std::fprintf(stderr, "scole-crosscheck: wrote %s\n", out.c_str());
     return converged ? 0 : 1;
-  } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-crosscheck: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "\nscole-crosscheck: %s\n", e.what());
-    return e.exit_code();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-crosscheck: run failed: %s\n", io::one_line(e.what()).c_str());
-    return 1;
-  }
+  });
 }

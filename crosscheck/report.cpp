@@ -71,21 +71,22 @@ std::vector<std::string> summary_lines(const ReportInputs& in) {
   }
   if (!in.identify.is_null()) {
     double worst = 0.0, worst_x = 0.0, worst_fe = 0.0;
-    int covered = 0, total = 0;
+    int covered = 0, total = 0, icovered = 0;
     for (const auto& p : in.identify["parameters"]) {
       worst = std::max(worst, std::abs(num(p["relative_error"].front())));
       worst_x = std::max(worst_x, std::abs(num(p["extrapolated_relative_error"])));
       worst_fe = std::max(worst_fe, std::abs(num(p["fe_on_fe_relative_error"])));
       covered += p["covered_by_2std"].front().get<bool>() ? 1 : 0;
+      icovered += p.contains("covered_by_interval") && p["covered_by_interval"].front().get<bool>() ? 1 : 0;
       ++total;
     }
     const int n = in.identify["segments"].front().get<int>();
     out.push_back("parameters    within " + pct(worst) + " of the truth at n = " + std::to_string(n) + "; " + pct(worst_x) +
                   " extrapolated in n; FE-on-FE " + pct(worst_fe) +
                   (in.identify["all_converged"].get<bool>() ? "" : "  (NOT all runs converged)"));
-    out.push_back("uncertainty   the reported +-2 std covers the error for " + std::to_string(covered) + " of " +
-                  std::to_string(total) + " parameters at n = " + std::to_string(n) +
-                  (covered == total ? "" : ": the std measures the fit, not the model error"));
+    out.push_back("uncertainty   at n = " + std::to_string(n) + " the reported interval covers the error for " +
+                  std::to_string(icovered) + " of " + std::to_string(total) + " parameters, +-2 std for " +
+                  std::to_string(covered) + (covered == total ? "" : " (the std measures the noise, not the model error)"));
   }
   return out;
 }
@@ -178,7 +179,7 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
     Table t;
     t.header = {"parameter", "truth"};
     for (const auto& n : id["segments"]) t.header.push_back("n=" + std::to_string(n.get<int>()) + " %");
-    t.header.insert(t.header.end(), {"extrapolated %", "rate", "FE-on-FE %", "2 std (n) %", "covered"});
+    t.header.insert(t.header.end(), {"extrapolated %", "rate", "FE-on-FE %", "2 std (n) %", "covered", "± interval (n) %", "covered"});
     Table conv;
     conv.header = {"n"};
     for (const auto& p : id["parameters"]) conv.header.push_back(p["name"].get<std::string>());
@@ -195,6 +196,9 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
       row.push_back(percent(num(p["fe_on_fe_relative_error"]), 3));
       row.push_back(percent(2.0 * num(p["std"].front()) / std::abs(num(p["truth"])), 3));
       row.push_back(p["covered_by_2std"].front().get<bool>() ? "yes" : "no");
+      const bool has = p.contains("half_width") && p["half_width"].front().is_number();
+      row.push_back(has ? percent(num(p["half_width"].front()) / std::abs(num(p["truth"])), 3) : "-");
+      row.push_back(has ? (p["covered_by_interval"].front().get<bool>() ? "yes" : "no") : "flagged");
       t.rows.push_back(row);
     }
     rf.files.push_back({"identify_convergence.csv", conv.csv()});

@@ -52,6 +52,11 @@ double fe_reference_step(const identify::Problem& p) {
 
 FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
   io::Scenario sc = io::truth_scenario(scenario);
+  if (sc.structure == "scole" && sc.scole.actuator_lag > 0)
+    io::fail_field(scenario.source, "truth.overrides.scole.actuator_lag",
+                   "is a servo lag of the Simbody truth only: the finite-element model cannot follow it, so the "
+                   "trajectories cannot be compared at the truth's physics",
+                   io::format_value(sc.scole.actuator_lag));
   sc.truth.overrides.clear();
   sc.identification.elements = elements;
   sc.identification.time_step = 0.0;

@@ -5,10 +5,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -79,5 +84,92 @@ TEST(CrosscheckCli, AllWritesTablesReportAndRecoversFromFeData) {
   EXPECT_EQ(fs::last_write_time(out / "modes.json"), modes_time);
   EXPECT_TRUE(fs::exists(out / "identify.json"));
   EXPECT_EQ(slurp(out / "report.md"), md);
+  fs::remove_all(d);
+}
+
+namespace {
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+}  // namespace
+
+// scole-crosscheck suite: a family file with an error is one line naming the file, the field and
+// the value, exit 2, and nothing is run or written.
+TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
+  const fs::path d = scratch("suite-bad");
+  const std::string good_head =
+      "family: f\nmismatch: m\nreason: r\nscenario: paper-beam-1\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {good_head + "cases: [{label: a, size: 1}]\nfrobnicate: 1\n", "frobnicate"},
+      {good_head + "cases: []\n", "cases"},
+      {good_head + "cases: [{label: 'a b', size: 1}]\n", "cases[0].label"},
+      {good_head + "cases: [{label: a, size: .nan}]\n", "cases[0].size"},
+      {good_head + "cases: [{label: a, size: 1, overlay: {beam: {EI: -5}}}]\n", "EI"},
+      {"family: f\nmismatch: m\nreason: r\nscenario: no-such-base\ncases: [{label: a, size: 1}]\n", "no-such-base"},
+      {good_head + "cases: [{label: a, size: 1}]\nnoise: {relative: 2, seeds: 5}\n", "noise.relative"},
+      {good_head + "cases: [{label: a, size: 1}]\nexpect: {rate: [3, 1]}\n", "expect.rate"},
+      {good_head + "cases: [{label: a, size: 1, overlay: {identification: {uncertain: {beam.nothing: 1}}}}]\n", "beam.nothing"},
+      {good_head + "cases: [{label: a, size: 1}\n", "malformed"},
+  };
+  int k = 0;
+  for (const auto& [text, needle] : cases) {
+    const fs::path f = d / ("bad" + std::to_string(k++) + ".yaml");
+    write(f, text);
+    const fs::path out = d / "out";
+    EXPECT_EQ(sh(exe + " suite --only " + f.string() + " --out " + out.string() + " 2> " + (d / "err").string()), 2) << text;
+    const std::string err = slurp(d / "err");
+    EXPECT_NE(err.find(needle), std::string::npos) << err;
+    EXPECT_NE(err.find(f.filename().string()), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_FALSE(fs::exists(out)) << text;
+  }
+  EXPECT_EQ(sh(exe + " suite --only no-such-family --out " + (d / "out").string() + " 2> /dev/null"), 2);
+  fs::remove_all(d);
+}
+
+// A small family on a beam (the paper's Case I, chain of 10 and 20 segments): the family's results
+// and the suite's report; the chain's error in q2 falls at second order and the report states the
+// coverage it measured. --collect without the family's results is an incomplete suite: exit 1.
+TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
+  const fs::path d = scratch("suite-beam");
+  fs::create_directories(d / "families");
+  write(d / "families" / "chain.yaml",
+        "family: beam-chain\nmismatch: chain of n segments\nsize_unit: n\nreason: second-order lumping\n"
+        "scenario: paper-beam-1\n"
+        "cases:\n  - {label: n10, size: 10, overlay: {truth: {segments: 10}}}\n"
+        "  - {label: n20, size: 20, overlay: {truth: {segments: 20}}}\n"
+        "expect: {rate: {q2: [1.5, 2.5]}}\n");
+  const fs::path out = d / "out";
+  const std::string dir = " --suite-dir " + (d / "families").string() + " --out " + out.string();
+  EXPECT_EQ(sh(exe + " suite --collect -q" + dir + " > /dev/null 2>&1"), 1);
+  ASSERT_EQ(sh(exe + " suite --only beam-chain -q" + dir), 0);
+  const auto r = nlohmann::json::parse(slurp(out / "results" / "beam-chain.json"));
+  ASSERT_EQ(r["cases"].size(), 2u);
+  // q2 (1/rho_A) carries the chain's lumping; q1 sits on the geometric nonlinearity's floor.
+  ASSERT_EQ(r["observed_orders"]["q2"].size(), 1u);
+  for (const auto& order : r["observed_orders"]["q2"]) {
+    EXPECT_GT(order.get<double>(), 1.5);
+    EXPECT_LT(order.get<double>(), 2.5);
+  }
+  EXPECT_TRUE(r["expectations_met"].get<bool>());
+  // Every estimate carries its interval and whether it covers the truth.
+  int covered = 0, n = 0;
+  for (const auto& c : r["cases"])
+    for (const auto& q : c["parameters"]) {
+      ASSERT_TRUE(q["relative_half_width"].is_number());
+      const bool cov = std::abs(q["relative_error"].get<double>()) <= q["relative_half_width"].get<double>();
+      EXPECT_EQ(cov, q["covered"].get<bool>());
+      covered += cov;
+      ++n;
+    }
+  sh(exe + " suite --collect" + dir + " > " + (d / "stdout").string() + " 2>&1");
+  const std::string md = slurp(out / "report.md");
+  const auto s = nlohmann::json::parse(slurp(out / "suite.json"));
+  EXPECT_EQ(s["cases"].get<int>(), n);
+  EXPECT_EQ(s["covered"].get<int>(), covered);
+  EXPECT_NE(md.find("Coverage"), std::string::npos);
+  EXPECT_NE(md.find("| beam-chain |"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "suite.csv"));
+  EXPECT_TRUE(fs::exists(out / "suite.gp"));
   fs::remove_all(d);
 }
