@@ -23,6 +23,7 @@
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/crosscheck/report.h"
 #include "scoleid/crosscheck/trajectories.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
@@ -84,7 +85,9 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
               crosscheck::SuiteOptions so, bool quiet) {
   so.progress = !quiet;
   return guarded([&] {
-    // Every file is read and checked before anything runs: bad input costs nothing.
+    if (so.seeds != 0 && so.seeds < 2) throw io::InputError("--seeds must be at least 2 (a scatter needs two draws), got " + std::to_string(so.seeds));
+    // Every file is read and checked before anything runs, the identifier's model of each case
+    // built once: bad input costs nothing and writes nothing.
     std::vector<crosscheck::SuiteFile> files;
     if (!collect || !only.empty()) {
       std::vector<std::string> paths;
@@ -102,7 +105,14 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
       if (paths.empty()) throw io::InputError("suite directory '" + suite_dir + "': no *.yaml family files");
       for (const auto& p : paths) {
         files.push_back(crosscheck::load_suite_file(p));
-        for (std::size_t k = 0; k < files.back().cases.size(); ++k) crosscheck::case_scenario(files.back(), k);
+        for (const auto& f : files)
+          if (&f != &files.back() && f.family == files.back().family)
+            throw io::InputError("suite file '" + p + "': family '" + f.family + "' is also the family of '" + f.path + "'");
+        for (std::size_t k = 0; k < files.back().cases.size(); ++k) {
+          const io::Scenario sc = crosscheck::case_scenario(files.back(), k);
+          const auto st = identify::make_structure(sc, sc.identification.elements);
+          st->parameterize(sc);
+        }
       }
     }
     fs::create_directories(fs::path(out) / "results");
@@ -124,15 +134,15 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
     std::vector<nlohmann::json> results;
     // One result per family of the suite directory (a family without one has not been run: that
     // is an incomplete suite, not a smaller one).
-    std::vector<std::string> missing;
-    for (const auto& p : only.empty() ? crosscheck::suite_files(suite_dir) : std::vector<std::string>{}) {
-      const std::string fam = crosscheck::load_suite_file(p).family;
+    std::vector<std::string> missing, families;
+    for (const auto& p : crosscheck::suite_files(suite_dir)) families.push_back(crosscheck::load_suite_file(p).family);
+    for (const auto& f : files)
+      if (std::find(families.begin(), families.end(), f.family) == families.end()) families.push_back(f.family);
+    for (const auto& fam : families) {
       const fs::path r = fs::path(out) / "results" / (fam + ".json");
       if (fs::exists(r)) results.push_back(io::read_json(r.string()));
       else missing.push_back(fam);
     }
-    for (const auto& f : files)
-      if (!only.empty()) results.push_back(io::read_json((fs::path(out) / "results" / (f.family + ".json")).string()));
     if (!missing.empty()) {
       std::string m;
       for (const auto& f : missing) m += (m.empty() ? "" : ", ") + f;
@@ -222,7 +232,7 @@ int main(int argc, char** argv) {
                "(error and interval against mismatch size) with the coverage (truth inside the interval, target >= 90 %) "
                "and the sharpness (median interval / median error, target <= 10). Exit 1 when an expectation or a "
                "target fails (outputs written, marked).");
-  suite->add_option("--only", suite_only, "run only these families (file path or family name); no report unless --collect follows")
+  suite->add_option("--only", suite_only, "run only these families (file path or family name); no report unless --collect is given too (the report then covers every family of --suite-dir)")
       ->take_all();
   suite->add_option("--suite-dir", suite_dir, "directory of the family files")->capture_default_str();
   suite->add_option("-o,--out", suite_out, "output directory")->capture_default_str();

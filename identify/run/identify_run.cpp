@@ -66,10 +66,11 @@ const char* integrator_name(SolverOptions::Integrator i) {
   return "?";
 }
 
-// Consider terms (interval.h): for each declared tolerance, the shift of the least-squares
-// estimate that the quantity's change would cause, −F⁻¹ Gᵀ W G_θ Δθ with G_θ Δθ the central
-// difference of the model's outputs at q̂ (or the difference to the alternative model form), over
-// the parameters the Fisher test kept.
+// Consider terms (interval.h): for each declared tolerance, the bias of the least-squares
+// estimate when the structure's value is θ + Δθ and the model's θ: F⁻¹ Gᵀ W G_θ Δθ, with G_θ Δθ
+// the central difference of the model's outputs at q̂ (or the difference to the alternative model
+// form), over the parameters the Fisher test kept. A quantity the outputs do not depend on at q̂
+// (an estimated one: the parameters overwrite it) is refused.
 std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const Identifiability& id, const VectorXd& q) {
   std::vector<ConsiderTerm> terms;
   const auto& uncertain = p.scenario.identification.uncertain;
@@ -134,6 +135,11 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const
         io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
                        "moves the scenario out of its valid range on both sides", io::format_value(u.tolerance));
     }
+    if (!(d.squaredNorm() > 0) || !d.allFinite())
+      io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
+                     d.allFinite() ? "does not change the model's outputs (an estimated quantity, or one the sensors do not depend on)"
+                                   : "makes the model's response non-finite",
+                     u.is_switch ? (u.alternative ? "true" : "false") : io::format_value(u.tolerance));
     const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
     t.shift = VectorXd::Zero(P);
     for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];

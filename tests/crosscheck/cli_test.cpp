@@ -110,6 +110,9 @@ TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
       {good_head + "cases: [{label: a, size: 1}]\nexpect: {rate: [3, 1]}\n", "expect.rate"},
       {good_head + "cases: [{label: a, size: 1, overlay: {identification: {uncertain: {beam.nothing: 1}}}}]\n", "beam.nothing"},
       {good_head + "cases: [{label: a, size: 1}\n", "malformed"},
+      {good_head + "cases: [{label: a, size: 1}]\nexpect: {all_covered: 1}\n", "expect.all_covered"},
+      {"family: f\nmismatch: m\nreason: r\nscenario: paper-scole-1\n"
+       "cases: [{label: a, size: 1, overlay: {scole: {actuator_lag: 0.1}}}]\n", "scole.actuator_lag"},
   };
   int k = 0;
   for (const auto& [text, needle] : cases) {
@@ -124,6 +127,14 @@ TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
     EXPECT_FALSE(fs::exists(out)) << text;
   }
   EXPECT_EQ(sh(exe + " suite --only no-such-family --out " + (d / "out").string() + " 2> /dev/null"), 2);
+  // The same family twice, and a seed count that has no scatter.
+  write(d / "one.yaml", good_head + "cases: [{label: a, size: 1}]\n");
+  write(d / "two.yaml", good_head + "cases: [{label: b, size: 2}]\n");
+  EXPECT_EQ(sh(exe + " suite --only " + (d / "one.yaml").string() + " " + (d / "two.yaml").string() + " --out " +
+               (d / "out").string() + " 2> /dev/null"),
+            2);
+  EXPECT_EQ(sh(exe + " suite --seeds 1 --only " + (d / "one.yaml").string() + " --out " + (d / "out").string() + " 2> /dev/null"), 2);
+  EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);
 }
 

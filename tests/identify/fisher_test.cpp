@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "scoleid/identify/run/identify_run.h"
+#include "scoleid/io/error.h"
 
 using namespace scoleid::identify;
 
@@ -145,5 +146,21 @@ truth: {overrides: {beam: {tip_mass: 21}}}
     EXPECT_GT(std::abs(bias), 1e-4 * truth[i]);  // a real bias, far above the FE's own error (~1e-6)
     EXPECT_NEAR(predicted / bias, 1.0, 0.15);     // first order in a 5 % change
     EXPECT_LE(std::abs(bias), r.interval.half_width[i]);
+  }
+}
+
+// A tolerance on a quantity the run estimates would be a consider term of zero (the parameters
+// overwrite it): refused, naming the field.
+TEST(Interval, ToleranceOnAnEstimatedQuantityIsRefused) {
+  auto sc = scoleid::io::load_scenario("paper-beam-1");
+  sc.identification.uncertain.push_back({"beam.rho_A", 2.0, false, false});
+  auto p = make_problem(sc, std::nullopt);
+  RunOptions ro;
+  ro.verbose = false;
+  try {
+    run_identification(*p, ro);
+    FAIL() << "a tolerance on an estimated quantity gave an interval";
+  } catch (const scoleid::io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("identification.uncertain.beam.rho_A"), std::string::npos) << e.what();
   }
 }

@@ -18,8 +18,9 @@
 //     record is halved is not determined to better than that move; a consistent model and white
 //     noise give a shift of about one std.
 //   Consider terms (Schmidt's consider analysis, as in orbit determination): a quantity the model
-//     holds fixed at a value known only to ±Δθ shifts the least-squares estimate by
-//     ∂q̂/∂θ·Δθ = −F⁻¹ Gᵀ W G_θ·Δθ, with G_θ the output sensitivity to θ (central differences).
+//     holds fixed at θ while the structure's value is θ + Δθ biases the least-squares estimate by
+//     F⁻¹ Gᵀ W G_θ·Δθ (G_θ the output sensitivity to θ, central differences); only its size
+//     enters the interval.
 //     A mismatch that the data cannot tell from a parameter change (a reflector mass error looks
 //     like a mast mass error) leaves no residual: only a declared uncertainty can cover it.
 //
@@ -35,7 +36,7 @@ struct ConsiderTerm {
   std::string field;     // scenario field, e.g. scole.reflector.mass
   double value = 0;      // the model's value
   double delta = 0;      // its declared uncertainty (absolute)
-  VectorXd shift;        // ∂q̂/∂θ·Δθ per estimated parameter
+  VectorXd shift;        // F⁻¹ Gᵀ W G_θ Δθ per estimated parameter: the bias if the structure's θ is θ + Δθ
 };
 
 struct IntervalInputs {
