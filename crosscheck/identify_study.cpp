@@ -43,7 +43,7 @@ LevelRun run_one(identify::Problem& p, int segments, identify::RunResult& result
   result = identify::run_identification(p, ro);
   LevelRun r;
   r.segments = segments;
-  r.converged = result.summary.converged();
+  r.converged = result.converged();
   r.iterations = result.summary.iterations_done;
   r.termination = identify::to_string(result.summary.termination);
   r.seconds = result.wall_seconds;

@@ -93,7 +93,11 @@ json identify_row(identify::Problem& p) {
   ro.data_csv = p.data_source;
   const identify::RunResult r = identify::run_identification(p, ro);
   json row;
-  row["converged"] = r.summary.converged();
+  row["converged"] = r.converged();
+  row["optimizer_converged"] = r.summary.converged();
+  row["explains_data"] = r.fit.explains_data;
+  row["fit_ratio"] = r.fit.ratio;
+  row["fit_test"] = r.fit.message;
   row["termination"] = identify::to_string(r.summary.termination);
   row["iterations"] = r.summary.iterations_done;
   row["seconds"] = r.wall_seconds;
@@ -390,7 +394,9 @@ json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptio
   json checks = json::array();
   for (const auto& c : res["cases"]) {
     const std::string at = " (case " + c["label"].get<std::string>() + ")";
-    checks.push_back(check("the identification converged" + at, c["converged"].get<bool>(), c["termination"].get<std::string>()));
+    // The optimiser must converge; whether the model then explains the data (the fit test) is what
+    // the family measures, reported beside the errors, not an expectation.
+    checks.push_back(check("the optimiser converged" + at, c["optimizer_converged"].get<bool>(), c["termination"].get<std::string>()));
     for (const auto& q : c["parameters"]) {
       const std::string n = q["name"];
       const bool expect_flag = std::find(f.expect.flagged.begin(), f.expect.flagged.end(), n) != f.expect.flagged.end();
@@ -493,7 +499,8 @@ SuiteSummary summarise_suite(const std::vector<json>& families) {
 std::map<std::string, std::string> suite_report(const std::vector<json>& families, const SuiteSummary& s) {
   std::map<std::string, std::string> files;
   // suite.csv and the data blocks of the plot.
-  std::string csv = "family,case,size,size_unit,parameter,truth,estimate,relative_error,relative_half_width,covered,identifiable\n";
+  std::string csv =
+      "family,case,size,size_unit,parameter,truth,estimate,relative_error,relative_half_width,covered,identifiable,explains_data\n";
   std::ostringstream md;
   md << "# Mismatch suite\n\n"
      << "Identification on the Simbody truth when the truth differs from the identifier's model, one family per row "
@@ -509,7 +516,11 @@ std::map<std::string, std::string> suite_report(const std::vector<json>& familie
   md << "**Expectations of the suite files:** " << (s.expectations_met ? "all held" : "NOT all held") << ".\n\n";
   for (const auto& f : s.failures) md << "- failed: " << f << "\n";
   md << "\n![error and interval against mismatch size](suite.png)\n\n";
-  md << "| family | mismatch | case | size | parameter | error % | ± interval % | covered |\n|---|---|---|---|---|---|---|---|\n";
+  md << "The last column is the fit test (docs/theory.md §7.6): whether the model at the estimate explains the data "
+        "within noise, discretisation and the default 1 % model error — where it says no, the mismatch shows in the "
+        "residual and the run exits 1 (not converged).\n\n";
+  md << "| family | mismatch | case | size | parameter | error % | ± interval % | covered | explains data |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
   std::ostringstream gp;
   gp << "# Error and reported interval against mismatch size, one panel per family (gnuplot suite.gp)\n"
      << "set terminal pngcairo noenhanced size 1400," << 300 * ((families.size() + 2) / 3) << " font ',9'\nset output 'suite.png'\n"
@@ -522,15 +533,18 @@ std::map<std::string, std::string> suite_report(const std::vector<json>& familie
         const bool ok = q["identifiable"].get<bool>();
         const double err = q["relative_error"].is_number() ? q["relative_error"].get<double>() : std::nan("");
         const double hw = ok && q["relative_half_width"].is_number() ? q["relative_half_width"].get<double>() : std::nan("");
-        std::snprintf(buf, sizeof buf, "%s,%s,%.9g,%s,%s,%.12g,%.12g,%.6e,%.6e,%s,%s\n", fam.c_str(),
+        const bool explains = c.value("explains_data", true);
+        std::snprintf(buf, sizeof buf, "%s,%s,%.9g,%s,%s,%.12g,%.12g,%.6e,%.6e,%s,%s,%s\n", fam.c_str(),
                       c["label"].get<std::string>().c_str(), c["size"].get<double>(), f["size_unit"].get<std::string>().c_str(),
                       q["name"].get<std::string>().c_str(), q["truth"].get<double>(), q["estimate"].get<double>(), err, hw,
-                      q["covered"].get<bool>() ? "yes" : "no", ok ? "yes" : "no");
+                      q["covered"].get<bool>() ? "yes" : "no", ok ? "yes" : "no", explains ? "yes" : "no");
         csv += buf;
-        std::snprintf(buf, sizeof buf, "| %s | %s | %s | %g %s | %s | %+.4f | %s | %s |\n", fam.c_str(),
+        const std::string fit = explains ? "yes" : "no (" + fmt("%.2g", c.value("fit_ratio", 0.0)) + "x)";
+        std::snprintf(buf, sizeof buf, "| %s | %s | %s | %g %s | %s | %+.4f | %s | %s | %s |\n", fam.c_str(),
                       f["mismatch"].get<std::string>().c_str(), c["label"].get<std::string>().c_str(), c["size"].get<double>(),
                       f["size_unit"].get<std::string>().c_str(), q["name"].get<std::string>().c_str(), 100.0 * err,
-                      ok ? fmt("%.4f", 100.0 * hw).c_str() : "NOT IDENTIFIABLE", !ok ? "(flagged)" : q["covered"].get<bool>() ? "yes" : "**no**");
+                      ok ? fmt("%.4f", 100.0 * hw).c_str() : "NOT IDENTIFIABLE", !ok ? "(flagged)" : q["covered"].get<bool>() ? "yes" : "**no**",
+                      fit.c_str());
         md << buf;
         std::snprintf(buf, sizeof buf, "%.9g %.6e %s\n", c["size"].get<double>(), 100.0 * std::abs(err), ok ? fmt("%.6e", 100.0 * hw).c_str() : "NaN");
         blocks[q["name"].get<std::string>()] += buf;

@@ -22,8 +22,9 @@ int main(int argc, char** argv) {
       "the identifier's, so the identifier never fits its own discretisation. Writes DIR/identify.json\n"
       "(estimates, truth, std, iteration history, counts, timings, settings) and DIR/fit.csv\n"
       "(measured, predicted, residual per sensor), and prints the iteration table.\n\n"
-      "Exit codes: 0 converged; 1 the run failed, or did not converge (its outputs are written, marked\n"
-      "\"converged\": false); 2 bad usage or bad input (nothing written); 130/143 interrupted by\n"
+      "Exit codes: 0 converged; 1 the run failed, did not converge, or stopped at a point that does not explain\n"
+      "the data (the fit test: residual beyond noise, discretisation and identification.model_error; its outputs\n"
+      "are written, marked \"converged\": false); 2 bad usage or bad input (nothing written); 130/143 interrupted by\n"
       "SIGINT/SIGTERM (nothing written). The outputs of a run appear together or not at all: they are\n"
       "written beside --out and moved into place as one directory at the end."};
   std::string scenario = "paper-beam-1";
@@ -120,6 +121,13 @@ int main(int argc, char** argv) {
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
+    if (r.summary.converged() && !r.fit.explains_data) {
+      std::fprintf(stderr,
+                   "scole-identify: stopped at a point that does not explain the data (%s); %zu attempt%s; outputs written "
+                   "with \"converged\": false\n",
+                   io::one_line(r.fit.message).c_str(), r.attempts.size(), r.attempts.size() > 1 ? "s" : "");
+      return 1;
+    }
     if (!r.summary.converged()) {
       std::fprintf(stderr, "scole-identify: did not converge (%s: %s); outputs written with \"converged\": false\n",
                    identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());

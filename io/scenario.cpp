@@ -454,6 +454,8 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
   id.time_step = r.nonneg("time_step", id.time_step);
   id.rtol = r.positive("rtol", id.rtol);
+  if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
+  id.restarts = r.integer("restarts", id.restarts, 0, 10);
   if (r.has("uncertain")) {
     // Paths are checked against the whole scenario once it is read (parse_scenario).
     const YAML::Node m = r.child("uncertain");
@@ -714,7 +716,9 @@ nlohmann::json to_json(const Scenario& s) {
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
-                         {"time_step", id.time_step}, {"rtol", id.rtol}};
+                         {"time_step", id.time_step}, {"rtol", id.rtol},
+                         {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
+                         {"restarts", id.restarts}};
   if (!id.uncertain.empty()) {
     json u = json::object();
     for (const auto& x : id.uncertain) u[x.field] = x.is_switch ? json(x.alternative) : json(x.tolerance);

@@ -66,12 +66,12 @@ int main(int argc, char** argv) {
   identify::RunOptions options;
   options.verbose = false;
   const identify::RunResult r = identify::run_identification(*problem, options);
-  std::printf("step 4: %s (%s) after %zu iterations\n", r.summary.converged() ? "converged" : "NOT converged",
+  std::printf("step 4: %s (%s) after %zu iterations\n", r.converged() ? "converged" : "NOT converged",
               identify::to_string(r.summary.termination), r.summary.iterations.size() - 1);
 
   // Step 5. The answer, against the values the synthetic data were made with.
   const auto truth = identify::make_problem(sc, std::nullopt)->true_values;
-  bool ok = r.summary.converged();
+  bool ok = r.converged();
   std::printf("step 5:");
   for (std::size_t i = 0; i < r.names.size(); ++i) {
     const auto e = static_cast<Eigen::Index>(i);

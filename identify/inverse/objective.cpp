@@ -441,19 +441,31 @@ Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& 
   return solver.solve(data_.t.front(), t_end, f, breakpoints_, nullptr);
 }
 
+int Objective::sensitivity_block(double t_end) const {
+  const int P = size();
+  const double t0 = data_.t.front();
+  const double h = options_.solver.step > 0 ? options_.solver.step : (t_end - t0) / 2000.0;
+  const double points = (t_end - t0) / h + 1.0 + 2.0 * static_cast<double>(breakpoints_.size());
+  const double bytes = points * model_.ndof * 3.0 * sizeof(double);
+  const double fit = std::floor(kSensitivityBlockBytes / std::max(bytes, 1.0));
+  return static_cast<int>(std::max(1.0, std::min(static_cast<double>(P), fit)));
+}
+
 std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s,
-                                                            double state_end, double tangent_end, Trajectory& u) {
-  const int P = size(), n = model_.ndof;
+                                                            double state_end, double tangent_end, Trajectory& u,
+                                                            int first, int count) {
+  const int n = model_.ndof;
+  if (count < 0) count = size() - first;
   const auto ts = Clock::now();
   std::vector<Trajectory> S;
   if (solver.has_tangent_solve()) {
     std::vector<Derivative> d;
-    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    for (int i = first; i < first + count; ++i) d.push_back(derivative(s, i));
     std::vector<double> f(inputs_.size());
     SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* v, const double* a, double* Gp) {
       const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
       for (std::size_t k = 0; k < inputs_.size(); ++k) f[k] = inputs_[k](t);
-      for (int i = 0; i < P; ++i) {
+      for (int i = 0; i < count; ++i) {
         Eigen::Map<VectorXd> Gi(Gp + static_cast<std::size_t>(i) * n, n);
         const Derivative& di = d[static_cast<std::size_t>(i)];
         Gi.noalias() -= di.dM * A;
@@ -464,16 +476,16 @@ std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSol
       }
     };
     SolverSummary sum;
-    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), P, G, tangent_end, breakpoints_, &sum);
+    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), count, G, tangent_end, breakpoints_, &sum);
     counters_.solver.Accumulate(sum);
     ++counters_.forward_solves;
     u = std::move(sol.state);
     S = std::move(sol.tangents);
   } else {
     u = forward(solver, s, state_end);
-    for (int i = 0; i < P; ++i) S.push_back(sensitivity(solver, s, u, i, tangent_end));
+    for (int i = first; i < first + count; ++i) S.push_back(sensitivity(solver, s, u, i, tangent_end));
   }
-  counters_.sensitivity_solves += P;
+  counters_.sensitivity_solves += count;
   counters_.sensitivity_seconds += since(ts);
   return S;
 }
@@ -482,32 +494,59 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
+  const double state_end = profile ? data_.t.back() : T_;
+  // The tangents in blocks of at most sensitivity_block() trajectories, the state re-solved with
+  // each block; their outputs C S at the quadrature points are kept (quadrature points × sensors ×
+  // P numbers), not the trajectories.
+  const int B = sensitivity_block(state_end);
   Trajectory u;
-  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, profile ? data_.t.back() : T_, T_, u);
+  std::vector<double> grid;
+  MatrixXd CSall;  // row (point · ns + sensor), column parameter
+  VectorXd x(n), v(n), a(n), si(n), sv(n);
+  for (int first = 0; first < P; first += B) {
+    const int count = std::min(B, P - first);
+    const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, state_end, T_, u, first, count);
+    const auto tq = Clock::now();
+    if (first == 0) {
+      grid = union_grid({&u.times()}, T_);
+      CSall.resize(static_cast<Eigen::Index>(3 * (grid.size() - 1) * static_cast<std::size_t>(ns)), P);
+    }
+    std::vector<Derivative> d;
+    if (accelerations_)
+      for (int i = first; i < first + count; ++i) d.push_back(derivative(s, i));
+    Eigen::Index row = 0;
+    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+      const double h = grid[k + 1] - grid[k];
+      for (int gq = 0; gq < 3; ++gq, row += ns) {
+        const double t = grid[k] + kGx[gq] * h;
+        u.eval(t, x.data(), v.data());
+        if (accelerations_) output_at(s, solver, t, x, v, &a);
+        for (int i = 0; i < count; ++i) {
+          S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
+          CSall.block(row, first + i, ns, 1) = accelerations_
+                                                   ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
+                                                   : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
+        }
+      }
+    }
+    counters_.quadrature_seconds += since(tq);
+  }
 
   const auto tq = Clock::now();
-  const auto grid = union_grid({&u.times()}, T_);
-  VectorXd x(n), v(n), a(n), z(ns), si(n), sv(n);
-  MatrixXd CS(ns, P);
-  std::vector<Derivative> d;
-  if (accelerations_)
-    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+  VectorXd z(ns);
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   double J = 0.0;
+  Eigen::Index row = 0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
-    for (int gq = 0; gq < 3; ++gq) {
+    for (int gq = 0; gq < 3; ++gq, row += ns) {
       const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
       u.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
       const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-      for (int i = 0; i < P; ++i) {
-        S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
-        CS.col(i) = accelerations_ ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
-                                   : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
-      }
+      const auto CS = CSall.middleRows(row, ns);
       const MatrixXd RCS = Rv.asDiagonal() * CS;
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
@@ -561,21 +600,26 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
-  Trajectory u;
   const double t_end = data_.t.back();
-  const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, t_end, t_end, u);
+  // In blocks of tangents (as gauss_newton): memory O(block · steps · DOF + samples · sensors · P).
+  const int B = sensitivity_block(t_end);
   MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
   VectorXd x(n), v(n), a(n), ux(n), uv(n);
-  for (int i = 0; i < P; ++i) {
-    const Derivative d = accelerations_ ? derivative(s, i) : Derivative{};
-    for (std::size_t k = 0; k < data_.t.size(); ++k) {
-      const double t = data_.t[k];
-      S[static_cast<std::size_t>(i)].eval(t, x.data(), v.data());
-      if (accelerations_) {
-        u.eval(t, ux.data(), uv.data());
-        output_at(s, solver, t, ux, uv, &a);
+  for (int first = 0; first < P; first += B) {
+    const int count = std::min(B, P - first);
+    Trajectory u;
+    const std::vector<Trajectory> S = solve_with_sensitivities(solver, s, t_end, t_end, u, first, count);
+    for (int i = 0; i < count; ++i) {
+      const Derivative d = accelerations_ ? derivative(s, first + i) : Derivative{};
+      for (std::size_t k = 0; k < data_.t.size(); ++k) {
+        const double t = data_.t[k];
+        S[static_cast<std::size_t>(i)].eval(t, x.data(), v.data());
+        if (accelerations_) {
+          u.eval(t, ux.data(), uv.data());
+          output_at(s, solver, t, ux, uv, &a);
+        }
+        G.block(static_cast<Eigen::Index>(k) * ns, first + i, ns, 1) = tangent_output_at(solver, d, t, ux, uv, a, x, v);
       }
-      G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) = tangent_output_at(solver, d, t, ux, uv, a, x, v);
     }
   }
   return G;

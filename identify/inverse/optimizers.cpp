@@ -235,102 +235,152 @@ void gauss_newton(Run& r, VectorXd x) {
 }
 
 void lbfgs(Run& r, VectorXd x, bool steepest) {
+  Objective& obj = r.obj;
+  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const double t_min = t0 + r.opt.continuation_min_fraction * (t_end - t0);
+  // Horizon continuation as for Gauss–Newton (header): the longest T >= t_min up to which the
+  // misfit profile at x stays within the bound; one extra state solve per accepted step while the
+  // horizon is short of the record.
+  const bool continuation = r.opt.continuation;
+  auto full = [&]() { return obj.horizon() >= t_end; };
+  auto choose_horizon = [&](const VectorXd& xx, double current) {
+    const Objective::MisfitProfile p = obj.misfit_profile(xx.array().exp());
+    double Th = t_min;
+    for (std::size_t i = 0; i < p.t.size(); ++i) {
+      if (p.t[i] <= t_min) continue;
+      if (!(p.misfit[i] <= r.opt.continuation_misfit)) break;
+      Th = p.t[i];
+    }
+    Th = std::max(Th, current);
+    return Th >= t_end - 1e-9 * (t_end - t0) ? t_end : Th;
+  };
   double J;
   VectorXd gx;
-  if (!r.eval_grad(x, J, gx)) {
+  std::deque<std::pair<VectorXd, VectorXd>> mem;  // (s, y)
+  // A new horizon is a new cost: its gradient, and the curvature pairs of the old one dropped.
+  auto extend = [&](double T_new) {
+    if (full() || !(T_new > obj.horizon())) return false;
+    obj.set_horizon(T_new);
+    if (!r.eval_grad(x, J, gx)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    mem.clear();
+    return true;
+  };
+  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
+  obj.set_horizon(t_end);
+  bool start_ok = true;
+  if (continuation) {
+    try {
+      obj.set_horizon(choose_horizon(x, t0));
+    } catch (const std::exception&) {
+      start_ok = false;
+    }
+  }
+  if (!start_ok || !r.eval_grad(x, J, gx)) {
     r.sum.termination = T::LineSearchFailed;
     r.sum.message = "cost cannot be evaluated at the starting point";
     r.sum.q = x.array().exp();
+    obj.set_horizon(t_end);
     return;
   }
   r.record(0, J, x.array().exp(), gx);
-  std::deque<std::pair<VectorXd, VectorXd>> mem;  // (s, y)
   const int m = 8;
   double alpha0 = 1.0;
   const bool fixed_weights = steepest && !r.opt.steepest_weights.empty();
   VectorXd w;
   if (fixed_weights) {
     w = Eigen::Map<const VectorXd>(r.opt.steepest_weights.data(), static_cast<Eigen::Index>(r.opt.steepest_weights.size()));
-    if (w.size() != x.size()) throw std::invalid_argument("steepest_weights: one weight per parameter");
+    if (w.size() != x.size()) {
+      obj.set_horizon(t_end);
+      throw std::invalid_argument("steepest_weights: one weight per parameter");
+    }
   }
   int k = 0;
   r.sum.termination = T::MaxIterations;
-  while (true) {
-    if (J <= r.opt.cost_floor) { r.sum.termination = T::CostFloor; break; }
-    if (r.small_gradient(gx, J)) { r.sum.termination = T::GradientTolerance; break; }
-    if (k >= r.opt.max_iterations) break;
-    VectorXd d;
-    if (fixed_weights) {
-      // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
-      const VectorXd q = x.array().exp();
-      d = -(w.array() * (gx.array() / q.array()) / q.array()).matrix();
-    } else if (steepest || mem.empty()) {
-      d = -gx;
-      if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
-      if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
-    } else {
-      // two-loop recursion
-      VectorXd qv = gx;
-      std::vector<double> al(mem.size());
-      for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
-        const auto& [s, y] = mem[static_cast<std::size_t>(i)];
-        al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
-        qv -= al[static_cast<std::size_t>(i)] * y;
-      }
-      const auto& [sl, yl] = mem.back();
-      qv *= sl.dot(yl) / yl.dot(yl);
-      for (std::size_t i = 0; i < mem.size(); ++i) {
-        const auto& [s, y] = mem[i];
-        const double b = y.dot(qv) / y.dot(s);
-        qv += (al[i] - b) * s;
-      }
-      d = -qv;
-    }
-    if (gx.dot(d) >= 0) {
-      mem.clear();
-      d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
-    }
-    const double mx = d.cwiseAbs().maxCoeff();
-    if (mx > 1.0) d *= 1.0 / mx;
-    double a = 1.0, Jn = 0.0;
-    VectorXd gn;
-    bool ok = false;
-    for (int ls = 0; ls < 40; ++ls) {
-      if (r.eval_grad(x + a * d, Jn, gn) && Jn <= J + 1e-4 * a * gx.dot(d) && Jn <= J) {
-        ok = true;
+  try {
+    while (true) {
+      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
+        if (extend(doubled())) continue;
+        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
         break;
       }
-      a *= 0.5;
+      if (k >= r.opt.max_iterations) break;
+      VectorXd d;
+      if (fixed_weights) {
+        // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
+        const VectorXd q = x.array().exp();
+        d = -(w.array() * (gx.array() / q.array()) / q.array()).matrix();
+      } else if (steepest || mem.empty()) {
+        d = -gx;
+        if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
+        if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
+      } else {
+        // two-loop recursion
+        VectorXd qv = gx;
+        std::vector<double> al(mem.size());
+        for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
+          const auto& [s, y] = mem[static_cast<std::size_t>(i)];
+          al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
+          qv -= al[static_cast<std::size_t>(i)] * y;
+        }
+        const auto& [sl, yl] = mem.back();
+        qv *= sl.dot(yl) / yl.dot(yl);
+        for (std::size_t i = 0; i < mem.size(); ++i) {
+          const auto& [s, y] = mem[i];
+          const double b = y.dot(qv) / y.dot(s);
+          qv += (al[i] - b) * s;
+        }
+        d = -qv;
+      }
+      if (gx.dot(d) >= 0) {
+        mem.clear();
+        d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
+      }
+      const double mx = d.cwiseAbs().maxCoeff();
+      if (mx > 1.0) d *= 1.0 / mx;
+      double a = 1.0, Jn = 0.0;
+      VectorXd gn;
+      bool ok = false;
+      for (int ls = 0; ls < 40; ++ls) {
+        if (r.eval_grad(x + a * d, Jn, gn) && Jn <= J + 1e-4 * a * gx.dot(d) && Jn <= J) {
+          ok = true;
+          break;
+        }
+        a *= 0.5;
+      }
+      if (!ok) {
+        if (extend(doubled())) continue;
+        r.sum.termination = T::LineSearchFailed;
+        r.sum.message = "no decrease along the search direction";
+        break;
+      }
+      const VectorXd s = a * d, y = gn - gx;
+      const bool stalled = J - Jn <= (r.opt.cost_stall > 0 ? r.opt.cost_stall : 1e-5) * J;
+      x += s;
+      J = Jn;
+      gx = gn;
+      if (!steepest && y.dot(s) > 1e-300) {
+        mem.emplace_back(s, y);
+        if (static_cast<int>(mem.size()) > m) mem.pop_front();
+      }
+      if (steepest && !fixed_weights) alpha0 = std::min(1e3, a * 2.0 * alpha0);
+      ++k;
+      const bool extended = continuation && !full() && extend(choose_horizon(x, obj.horizon()));
+      r.record(k, J, x.array().exp(), gx);
+      if (extended) continue;
+      if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance || (stalled && !steepest)) {
+        if (extend(doubled())) continue;
+        r.sum.termination = s.cwiseAbs().maxCoeff() < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+        break;
+      }
     }
-    if (!ok) {
-      r.sum.termination = T::LineSearchFailed;
-      r.sum.message = "no decrease along the search direction";
-      break;
-    }
-    const VectorXd s = a * d, y = gn - gx;
-    const bool stalled = J - Jn <= (r.opt.cost_stall > 0 ? r.opt.cost_stall : 1e-5) * J;
-    x += s;
-    J = Jn;
-    gx = gn;
-    if (!steepest && y.dot(s) > 1e-300) {
-      mem.emplace_back(s, y);
-      if (static_cast<int>(mem.size()) > m) mem.pop_front();
-    }
-    if (steepest && !fixed_weights) alpha0 = std::min(1e3, a * 2.0 * alpha0);
-    ++k;
-    r.record(k, J, x.array().exp(), gx);
-    if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance) {
-      r.sum.termination = T::StepTolerance;
-      break;
-    }
-    if (stalled && !steepest) {
-      r.sum.termination = T::CostStalled;
-      break;
-    }
+  } catch (const std::runtime_error& e) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = e.what();
   }
   r.sum.iterations_done = k;
   r.sum.q = x.array().exp();
-  r.sum.cost = J;
+  r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
+  obj.set_horizon(t_end);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/error.h"
@@ -150,6 +151,42 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const
 
 }  // namespace
 
+double model_error(const Problem& p) {
+  const double m = p.scenario.identification.model_error;
+  if (m >= 0) return m;
+  const bool own_model = p.data_source.rfind("synthetic", 0) == 0 && !io::has_truth_overrides(p.scenario);
+  return own_model ? 0.0 : 0.01;
+}
+
+FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
+  FitTestInputs in;
+  in.data = p.data.z;
+  in.names = p.data.names;
+  in.noise_std = p.noise_std;
+  in.model_error = model_error(p);
+  if (!q.allFinite()) {
+    in.residual = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));
+    return fit_test(in);
+  }
+  const MatrixXd Y = obj.predict(q);
+  in.residual = Y - p.data.z;
+  // The discretisation estimate: the same model on twice the elements at a quarter of the step (the
+  // refinement the synthetic data are made with, problem.h).
+  try {
+    const auto fine = make_structure(p.scenario, 2 * p.structure->elements());
+    const auto params = fine->parameterize(p.scenario);
+    if (params->names() == p.params->names()) {
+      ObjectiveOptions o = p.objective_options;
+      if (o.solver.step > 0) o.solver.step /= 4.0;
+      Objective fo(fine->model(), *params, p.signals, p.data, o);
+      in.discretisation = fo.predict(q) - Y;
+    }
+  } catch (const io::InputError&) {
+    // A model that cannot be refined (beyond the element limit): no discretisation estimate.
+  }
+  return fit_test(in);
+}
+
 RunResult run_identification(Problem& p, const RunOptions& ro) {
   const auto t0 = std::chrono::steady_clock::now();
   RunResult r;
@@ -176,10 +213,98 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
                    std::to_string(oo.steepest_weights.size()) + " values");
   Table table(*p.params, p.params->names().size() <= 3 && p.params->paper_form());
   if (ro.verbose) table.header();
-  r.summary = minimize(obj, r.initial, oo, [&](const IterationRecord& rec) {
+  auto progress = [&](const IterationRecord& rec) {
     io::check_interrupt();
     if (ro.verbose) table.row(rec);
-  });
+  };
+  r.summary = minimize(obj, r.initial, oo, progress);
+  r.fit = test_fit(p, obj, r.summary.q);
+  auto attempt_record = [&](const std::string& strategy, const OptimizerSummary& s, const FitTest& f, int iterations) {
+    RunResult::Attempt a;
+    a.strategy = strategy;
+    a.termination = to_string(s.termination);
+    a.cost = std::isfinite(s.q.sum()) ? obj.cost(s.q) : std::nan("");
+    a.iterations = iterations;
+    a.explains_data = f.explains_data;
+    a.fit_message = f.message;
+    return a;
+  };
+  r.attempts.push_back(attempt_record("plain " + method, r.summary, r.fit, r.summary.iterations_done));
+  // Further attempts when the model at the estimate does not explain the data.
+  const auto families = section_families(r.names);
+  std::vector<std::string> strategies;
+  if (!families.empty()) strategies.push_back("coarse-to-fine");
+  strategies.push_back("cautious-continuation");
+  ObjectiveCounters extra;  // solves of the tied levels' objectives
+  for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
+    const std::string& how = strategies[k];
+    // Coarse to fine is tried whenever the residual exceeds noise and discretisation (a local
+    // minimum of a sectional profile may still fit within a declared model error); the others
+    // only when the fit does not explain the data.
+    if (how == "coarse-to-fine" ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
+    if (ro.verbose)
+      std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
+                  r.fit.explains_data ? "the residual exceeds noise and discretisation" : r.fit.message.c_str(), k + 1,
+                  how.c_str());
+    OptimizerSummary s;
+    int iterations = 0;
+    std::string label;
+    if (how == "coarse-to-fine") {
+      // Levels of 1, 2, 4, … blocks per sectional family, each from the end of the previous one,
+      // then the full parameterization.
+      std::size_t N = 0;
+      for (const auto& f : families) N = std::max(N, f.size());
+      VectorXd q = r.initial;
+      label = "coarse-to-fine over";
+      for (int B = 1; B < static_cast<int>(N); B *= 2) {
+        auto [group, gnames] = block_grouping(r.names, families, B);
+        TiedParameterization tied(*p.params, q, group, gnames);
+        Objective level(p.model(), tied, p.signals, p.data, p.objective_options);
+        OptimizerOptions ol = oo;
+        ol.method = "gauss-newton";
+        ol.continuation = p.scenario.identification.continuation_misfit > 0;
+        const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
+        const auto& c = level.counters();
+        extra.forward_solves += c.forward_solves;
+        extra.costate_solves += c.costate_solves;
+        extra.sensitivity_solves += c.sensitivity_solves;
+        extra.gradient_evaluations += c.gradient_evaluations;
+        extra.forward_seconds += c.forward_seconds;
+        extra.costate_seconds += c.costate_seconds;
+        extra.sensitivity_seconds += c.sensitivity_seconds;
+        extra.quadrature_seconds += c.quadrature_seconds;
+        extra.solver.Accumulate(c.solver);
+        iterations += sl.iterations_done;
+        if (sl.q.allFinite()) q = tied.expand(sl.q);
+        label += " " + std::to_string(B);
+        if (ro.verbose) std::printf("  %d block%s per family: %s\n", B, B > 1 ? "s" : "", sl.BriefReport().c_str());
+      }
+      label += " blocks, then " + std::to_string(N) + " sections";
+      if (ro.verbose) table.header();
+      s = minimize(obj, q, oo, progress);
+    } else {
+      OptimizerOptions oc = oo;
+      oc.method = "gauss-newton";
+      oc.continuation = true;
+      oc.continuation_misfit = (p.scenario.identification.continuation_misfit > 0 ? p.scenario.identification.continuation_misfit
+                                                                                  : OptimizerOptions{}.continuation_misfit) / 4.0;
+      label = "gauss-newton, horizon continuation at misfit " + io::format_value(oc.continuation_misfit);
+      if (ro.verbose) table.header();
+      s = minimize(obj, r.initial, oc, progress);
+    }
+    iterations += s.iterations_done;
+    const FitTest f = test_fit(p, obj, s.q);
+    r.attempts.push_back(attempt_record(label, s, f, iterations));
+    const auto& best = r.attempts[static_cast<std::size_t>(r.chosen_attempt)];
+    const auto& now = r.attempts.back();
+    if ((now.explains_data && !best.explains_data) ||
+        (now.explains_data == best.explains_data && now.cost < best.cost)) {
+      r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
+      r.summary = s;
+      r.fit = f;
+    }
+  }
+  if (ro.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
   r.estimate = r.summary.q;
   if (ro.compute_std) {
     const auto ti = std::chrono::steady_clock::now();
@@ -223,6 +348,15 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();
+  r.counters.forward_solves += extra.forward_solves;
+  r.counters.costate_solves += extra.costate_solves;
+  r.counters.sensitivity_solves += extra.sensitivity_solves;
+  r.counters.gradient_evaluations += extra.gradient_evaluations;
+  r.counters.forward_seconds += extra.forward_seconds;
+  r.counters.costate_seconds += extra.costate_seconds;
+  r.counters.sensitivity_seconds += extra.sensitivity_seconds;
+  r.counters.quadrature_seconds += extra.quadrature_seconds;
+  r.counters.solver.Accumulate(extra.solver);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -284,7 +418,29 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"iterations", iters},
            {"termination", to_string(summary.termination)},
            {"termination_message", summary.message},
-           {"converged", summary.converged()},
+           {"converged", converged()},
+           {"optimizer_converged", summary.converged()},
+           {"fit_test", [&] {
+              nlohmann::json sens = nlohmann::json::array();
+              for (const auto& sf : fit.sensors)
+                sens.push_back({{"name", sf.name}, {"rms_signal", sf.rms_signal}, {"rms_residual", sf.rms_residual},
+                                {"noise", sf.noise}, {"noise_estimated", sf.noise_estimated}, {"systematic", sf.systematic},
+                                {"discretisation", std::isfinite(sf.discretisation) ? nlohmann::json(sf.discretisation) : nlohmann::json(nullptr)},
+                                {"allowed", sf.allowed}, {"explained", sf.explained}});
+              return nlohmann::json{{"explains_data", fit.explains_data},
+                                    {"within_noise_and_discretisation", fit.within_noise_and_discretisation},
+                                    {"model_error", fit.model_error}, {"ratio", fit.ratio},
+                                    {"message", fit.message}, {"sensors", sens}};
+            }()},
+           {"attempts", [&] {
+              nlohmann::json a = nlohmann::json::array();
+              for (std::size_t k = 0; k < attempts.size(); ++k)
+                a.push_back({{"strategy", attempts[k].strategy}, {"termination", attempts[k].termination},
+                             {"cost", std::isfinite(attempts[k].cost) ? nlohmann::json(attempts[k].cost) : nlohmann::json(nullptr)},
+                             {"iterations", attempts[k].iterations}, {"explains_data", attempts[k].explains_data},
+                             {"fit_message", attempts[k].fit_message}, {"chosen", static_cast<int>(k) == chosen_attempt}});
+              return a;
+            }()},
            {"cost", summary.cost},
            {"gradient_evaluations", counters.gradient_evaluations},
            {"forward_solves", counters.forward_solves},

@@ -45,19 +45,74 @@ std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elem
 
 }  // namespace
 
-double resolved_frequency(const StructuralModel& model, const Parameterization& params) {
+DataContent data_content(const StructuralModel& model, const Parameterization& params,
+                         const std::vector<io::Signal>& signals, double t_end, double sample_interval) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
   const AssembledModel ops = assemble(model, c);
-  const std::vector<double> w = natural_frequencies(ops.M, ops.K);
-  const double wmax = w.empty() ? 0.0 : w.back();
-  std::vector<double> flexible;
-  for (double x : w)
-    if (x > 1e-6 * wmax) flexible.push_back(x);
-  if (flexible.empty()) return 0.0;
-  const std::size_t r = std::min(flexible.size(), static_cast<std::size_t>(params.size() + 2)) - 1;
-  return flexible[r];
+  const NaturalModes m = natural_modes(ops.M, ops.K);
+  DataContent d;
+  d.nyquist = M_PI / sample_interval;
+  std::vector<Eigen::Index> flexible;
+  for (Eigen::Index k = 0; k < m.omega.size(); ++k)
+    if (m.omega[k] > m.floor && m.omega[k] <= d.nyquist) flexible.push_back(k);
+  d.modes_below_nyquist = static_cast<int>(flexible.size());
+  if (flexible.empty()) return d;
+  // The inputs sampled once on a grid fine enough for every frequency up to Nyquist (16 points per
+  // sample interval: ω δ <= π/16); F_i(ω) = ∫₀ᵀ f_i(t) e^{−iωt} dt by the midpoint rule.
+  const long n = std::max(16L, static_cast<long>(std::ceil(16.0 * t_end / sample_interval)));
+  const double delta = t_end / static_cast<double>(n);
+  std::vector<std::vector<double>> f(signals.size(), std::vector<double>(static_cast<std::size_t>(n)));
+  for (std::size_t i = 0; i < signals.size(); ++i)
+    for (long q = 0; q < n; ++q) f[i][static_cast<std::size_t>(q)] = signals[i]((q + 0.5) * delta);
+  const MatrixXd C0 = model.output_matrix(0), C1 = model.output_matrix(1), C2 = model.output_matrix(2);
+  const Eigen::Index ns = C0.rows();
+  MatrixXd A(ns, static_cast<Eigen::Index>(flexible.size()));
+  for (std::size_t a = 0; a < flexible.size(); ++a) {
+    const Eigen::Index k = flexible[a];
+    const double w = m.omega[k];
+    const VectorXd phi = m.vectors.col(k);
+    // Modal excitation |Σ_i (φᵀ b_i) F_i(ω_k)|; the undamped modal response to it has amplitude at
+    // most that over ω_k.
+    std::complex<double> excitation = 0.0;
+    const std::complex<double> rot = std::polar(1.0, -w * delta);
+    for (std::size_t i = 0; i < signals.size(); ++i) {
+      std::complex<double> e = std::polar(1.0, -w * 0.5 * delta), F = 0.0;
+      for (long q = 0; q < n; ++q) {
+        F += f[i][static_cast<std::size_t>(q)] * e;
+        e *= rot;
+      }
+      excitation += phi.dot(ops.loads[i]) * F * delta;
+    }
+    const VectorXd g = C0 * phi;
+    const VectorXd g1 = C1.rows() == ns ? VectorXd(C1 * phi) : VectorXd::Zero(ns);
+    const VectorXd g2 = C2.rows() == ns ? VectorXd(C2 * phi) : VectorXd::Zero(ns);
+    for (Eigen::Index j = 0; j < ns; ++j)
+      A(j, static_cast<Eigen::Index>(a)) =
+          (std::abs(g[j]) + w * std::abs(g1[j]) + w * w * std::abs(g2[j])) * std::abs(excitation) / w;
+  }
+  int last = -1;
+  for (Eigen::Index j = 0; j < ns; ++j) {
+    const double top = A.row(j).maxCoeff();
+    if (!(top > 0)) continue;
+    for (Eigen::Index a = A.cols() - 1; a > last; --a)
+      if (A(j, a) >= kModeContentThreshold * top) {
+        last = static_cast<int>(a);
+        break;
+      }
+  }
+  d.content_mode = last + 1;
+  // P + 2 modes — P parameters are fixed mostly by the first P modes' frequencies and shapes — but
+  // never more than the samples can carry: for many parameters the step stops shrinking there.
+  // (The content K_data is reported, not used: a mode far below the largest in amplitude can still
+  // be the one that carries a weakly seen parameter — SCOLE's modes 5 and 6, at < 1e-4 of the
+  // first in every sensor, fix ρI_ψ to 4e-5 when resolved and leave it 5e-3 off when not.)
+  last = std::min(static_cast<int>(flexible.size()), params.size() + 2) - 1;
+  if (last < 0) last = 0;  // nothing measurable: resolve the first flexible mode
+  d.mode = last + 1;
+  d.omega = m.omega[flexible[static_cast<std::size_t>(last)]];
+  return d;
 }
 
 double numerical_damping_ratio(const ButcherTable& t, double x) {
@@ -86,8 +141,8 @@ bool estimates_damping(const StructuralModel& model, const Parameterization& par
 }
 
 // The smallest positive modal damping ratio φᵀDφ / (2ω) (M-orthonormal φ) over the flexible
-// modes 1 … P + 2 at the starting parameters; 0 if none is damped.
-double smallest_modal_damping(const StructuralModel& model, const Parameterization& params) {
+// modes 1 … count at the starting parameters; 0 if none is damped.
+double smallest_modal_damping(const StructuralModel& model, const Parameterization& params, int count) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
@@ -96,7 +151,7 @@ double smallest_modal_damping(const StructuralModel& model, const Parameterizati
   const MatrixXd D(ops.D);
   double smallest = 0.0;
   int counted = 0;
-  for (Eigen::Index k = 0; k < m.omega.size() && counted < params.size() + 2; ++k) {
+  for (Eigen::Index k = 0; k < m.omega.size() && counted < count; ++k) {
     if (!(m.omega[k] > m.floor)) continue;
     ++counted;
     const VectorXd phi = m.vectors.col(k);
@@ -107,19 +162,20 @@ double smallest_modal_damping(const StructuralModel& model, const Parameterizati
 }
 }  // namespace
 
-double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params) {
+double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
+                       const std::vector<io::Signal>& signals) {
   if (sc.identification.time_step > 0) return sc.identification.time_step;
-  // Resolve (ω h <= 0.3) the flexible modes up to number P + 2 at the starting parameters:
-  // an L-stable step damps what it does not resolve, and P parameters are fixed mostly by the
-  // first P modes' frequencies and shapes.
-  const double w = resolved_frequency(model, params);
+  // Resolve (ω h <= 0.3) modes 1 … K, K = min(P + 2, modes below Nyquist) (data_content): an
+  // L-stable step damps what it does not resolve, keeping its quasi-static part.
+  const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval);
+  const double w = content.omega;
   double h = sc.simulation.sample_interval;
   if (w > 0) h = std::min(h, 0.3 / w);
   // A damping parameter is read from decay rates: the step's own damping in that band must be
-  // small against the physical one, ζ_num(ω_{P+2} h) <= 1 % of the smallest modal damping ratio
+  // small against the physical one, ζ_num(ω_K h) <= 1 % of the smallest modal damping ratio
   // there (docs/theory.md §5.2), or the fit absorbs the integrator's damping into the estimate.
   if (w > 0 && estimates_damping(model, params)) {
-    const double target = 0.01 * smallest_modal_damping(model, params);
+    const double target = 0.01 * smallest_modal_damping(model, params, content.mode);
     const ButcherTable table = ButcherTable::arkode_dirk(SolverOptions{}.dirk_table);
     if (target > 0.0 && numerical_damping_ratio(table, w * h) > target) {
       double lo = 0.0, hi = w * h;  // ζ_num grows with x = ω h on (0, 0.3]
@@ -135,29 +191,32 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
 
 namespace {
 // Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
-// scenario that does not resolve the modes the parameters live in (ω_{P+2} h > 1: the L-stable
-// step would damp them away and the fit would absorb that into the parameters), and trajectory
-// storage beyond io::limits (state, costate and, for Gauss–Newton or the standard deviations,
-// one sensitivity trajectory per parameter; synthetic data on its finer mesh and step).
-void check_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params, double h,
-                bool synthetic) {
+// scenario that does not resolve the modes the data contain (ω_K h > 1: the L-stable step would
+// damp them away and the fit would absorb that into the parameters), and trajectory storage
+// beyond io::limits (state, costate and, for Gauss–Newton or the standard deviations, a block of
+// sensitivity trajectories; synthetic data on its finer mesh and step).
+void check_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
+                const std::vector<io::Signal>& signals, double h, bool synthetic) {
   const auto& id = sc.identification;
   const double T = sc.simulation.duration;
   const std::string field = id.time_step > 0 ? "identification.time_step" : "identification.elements";
-  const std::string got = id.time_step > 0 ? io::format_value(id.time_step) : std::to_string(id.elements);
+  const std::string got = id.time_step > 0 ? io::format_value(id.time_step)
+                                           : std::to_string(id.elements) + " (automatic time step " + io::format_value(h) + ")";
   if (id.time_step > 0 && id.integrator != "bdf") {
-    const double w = resolved_frequency(model, params);
+    const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval);
+    const double w = content.omega;
     if (w * h > 1.0)
       fail_field(sc.source, "identification.time_step",
-                 "must resolve flexible mode " + std::to_string(params.size() + 2) + " (" +
+                 "must resolve flexible mode " + std::to_string(content.mode) + " = min(P + 2, modes below Nyquist) (" +
                      io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
                      io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
                      io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
                  io::format_value(h));
   }
   const double steps = T / h;
-  const double trajectories = 2.0 + params.size();
-  const double bytes = (steps + 1.0) * model.ndof * 3.0 * 8.0 * trajectories;
+  // State and costate, and the sensitivities in blocks of at most kSensitivityBlockBytes (objective.h).
+  const double one = (steps + 1.0) * model.ndof * 3.0 * 8.0;
+  const double bytes = 2.0 * one + std::min(params.size() * one, std::max(one, kSensitivityBlockBytes));
   if (!(steps <= io::limits::kMaxSteps) || !(bytes <= io::limits::kMaxTrajectoryBytes))
     fail_field(sc.source, field,
                "gives " + io::format_value(std::ceil(steps)) + " steps of " + std::to_string(model.ndof) + " DOF (about " +
@@ -257,8 +316,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       p->noise_std[j] = sc.sensors[j].noise_std;
       p->noise_origin[j] = "scenario";
     }
-  // The identifier's step (each call solves an eigenproblem): once.
-  const double step = identifier_step(sc, p->model(), *p->params);
+  // The identifier's step (each call solves an eigenproblem): once, from the inputs as they will
+  // drive the model (a data column replaces a scenario signal).
+  double step = 0.0;
   if (data_csv) {
     const io::DataTable tab = io::read_csv(*data_csv);
     // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
@@ -343,7 +403,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       fail_field(sc.source, "identification.data_elements",
                  "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                  std::to_string(data_elements));
-    check_step(sc, p->model(), *p->params, step, true);
+    step = identifier_step(sc, p->model(), *p->params, p->signals);
+    check_step(sc, p->model(), *p->params, p->signals, step, true);
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
@@ -356,7 +417,10 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     set_true_values(truth_sc);
   }
-  if (data_csv) check_step(sc, p->model(), *p->params, step, false);
+  if (data_csv) {
+    step = identifier_step(sc, p->model(), *p->params, p->signals);
+    check_step(sc, p->model(), *p->params, p->signals, step, false);
+  }
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = step;
   p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf

@@ -340,3 +340,25 @@ identification:
             "model's setting, got true");
   EXPECT_NE(error_of(head + "[1, 2]\n").find("identification.uncertain must be a map"), std::string::npos);
 }
+
+TEST(Scenario, ModelErrorAndRestartsAreReadAndChecked) {
+  const std::string head = R"(structure: beam
+inputs:
+  - {name: P, location: 5, signal: {type: step, amplitude: 10}}
+sensors:
+  - {name: w, location: 5}
+identification:
+  estimate: [EI]
+)";
+  const Scenario automatic = parse_scenario(head, "scenario 'x.yaml'");
+  EXPECT_LT(automatic.identification.model_error, 0.0);  // automatic
+  EXPECT_EQ(automatic.identification.restarts, 2);
+  EXPECT_EQ(to_json(automatic)["identification"]["model_error"].get<std::string>(), "auto");
+  const Scenario given = parse_scenario(head + "  model_error: 0.005\n  restarts: 0\n", "scenario 'x.yaml'");
+  EXPECT_DOUBLE_EQ(given.identification.model_error, 0.005);
+  EXPECT_EQ(given.identification.restarts, 0);
+  EXPECT_DOUBLE_EQ(to_json(given)["identification"]["model_error"].get<double>(), 0.005);
+  EXPECT_NE(error_of(head + "  model_error: -0.01\n").find("identification.model_error"), std::string::npos);
+  EXPECT_NE(error_of(head + "  model_error: .nan\n").find("identification.model_error"), std::string::npos);
+  EXPECT_NE(error_of(head + "  restarts: 11\n").find("identification.restarts"), std::string::npos);
+}

@@ -193,6 +193,14 @@ struct IdentificationSpec {
   double time_step = 0.0;             // esdirk step; 0 = automatic (resolves modes up to number P + 2)
   double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
   std::vector<UncertainSpec> uncertain;  // declared tolerances of fixed quantities (consider terms)
+  // The model-form error the data are expected to carry, as a fraction of each sensor's RMS
+  // signal: the fit test's allowance beyond noise and discretisation (identify/inverse/fit_test.h).
+  // < 0 = automatic: 0 for data the scenario synthesises from its own model (no truth.overrides),
+  // 0.01 for anything else (a data file, a truth with overrides).
+  double model_error = -1.0;
+  // Further attempts when the fit does not explain the data (coarse-to-fine over sections, a
+  // slower horizon continuation); 0 = report the first attempt as it is.
+  int restarts = 2;
 };
 
 struct TruthModelSpec {

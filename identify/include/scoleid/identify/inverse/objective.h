@@ -18,7 +18,7 @@
 //             u̇(0) = 0), so only displacements and velocities of the two recorded solutions
 //             enter; with them p(T) = −μ(T) ≠ 0 and ü is taken from the equation of motion.
 //             Either way the cost is one forward and one backward pass, independent of P.
-//   Gauss–Newton: sensitivities S_i = ∂u/∂q_i from
+//   Gauss–Newton (in blocks of parameters, see kSensitivityBlockBytes): sensitivities S_i = ∂u/∂q_i from
 //             M S̈_i + D Ṡ_i + K S_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f),
 //             H = ∫ (C S)ᵀ R (C S) dt,  g = ∫ (C S)ᵀ R r dt.
 //             With the esdirk integrator the S_i are stepped with u on u's own stages
@@ -45,6 +45,11 @@
 #include "scoleid/io/signal.h"
 
 namespace scoleid::identify {
+
+// Memory for recorded sensitivity trajectories at once: Gauss–Newton and the output sensitivities
+// step the P tangents in blocks that fit in it (the state re-solved with each block), so memory
+// does not grow with steps × DOFs × P.
+inline constexpr double kSensitivityBlockBytes = 64.0 * 1024 * 1024;
 
 struct ObjectiveOptions {
   SolverOptions solver;
@@ -142,9 +147,13 @@ private:
   };
   Derivative derivative(const Setup& s, int i) const;
   Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i, double t_end) const;
-  // The state over [t0, state_end] and its sensitivities over [t0, tangent_end] (tangent_end <= state_end).
+  // The state over [t0, state_end] and the sensitivities to parameters first … first + count − 1
+  // (count < 0: to the last) over [t0, tangent_end] (tangent_end <= state_end).
   std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,
-                                                   double tangent_end, Trajectory& u);
+                                                   double tangent_end, Trajectory& u, int first = 0, int count = -1);
+  // How many sensitivity trajectories over [t0, t_end] fit in kSensitivityBlockBytes (at least 1,
+  // at most P).
+  int sensitivity_block(double t_end) const;
   void default_weights();
 
   // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs

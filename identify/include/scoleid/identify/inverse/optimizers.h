@@ -12,7 +12,9 @@
 //                     see gauss_newton_step.h for the step and the radius, and below for the
 //                     horizon continuation.
 //
-// Horizon continuation (gauss-newton, `continuation`). Far from the solution the model and the
+// Horizon continuation (every method, `continuation`; described for Gauss–Newton, the gradient
+// methods do the same with a misfit-profile state solve after each accepted step while the
+// horizon is short, and drop their L-BFGS curvature pairs when it grows). Far from the solution the model and the
 // data drift out of phase: a frequency error δω gives a phase error δω·t that grows along the
 // record, and over many cycles the cost is no longer well described by its Gauss–Newton model
 // (its valleys repeat at every cycle slipped). The misfit of the data on [t0, T] against the model

@@ -2,6 +2,13 @@
 // One identification run: scenario (+ optional data file) → estimates, iteration history,
 // identifiability, written as identify.json (docs/theory.md §10) and fit.csv (t, measured, predicted).
 //
+// The fit test (fit_test.h, docs/theory.md §7.6): the run is converged only when the optimiser
+// stopped on a convergence test AND the model at the estimate explains the data. When it does not,
+// up to identification.restarts further attempts are made from the starting point — coarse to fine
+// over sectional parameters (tied_parameterization.h), then Gauss–Newton with a horizon
+// continuation four times as cautious — and the best attempt (one that explains the data, else the
+// lowest cost) is the result; every attempt is reported.
+//
 // Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
 // estimate; the uncertainty interval (interval.h) from them, a refit on the first half of the
 // record, and the consider shifts of the scenario's declared uncertainties
@@ -14,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scoleid/identify/inverse/fit_test.h"
 #include "scoleid/identify/inverse/identifiability.h"
 #include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/inverse/optimizers.h"
@@ -40,6 +48,19 @@ struct RunResult {
   ObjectiveCounters counters;
   Identifiability ident;
   UncertaintyInterval interval;
+  FitTest fit;  // at the estimate
+  struct Attempt {
+    std::string strategy;
+    std::string termination;
+    double cost = 0;  // J over the whole record
+    int iterations = 0;
+    bool explains_data = false;
+    std::string fit_message;
+  };
+  std::vector<Attempt> attempts;  // the first is the plain run
+  int chosen_attempt = 0;
+  // The optimiser stopped on a convergence test and the model explains the data.
+  bool converged() const { return summary.converged() && fit.explains_data; }
   VectorXd half_record_estimate;
   bool half_record_converged = false;
   double wall_seconds = 0;
@@ -48,6 +69,12 @@ struct RunResult {
 };
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
+
+// identification.model_error, with the automatic value resolved (io/scenario.h).
+double model_error(const Problem& problem);
+// The fit test at q (one forward solve on the identifier's model, one on twice its elements at
+// a quarter of its step for the discretisation estimate; skipped if that model cannot be built).
+FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q);
 
 // Writes identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's
 // staging area; the caller commits them as one unit (io/run_directory.h).

@@ -10,7 +10,8 @@
 //                     point load excites every mode of the mesh; the modes with ω h ≫ 1 are the ones
 //                     the mesh represents worst, and an L-stable method damps their oscillation
 //                     (keeping their quasi-static part) instead of tracking it with ~ω_max·T steps.
-//                     The step is min(sample interval, 0.3/ω_{P+2}) (problem.h); the method is
+//                     The step is min(sample interval, 0.3/ω_K), ω_K the highest mode the data
+//                     contain (problem.h, data_content); the method is
 //                     third order, so the time error is O(h³) in the resolved band.
 //   esdirk-arkode     the same table and step through SUNDIALS ARKODE (ARKStep) on the first-order
 //                     form y = [x; v], ẋ = v, v̇ = M⁻¹ (F(t) − D v − K x): the reference the stepper

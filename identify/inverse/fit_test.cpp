@@ -1,0 +1,89 @@
+#include "scoleid/identify/inverse/fit_test.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace scoleid::identify {
+
+FitTest fit_test(const FitTestInputs& in) {
+  const Eigen::Index N = in.residual.rows(), ns = in.residual.cols();
+  if (in.data.rows() != N || in.data.cols() != ns) throw std::invalid_argument("fit_test: residual and data differ in shape");
+  const bool disc = in.discretisation.size() > 0;
+  if (disc && (in.discretisation.rows() != N || in.discretisation.cols() != ns))
+    throw std::invalid_argument("fit_test: discretisation and residual differ in shape");
+  FitTest f;
+  f.model_error = in.model_error;
+  // Sums over sensors of s², a² and the strict a² (without m), each relative to the sensor's mean
+  // square signal, as the cost weighs them.
+  double S = 0.0, A = 0.0, A_strict = 0.0;
+  bool finite = N >= 3;
+  for (Eigen::Index k = 0; k < ns; ++k) {
+    SensorFit s;
+    s.name = static_cast<std::size_t>(k) < in.names.size() ? in.names[static_cast<std::size_t>(k)] : "sensor " + std::to_string(k);
+    const Eigen::VectorXd r = in.residual.col(k);
+    const double ms_r = r.squaredNorm() / static_cast<double>(N);
+    s.rms_residual = std::sqrt(ms_r);
+    s.rms_signal = std::sqrt(in.data.col(k).squaredNorm() / static_cast<double>(N));
+    const double stated = static_cast<std::size_t>(k) < in.noise_std.size() ? in.noise_std[static_cast<std::size_t>(k)] : 0.0;
+    double var = 0.0;
+    if (stated > 0) {
+      var = stated * stated;
+    } else if (N >= 3) {
+      double sum = 0.0;
+      for (Eigen::Index i = 1; i + 1 < N; ++i) {
+        const double d2 = r[i + 1] - 2.0 * r[i] + r[i - 1];
+        sum += d2 * d2;
+      }
+      var = sum / (6.0 * static_cast<double>(N - 2));
+      s.noise_estimated = true;
+    }
+    s.noise = std::sqrt(var);
+    s.systematic = std::sqrt(std::max(0.0, ms_r - var));
+    s.discretisation = disc ? std::sqrt(in.discretisation.col(k).squaredNorm() / static_cast<double>(N)) : std::nan("");
+    const double strict2 = 3.0 * var * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(N, 1))) +
+                           (disc ? 4.0 * s.discretisation * s.discretisation : 0.0);
+    const double allowed2 = strict2 + std::pow(in.model_error * s.rms_signal, 2);
+    s.allowed = std::sqrt(allowed2);
+    s.explained = std::isfinite(ms_r) && s.systematic <= s.allowed;
+    if (!std::isfinite(ms_r)) finite = false;
+    // A sensor that reads nothing weighs by its noise alone (its allowance, when there is one).
+    const double scale = s.rms_signal > 0 ? s.rms_signal * s.rms_signal : std::max(allowed2, 1e-300);
+    S += s.systematic * s.systematic / scale;
+    A += allowed2 / scale;
+    A_strict += strict2 / scale;
+    f.sensors.push_back(s);
+  }
+  f.explains_data = finite && S <= A;
+  f.within_noise_and_discretisation = finite && S <= A_strict;
+  f.ratio = A > 0 ? std::sqrt(S / A) : (S > 0 ? INFINITY : 0.0);
+  char buf[512];
+  if (N < 3) {
+    f.message = "fewer than 3 samples: the fit cannot be tested";
+  } else if (!finite) {
+    f.message = "the model's outputs at the estimate are not finite";
+  } else {
+    // The sensor furthest beyond its own allowance, to say where the misfit is.
+    const SensorFit* worst = nullptr;
+    for (const auto& s : f.sensors)
+      if (!worst || (s.allowed > 0 ? s.systematic / s.allowed : INFINITY) >
+                        (worst->allowed > 0 ? worst->systematic / worst->allowed : INFINITY))
+        worst = &s;
+    char dbuf[40] = "not estimated";
+    if (disc && worst) std::snprintf(dbuf, sizeof dbuf, "%.3g %%", 100.0 * worst->discretisation / worst->rms_signal);
+    if (f.explains_data)
+      std::snprintf(buf, sizeof buf, "the systematic residual is %.2f of what noise, discretisation and the declared model error allow",
+                    f.ratio);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "the systematic residual is %.3g times what noise, discretisation and the declared model error (%.3g %%) "
+                    "allow; worst sensor %s: %.3g %% of its RMS signal against %.3g %% (noise %.3g %%%s, discretisation %s)",
+                    f.ratio, 100.0 * in.model_error, worst->name.c_str(), 100.0 * worst->systematic / worst->rms_signal,
+                    100.0 * worst->allowed / worst->rms_signal, 100.0 * worst->noise / worst->rms_signal,
+                    worst->noise_estimated ? " estimated" : " stated", dbuf);
+    f.message = buf;
+  }
+  return f;
+}
+
+}  // namespace scoleid::identify
