@@ -127,6 +127,12 @@ int run_case(int N, const std::string& method, bool compute_std) {
     out["optimizer_converged"] = r.summary.converged();
     out["explains_data"] = r.fit.explains_data;
     out["attempts"] = static_cast<int>(r.attempts.size());
+    out["fit_ratio"] = r.fit.ratio;
+    json att = json::array();
+    for (const auto& a : r.attempts)
+      att.push_back({{"strategy", a.strategy}, {"termination", a.termination}, {"cost", a.cost}, {"iterations", a.iterations},
+                     {"explains_data", a.explains_data}, {"fit_message", a.fit_message}});
+    out["attempt_list"] = att;
     out["cost"] = r.summary.cost;
     out["step"] = p->objective_options.solver.step;
     out["forward_solves"] = r.counters.forward_solves;

@@ -16,7 +16,7 @@ FitTest fit_test(const FitTestInputs& in) {
   f.model_error = in.model_error;
   // Sums over sensors of s², a² and the strict a² (without m), each relative to the sensor's mean
   // square signal, as the cost weighs them.
-  double S = 0.0, A = 0.0, A_strict = 0.0;
+  double S = 0.0, A = 0.0, A_strict = 0.0, band_var = 0.0;
   bool finite = N >= 3;
   for (Eigen::Index k = 0; k < ns; ++k) {
     SensorFit s;
@@ -30,19 +30,30 @@ FitTest fit_test(const FitTestInputs& in) {
     if (stated > 0) {
       var = stated * stated;
     } else if (N >= 3) {
+      // Second differences of the residual, bounded by fourth differences of the data: noise is in
+      // the data, so a high-frequency misfit of a model to smooth data is not counted as noise.
       double sum = 0.0;
       for (Eigen::Index i = 1; i + 1 < N; ++i) {
         const double d2 = r[i + 1] - 2.0 * r[i] + r[i - 1];
         sum += d2 * d2;
       }
       var = sum / (6.0 * static_cast<double>(N - 2));
+      if (N >= 5) {
+        const Eigen::VectorXd z = in.data.col(k);
+        double sz = 0.0;
+        for (Eigen::Index i = 2; i + 2 < N; ++i) {
+          const double d4 = z[i + 2] - 4.0 * z[i + 1] + 6.0 * z[i] - 4.0 * z[i - 1] + z[i - 2];
+          sz += d4 * d4;
+        }
+        var = std::min(var, sz / (70.0 * static_cast<double>(N - 4)));
+      }
       s.noise_estimated = true;
     }
     s.noise = std::sqrt(var);
     s.systematic = std::sqrt(std::max(0.0, ms_r - var));
     s.discretisation = disc ? std::sqrt(in.discretisation.col(k).squaredNorm() / static_cast<double>(N)) : std::nan("");
-    const double strict2 = 3.0 * var * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(N, 1))) +
-                           (disc ? 4.0 * s.discretisation * s.discretisation : 0.0);
+    const double band2 = 3.0 * var * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(N, 1)));
+    const double strict2 = band2 + (disc ? 4.0 * s.discretisation * s.discretisation : 0.0);
     const double allowed2 = strict2 + std::pow(in.model_error * s.rms_signal, 2);
     s.allowed = std::sqrt(allowed2);
     s.explained = std::isfinite(ms_r) && s.systematic <= s.allowed;
@@ -50,10 +61,15 @@ FitTest fit_test(const FitTestInputs& in) {
     // A sensor that reads nothing weighs by its noise alone (its allowance, when there is one).
     const double scale = s.rms_signal > 0 ? s.rms_signal * s.rms_signal : std::max(allowed2, 1e-300);
     S += s.systematic * s.systematic / scale;
-    A += allowed2 / scale;
-    A_strict += strict2 / scale;
+    // The noise bands enter the sum as one χ² band: the variances of independent sensors' sample
+    // variances add (2σ⁴/N each), so three standard deviations of the sum.
+    band_var += std::pow(band2 / 3.0 / scale, 2);
+    A += (allowed2 - band2) / scale;
+    A_strict += (strict2 - band2) / scale;
     f.sensors.push_back(s);
   }
+  A += 3.0 * std::sqrt(band_var);
+  A_strict += 3.0 * std::sqrt(band_var);
   f.explains_data = finite && S <= A;
   f.within_noise_and_discretisation = finite && S <= A_strict;
   f.ratio = A > 0 ? std::sqrt(S / A) : (S > 0 ? INFINITY : 0.0);
@@ -65,13 +81,12 @@ FitTest fit_test(const FitTestInputs& in) {
   } else {
     // The sensor furthest beyond its own allowance, to say where the misfit is.
     const SensorFit* worst = nullptr;
+    auto beyond = [](const SensorFit& s) { return s.allowed > 0 ? s.systematic / s.allowed : (s.systematic > 0 ? INFINITY : 0.0); };
     for (const auto& s : f.sensors)
-      if (!worst || (s.allowed > 0 ? s.systematic / s.allowed : INFINITY) >
-                        (worst->allowed > 0 ? worst->systematic / worst->allowed : INFINITY))
-        worst = &s;
+      if (s.rms_signal > 0 && (!worst || beyond(s) > beyond(*worst))) worst = &s;
     char dbuf[40] = "not estimated";
     if (disc && worst) std::snprintf(dbuf, sizeof dbuf, "%.3g %%", 100.0 * worst->discretisation / worst->rms_signal);
-    if (f.explains_data)
+    if (f.explains_data || !worst)
       std::snprintf(buf, sizeof buf, "the systematic residual is %.2f of what noise, discretisation and the declared model error allow",
                     f.ratio);
     else

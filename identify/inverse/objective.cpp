@@ -447,7 +447,7 @@ int Objective::sensitivity_block(double t_end) const {
   const double h = options_.solver.step > 0 ? options_.solver.step : (t_end - t0) / 2000.0;
   const double points = (t_end - t0) / h + 1.0 + 2.0 * static_cast<double>(breakpoints_.size());
   const double bytes = points * model_.ndof * 3.0 * sizeof(double);
-  const double fit = std::floor(kSensitivityBlockBytes / std::max(bytes, 1.0));
+  const double fit = std::floor(options_.sensitivity_block_bytes / std::max(bytes, 1.0));
   return static_cast<int>(std::max(1.0, std::min(static_cast<double>(P), fit)));
 }
 

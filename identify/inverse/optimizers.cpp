@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/optimizers.h"
 
 #include "scoleid/identify/inverse/gauss_newton_step.h"
+#include "scoleid/io/interrupt.h"
 
 #include <chrono>
 #include <cmath>
@@ -78,6 +79,8 @@ struct Run {
       return std::isfinite(J);
     } catch (const std::domain_error&) {
       return false;
+    } catch (const io::Interrupted&) {
+      throw;
     } catch (const std::runtime_error&) {
       return false;  // integrator failure at an extreme trial point: treat as infeasible
     }
@@ -113,6 +116,8 @@ void gauss_newton(Run& r, VectorXd x) {
       gx = q.cwiseProduct(g);
       Hx = q.asDiagonal() * H * q.asDiagonal();
       return std::isfinite(J) && gx.allFinite() && Hx.allFinite();
+    } catch (const io::Interrupted&) {
+      throw;
     } catch (const std::exception&) {
       return false;
     }
@@ -224,6 +229,8 @@ void gauss_newton(Run& r, VectorXd x) {
         break;
       }
     }
+  } catch (const io::Interrupted&) {
+    throw;
   } catch (const std::runtime_error& e) {
     r.sum.termination = T::LineSearchFailed;
     r.sum.message = e.what();
@@ -241,7 +248,8 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   // Horizon continuation as for Gauss–Newton (header): the longest T >= t_min up to which the
   // misfit profile at x stays within the bound; one extra state solve per accepted step while the
   // horizon is short of the record.
-  const bool continuation = r.opt.continuation;
+  // The paper's update with fixed weights is reproduced as it is: on the whole record.
+  const bool continuation = r.opt.continuation && !(steepest && !r.opt.steepest_weights.empty());
   auto full = [&]() { return obj.horizon() >= t_end; };
   auto choose_horizon = [&](const VectorXd& xx, double current) {
     const Objective::MisfitProfile p = obj.misfit_profile(xx.array().exp());
@@ -373,6 +381,8 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
         break;
       }
     }
+  } catch (const io::Interrupted&) {
+    throw;
   } catch (const std::runtime_error& e) {
     r.sum.termination = T::LineSearchFailed;
     r.sum.message = e.what();
@@ -392,6 +402,11 @@ OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const Optimi
   const auto t0 = Clock::now();
   Run r{objective, options, on_iteration, {}};
   const VectorXd x0 = q0.array().log();
+  // Whatever happens inside, the objective is left on the whole record.
+  struct HorizonGuard {
+    Objective& o;
+    ~HorizonGuard() { o.set_horizon(o.data_end()); }
+  } guard{objective};
   if (options.method == "gauss-newton") gauss_newton(r, x0);
   else lbfgs(r, x0, options.method == "steepest-descent");
   r.sum.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();

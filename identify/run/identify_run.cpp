@@ -10,6 +10,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/limits.h"
 #include "scoleid/io/scenario_fields.h"
 
 namespace scoleid::identify {
@@ -168,21 +169,37 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
     in.residual = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));
     return fit_test(in);
   }
-  const MatrixXd Y = obj.predict(q);
+  MatrixXd Y;
+  try {
+    Y = obj.predict(q);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    Y = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));  // not explained
+  }
   in.residual = Y - p.data.z;
   // The discretisation estimate: the same model on twice the elements at a quarter of the step (the
-  // refinement the synthetic data are made with, problem.h).
-  try {
-    const auto fine = make_structure(p.scenario, 2 * p.structure->elements());
-    const auto params = fine->parameterize(p.scenario);
-    if (params->names() == p.params->names()) {
-      ObjectiveOptions o = p.objective_options;
-      if (o.solver.step > 0) o.solver.step /= 4.0;
-      Objective fo(fine->model(), *params, p.signals, p.data, o);
-      in.discretisation = fo.predict(q) - Y;
+  // refinement the synthetic data are made with, problem.h), when that fits the limits.
+  const int fine_elements = 2 * p.structure->elements();
+  const double T = p.data.t.back() - p.data.t.front();
+  const double h = p.objective_options.solver.step > 0 ? p.objective_options.solver.step / 4.0 : T / 8000.0;
+  const double bytes = (T / h + 1.0) * 2.0 * p.model().ndof * 3.0 * 8.0;
+  if (Y.allFinite() && fine_elements <= io::limits::kMaxDataElements && bytes <= io::limits::kMaxTrajectoryBytes) {
+    try {
+      const auto fine = make_structure(p.scenario, fine_elements);
+      const auto params = fine->parameterize(p.scenario);
+      if (params->names() == p.params->names()) {
+        ObjectiveOptions o = p.objective_options;
+        if (o.solver.step > 0) o.solver.step /= 4.0;
+        Objective fo(fine->model(), *params, p.signals, p.data, o);
+        const MatrixXd d = fo.predict(q) - Y;
+        if (d.allFinite()) in.discretisation = d;
+      }
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      // A model that cannot be refined: no discretisation estimate.
     }
-  } catch (const io::InputError&) {
-    // A model that cannot be refined (beyond the element limit): no discretisation estimate.
   }
   return fit_test(in);
 }
@@ -219,17 +236,34 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   };
   r.summary = minimize(obj, r.initial, oo, progress);
   r.fit = test_fit(p, obj, r.summary.q);
-  auto attempt_record = [&](const std::string& strategy, const OptimizerSummary& s, const FitTest& f, int iterations) {
+  auto attempt_record = [&](const std::string& strategy, const std::string& how, const OptimizerSummary& s,
+                            const FitTest& f, int iterations) {
     RunResult::Attempt a;
     a.strategy = strategy;
+    a.method = how;
     a.termination = to_string(s.termination);
-    a.cost = std::isfinite(s.q.sum()) ? obj.cost(s.q) : std::nan("");
+    a.optimizer_converged = s.converged();
+    obj.set_horizon(obj.data_end());  // the cost over the whole record, whatever horizon the run ended on
+    a.cost = INFINITY;
+    try {
+      if (s.q.allFinite()) a.cost = obj.cost(s.q);
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+    }
+    if (!std::isfinite(a.cost)) a.cost = INFINITY;
     a.iterations = iterations;
     a.explains_data = f.explains_data;
     a.fit_message = f.message;
     return a;
   };
-  r.attempts.push_back(attempt_record("plain " + method, r.summary, r.fit, r.summary.iterations_done));
+  r.attempts.push_back(attempt_record("plain " + method, method, r.summary, r.fit, r.summary.iterations_done));
+  // Rank of an attempt: converged and explaining the data, then explaining it, then the cost.
+  auto better = [](const RunResult::Attempt& a, const RunResult::Attempt& b) {
+    const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
+    const int rb = (b.optimizer_converged && b.explains_data ? 2 : 0) + (b.explains_data ? 1 : 0);
+    return ra != rb ? ra > rb : a.cost < b.cost;
+  };
   // Further attempts when the model at the estimate does not explain the data.
   const auto families = section_families(r.names);
   std::vector<std::string> strategies;
@@ -238,9 +272,12 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   ObjectiveCounters extra;  // solves of the tied levels' objectives
   for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
     const std::string& how = strategies[k];
+    // Restarts answer a false convergence: the optimiser stopped on a convergence test where the
+    // model does not explain the data (a run that ran out of iterations is reported as such).
     // Coarse to fine is tried whenever the residual exceeds noise and discretisation (a local
     // minimum of a sectional profile may still fit within a declared model error); the others
     // only when the fit does not explain the data.
+    if (!r.summary.converged()) break;
     if (how == "coarse-to-fine" ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
     if (ro.verbose)
       std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
@@ -283,27 +320,25 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
       if (ro.verbose) table.header();
       s = minimize(obj, q, oo, progress);
     } else {
-      OptimizerOptions oc = oo;
-      oc.method = "gauss-newton";
+      OptimizerOptions oc = oo;  // the run's own method, with a four times more cautious continuation
       oc.continuation = true;
       oc.continuation_misfit = (p.scenario.identification.continuation_misfit > 0 ? p.scenario.identification.continuation_misfit
                                                                                   : OptimizerOptions{}.continuation_misfit) / 4.0;
-      label = "gauss-newton, horizon continuation at misfit " + io::format_value(oc.continuation_misfit);
+      label = oc.method + ", horizon continuation at misfit " + io::format_value(oc.continuation_misfit);
       if (ro.verbose) table.header();
       s = minimize(obj, r.initial, oc, progress);
     }
     iterations += s.iterations_done;
     const FitTest f = test_fit(p, obj, s.q);
-    r.attempts.push_back(attempt_record(label, s, f, iterations));
-    const auto& best = r.attempts[static_cast<std::size_t>(r.chosen_attempt)];
-    const auto& now = r.attempts.back();
-    if ((now.explains_data && !best.explains_data) ||
-        (now.explains_data == best.explains_data && now.cost < best.cost)) {
+    r.attempts.push_back(attempt_record(label, method, s, f, iterations));
+    if (better(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
       r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
       r.summary = s;
       r.fit = f;
     }
+    if (r.converged()) break;
   }
+  r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record
   if (ro.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
   r.estimate = r.summary.q;
   if (ro.compute_std) {
@@ -435,7 +470,8 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"attempts", [&] {
               nlohmann::json a = nlohmann::json::array();
               for (std::size_t k = 0; k < attempts.size(); ++k)
-                a.push_back({{"strategy", attempts[k].strategy}, {"termination", attempts[k].termination},
+                a.push_back({{"strategy", attempts[k].strategy}, {"method", attempts[k].method},
+                             {"termination", attempts[k].termination}, {"optimizer_converged", attempts[k].optimizer_converged},
                              {"cost", std::isfinite(attempts[k].cost) ? nlohmann::json(attempts[k].cost) : nlohmann::json(nullptr)},
                              {"iterations", attempts[k].iterations}, {"explains_data", attempts[k].explains_data},
                              {"fit_message", attempts[k].fit_message}, {"chosen", static_cast<int>(k) == chosen_attempt}});
@@ -458,7 +494,10 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
             {{"name", integrator_name(p.objective_options.solver.integrator)},
              {"step", p.objective_options.solver.step},
              {"rtol", p.objective_options.solver.rtol},
-             {"steps", counters.solver.steps}}},
+             {"steps", counters.solver.steps},
+             {"resolved_modes", p.content.mode},
+             {"modes_below_nyquist", p.content.modes_below_nyquist},
+             {"visible_content_modes", p.content.content_mode}}},
            {"data_source", p.data_source},
            {"elements", p.structure->elements()},
            {"settings", io::to_json(p.scenario)}};

@@ -51,13 +51,25 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
   const AssembledModel ops = assemble(model, c);
-  const NaturalModes m = natural_modes(ops.M, ops.K);
   DataContent d;
   d.nyquist = M_PI / sample_interval;
+  // K and ω_K from the frequencies alone (modes with ω <= 1e-6 ω_max count as rigid).
+  {
+    const std::vector<double> w = natural_frequencies(ops.M, ops.K);
+    const double wmax = w.empty() ? 0.0 : w.back();
+    std::vector<double> below;
+    for (double x : w)
+      if (x > 1e-6 * wmax && x <= d.nyquist) below.push_back(x);
+    d.modes_below_nyquist = static_cast<int>(below.size());
+    if (below.empty()) return d;
+    d.mode = std::min(d.modes_below_nyquist, params.size() + 2);
+    d.omega = below[static_cast<std::size_t>(d.mode - 1)];
+  }
+  // The visible content K_data (reported): from the mode shapes.
+  const NaturalModes m = natural_modes(ops.M, ops.K);
   std::vector<Eigen::Index> flexible;
   for (Eigen::Index k = 0; k < m.omega.size(); ++k)
     if (m.omega[k] > m.floor && m.omega[k] <= d.nyquist) flexible.push_back(k);
-  d.modes_below_nyquist = static_cast<int>(flexible.size());
   if (flexible.empty()) return d;
   // The inputs sampled once on a grid fine enough for every frequency up to Nyquist (16 points per
   // sample interval: ω δ <= π/16); F_i(ω) = ∫₀ᵀ f_i(t) e^{−iωt} dt by the midpoint rule.
@@ -103,15 +115,9 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
       }
   }
   d.content_mode = last + 1;
-  // P + 2 modes — P parameters are fixed mostly by the first P modes' frequencies and shapes — but
-  // never more than the samples can carry: for many parameters the step stops shrinking there.
-  // (The content K_data is reported, not used: a mode far below the largest in amplitude can still
-  // be the one that carries a weakly seen parameter — SCOLE's modes 5 and 6, at < 1e-4 of the
-  // first in every sensor, fix ρI_ψ to 4e-5 when resolved and leave it 5e-3 off when not.)
-  last = std::min(static_cast<int>(flexible.size()), params.size() + 2) - 1;
-  if (last < 0) last = 0;  // nothing measurable: resolve the first flexible mode
-  d.mode = last + 1;
-  d.omega = m.omega[flexible[static_cast<std::size_t>(last)]];
+  // The step resolves K = min(P + 2, K_nyq), not K_data: a mode far below the largest in amplitude
+  // can still be the one that carries a weakly seen parameter (SCOLE's modes 5 and 6, at < 1e-4 of
+  // the first in every sensor, fix ρI_ψ to 4e-5 when resolved and leave it 5e-3 off when not).
   return d;
 }
 
@@ -405,6 +411,7 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
                  std::to_string(data_elements));
     step = identifier_step(sc, p->model(), *p->params, p->signals);
     check_step(sc, p->model(), *p->params, p->signals, step, true);
+    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval);
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
@@ -420,6 +427,7 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   if (data_csv) {
     step = identifier_step(sc, p->model(), *p->params, p->signals);
     check_step(sc, p->model(), *p->params, p->signals, step, false);
+    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval);
   }
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = step;

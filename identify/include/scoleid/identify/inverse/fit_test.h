@@ -9,13 +9,13 @@
 // sensor by sensor, the systematic part of the residual with what those three parts allow:
 //
 //   r_k(t_i) = y_k(q̂, t_i) − z_k(t_i),  i = 1 … N (the whole record)
-//   σ_k      the sensor's stated noise std, else estimated from the residual itself by second
-//            differences, σ̂² = Σ (r_{i+1} − 2r_i + r_{i−1})² / (6 (N − 2)): white noise passes
+//   σ_k      the sensor's stated noise std, else estimated from the residual by second
+//            differences, σ̂² = Σ (r_{i+1} − 2r_i + r_{i−1})² / (6 (N − 2)) — white noise passes
 //            with variance 6σ², a smooth residual of angular frequency ω sampled at Δt is reduced by
-//            (ωΔt)⁴ — only the part of the residual that looks like noise is counted as noise
+//            (ωΔt)⁴ — but at most the data's own fourth-difference estimate Σ (Δ⁴z)² / (70 (N − 4)):
+//            noise is in the data, so a high-frequency misfit to smooth data is not noise
 //   s_k²     = mean r_k² − σ_k²: the systematic residual (mean square beyond the noise)
-//   a_k²     = 3σ_k²·√(2/N)          three standard deviations of the sample variance of white
-//                                     noise (the χ² band)
+//   a_k²     = (χ² band, below)
 //            + (2 d_k)²              d_k the RMS difference of the outputs at q̂ between the model
 //                                     and the same model on twice the elements at a quarter of the
 //                                     step (as the identifier's own synthetic data are made): an
@@ -23,8 +23,9 @@
 //                                     not exact either)
 //            + (m · z_k,rms)²        m the declared model-form error, a fraction of the sensor's RMS
 //                                     signal (identification.model_error)
-//   explained when Σ_k s_k²/z_k,rms² <= Σ_k a_k²/z_k,rms², the sensors weighed as the cost weighs
-//   them. The test is on the sum, not sensor by sensor: the least-squares estimate minimises that
+//   explained when Σ_k s_k²/z_k,rms² <= Σ_k a_k²/z_k,rms² + 3·√(Σ_k 2σ_k⁴/(N z_k,rms⁴)), the
+//   sensors weighed as the cost weighs them; the last term is three standard deviations of the
+//   weighted sum of the sensors' sample variances of white noise (the χ² band). The test is on the sum, not sensor by sensor: the least-squares estimate minimises that
 //   sum, so at the right parameters it is at most what it is at the true ones (the noise,
 //   discretisation and model error), but it may trade one sensor's misfit for another's. The
 //   per-sensor figures are reported, and the message names the sensor furthest beyond its own.

@@ -49,10 +49,11 @@ namespace scoleid::identify {
 // Memory for recorded sensitivity trajectories at once: Gauss–Newton and the output sensitivities
 // step the P tangents in blocks that fit in it (the state re-solved with each block), so memory
 // does not grow with steps × DOFs × P.
-inline constexpr double kSensitivityBlockBytes = 64.0 * 1024 * 1024;
+inline constexpr double kSensitivityBlockBytes = 128.0 * 1024 * 1024;
 
 struct ObjectiveOptions {
   SolverOptions solver;
+  double sensitivity_block_bytes = kSensitivityBlockBytes;
   std::vector<double> weights;  // R_kk; empty = 1/(T mean z_k²)
 };
 
@@ -151,8 +152,8 @@ private:
   // (count < 0: to the last) over [t0, tangent_end] (tangent_end <= state_end).
   std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,
                                                    double tangent_end, Trajectory& u, int first = 0, int count = -1);
-  // How many sensitivity trajectories over [t0, t_end] fit in kSensitivityBlockBytes (at least 1,
-  // at most P).
+  // How many sensitivity trajectories over [t0, t_end] fit in options.sensitivity_block_bytes (at
+  // least 1, at most P).
   int sensitivity_block(double t_end) const;
   void default_weights();
 

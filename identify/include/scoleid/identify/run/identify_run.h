@@ -4,10 +4,12 @@
 //
 // The fit test (fit_test.h, docs/theory.md §7.6): the run is converged only when the optimiser
 // stopped on a convergence test AND the model at the estimate explains the data. When it does not,
-// up to identification.restarts further attempts are made from the starting point — coarse to fine
-// over sectional parameters (tied_parameterization.h), then Gauss–Newton with a horizon
-// continuation four times as cautious — and the best attempt (one that explains the data, else the
-// lowest cost) is the result; every attempt is reported.
+// although the optimiser stopped on a convergence test (a false convergence), up to
+// identification.restarts further attempts are made from the starting point — coarse to fine over
+// sectional parameters (tied_parameterization.h), then the run's method with a horizon
+// continuation four times as cautious — and the best attempt (converged and explaining the data,
+// else explaining it, else the lowest cost over the whole record) is the result; every attempt is
+// reported.
 //
 // Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
 // estimate; the uncertainty interval (interval.h) from them, a refit on the first half of the
@@ -51,7 +53,9 @@ struct RunResult {
   FitTest fit;  // at the estimate
   struct Attempt {
     std::string strategy;
+    std::string method;  // the optimiser of its last stage
     std::string termination;
+    bool optimizer_converged = false;
     double cost = 0;  // J over the whole record
     int iterations = 0;
     bool explains_data = false;

@@ -22,6 +22,28 @@
 
 namespace scoleid::identify {
 
+// The modes the identifier resolves (docs/theory.md §5.2). At the starting parameters, mode k of
+// the undamped FE model (M-orthonormal φ_k, frequency ω_k) responds to the inputs with a dynamic
+// amplitude of at most A_jk = |c_j φ_k|·|Σ_i φ_kᵀ b_i F_i(ω_k)|/ω_k at sensor j, F_i(ω) =
+// ∫₀ᵀ f_i(t) e^{−iωt} dt the input's spectrum over the record (ω_k|c_j φ_k| for a velocity row,
+// ω_k²|…| for an acceleration). Only modes below the sampling's Nyquist frequency π/Δt count (the
+// samples cannot carry more); there are K_nyq of them. The identifier resolves
+//     K = min(P + 2, K_nyq)
+// modes, P the number of parameters: P parameters are fixed mostly by the first P modes, and a mode
+// above Nyquist cannot be resolved from the samples (it aliases). For few parameters this is P + 2; for many the step stops
+// shrinking at what the sampling carries. Also reported: K_data, the highest mode whose amplitude
+// at some sensor is at least kModeContentThreshold of the largest mode's there (what the signal
+// visibly contains; not used for the step: a weakly seen parameter can live in a mode far below
+// that, docs/theory.md §5.2).
+// `mode` = K (1-based among the flexible modes), `omega` = ω_K.
+inline constexpr double kModeContentThreshold = 1e-4;
+struct DataContent {
+  int mode = 0;                 // K (0: no flexible mode below Nyquist)
+  int content_mode = 0;         // K_data (reported)
+  double omega = 0.0;           // ω_K [rad/s]
+  double nyquist = 0.0;         // π / sample interval
+  int modes_below_nyquist = 0;  // flexible modes below it
+};
 // How a data file's columns were used (identify.json "data_columns", and stderr).
 struct ColumnUse {
   std::vector<std::string> sensors;               // matched to the scenario's sensors
@@ -41,6 +63,7 @@ struct Problem {
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
   ColumnUse columns;                          // with a data file
+  DataContent content;                        // the modes the step resolves (data_content)
   const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };
@@ -50,28 +73,6 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
-// The modes the identifier resolves (docs/theory.md §5.2). At the starting parameters, mode k of
-// the undamped FE model (M-orthonormal φ_k, frequency ω_k) responds to the inputs with a dynamic
-// amplitude of at most A_jk = |c_j φ_k|·|Σ_i φ_kᵀ b_i F_i(ω_k)|/ω_k at sensor j, F_i(ω) =
-// ∫₀ᵀ f_i(t) e^{−iωt} dt the input's spectrum over the record (ω_k|c_j φ_k| for a velocity row,
-// ω_k²|…| for an acceleration). Only modes below the sampling's Nyquist frequency π/Δt count (the
-// samples cannot carry more); there are K_nyq of them. The identifier resolves
-//     K = min(P + 2, K_nyq)
-// modes, P the number of parameters: P parameters are fixed mostly by the first P modes, and a mode
-// above Nyquist is not in the samples. For few parameters this is P + 2; for many the step stops
-// shrinking at what the sampling carries. Also reported: K_data, the highest mode whose amplitude
-// at some sensor is at least kModeContentThreshold of the largest mode's there (what the signal
-// visibly contains; not used for the step: a weakly seen parameter can live in a mode far below
-// that, docs/theory.md §5.2).
-// `mode` = K (1-based among the flexible modes), `omega` = ω_K.
-inline constexpr double kModeContentThreshold = 1e-4;
-struct DataContent {
-  int mode = 0;                 // K (0: no flexible mode below Nyquist)
-  int content_mode = 0;         // K_data (reported)
-  double omega = 0.0;           // ω_K [rad/s]
-  double nyquist = 0.0;         // π / sample interval
-  int modes_below_nyquist = 0;  // flexible modes below it
-};
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
                          const std::vector<io::Signal>& signals, double t_end, double sample_interval);
 // The identifier's fixed time step: identification.time_step if set, else
