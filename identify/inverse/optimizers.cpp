@@ -66,6 +66,20 @@ struct Run {
     sum.iterations.push_back(r);
     if (cb) cb(r);
   }
+  // Horizon continuation: the longest T >= t0 + continuation_min_fraction·(t_end − t0) up to
+  // which the misfit profile stays within the bound, never shorter than `current`.
+  double horizon_from(const Objective::MisfitProfile& p, double current) const {
+    const double t0 = obj.data_start(), t_end = obj.data_end();
+    const double t_min = t0 + opt.continuation_min_fraction * (t_end - t0);
+    double T = t_min;
+    for (std::size_t i = 0; i < p.t.size(); ++i) {
+      if (p.t[i] <= t_min) continue;
+      if (!(p.misfit[i] <= opt.continuation_misfit)) break;
+      T = p.t[i];
+    }
+    T = std::max(T, current);
+    return T >= t_end - 1e-9 * (t_end - t0) ? t_end : T;
+  }
   bool small_gradient(const VectorXd& gx, double J) const {
     return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
   }
@@ -90,19 +104,7 @@ struct Run {
 void gauss_newton(Run& r, VectorXd x) {
   Objective& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
-  const double t_min = t0 + r.opt.continuation_min_fraction * (t_end - t0);
-  // Horizon from a misfit profile: the longest T >= t_min up to which the misfit stays within
-  // the bound (never shorter than the current one).
-  auto choose_horizon = [&](const Objective::MisfitProfile& p, double current) {
-    double T = t_min;
-    for (std::size_t i = 0; i < p.t.size(); ++i) {
-      if (p.t[i] <= t_min) continue;
-      if (!(p.misfit[i] <= r.opt.continuation_misfit)) break;
-      T = p.t[i];
-    }
-    T = std::max(T, current);
-    return T >= t_end - 1e-9 * (t_end - t0) ? t_end : T;
-  };
+  auto choose_horizon = [&](const Objective::MisfitProfile& p, double current) { return r.horizon_from(p, current); };
   const bool continuation = r.opt.continuation;
   auto full = [&]() { return obj.horizon() >= t_end; };
 
@@ -244,23 +246,13 @@ void gauss_newton(Run& r, VectorXd x) {
 void lbfgs(Run& r, VectorXd x, bool steepest) {
   Objective& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
-  const double t_min = t0 + r.opt.continuation_min_fraction * (t_end - t0);
-  // Horizon continuation as for Gauss–Newton (header): the longest T >= t_min up to which the
-  // misfit profile at x stays within the bound; one extra state solve per accepted step while the
-  // horizon is short of the record.
+  // Horizon continuation as for Gauss–Newton (header, Run::horizon_from), from the misfit profile
+  // of one extra state solve per accepted step while the horizon is short of the record.
   // The paper's update with fixed weights is reproduced as it is: on the whole record.
   const bool continuation = r.opt.continuation && !(steepest && !r.opt.steepest_weights.empty());
   auto full = [&]() { return obj.horizon() >= t_end; };
   auto choose_horizon = [&](const VectorXd& xx, double current) {
-    const Objective::MisfitProfile p = obj.misfit_profile(xx.array().exp());
-    double Th = t_min;
-    for (std::size_t i = 0; i < p.t.size(); ++i) {
-      if (p.t[i] <= t_min) continue;
-      if (!(p.misfit[i] <= r.opt.continuation_misfit)) break;
-      Th = p.t[i];
-    }
-    Th = std::max(Th, current);
-    return Th >= t_end - 1e-9 * (t_end - t0) ? t_end : Th;
+    return r.horizon_from(obj.misfit_profile(xx.array().exp()), current);
   };
   double J;
   VectorXd gx;
