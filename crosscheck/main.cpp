@@ -6,6 +6,8 @@
 //   scole-crosscheck all          --scenario X [--out DIR]   the four, then the one-screen summary
 //   scole-crosscheck suite        [--only F] [--out DIR]     the mismatch suite (crosscheck/mismatch/*.yaml):
 //                                 errors, reported intervals, coverage, sharpness; report.md
+//   scole-crosscheck campaign FILE [--out DIR]             scenarios x grid x noise seeds, serially or
+//                                 over MPI ranks (mpirun -n K), resumable; report.md, histogram
 // DIR defaults to run/<scenario>/crosscheck. Each verb replaces only its own files there, as one
 // unit (io/run_directory.h). Exit codes: 0 success; 1 a run failed or an identification did not
 // converge (its outputs are written and say so); 2 bad usage or bad input (nothing written);
@@ -14,10 +16,13 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 
+#include "campaign_mpi.h"
+#include "scoleid/crosscheck/campaign_runner.h"
 #include "scoleid/crosscheck/identify_study.h"
 #include "scoleid/crosscheck/mismatch_suite.h"
 #include "scoleid/crosscheck/modes.h"
@@ -166,6 +171,42 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
     return ok && s.expectations_met && targets ? 0 : 1;
   });
 }
+
+// The number of ranks when an MPI launcher (mpirun, srun) started this process, else 0; `rank`
+// this process's rank.
+int launched_ranks(int* rank) {
+  auto env = [](const char* k) { const char* v = std::getenv(k); return v ? std::atoi(v) : -1; };
+  *rank = std::max({env("OMPI_COMM_WORLD_RANK"), env("PMI_RANK"), env("PMIX_RANK"), 0});
+  const int n = std::max(env("OMPI_COMM_WORLD_SIZE"), env("PMI_SIZE"));
+  if (n > 0) return n;
+  return std::getenv("PMIX_RANK") ? 1 : 0;  // PMIx does not always state the size; MPI will
+}
+
+// scole-crosscheck campaign: see --help.
+int run_campaign(const std::string& file, crosscheck::CampaignRunOptions opt) {
+  int rank = 0;
+  const int ranks = launched_ranks(&rank);
+  if (ranks > 0) {
+#ifdef SCOLEID_HAVE_MPI
+    return crosscheck::run_campaign_mpi(file, opt);
+#else
+    if (ranks > 1) {
+      if (rank == 0)
+        std::fprintf(stderr, "scole-crosscheck: campaign: started by an MPI launcher with %d ranks, but this build has no MPI "
+                             "(install libopenmpi-dev and reconfigure); run it without mpirun to run serially\n", ranks);
+      return 2;
+    }
+#endif
+  }
+  return guarded([&] {
+    const crosscheck::Campaign c = crosscheck::load_campaign(file);
+    if (opt.out.empty()) opt.out = "run/campaign/" + c.name;
+    const crosscheck::CampaignStore store(c, opt.out);
+    if (opt.progress) std::fprintf(stderr, "scole-crosscheck campaign: %s: %zu points, %zu cases, serially\n", c.name.c_str(), c.points.size(), c.cases.size());
+    const auto run = crosscheck::run_campaign_serial(c, store, opt);
+    return crosscheck::finish_campaign(c, store, run, opt);
+  });
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -239,6 +280,21 @@ int main(int argc, char** argv) {
   suite->add_option("--seeds", so.seeds, "noise seeds per noise case (default: the file's)");
   suite->add_flag("--collect", suite_collect, "only summarise the results already in --out/results: report, coverage, sharpness");
   suite->add_flag("-q,--quiet", quiet, "no progress on stderr");
+  std::string campaign_file;
+  crosscheck::CampaignRunOptions co;
+  auto* camp = app.add_subcommand(
+      "campaign", "a campaign file: scenarios x a parameter grid x noise seeds, each point's Simbody truth once and "
+                  "its identifications (noise-free and one per seed); per-case results stored atomically under "
+                  "--out/cases (a second run resumes: stored cases are not run again); then report.md (per point: "
+                  "error, seed scatter against the reported std, interval coverage), cases.csv, points.csv, "
+                  "histogram.png, campaign.json, and timing.json. Serial by default; started by `mpirun -n K` (or "
+                  "srun) the cases are shared out dynamically over the K ranks, the report identical. Exit 1 when a "
+                  "case failed.");
+  camp->add_option("file", campaign_file, "the campaign file (YAML)")->required();
+  camp->add_option("-o,--out", co.out, "output directory (default: run/campaign/<campaign name>)");
+  camp->add_flag("-q,--quiet", quiet, "no progress on stderr");
+  camp->add_option("--kill-after", co.kill_after, "restart test: exit abruptly during the case after this many")->group("");
+  camp->add_option("--kill-rank", co.kill_rank, "restart test: the rank that exits (default the last)")->group("");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -249,6 +305,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   io::install_interrupt_handlers();
+  if (camp->parsed()) {
+    co.progress = !quiet;
+    return run_campaign(campaign_file, co);
+  }
   if (suite->parsed()) return run_suite(suite_only, suite_dir, suite_out, suite_collect, so, quiet);
   return guarded([&] {
     const io::Scenario sc = io::load_scenario(scenario);

@@ -11,6 +11,8 @@
 #include <random>
 #include <sstream>
 
+#include "scoleid/crosscheck/case_identification.h"
+#include "scoleid/crosscheck/scenario_overlay.h"
 #include "scoleid/crosscheck/table.h"
 #include "scoleid/crosscheck/truth_levels.h"
 #include "scoleid/identify/run/identify_run.h"
@@ -33,18 +35,6 @@ std::string text_of(const YAML::Node& n) {
   YAML::Emitter e;
   e << n;
   return e.c_str();
-}
-
-// Maps merge key by key; anything else replaces.
-YAML::Node merge(const YAML::Node& base, const YAML::Node& over) {
-  if (!over || over.IsNull()) return YAML::Clone(base);
-  if (!base || !base.IsMap() || !over.IsMap()) return YAML::Clone(over);
-  YAML::Node out = YAML::Clone(base);
-  for (const auto& kv : over) {
-    const std::string key = kv.first.as<std::string>();
-    out[key] = merge(base[key], kv.second);
-  }
-  return out;
 }
 
 double number_of(const YAML::Node& n, const std::string& file, const std::string& field) {
@@ -84,66 +74,6 @@ json num(double v) { return json_number(v); }
 
 // A number of the results, NaN where it was not finite (written as null).
 double val(const json& v) { return v.is_number() ? v.get<double>() : std::nan(""); }
-
-// One identification on `p` into the result row of one case (or seed).
-json identify_row(identify::Problem& p) {
-  identify::RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = true;
-  ro.data_csv = p.data_source;
-  const identify::RunResult r = identify::run_identification(p, ro);
-  json row;
-  row["converged"] = r.converged();
-  row["optimizer_converged"] = r.summary.converged();
-  row["explains_data"] = r.fit.explains_data;
-  row["fit_ratio"] = r.fit.ratio;
-  row["fit_test"] = r.fit.message;
-  row["termination"] = identify::to_string(r.summary.termination);
-  row["iterations"] = r.summary.iterations_done;
-  row["seconds"] = r.wall_seconds;
-  row["parameters"] = json::array();
-  for (std::size_t i = 0; i < r.names.size(); ++i) {
-    const auto e = static_cast<Eigen::Index>(i);
-    const auto it = p.true_values.find(r.names[i]);
-    if (it == p.true_values.end())
-      throw io::InputError("truth file for " + p.data_source + ": no true value for parameter '" + r.names[i] + "'");
-    const double truth = it->second, est = r.estimate[e];
-    const bool ok = r.ident.identifiable.size() > i && r.ident.identifiable[i];
-    const double hw = r.interval.half_width.size() > e ? r.interval.half_width[e] : std::nan("");
-    json q{{"name", r.names[i]},
-           {"truth", num(truth)},
-           {"estimate", num(est)},
-           {"relative_error", num(est / truth - 1.0)},
-           {"std", num(r.ident.std.size() > e ? r.ident.std[e] : std::nan(""))},
-           {"resolution", num(r.ident.resolution.size() > e ? r.ident.resolution[e] : std::nan(""))},
-           {"half_record_shift", num(r.interval.half_record_shift.size() > e ? r.interval.half_record_shift[e] : std::nan(""))},
-           {"half_width", num(ok ? hw : std::nan(""))},
-           {"relative_half_width", num(ok ? hw / std::abs(truth) : std::nan(""))},
-           {"identifiable", ok},
-           {"covered", ok && std::isfinite(hw) && std::abs(est - truth) <= hw}};
-    if (!ok && r.ident.reason.size() > i) q["not_identifiable_because"] = r.ident.reason[i];
-    row["parameters"].push_back(q);
-  }
-  return row;
-}
-
-// Gaussian noise of `relative` × each sensor's RMS, seeded; the level is stated to the identifier
-// (it is what a test engineer knows of the instrument).
-void add_noise(identify::Problem& p, double relative, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  auto& z = p.data.z;
-  for (Eigen::Index k = 0; k < z.cols(); ++k) {
-    const double rms = std::sqrt(z.col(k).squaredNorm() / static_cast<double>(z.rows()));
-    const double sd = relative * rms;
-    for (Eigen::Index i = 0; i < z.rows(); ++i) z(i, k) += sd * n01(rng);
-    const auto kk = static_cast<std::size_t>(k);
-    if (p.noise_std.size() <= kk) p.noise_std.resize(kk + 1, 0.0);
-    if (p.noise_origin.size() <= kk) p.noise_origin.resize(kk + 1, "");
-    p.noise_std[kk] = sd;
-    p.noise_origin[kk] = "scenario";
-  }
-}
 
 json check(const std::string& what, bool held, const std::string& measured) {
   return json{{"what", what}, {"held", held}, {"measured", measured}};
@@ -288,24 +218,9 @@ static SuiteFile load_suite_file_checked(const std::string& path) {
 }
 
 io::Scenario case_scenario(const SuiteFile& f, std::size_t k) {
-  std::string base = io::builtin_scenario_yaml(f.base), source = "built-in scenario '" + f.base + "'";
-  if (base.empty()) {
-    const fs::path p = fs::path(f.path).parent_path() / f.base;
-    if (!fs::exists(p)) bad(f.path, "scenario", "is neither a built-in scenario nor a file beside the suite file", "'" + f.base + "'");
-    base = read_file(p.string());
-    source = p.string();
-  }
   const SuiteCase& c = f.cases.at(k);
-  YAML::Node node;
-  try {
-    node = merge(merge(YAML::Load(base), f.overlay.empty() ? YAML::Node() : YAML::Load(f.overlay)),
-                          c.overlay.empty() ? YAML::Node() : YAML::Load(c.overlay));
-  } catch (const YAML::Exception& e) {
-    throw io::InputError("suite file '" + f.path + "': scenario '" + source + "': malformed YAML: " + e.msg);
-  }
-  io::Scenario sc = io::parse_scenario(text_of(node), f.path + " (case '" + c.label + "' on " + source + ")");
-  io::validate_scenario(sc);
-  return sc;
+  const std::string yaml = overlaid_scenario_yaml(f.base, f.path, "scenario", {f.overlay, c.overlay});
+  return checked_scenario(yaml, f.path + " (case '" + c.label + "' on '" + f.base + "')");
 }
 
 json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptions& opt) {

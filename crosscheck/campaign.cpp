@@ -1,0 +1,361 @@
+#include "scoleid/crosscheck/campaign.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "scoleid/crosscheck/scenario_overlay.h"
+#include "scoleid/crosscheck/table.h"
+#include "scoleid/io/error.h"
+
+namespace scoleid::crosscheck {
+
+using nlohmann::json;
+
+namespace {
+
+[[noreturn]] void bad(const std::string& file, const std::string& field, const std::string& what, const std::string& value) {
+  io::fail_field(file, field, what, value);
+  throw io::InputError(file);  // not reached
+}
+
+std::string text_of(const YAML::Node& n) {
+  YAML::Emitter e;
+  e << YAML::Flow << n;
+  return e.c_str();
+}
+
+double number_of(const YAML::Node& n, const std::string& file, const std::string& field) {
+  double v = std::nan("");
+  try {
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    bad(file, field, "must be a number", n.IsScalar() ? "'" + n.Scalar() + "'" : text_of(n));
+  }
+  if (!std::isfinite(v)) bad(file, field, "must be finite", n.Scalar());
+  return v;
+}
+
+bool name_ok(const std::string& s, const char* extra) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || std::string(extra).find(c) != std::string::npos)) return false;
+  return true;
+}
+
+// FNV-1a, 64 bits, as 16 hex digits: a fingerprint of a case's inputs (not a security hash).
+std::string fingerprint(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+Campaign load_checked(const std::string& path) {
+  Campaign c;
+  c.path = path;
+  std::ifstream in(path);
+  if (!in) throw io::InputError("campaign file '" + path + "': cannot be read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(ss.str());
+  } catch (const YAML::Exception& e) {
+    throw io::InputError("campaign file '" + path + "': malformed YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+  }
+  if (!root.IsMap()) bad(path, "(top level)", "must be a map", "");
+  static const std::vector<std::string> known = {"campaign", "description", "scenarios", "overlay", "grid", "noise"};
+  for (const auto& kv : root) {
+    const std::string k = kv.first.as<std::string>();
+    if (std::find(known.begin(), known.end(), k) == known.end()) bad(path, k, "is not a campaign field", "'" + k + "'");
+  }
+  if (!root["campaign"] || !root["campaign"].IsScalar()) bad(path, "campaign", "is required (the campaign's name)", "none");
+  c.name = root["campaign"].Scalar();
+  if (!name_ok(c.name, "-_")) bad(path, "campaign", "must be letters, digits, - and _", "'" + c.name + "'");
+  if (root["description"]) {
+    if (!root["description"].IsScalar()) bad(path, "description", "must be text", text_of(root["description"]));
+    c.description = root["description"].Scalar();
+  }
+  const YAML::Node sc = root["scenarios"];
+  if (!sc || !sc.IsSequence() || sc.size() == 0) bad(path, "scenarios", "must be a non-empty list of scenario names or files", sc ? text_of(sc) : "none");
+  for (std::size_t i = 0; i < sc.size(); ++i) {
+    if (!sc[i].IsScalar() || sc[i].Scalar().empty()) bad(path, "scenarios[" + std::to_string(i) + "]", "must be a scenario name or file", text_of(sc[i]));
+    c.scenarios.push_back(sc[i].Scalar());
+  }
+  if (root["overlay"]) {
+    if (!root["overlay"].IsMap()) bad(path, "overlay", "must be a map of scenario fields", text_of(root["overlay"]));
+    c.overlay = text_of(root["overlay"]);
+  }
+  if (const YAML::Node g = root["grid"]) {
+    if (!g.IsMap()) bad(path, "grid", "must be a map {dotted.path: [values]}", text_of(g));
+    for (const auto& kv : g) {
+      const std::string p = kv.first.as<std::string>(), field = "grid." + p;
+      if (!name_ok(p, "-_.") || p.front() == '.' || p.back() == '.' || p.find("..") != std::string::npos)
+        bad(path, "grid", "keys must be dotted scenario paths (e.g. truth.segments)", "'" + p + "'");
+      if (!kv.second.IsSequence() || kv.second.size() == 0) bad(path, field, "must be a non-empty list of values", text_of(kv.second));
+      std::vector<std::string> values;
+      for (const auto& v : kv.second) values.push_back(text_of(v));
+      c.grid.emplace_back(p, values);
+    }
+  }
+  if (const YAML::Node n = root["noise"]) {
+    if (!n.IsMap() || !n["relative"] || !n["seeds"]) bad(path, "noise", "must be {relative: r, seeds: K, seed: first}", text_of(n));
+    for (const auto& kv : n) {
+      const std::string k = kv.first.as<std::string>();
+      if (k != "relative" && k != "seeds" && k != "seed") bad(path, "noise." + k, "is not a noise field (relative, seeds, seed)", "'" + k + "'");
+    }
+    c.noise_relative = number_of(n["relative"], path, "noise.relative");
+    if (!(c.noise_relative > 0 && c.noise_relative < 1)) bad(path, "noise.relative", "must be in (0, 1)", n["relative"].Scalar());
+    const double s = number_of(n["seeds"], path, "noise.seeds");
+    if (!(s >= 2 && s <= 100000 && s == std::floor(s))) bad(path, "noise.seeds", "must be an integer in [2, 100000]", n["seeds"].Scalar());
+    c.seeds = static_cast<int>(s);
+    if (n["seed"]) {
+      const double b = number_of(n["seed"], path, "noise.seed");
+      if (!(b >= 0 && b < 4294967296.0 && b == std::floor(b))) bad(path, "noise.seed", "must be an integer in [0, 2^32)", n["seed"].Scalar());
+      c.noise_seed = static_cast<unsigned>(b);
+    }
+  }
+  // Points: scenarios × grid, last grid path fastest.
+  std::size_t combos = 1;
+  for (const auto& [p, v] : c.grid) combos *= v.size();
+  if (combos * c.scenarios.size() > 100000) bad(path, "grid", "gives more than 100000 points", std::to_string(combos * c.scenarios.size()));
+  for (const auto& s : c.scenarios)
+    for (std::size_t g = 0; g < combos; ++g) {
+      std::vector<std::string> overlays{c.overlay};
+      std::string label = s;
+      std::size_t rest = g;
+      std::vector<std::size_t> idx(c.grid.size());
+      for (std::size_t a = c.grid.size(); a-- > 0;) {
+        idx[a] = rest % c.grid[a].second.size();
+        rest /= c.grid[a].second.size();
+      }
+      for (std::size_t a = 0; a < c.grid.size(); ++a) {
+        const std::string& v = c.grid[a].second[idx[a]];
+        overlays.push_back(path_overlay(c.grid[a].first, v));
+        label += " " + c.grid[a].first + "=" + v;
+      }
+      CampaignPoint pt;
+      char id[16];
+      std::snprintf(id, sizeof id, "p%03zu", c.points.size());
+      pt.id = id;
+      pt.label = label;
+      pt.yaml = overlaid_scenario_yaml(s, path, "scenarios", overlays);
+      pt.key = fingerprint(pt.yaml);
+      pt.scenario = checked_scenario(pt.yaml, path + " (point " + pt.id + ": " + label + ")");
+      c.points.push_back(std::move(pt));
+    }
+  for (std::size_t p = 0; p < c.points.size(); ++p)
+    for (int s = -1; s < c.seeds; ++s) {
+      CampaignCase k;
+      k.point = p;
+      k.seed = s;
+      char id[32];
+      if (s < 0)
+        std::snprintf(id, sizeof id, "%s-ref", c.points[p].id.c_str());
+      else
+        std::snprintf(id, sizeof id, "%s-s%04d", c.points[p].id.c_str(), s);
+      k.id = id;
+      char noise[96];
+      std::snprintf(noise, sizeof noise, "|seed %d|relative %.17g|base %u", s, c.noise_relative, c.noise_seed);
+      k.key = fingerprint(c.points[p].yaml + noise);
+      c.cases.push_back(std::move(k));
+    }
+  return c;
+}
+
+double val(const json& j, const char* k) {
+  return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan("");
+}
+
+double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+}  // namespace
+
+Campaign load_campaign(const std::string& path) {
+  try {
+    return load_checked(path);
+  } catch (const YAML::Exception& e) {
+    throw io::InputError("campaign file '" + path + "': " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+  }
+}
+
+unsigned case_noise_seed(const Campaign& c, const CampaignCase& k) {
+  return c.noise_seed + 1000003u * static_cast<unsigned>(k.point) + static_cast<unsigned>(std::max(k.seed, 0));
+}
+
+std::map<std::string, std::string> campaign_report(const Campaign& c, const std::vector<json>& results) {
+  std::map<std::string, std::string> files;
+  std::ostringstream md;
+  md << "# Campaign " << c.name << "\n\n";
+  if (!c.description.empty()) md << c.description << "\n\n";
+  md << "Points: " << c.points.size() << " (scenarios × grid); cases: " << c.cases.size() << " (per point a noise-free identification";
+  if (c.seeds) md << " and " << c.seeds << " with Gaussian noise of " << 100.0 * c.noise_relative << " % of each sensor's RMS";
+  md << "). Each point's truth is the Simbody chain, noise-free; docs/theory.md §11.6.\n\n";
+
+  Table cases{"cases", {"case", "point", "seed", "parameter", "truth", "estimate", "relative_error", "std", "half_width",
+                        "identifiable", "covered", "converged", "explains_data", "failed"}, {}};
+  int failed = 0, converged = 0;
+  std::vector<std::string> failures;
+  for (std::size_t k = 0; k < c.cases.size(); ++k) {
+    const json& r = results.at(k);
+    const CampaignCase& kc = c.cases[k];
+    if (r.contains("failed")) {
+      ++failed;
+      failures.push_back(kc.id + ": " + r["failed"].get<std::string>());
+      cases.rows.push_back({kc.id, c.points[kc.point].id, std::to_string(kc.seed), "", "", "", "", "", "", "", "", "", "", r["failed"].get<std::string>()});
+      continue;
+    }
+    converged += r.value("converged", false) ? 1 : 0;
+    for (const auto& q : r["parameters"])
+      cases.rows.push_back({kc.id, c.points[kc.point].id, std::to_string(kc.seed), q["name"].get<std::string>(), number(val(q, "truth"), 12),
+                            number(val(q, "estimate"), 12), number(val(q, "relative_error"), 6), number(val(q, "std"), 6),
+                            number(val(q, "half_width"), 6), q["identifiable"].get<bool>() ? "yes" : "no",
+                            q["covered"].get<bool>() ? "yes" : "no", r.value("converged", false) ? "yes" : "no",
+                            r.value("explains_data", false) ? "yes" : "no", ""});
+  }
+  md << "**Cases:** " << c.cases.size() - static_cast<std::size_t>(failed) << " of " << c.cases.size() << " ran; "
+     << converged << " converged (optimiser converged and the fit test passed, docs/theory.md §7.6)"
+     << (failed ? "; **" + std::to_string(failed) + " failed** (listed at the end)" : std::string()) << ".\n\n";
+
+  // Per point and parameter: the noise-free estimate, and over the seeds the scatter against the
+  // reported std and the coverage of the reported interval.
+  Table points{"points", {"point", "label", "parameter", "truth", "ref_relative_error", "ref_relative_half_width", "ref_covered",
+                          "seeds", "converged_seeds", "mean_relative_error", "relative_scatter", "relative_mean_std",
+                          "scatter_over_std", "noise_bias_std_of_mean", "within_1.96_std", "interval_coverage"}, {}};
+  std::map<std::string, std::vector<double>> z_by_name;  // (estimate - noise-free estimate) / std
+  std::vector<std::string> name_order;
+  json summary = json::array();
+  for (std::size_t p = 0; p < c.points.size(); ++p) {
+    std::vector<std::size_t> seeds;
+    std::size_t ref = c.cases.size();
+    for (std::size_t k = 0; k < c.cases.size(); ++k) {
+      if (c.cases[k].point != p || results[k].contains("failed")) continue;
+      if (c.cases[k].seed < 0) ref = k;
+      else seeds.push_back(k);
+    }
+    if (ref == c.cases.size()) continue;  // the reference failed: listed with the failures
+    const json& rr = results[ref];
+    for (std::size_t i = 0; i < rr["parameters"].size(); ++i) {
+      const json& q = rr["parameters"][i];
+      const std::string name = q["name"];
+      if (!z_by_name.count(name)) name_order.push_back(name);
+      auto& zs = z_by_name[name];
+      const double truth = val(q, "truth"), ref_est = val(q, "estimate");
+      std::vector<std::string> row{c.points[p].id, c.points[p].label, name, number(truth, 10), number(val(q, "relative_error"), 4),
+                                   number(val(q, "relative_half_width"), 4), q["covered"].get<bool>() ? "yes" : "no"};
+      json js{{"point", c.points[p].id}, {"label", c.points[p].label}, {"parameter", name},
+              {"ref_relative_error", json_number(val(q, "relative_error"))}, {"ref_covered", q["covered"]}};
+      if (!seeds.empty()) {
+        double mean = 0, var = 0, std_mean = 0;
+        int conv = 0, covered = 0, within = 0, n = 0;
+        for (std::size_t k : seeds) {
+          const json& s = results[k]["parameters"][i];
+          mean += val(s, "estimate");
+          std_mean += val(s, "std");
+          ++n;
+        }
+        mean /= n;
+        std_mean /= n;
+        for (std::size_t k : seeds) {
+          const json& s = results[k]["parameters"][i];
+          const double e = val(s, "estimate"), sd = val(s, "std");
+          var += (e - mean) * (e - mean) / (n > 1 ? n - 1 : 1);
+          conv += results[k].value("converged", false) ? 1 : 0;
+          covered += s["covered"].get<bool>() ? 1 : 0;
+          const double z = (e - ref_est) / sd;
+          within += std::abs(z) <= 1.959964 ? 1 : 0;
+          zs.push_back(z);
+        }
+        const double scatter = std::sqrt(var);
+        const double bias = (mean - ref_est) / (scatter / std::sqrt(static_cast<double>(n)));
+        for (const std::string& s : {std::to_string(n), std::to_string(conv), number(mean / truth - 1.0, 4), number(scatter / std::abs(truth), 4),
+                                     number(std_mean / std::abs(truth), 4), number(scatter / std_mean, 4), number(bias, 3),
+                                     number(static_cast<double>(within) / n, 4), number(static_cast<double>(covered) / n, 4)})
+          row.push_back(s);
+        js["seeds"] = n;
+        js["converged_seeds"] = conv;
+        js["scatter_over_std"] = json_number(scatter / std_mean);
+        js["noise_bias_std_of_mean"] = json_number(bias);
+        js["within_1.96_std"] = json_number(static_cast<double>(within) / n);
+        js["interval_coverage"] = json_number(static_cast<double>(covered) / n);
+      } else {
+        for (int j = 0; j < 9; ++j) row.push_back("");
+      }
+      points.rows.push_back(row);
+      summary.push_back(js);
+    }
+  }
+  md << "## Points\n\nref: the noise-free identification on the point's truth (its error is the model error: chain "
+        "lumping, mismatch). Over the seeds: the scatter of the estimates against the mean reported std (1 if the "
+        "std is right), the noise-induced bias of the mean from ref in std of the mean, the share of seeds within "
+        "1.96 reported std of ref (0.95 if the std is right), and the share whose reported interval covers the "
+        "truth.\n\n"
+     << points.markdown() << "\n";
+
+  // Histogram of z = (estimate - ref) / std, per parameter, with the standard normal's counts.
+  std::string hist = "parameter,bin_low,bin_high,count,normal_expected\n";
+  std::ostringstream gp;
+  if (!name_order.empty() && c.seeds) {
+    const double w = 0.5, lo = -4.0;
+    const int bins = 16;
+    gp << "# Histogram of (estimate - noise-free estimate) / reported std over the seeds, per parameter, against the\n"
+       << "# standard normal (gnuplot histogram.gp)\nset terminal pngcairo noenhanced size " << 500 * name_order.size()
+       << ",400 font ',10'\nset output 'histogram.png'\nset multiplot layout 1," << name_order.size()
+       << "\nset grid\nset style fill solid 0.5\nset xlabel '(estimate - noise-free estimate) / reported std'\nset ylabel 'seeds'\n";
+    for (const auto& name : name_order) {
+      const auto& zs = z_by_name[name];
+      std::string block;
+      int under = 0, over = 0;
+      for (double z : zs) {
+        if (!(z >= lo)) ++under;
+        if (!(z < lo + bins * w)) ++over;
+      }
+      for (int b = 0; b < bins; ++b) {
+        const double a = lo + b * w, e = a + w;
+        const auto cnt = std::count_if(zs.begin(), zs.end(), [&](double z) { return z >= a && z < e; });
+        const double expected = static_cast<double>(zs.size()) * (normal_cdf(e) - normal_cdf(a));
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%s,%.2f,%.2f,%ld,%.4f\n", name.c_str(), a, e, static_cast<long>(cnt), expected);
+        hist += buf;
+        std::snprintf(buf, sizeof buf, "%.2f %ld %.4f\n", a + 0.5 * w, static_cast<long>(cnt), expected);
+        block += buf;
+      }
+      gp << "set title '" << name << ": " << zs.size() << " seeds (" << under + over << " outside [-4, 4])'\n"
+         << "plot '-' using 1:2 with boxes title 'seeds', '-' using 1:3 with linespoints lw 2 title 'standard normal'\n"
+         << block << "e\n" << block << "e\n";
+    }
+    gp << "unset multiplot\n";
+    md << "## Normalised scatter\n\n![histogram of (estimate - ref) / std](histogram.png)\n\n";
+  }
+  if (!failures.empty()) {
+    md << "## Failed cases\n\n";
+    for (const auto& f : failures) md << "- " << f << "\n";
+  }
+  md << "\nFiles: cases.csv (one row per case and parameter), points.csv (the table above), histogram.csv, "
+        "histogram.gp, campaign.json; per-case results in cases/; timings (which rank ran what, how long) in "
+        "timing.json, kept out of the report so that the report depends only on the results.\n";
+  files["report.md"] = md.str();
+  files["cases.csv"] = cases.csv();
+  files["points.csv"] = points.csv();
+  if (c.seeds && !name_order.empty()) {
+    files["histogram.csv"] = hist;
+    files["histogram.gp"] = gp.str();
+  }
+  json cj{{"campaign", c.name}, {"points", c.points.size()}, {"cases", c.cases.size()}, {"failed", failed},
+          {"converged", converged}, {"failures", failures}, {"summary", summary}};
+  files["campaign.json"] = cj.dump(2) + "\n";
+  return files;
+}
+
+}  // namespace scoleid::crosscheck
