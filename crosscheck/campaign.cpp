@@ -9,9 +9,11 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
 
 #include "scoleid/crosscheck/scenario_overlay.h"
 #include "scoleid/crosscheck/table.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
 
 namespace scoleid::crosscheck {
@@ -76,9 +78,12 @@ Campaign load_checked(const std::string& path) {
   }
   if (!root.IsMap()) bad(path, "(top level)", "must be a map", "");
   static const std::vector<std::string> known = {"campaign", "description", "scenarios", "overlay", "grid", "noise"};
+  std::vector<std::string> seen;
   for (const auto& kv : root) {
     const std::string k = kv.first.as<std::string>();
     if (std::find(known.begin(), known.end(), k) == known.end()) bad(path, k, "is not a campaign field", "'" + k + "'");
+    if (std::find(seen.begin(), seen.end(), k) != seen.end()) bad(path, k, "is given twice", "'" + k + "'");
+    seen.push_back(k);
   }
   if (!root["campaign"] || !root["campaign"].IsScalar()) bad(path, "campaign", "is required (the campaign's name)", "none");
   c.name = root["campaign"].Scalar();
@@ -91,6 +96,8 @@ Campaign load_checked(const std::string& path) {
   if (!sc || !sc.IsSequence() || sc.size() == 0) bad(path, "scenarios", "must be a non-empty list of scenario names or files", sc ? text_of(sc) : "none");
   for (std::size_t i = 0; i < sc.size(); ++i) {
     if (!sc[i].IsScalar() || sc[i].Scalar().empty()) bad(path, "scenarios[" + std::to_string(i) + "]", "must be a scenario name or file", text_of(sc[i]));
+    if (std::find(c.scenarios.begin(), c.scenarios.end(), sc[i].Scalar()) != c.scenarios.end())
+      bad(path, "scenarios[" + std::to_string(i) + "]", "is listed twice", "'" + sc[i].Scalar() + "'");
     c.scenarios.push_back(sc[i].Scalar());
   }
   if (root["overlay"]) {
@@ -104,8 +111,24 @@ Campaign load_checked(const std::string& path) {
       if (!name_ok(p, "-_.") || p.front() == '.' || p.back() == '.' || p.find("..") != std::string::npos)
         bad(path, "grid", "keys must be dotted scenario paths (e.g. truth.segments)", "'" + p + "'");
       if (!kv.second.IsSequence() || kv.second.size() == 0) bad(path, field, "must be a non-empty list of values", text_of(kv.second));
+      for (const auto& [q, v] : c.grid)
+        if (q == p) bad(path, field, "is given twice", "'" + p + "'");
       std::vector<std::string> values;
-      for (const auto& v : kv.second) values.push_back(text_of(v));
+      for (std::size_t i = 0; i < kv.second.size(); ++i) {
+        const YAML::Node v = kv.second[i];
+        if (!v || v.IsNull()) bad(path, field + "[" + std::to_string(i) + "]", "must be a value", "null");
+        // The same value twice (also as 10 and 10.0) would be the same point twice.
+        for (std::size_t j = 0; j < i; ++j) {
+          const YAML::Node u = kv.second[j];
+          bool same = text_of(u) == text_of(v);
+          if (!same && u.IsScalar() && v.IsScalar()) {
+            double a = 0, b = 0;
+            same = YAML::convert<double>::decode(u, a) && YAML::convert<double>::decode(v, b) && a == b;
+          }
+          if (same) bad(path, field + "[" + std::to_string(i) + "]", "repeats an earlier value", text_of(v));
+        }
+        values.push_back(text_of(v));
+      }
       c.grid.emplace_back(p, values);
     }
   }
@@ -126,10 +149,18 @@ Campaign load_checked(const std::string& path) {
       c.noise_seed = static_cast<unsigned>(b);
     }
   }
-  // Points: scenarios × grid, last grid path fastest.
+  // Points: scenarios × grid, last grid path fastest; each a different scenario.
+  std::unordered_map<std::string, std::size_t> keys;
+  constexpr std::size_t kMaxPoints = 100000, kMaxCases = 1000000;
   std::size_t combos = 1;
-  for (const auto& [p, v] : c.grid) combos *= v.size();
-  if (combos * c.scenarios.size() > 100000) bad(path, "grid", "gives more than 100000 points", std::to_string(combos * c.scenarios.size()));
+  for (const auto& [p, v] : c.grid) {
+    combos *= v.size();
+    if (combos * c.scenarios.size() > kMaxPoints)
+      bad(path, "grid", "gives more than " + std::to_string(kMaxPoints) + " points", "at '" + p + "'");
+  }
+  if (combos * c.scenarios.size() * static_cast<std::size_t>(c.seeds + 1) > kMaxCases)
+    bad(path, "noise.seeds", "gives more than " + std::to_string(kMaxCases) + " cases with the grid's " +
+                                 std::to_string(combos * c.scenarios.size()) + " points", std::to_string(c.seeds));
   for (const auto& s : c.scenarios)
     for (std::size_t g = 0; g < combos; ++g) {
       std::vector<std::string> overlays{c.overlay};
@@ -152,7 +183,15 @@ Campaign load_checked(const std::string& path) {
       pt.label = label;
       pt.yaml = overlaid_scenario_yaml(s, path, "scenarios", overlays);
       pt.key = fingerprint(pt.yaml);
-      pt.scenario = checked_scenario(pt.yaml, path + " (point " + pt.id + ": " + label + ")");
+      const std::string where = path + " (point " + pt.id + ": " + label + ")";
+      pt.scenario = checked_scenario(pt.yaml, where);
+      // The identifier's own checks, before anything runs (make_problem's).
+      if (pt.scenario.sensors.empty()) io::fail_field(where, "sensors", "must list at least one sensor", "none");
+      if (pt.scenario.inputs.empty()) io::fail_field(where, "inputs", "must list at least one input", "none");
+      identify::make_structure(pt.scenario, pt.scenario.identification.elements)->parameterize(pt.scenario);
+      if (const auto it = keys.find(pt.key); it != keys.end())
+        bad(path, "grid", "gives the same scenario twice", "points " + c.points[it->second].label + " and " + label);
+      keys[pt.key] = c.points.size();
       c.points.push_back(std::move(pt));
     }
   for (std::size_t p = 0; p < c.points.size(); ++p)
@@ -166,9 +205,10 @@ Campaign load_checked(const std::string& path) {
       else
         std::snprintf(id, sizeof id, "%s-s%04d", c.points[p].id.c_str(), s);
       k.id = id;
+      // The noise-free case depends on the point alone; a draw on the noise settings too.
       char noise[96];
       std::snprintf(noise, sizeof noise, "|seed %d|relative %.17g|base %u", s, c.noise_relative, c.noise_seed);
-      k.key = fingerprint(c.points[p].yaml + noise);
+      k.key = fingerprint(c.points[p].yaml + (s < 0 ? std::string("|noise-free") : std::string(noise)));
       c.cases.push_back(std::move(k));
     }
   return c;
@@ -231,7 +271,7 @@ std::map<std::string, std::string> campaign_report(const Campaign& c, const std:
   // Per point and parameter: the noise-free estimate, and over the seeds the scatter against the
   // reported std and the coverage of the reported interval.
   Table points{"points", {"point", "label", "parameter", "truth", "ref_relative_error", "ref_relative_half_width", "ref_covered",
-                          "seeds", "converged_seeds", "mean_relative_error", "relative_scatter", "relative_mean_std",
+                          "seeds", "seeds_with_std", "converged_seeds", "mean_relative_error", "relative_scatter", "relative_mean_std",
                           "scatter_over_std", "noise_bias_std_of_mean", "within_1.96_std", "interval_coverage"}, {}};
   std::map<std::string, std::vector<double>> z_by_name;  // (estimate - noise-free estimate) / std
   std::vector<std::string> name_order;
@@ -257,50 +297,58 @@ std::map<std::string, std::string> campaign_report(const Campaign& c, const std:
       json js{{"point", c.points[p].id}, {"label", c.points[p].label}, {"parameter", name},
               {"ref_relative_error", json_number(val(q, "relative_error"))}, {"ref_covered", q["covered"]}};
       if (!seeds.empty()) {
-        double mean = 0, var = 0, std_mean = 0;
-        int conv = 0, covered = 0, within = 0, n = 0;
+        // Over the draws whose estimate and std are finite numbers (the others are counted apart);
+        // scatter-based figures need two.
+        std::vector<std::pair<double, double>> es;  // (estimate, std)
+        int conv = 0, covered = 0, within = 0;
         for (std::size_t k : seeds) {
-          const json& s = results[k]["parameters"][i];
-          mean += val(s, "estimate");
-          std_mean += val(s, "std");
-          ++n;
-        }
-        mean /= n;
-        std_mean /= n;
-        for (std::size_t k : seeds) {
-          const json& s = results[k]["parameters"][i];
-          const double e = val(s, "estimate"), sd = val(s, "std");
-          var += (e - mean) * (e - mean) / (n > 1 ? n - 1 : 1);
+          const json& sq = results[k]["parameters"][i];
           conv += results[k].value("converged", false) ? 1 : 0;
-          covered += s["covered"].get<bool>() ? 1 : 0;
+          covered += sq["covered"].get<bool>() ? 1 : 0;
+          const double e = val(sq, "estimate"), sd = val(sq, "std");
+          if (!std::isfinite(e) || !(sd > 0) || !std::isfinite(sd)) continue;
+          es.emplace_back(e, sd);
           const double z = (e - ref_est) / sd;
           within += std::abs(z) <= 1.959964 ? 1 : 0;
-          zs.push_back(z);
+          if (std::isfinite(z)) zs.push_back(z);
         }
-        const double scatter = std::sqrt(var);
-        const double bias = (mean - ref_est) / (scatter / std::sqrt(static_cast<double>(n)));
-        for (const std::string& s : {std::to_string(n), std::to_string(conv), number(mean / truth - 1.0, 4), number(scatter / std::abs(truth), 4),
-                                     number(std_mean / std::abs(truth), 4), number(scatter / std_mean, 4), number(bias, 3),
-                                     number(static_cast<double>(within) / n, 4), number(static_cast<double>(covered) / n, 4)})
-          row.push_back(s);
+        const int n = static_cast<int>(seeds.size()), m = static_cast<int>(es.size());
+        double mean = 0, var = 0, std_mean = 0;
+        for (const auto& [e, sd] : es) {
+          mean += e / m;
+          std_mean += sd / m;
+        }
+        for (const auto& [e, sd] : es) var += (e - mean) * (e - mean) / (m > 1 ? m - 1 : 1);
+        const double scatter = m > 1 ? std::sqrt(var) : std::nan("");
+        const double bias = m > 1 ? (mean - ref_est) / (scatter / std::sqrt(static_cast<double>(m))) : std::nan("");
+        const double mean_err = m > 0 ? mean / truth - 1.0 : std::nan("");
+        const double msd = m > 0 ? std_mean / std::abs(truth) : std::nan("");
+        for (const std::string& cell : {std::to_string(n), std::to_string(m), std::to_string(conv), number(mean_err, 4),
+                                        number(scatter / std::abs(truth), 4), number(msd, 4), number(scatter / std_mean, 4),
+                                        number(bias, 3), number(m ? static_cast<double>(within) / m : std::nan(""), 4),
+                                        number(static_cast<double>(covered) / n, 4)})
+          row.push_back(cell);
         js["seeds"] = n;
+        js["seeds_with_std"] = m;
         js["converged_seeds"] = conv;
         js["scatter_over_std"] = json_number(scatter / std_mean);
         js["noise_bias_std_of_mean"] = json_number(bias);
-        js["within_1.96_std"] = json_number(static_cast<double>(within) / n);
+        js["within_1.96_std"] = json_number(m ? static_cast<double>(within) / m : std::nan(""));
         js["interval_coverage"] = json_number(static_cast<double>(covered) / n);
       } else {
-        for (int j = 0; j < 9; ++j) row.push_back("");
+        for (int j = 0; j < 10; ++j) row.push_back("");
       }
       points.rows.push_back(row);
       summary.push_back(js);
     }
   }
   md << "## Points\n\nref: the noise-free identification on the point's truth (its error is the model error: chain "
-        "lumping, mismatch). Over the seeds: the scatter of the estimates against the mean reported std (1 if the "
-        "std is right), the noise-induced bias of the mean from ref in std of the mean, the share of seeds within "
-        "1.96 reported std of ref (0.95 if the std is right), and the share whose reported interval covers the "
-        "truth.\n\n"
+        "lumping, mismatch). Over the seeds (every draw, converged or not; the statistics of the estimates over "
+        "those with a finite reported std, `seeds_with_std`; scatter-based figures need two): the scatter of the "
+        "estimates against the mean reported std (1 if the std is right), the noise-induced bias of the mean from "
+        "ref in std of the mean, the share of seeds within 1.96 reported std of ref (0.95 if the std is right), and "
+        "the share whose reported interval covers the truth (a draw that flags the parameter not identifiable "
+        "counts as not covered).\n\n"
      << points.markdown() << "\n";
 
   // Histogram of z = (estimate - ref) / std, per parameter, with the standard normal's counts.
@@ -336,7 +384,8 @@ std::map<std::string, std::string> campaign_report(const Campaign& c, const std:
          << block << "e\n" << block << "e\n";
     }
     gp << "unset multiplot\n";
-    md << "## Normalised scatter\n\n![histogram of (estimate - ref) / std](histogram.png)\n\n";
+    md << "## Normalised scatter\n\n(estimate − ref) / reported std over every point's draws, per parameter, against "
+          "the standard normal's counts.\n\n![histogram of (estimate - ref) / std](histogram.png)\n\n";
   }
   if (!failures.empty()) {
     md << "## Failed cases\n\n";

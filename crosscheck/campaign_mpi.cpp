@@ -13,6 +13,7 @@
 
 #include <mpi.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
@@ -49,6 +50,9 @@ struct Coordinator {
   CampaignRunSummary sum;
   std::mutex m;
   std::chrono::steady_clock::time_point t0;
+  // Set by rank 0's main thread when its own work fails: the coordinator thread, the only one in
+  // MPI while it runs, then aborts the job.
+  std::atomic<int> abort_code{0};
 
   // Records a finished task of `rank` (lock held).
   void record(const CampaignTask& t, const json& r, double sec, int rank) {
@@ -72,17 +76,17 @@ struct Coordinator {
     sched.finished(t);
   }
 
-  // Answers the other ranks until each has been told "done". `check_interrupts`: only when serving
-  // from the main thread (an exception cannot leave the coordinator thread; there rank 0's own
-  // work notices the signal and ends the job).
-  void serve(int ranks, bool check_interrupts) {
+  // Answers the other ranks until each has been told "done"; an interrupt (or rank 0's own work
+  // failing) ends the job from here.
+  void serve(int ranks) {
     int active = ranks - 1;
     while (active > 0) {
       int flag = 0;
       MPI_Status st;
       MPI_Iprobe(MPI_ANY_SOURCE, kTagRequest, MPI_COMM_WORLD, &flag, &st);
       if (!flag) {
-        if (check_interrupts) io::check_interrupt();
+        if (abort_code.load() != 0) abort_all(abort_code.load());
+        io::check_interrupt();
         nap(2);
         continue;
       }
@@ -127,6 +131,7 @@ struct Coordinator {
       }
       if (n == CampaignSchedule::Next::Done) return;
       if (n == CampaignSchedule::Next::Wait) {
+        io::check_interrupt();
         nap(50);
         continue;
       }
@@ -208,7 +213,7 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
     err.clear();
     if (rank == 0) {
       try {
-        store.emplace(*c, opt.out);
+        store.emplace(*c, opt.out, true);
       } catch (const io::InputError& e) {
         err = e.what();
       }
@@ -233,21 +238,32 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
         std::fprintf(stderr, "scole-crosscheck campaign: %s: %zu cases on %d ranks%s\n", c->name.c_str(), co.sum.cases, size,
                      co.sum.done_before ? (", " + std::to_string(co.sum.done_before) + " already stored, not run again").c_str() : "");
       if (size > 1 && provided >= MPI_THREAD_SERIALIZED) {
-        std::thread serve([&] { co.serve(size, false); });
-        // The coordinator thread cannot be left waiting for ranks: whatever stops rank 0's own
-        // work ends the job (finished cases are stored; a second run resumes).
+        // The coordinator thread is the only one in MPI while it runs: what ends the job on this
+        // rank (an interrupt, a failure of either thread) ends it from there.
+        std::thread serve([&] {
+          try {
+            co.serve(size);
+          } catch (const io::Interrupted& e) {
+            std::fprintf(stderr, "\nscole-crosscheck: rank 0: %s\n", interrupted_line(e).c_str());
+            abort_all(e.exit_code());
+          } catch (const std::exception& e) {
+            std::fprintf(stderr, "scole-crosscheck: rank 0: run failed: %s\n", io::one_line(e.what()).c_str());
+            abort_all(1);
+          }
+        });
         try {
           co.work(kill_after);
         } catch (const io::Interrupted& e) {
-          std::fprintf(stderr, "\nscole-crosscheck: rank 0: %s (finished cases are stored; run again to resume)\n", e.what());
-          abort_all(e.exit_code());
+          std::fprintf(stderr, "\nscole-crosscheck: rank 0: %s\n", interrupted_line(e).c_str());
+          co.abort_code = e.exit_code();
         } catch (const std::exception& e) {
           std::fprintf(stderr, "scole-crosscheck: rank 0: run failed: %s\n", io::one_line(e.what()).c_str());
-          abort_all(1);
+          co.abort_code = 1;
         }
         serve.join();
+        if (co.abort_code.load() != 0) abort_all(co.abort_code.load());  // the coordinator had finished
       } else if (size > 1) {
-        co.serve(size, true);  // no threads in this MPI: rank 0 only coordinates
+        co.serve(size);  // no threads in this MPI: rank 0 only coordinates
       } else {
         co.work(kill_after);
       }
@@ -258,7 +274,7 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
     }
     MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
   } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "\nscole-crosscheck: rank %d: %s (finished cases are stored; run again to resume)\n", rank, e.what());
+    std::fprintf(stderr, "\nscole-crosscheck: rank %d: %s\n", rank, interrupted_line(e).c_str());
     abort_all(e.exit_code());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "scole-crosscheck: rank %d: run failed: %s\n", rank, io::one_line(e.what()).c_str());

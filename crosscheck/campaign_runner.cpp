@@ -1,5 +1,6 @@
 #include "scoleid/crosscheck/campaign_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include "scoleid/crosscheck/case_identification.h"
 #include "scoleid/crosscheck/truth_levels.h"
@@ -22,11 +27,45 @@ namespace scoleid::crosscheck {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-CampaignStore::CampaignStore(const Campaign& c, std::string out) : c_(c), out_(std::move(out)) {
+const std::vector<std::string>& campaign_report_files() {
+  static const std::vector<std::string> f = {"report.md", "cases.csv", "points.csv", "histogram.csv", "histogram.gp",
+                                             "histogram.png", "campaign.json", "timing.json"};
+  return f;
+}
+
+CampaignStore::CampaignStore(const Campaign& c, std::string out, bool exclusive) : c_(c), out_(std::move(out)) {
   std::error_code ec;
+  // Only a campaign's own files may be there: nothing of the user's is ever replaced.
+  if (fs::exists(out_, ec)) {
+    if (!fs::is_directory(out_, ec)) throw io::InputError("campaign output directory '" + out_ + "': exists and is not a directory");
+    for (const auto& e : fs::directory_iterator(out_, ec)) {
+      const std::string n = e.path().filename().string();
+      const auto& own = campaign_report_files();
+      const bool ours = n == "cases" || n == "truths" || n == ".lock" || std::find(own.begin(), own.end(), n) != own.end() ||
+                        n.find(".tmp.") != std::string::npos;
+      if (!ours)
+        throw io::InputError("campaign output directory '" + out_ + "': holds '" + n +
+                             "', which a campaign does not write; choose an empty or a campaign's directory");
+    }
+  }
   fs::create_directories(fs::path(out_) / "cases", ec);
   if (!ec) fs::create_directories(fs::path(out_) / "truths", ec);
   if (ec) throw io::InputError("campaign output directory '" + out_ + "': cannot be created: " + ec.message());
+  if (exclusive) {
+    // One campaign run per directory at a time (two would race on the truths and the cases).
+    const std::string lock = (fs::path(out_) / ".lock").string();
+    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0) throw io::InputError("campaign output directory '" + out_ + "': cannot be written");
+    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(lock_fd_);
+      lock_fd_ = -1;
+      throw io::InputError("campaign output directory '" + out_ + "': another campaign run is using it");
+    }
+  }
+}
+
+CampaignStore::~CampaignStore() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);
 }
 
 std::string CampaignStore::case_path(std::size_t k) const { return (fs::path(out_) / "cases" / (c_.cases.at(k).id + ".json")).string(); }
@@ -36,7 +75,9 @@ bool CampaignStore::case_done(std::size_t k) const {
   if (!in) return false;
   try {
     const json j = json::parse(in);
-    return j.value("key", std::string()) == c_.cases[k].key;
+    // A case that failed is run again: its failure may have been the machine's (a full disk, a
+    // truth not yet visible on a shared file system).
+    return j.value("key", std::string()) == c_.cases[k].key && !j.contains("failed");
   } catch (const json::exception&) {
     return false;  // unreadable: run it again
   }
@@ -82,7 +123,9 @@ CampaignSchedule make_schedule(const Campaign& c, const CampaignStore& store) {
   for (std::size_t p = 0; p < c.points.size(); ++p) {
     truth_done.push_back(store.truth_done(p));
     const auto& s = c.points[p].scenario;
-    cost.push_back(static_cast<double>(s.truth.segments) * s.simulation.duration / s.simulation.sample_interval);
+    // The Simbody run's cost grows with the chain and the simulated time (its step is the chain's,
+    // not the sampling's).
+    cost.push_back(static_cast<double>(s.truth.segments) * s.simulation.duration);
   }
   return CampaignSchedule(case_point, cost, truth_done, case_done);
 }
@@ -153,6 +196,11 @@ void truth_started(const Campaign& c, std::size_t p, int rank) {
                c.points[p].label.c_str(), sc.truth.segments, sc.simulation.duration, rank);
 }
 
+std::string interrupted_line(const io::Interrupted& e) {
+  return "interrupted by signal " + std::to_string(e.signal()) +
+         ": the finished cases are stored; run the campaign again to resume";
+}
+
 double CampaignRunSummary::efficiency() const {
   double busy = 0;
   for (const auto& r : ranks) busy += r.busy_seconds;
@@ -206,7 +254,14 @@ CampaignRunSummary run_campaign_serial(const Campaign& c, const CampaignStore& s
 
 int finish_campaign(const Campaign& c, const CampaignStore& store, const CampaignRunSummary& run, const CampaignRunOptions& opt) {
   const std::vector<json> results = store.results();
-  for (const auto& [name, text] : campaign_report(c, results)) io::write_text_atomic((fs::path(store.out()) / name).string(), text);
+  const auto files = campaign_report(c, results);
+  for (const auto& [name, text] : files) io::write_text_atomic((fs::path(store.out()) / name).string(), text);
+  // Report files an earlier run wrote and this one does not (a histogram when the noise was dropped).
+  for (const auto& n : campaign_report_files())
+    if (!files.count(n) && n != "timing.json" && !(n == "histogram.png" && files.count("histogram.gp"))) {
+      std::error_code ec;
+      fs::remove(fs::path(store.out()) / n, ec);
+    }
   json t{{"ranks", run.ranks.size()}, {"cases", run.cases}, {"stored_before", run.done_before}, {"ran", run.ran},
          {"wall_seconds", run.wall_seconds}, {"efficiency", std::isfinite(run.efficiency()) ? json(run.efficiency()) : json()},
          {"busy_seconds", json::array()}, {"tasks_per_rank", json::array()}, {"tasks", run.tasks}};

@@ -11,7 +11,7 @@
 // DIR defaults to run/<scenario>/crosscheck. Each verb replaces only its own files there, as one
 // unit (io/run_directory.h). Exit codes: 0 success; 1 a run failed or an identification did not
 // converge (its outputs are written and say so); 2 bad usage or bad input (nothing written);
-// 130/143 interrupted (nothing written).
+// 130/143 interrupted (nothing written; a campaign keeps the cases it has stored).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -176,8 +176,8 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
 // this process's rank.
 int launched_ranks(int* rank) {
   auto env = [](const char* k) { const char* v = std::getenv(k); return v ? std::atoi(v) : -1; };
-  *rank = std::max({env("OMPI_COMM_WORLD_RANK"), env("PMI_RANK"), env("PMIX_RANK"), 0});
-  const int n = std::max(env("OMPI_COMM_WORLD_SIZE"), env("PMI_SIZE"));
+  *rank = std::max({env("OMPI_COMM_WORLD_RANK"), env("PMI_RANK"), env("PMIX_RANK"), env("SLURM_PROCID"), 0});
+  const int n = std::max({env("OMPI_COMM_WORLD_SIZE"), env("PMI_SIZE"), env("SLURM_NTASKS") > 1 ? env("SLURM_NTASKS") : -1});
   if (n > 0) return n;
   return std::getenv("PMIX_RANK") ? 1 : 0;  // PMIx does not always state the size; MPI will
 }
@@ -201,10 +201,15 @@ int run_campaign(const std::string& file, crosscheck::CampaignRunOptions opt) {
   return guarded([&] {
     const crosscheck::Campaign c = crosscheck::load_campaign(file);
     if (opt.out.empty()) opt.out = "run/campaign/" + c.name;
-    const crosscheck::CampaignStore store(c, opt.out);
+    const crosscheck::CampaignStore store(c, opt.out, true);
     if (opt.progress) std::fprintf(stderr, "scole-crosscheck campaign: %s: %zu points, %zu cases, serially\n", c.name.c_str(), c.points.size(), c.cases.size());
-    const auto run = crosscheck::run_campaign_serial(c, store, opt);
-    return crosscheck::finish_campaign(c, store, run, opt);
+    try {
+      const auto run = crosscheck::run_campaign_serial(c, store, opt);
+      return crosscheck::finish_campaign(c, store, run, opt);
+    } catch (const io::Interrupted& e) {
+      std::fprintf(stderr, "\nscole-crosscheck: %s\n", crosscheck::interrupted_line(e).c_str());
+      return e.exit_code();
+    }
   });
 }
 }  // namespace

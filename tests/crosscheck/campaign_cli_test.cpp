@@ -4,6 +4,8 @@
 // campaign on 2 MPI ranks gives the serial report byte for byte, with both ranks working, and a
 // rank killed mid-case resumes likewise.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -81,6 +83,27 @@ TEST(CampaignCli, BadInputIsOneLineExitTwoNothingWritten) {
   EXPECT_FALSE(fs::exists(d / "out"));
   EXPECT_EQ(sh(exe + " campaign " + (d / "missing.yaml").string() + " -o " + (d / "out").string() + " 2> /dev/null"), 2);
   EXPECT_FALSE(fs::exists(d / "out"));
+  // A directory holding a file of the user's is refused, the file untouched.
+  const fs::path f = campaign_file(d);
+  fs::create_directories(d / "mine");
+  std::ofstream(d / "mine" / "report.txt") << "mine";
+  EXPECT_EQ(sh(exe + " campaign " + f.string() + " -q -o " + (d / "mine").string() + " 2> " + (d / "err").string()), 2);
+  EXPECT_NE(slurp(d / "err").find("report.txt"), std::string::npos) << slurp(d / "err");
+  EXPECT_FALSE(fs::exists(d / "mine" / "cases"));
+  EXPECT_EQ(slurp(d / "mine" / "report.txt"), "mine");
+  fs::remove_all(d);
+}
+
+TEST(CampaignCli, ADirectoryInUseByAnotherRunIsRefused) {
+  const fs::path d = scratch("lock");
+  const fs::path f = campaign_file(d);
+  fs::create_directories(d / "out");
+  const int fd = ::open((d / "out" / ".lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);  // another run holds it
+  EXPECT_EQ(sh(exe + " campaign " + f.string() + " -q -o " + (d / "out").string() + " 2> " + (d / "err").string()), 2);
+  EXPECT_NE(slurp(d / "err").find("another campaign run"), std::string::npos) << slurp(d / "err");
+  ::close(fd);
   fs::remove_all(d);
 }
 
@@ -121,8 +144,14 @@ TEST(CampaignMpi, TwoRanksWriteTheSerialReportAndShareTheWork) {
   const auto t = timing(d / "mpi");
   EXPECT_EQ(t["ranks"].get<int>(), 2);
   std::set<int> ranks;
-  for (const auto& task : t["tasks"]) ranks.insert(task["rank"].get<int>());
+  std::set<std::string> tasks;
+  for (const auto& task : t["tasks"]) {
+    ranks.insert(task["rank"].get<int>());
+    EXPECT_TRUE(tasks.insert(task["task"].get<std::string>()).second) << task << " ran twice";
+  }
   EXPECT_EQ(ranks, (std::set<int>{0, 1}));  // both ranks ran tasks
+  EXPECT_EQ(t["ran"].get<int>(), 8);
+  EXPECT_EQ(tasks.size(), 10u);  // 2 truths and 8 cases, each once
   fs::remove_all(d);
 }
 

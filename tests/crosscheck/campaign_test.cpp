@@ -161,6 +161,7 @@ TEST(CampaignFile, GridProductPointsCasesAndFingerprints) {
   const auto other = scoleid::crosscheck::load_campaign((d / "c2.yaml").string());
   EXPECT_NE(other.cases[7].key, c.cases[7].key);
   EXPECT_EQ(other.points[1].key, c.points[1].key);  // the truths are still the same
+  EXPECT_EQ(other.cases[4].key, c.cases[4].key);    // and so are the noise-free identifications
   EXPECT_NE(scoleid::crosscheck::case_noise_seed(c, c.cases[6]), scoleid::crosscheck::case_noise_seed(c, c.cases[7]));
   fs::remove_all(d);
 }
@@ -182,6 +183,14 @@ TEST(CampaignFile, BadFieldsAreOneLineNamingTheField) {
       {head + "noise: {relative: 1.5, seeds: 3}\n", "noise.relative"},
       {head + "noise: {relative: 0.01, seeds: 3, colour: pink}\n", "noise.colour"},
       {head + "grid: {truth.segments: [10]\n", "malformed"},
+      {"campaign: c\nscenarios: [paper-beam-2, paper-beam-2]\n", "scenarios[1]"},
+      {head + "grid: {truth.segments: [10, 10.0]}\n", "grid.truth.segments[1]"},
+      {head + "grid: {truth.segments: [~, 20]}\n", "grid.truth.segments[0]"},
+      {head + "noise: {relative: 0.01, seeds: 3}\nnoise: {relative: 0.02, seeds: 3}\n", "noise"},
+      {head + "grid: {truth.segments: [10, 20], truth.segments: [40]}\n", "grid.truth.segments"},
+      {head + "noise: {relative: 0.01, seeds: 100000}\ngrid: {truth.segments: [10, 20, 30, 40, 50, 60, 70, 80, 90, 100, 110]}\n",
+       "noise.seeds"},
+      {head + "overlay: {sensors: []}\n", "sensors"},
   };
   int k = 0;
   for (const auto& [text, needle] : cases) {
@@ -194,6 +203,7 @@ TEST(CampaignFile, BadFieldsAreOneLineNamingTheField) {
       const std::string m = e.what();
       EXPECT_NE(m.find(needle), std::string::npos) << m;
       EXPECT_NE(m.find(f.filename().string()), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     }
   }
   EXPECT_THROW(scoleid::crosscheck::load_campaign((d / "missing.yaml").string()), scoleid::io::InputError);
@@ -240,6 +250,19 @@ TEST(CampaignReport, SeedStatisticsAreTheHandComputedOnes) {
   }
   EXPECT_EQ(count, 4);
   EXPECT_NEAR(expected, 4.0 * (std::erf(4.0 / std::sqrt(2.0))), 1e-3);
+  // A draw without a finite std is left out of the statistics and counted apart; one draw left
+  // gives no scatter.
+  res[3]["parameters"][0]["std"] = nullptr;
+  auto j3 = nlohmann::json::parse(scoleid::crosscheck::campaign_report(c, res).at("campaign.json"))["summary"][0];
+  EXPECT_EQ(j3["seeds"].get<int>(), 4);
+  EXPECT_EQ(j3["seeds_with_std"].get<int>(), 3);
+  EXPECT_TRUE(j3["scatter_over_std"].is_number());
+  for (int k : {1, 2}) res[static_cast<std::size_t>(k)]["parameters"][0]["std"] = nullptr;
+  j3 = nlohmann::json::parse(scoleid::crosscheck::campaign_report(c, res).at("campaign.json"))["summary"][0];
+  EXPECT_EQ(j3["seeds_with_std"].get<int>(), 1);
+  EXPECT_TRUE(j3["scatter_over_std"].is_null());
+  EXPECT_TRUE(j3["noise_bias_std_of_mean"].is_null());
+  for (int k : {1, 2, 3}) res[static_cast<std::size_t>(k)]["parameters"][0]["std"] = sd[k];
   // A failed case is listed, not counted.
   res[2] = {{"failed", "something broke"}};
   const auto f2 = scoleid::crosscheck::campaign_report(c, res);

@@ -6,8 +6,9 @@
 // The output directory:
 //   cases/<case>.json          one per finished case, written atomically (temp file + rename) and
 //                              carrying the case's fingerprint: a resumed campaign skips exactly
-//                              the cases already stored for the same inputs, and a case killed
-//                              mid-run left nothing
+//                              the cases already stored for the same inputs (a failed case runs
+//                              again), and a case killed mid-run left nothing
+//   .lock                      held (flock) by the run using the directory
 //   truths/<point>-<key>/n<segments>/truth.csv, truth.json   each point's Simbody truth (a
 //                              RunDirectory: complete or absent)
 //   report.md, cases.csv, points.csv, histogram.csv/.gp/.png, campaign.json   the report, from
@@ -23,6 +24,7 @@
 
 #include "scoleid/crosscheck/campaign.h"
 #include "scoleid/crosscheck/campaign_schedule.h"
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::crosscheck {
 
@@ -35,12 +37,20 @@ struct CampaignRunOptions {
   int kill_rank = -1;  // -1: the last rank
 };
 
+// The report's file names (and timing.json): with cases/, truths/ and .lock all a campaign writes.
+const std::vector<std::string>& campaign_report_files();
+
 class CampaignStore {
 public:
-  // Creates the directory (and cases/, truths/) if needed; io::InputError if it cannot.
-  CampaignStore(const Campaign& c, std::string out);
+  // Creates the directory (and cases/, truths/) if needed. io::InputError if it cannot, if it
+  // holds anything a campaign does not write, or (`exclusive`: the serial run, MPI rank 0) if
+  // another run holds its lock (flock on .lock, released when the store is destroyed).
+  CampaignStore(const Campaign& c, std::string out, bool exclusive = false);
+  ~CampaignStore();
+  CampaignStore(const CampaignStore&) = delete;
+  CampaignStore& operator=(const CampaignStore&) = delete;
   const std::string& out() const { return out_; }
-  // A stored result for case k with case k's fingerprint.
+  // A stored result for case k with case k's fingerprint that did not fail.
   bool case_done(std::size_t k) const;
   // Point p's truth is complete on disk.
   bool truth_done(std::size_t p) const;
@@ -55,10 +65,11 @@ private:
   std::string case_path(std::size_t k) const;
   const Campaign& c_;
   std::string out_;
+  int lock_fd_ = -1;
 };
 
-// The schedule for what the store does not hold yet; the truth's cost is estimated from the
-// point's chain segments and record length.
+// The schedule for what the store does not hold yet; the truth's cost is estimated as the point's
+// chain segments × simulated duration.
 CampaignSchedule make_schedule(const Campaign& c, const CampaignStore& store);
 
 // Runs one task in this process. A case returns its result row (campaign.h's case JSON, with
@@ -69,6 +80,9 @@ nlohmann::json execute_task(const Campaign& c, const CampaignStore& store, const
 
 // One line of progress for a finished case ("p000-s0003: q1 -3.1e-04 ±... covered").
 std::string case_line(const Campaign& c, std::size_t k, const nlohmann::json& result);
+
+// What an interrupted campaign says (its stored cases stay, unlike a run directory's outputs).
+std::string interrupted_line(const io::Interrupted& e);
 
 // The progress line of a truth handed to `rank` (truths are the long tasks).
 void truth_started(const Campaign& c, std::size_t p, int rank);
