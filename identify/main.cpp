@@ -34,8 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
   app.add_option("-d,--data", data, "measured data CSV (header t,<columns>; sensors and inputs matched by name)");
   app.add_option("-o,--out", out, "output directory (default: run/<scenario name>)");
-  app.add_option("-m,--method", method, "optimiser: auto | gauss-newton | lbfgs | steepest-descent (default: the scenario's)")
-      ->check(CLI::IsMember({"auto", "gauss-newton", "lbfgs", "steepest-descent"}));
+  app.add_option("-m,--method", method, "optimiser: auto | gauss-newton | gauss-newton-krylov | lbfgs | steepest-descent (default: the scenario's)")
+      ->check(CLI::IsMember({"auto", "gauss-newton", "gauss-newton-krylov", "lbfgs", "steepest-descent"}));
   app.add_option("--max-iterations", max_iterations, "override identification.max_iterations (>= 0)")
       ->check(CLI::Range(0, 100000));
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");

@@ -441,7 +441,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.elements = r.integer("elements", id.elements, 1, limits::kMaxElements);
   id.sections = r.integer("sections", id.sections, 0, limits::kMaxElements);
   id.data_elements = r.integer("data_elements", id.data_elements, 0, limits::kMaxDataElements);
-  id.method = r.choice("method", id.method, {"auto", "gauss-newton", "lbfgs", "steepest-descent"});
+  id.method = r.choice("method", id.method, {"auto", "gauss-newton", "gauss-newton-krylov", "lbfgs", "steepest-descent"});
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
   id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
   id.step_tolerance = r.positive("step_tolerance", id.step_tolerance);
@@ -456,6 +456,13 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.rtol = r.positive("rtol", id.rtol);
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
+  if (r.has("smoothness")) {
+    const YAML::Node m = r.child("smoothness");
+    if (m.IsScalar() && m.Scalar() == "discrepancy")
+      id.smoothness = -1.0;
+    else
+      id.smoothness = r.nonneg("smoothness", 0.0);
+  }
   if (r.has("uncertain")) {
     // Paths are checked against the whole scenario once it is read (parse_scenario).
     const YAML::Node m = r.child("uncertain");
@@ -718,7 +725,8 @@ nlohmann::json to_json(const Scenario& s) {
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
-                         {"restarts", id.restarts}};
+                         {"restarts", id.restarts},
+                         {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};
   if (!id.uncertain.empty()) {
     json u = json::object();
     for (const auto& x : id.uncertain) u[x.field] = x.is_switch ? json(x.alternative) : json(x.tolerance);

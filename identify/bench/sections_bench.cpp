@@ -495,7 +495,7 @@ int main(int argc, char** argv) {
       } else if (a == "--methods") {
         methods = split(value());
         for (const auto& m : methods)
-          if (m != "gauss-newton" && m != "lbfgs" && m != "auto")
+          if (m != "gauss-newton" && m != "gauss-newton-krylov" && m != "lbfgs" && m != "auto")
             throw std::invalid_argument("--methods: unknown method " + m);
       } else if (a == "--timeout") {
         timeout_s = std::stod(value());

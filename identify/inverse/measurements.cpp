@@ -4,40 +4,74 @@
 
 namespace scoleid::identify {
 
-void Measurements::eval(double tt, double* out) const {
-  const int ns = sensors();
+namespace {
+// The interpolant at tt as Σ_a w[a] z(s0 + a): linear for fewer than 4 samples (count 2), else the
+// 4-point Lagrange stencil around the interval, shifted inside the range at the ends; clamped
+// beyond the ends (count 1).
+int stencil(const std::vector<double>& t, double tt, std::size_t& s0, double* w) {
   const std::size_t N = t.size();
   if (N == 1 || tt <= t.front()) {
-    for (int k = 0; k < ns; ++k) out[k] = z(0, k);
-    return;
+    s0 = 0;
+    w[0] = 1.0;
+    return 1;
   }
   if (tt >= t.back()) {
-    for (int k = 0; k < ns; ++k) out[k] = z(static_cast<Eigen::Index>(N - 1), k);
-    return;
+    s0 = N - 1;
+    w[0] = 1.0;
+    return 1;
   }
   const auto it = std::upper_bound(t.begin(), t.end(), tt);
   const std::size_t j = static_cast<std::size_t>(it - t.begin());  // t[j-1] <= tt < t[j]
   if (N < 4) {
     const double a = (tt - t[j - 1]) / (t[j] - t[j - 1]);
-    for (int k = 0; k < ns; ++k)
-      out[k] = (1 - a) * z(static_cast<Eigen::Index>(j - 1), k) + a * z(static_cast<Eigen::Index>(j), k);
-    return;
+    s0 = j - 1;
+    w[0] = 1 - a;
+    w[1] = a;
+    return 2;
   }
-  // Stencil of 4 samples around the interval, shifted inside the range at the ends.
-  std::size_t s0 = j >= 2 ? j - 2 : 0;
+  s0 = j >= 2 ? j - 2 : 0;
   if (s0 + 4 > N) s0 = N - 4;
-  double w[4];
   for (int a = 0; a < 4; ++a) {
     double l = 1.0;
     for (int b = 0; b < 4; ++b)
       if (b != a) l *= (tt - t[s0 + static_cast<std::size_t>(b)]) / (t[s0 + static_cast<std::size_t>(a)] - t[s0 + static_cast<std::size_t>(b)]);
     w[a] = l;
   }
+  return 4;
+}
+}  // namespace
+
+void Measurements::eval(double tt, double* out) const {
+  const int ns = sensors();
+  std::size_t s0 = 0;
+  double w[4];
+  const int m = stencil(t, tt, s0, w);
   for (int k = 0; k < ns; ++k) {
     double v = 0.0;
-    for (int a = 0; a < 4; ++a) v += w[a] * z(static_cast<Eigen::Index>(s0 + static_cast<std::size_t>(a)), k);
+    for (int a = 0; a < m; ++a) v += w[a] * z(static_cast<Eigen::Index>(s0 + static_cast<std::size_t>(a)), k);
     out[k] = v;
   }
+}
+
+double Measurements::white_noise_integral(double t0, double T) const {
+  // ∫ Σ_a w_a(t)² dt, 5-point Gauss–Legendre per sample interval (the integrand is a polynomial of
+  // degree 6 on each).
+  static const double gx[5] = {0.04691007703066800, 0.2307653449471585, 0.5, 0.7692346550528415, 0.9530899229693320};
+  static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832, 0.1184634425280945};
+  double sum = 0.0;
+  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
+    const double a = std::max(t[i], t0), b = std::min(t[i + 1], T);
+    if (!(b > a)) continue;
+    for (int g = 0; g < 5; ++g) {
+      std::size_t s0 = 0;
+      double w[4];
+      const int m = stencil(t, a + gx[g] * (b - a), s0, w);
+      double q = 0.0;
+      for (int k = 0; k < m; ++k) q += w[k] * w[k];
+      sum += gw[g] * (b - a) * q;
+    }
+  }
+  return sum;
 }
 
 }  // namespace scoleid::identify

@@ -386,20 +386,7 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
       J += 0.5 * wt * e;
-      // Without rate sensors the mass term is taken by parts, −ṗᵀ M_j u̇ (p(T) = 0); with them p(T) ≠ 0
-      // and it is pᵀ M_j ü. Damping pᵀ D_j u̇, stiffness pᵀ K_j u.
-      for (const auto& e : terms_) {
-        const bool by_parts = e.kind == 0 && !rates;
-        const double* left = by_parts ? pd.data() : p.data();
-        const double* right = e.kind == 2 ? x.data() : (e.kind == 0 && rates ? a.data() : v.data());
-        double acc = 0.0;
-        for (std::size_t mm = 0; mm < e.value.size(); ++mm) acc += left[e.row[mm]] * e.value[mm] * right[e.col[mm]];
-        gc[e.coefficient] += (by_parts ? -wt : wt) * acc;
-      }
-      for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
-        const int ci = model_.inputs[i].coefficient;
-        if (ci >= 0) gc[ci] -= wt * inputs_[i](t) * p.dot(model_.inputs[i].vector);
-      }
+      add_coefficient_gradient(t, wt, p, pd, x, v, a, rates, gc);
     }
   }
   gradient = s.dcdq.transpose() * gc;
@@ -408,9 +395,28 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   return J;
 }
 
-Objective::Derivative Objective::derivative(const Setup& s, int i) const {
+void Objective::add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
+                                         const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const {
+  // Without rate sensors the mass term is taken by parts, −ṗᵀ M_j u̇ (p(T) = 0); with them p(T) ≠ 0
+  // and it is pᵀ M_j ü. Damping pᵀ D_j u̇, stiffness pᵀ K_j u.
+  for (const auto& e : terms_) {
+    const bool by_parts = e.kind == 0 && !rates;
+    const double* left = by_parts ? pd.data() : p.data();
+    const double* right = e.kind == 2 ? x.data() : (e.kind == 0 && rates ? a.data() : v.data());
+    double acc = 0.0;
+    for (std::size_t mm = 0; mm < e.value.size(); ++mm) acc += left[e.row[mm]] * e.value[mm] * right[e.col[mm]];
+    gc[e.coefficient] += (by_parts ? -wt : wt) * acc;
+  }
+  for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
+    const int ci = model_.inputs[i].coefficient;
+    if (ci >= 0) gc[ci] -= wt * inputs_[i](t) * p.dot(model_.inputs[i].vector);
+  }
+}
+
+Objective::Derivative Objective::derivative(const Setup& s, int i) const { return derivative_along(s.dcdq.col(i)); }
+
+Objective::Derivative Objective::derivative_along(const VectorXd& dcol) const {
   const int n = model_.ndof;
-  const VectorXd dcol = s.dcdq.col(i);
   // Constant terms (coefficient −1) do not enter the derivative.
   auto only_coef = [&](const std::vector<OperatorTerm>& terms) {
     SparseMatrix A(n, n);
@@ -424,10 +430,9 @@ Objective::Derivative Objective::derivative(const Setup& s, int i) const {
   return d;
 }
 
-Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i,
+Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, const Derivative& d,
                                   double t_end) const {
   const int n = model_.ndof;
-  const Derivative d = derivative(s, i);
   VectorXd x(n), v(n), a(n), Fe(n);
   SecondOrderSolver::Forcing f = [&](double t, double* F) {
     u.eval(t, x.data(), v.data());
@@ -454,13 +459,19 @@ int Objective::sensitivity_block(double t_end) const {
 std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s,
                                                             double state_end, double tangent_end, Trajectory& u,
                                                             int first, int count) {
-  const int n = model_.ndof;
   if (count < 0) count = size() - first;
+  std::vector<Derivative> d;
+  for (int i = first; i < first + count; ++i) d.push_back(derivative(s, i));
+  return solve_tangents(solver, s, state_end, tangent_end, u, d);
+}
+
+std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,
+                                                  double tangent_end, Trajectory& u, const std::vector<Derivative>& d) {
+  const int n = model_.ndof;
+  const int count = static_cast<int>(d.size());
   const auto ts = Clock::now();
   std::vector<Trajectory> S;
   if (solver.has_tangent_solve()) {
-    std::vector<Derivative> d;
-    for (int i = first; i < first + count; ++i) d.push_back(derivative(s, i));
     std::vector<double> f(inputs_.size());
     SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* v, const double* a, double* Gp) {
       const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
@@ -483,7 +494,7 @@ std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSol
     S = std::move(sol.tangents);
   } else {
     u = forward(solver, s, state_end);
-    for (int i = first; i < first + count; ++i) S.push_back(sensitivity(solver, s, u, i, tangent_end));
+    for (const Derivative& di : d) S.push_back(sensitivity(solver, s, u, di, tangent_end));
   }
   counters_.sensitivity_solves += count;
   counters_.sensitivity_seconds += since(ts);
@@ -623,6 +634,56 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
     }
   }
   return G;
+}
+
+VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
+  if (!has_matrix_free_products())
+    throw std::logic_error("Objective::gauss_newton_product: velocity and acceleration sensors are not supported");
+  if (v.size() != size()) throw std::invalid_argument("Objective::gauss_newton_product: v has the wrong size");
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t0 = data_.t.front();
+  // Tangent along v: M Ṡ̈ + D Ṡ + K S = −(∂_v M ü + ∂_v D u̇ + ∂_v K u − ∂_v B f), ∂_v = Σ v_i ∂_i.
+  Trajectory u;
+  const std::vector<Trajectory> S = solve_tangents(solver, s, T_, T_, u, {derivative_along(s.dcdq * v)});
+  const Trajectory& Sv = S.front();
+  // Costate with the tangent's output in place of the residual: M P'' + D P' + K P = −Cᵀ R C S(T − τ).
+  std::vector<double> bp_tau;
+  for (double b : breakpoints_)
+    if (b < T_) bp_tau.push_back(T_ - b);
+  std::sort(bp_tau.begin(), bp_tau.end());
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  const MatrixXd CtRC = C_.transpose() * Rv.asDiagonal() * C_;
+  auto tc = Clock::now();
+  VectorXd sx(n), sv(n);
+  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
+    Sv.eval(T_ - tau, sx.data(), sv.data());
+    Eigen::Map<VectorXd>(F, n).noalias() = -CtRC * sx;
+  };
+  SolverSummary sum;
+  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.costate_solves;
+  counters_.costate_seconds += since(tc);
+  // Eq. 25 on that costate and the state.
+  const auto tq = Clock::now();
+  std::vector<double> ptimes;
+  for (double tau : P.times()) ptimes.push_back(T_ - tau);
+  const auto grid = union_grid({&u.times(), &Sv.times(), &ptimes}, T_);
+  VectorXd x(n), xv(n), a(n), p(n), pd(n), gc = VectorXd::Zero(model_.ncoef);
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int gq = 0; gq < 3; ++gq) {
+      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
+      u.eval(t, x.data(), xv.data());
+      P.eval(T_ - t, p.data(), pd.data());
+      pd = -pd;
+      add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
+    }
+  }
+  counters_.quadrature_seconds += since(tq);
+  return s.dcdq.transpose() * gc;
 }
 
 }  // namespace scoleid::identify

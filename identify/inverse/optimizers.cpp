@@ -15,8 +15,11 @@ bool OptimizerOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (method != "gauss-newton" && method != "lbfgs" && method != "steepest-descent")
-    return bad("method must be gauss-newton, lbfgs or steepest-descent");
+  if (method != "gauss-newton" && method != "gauss-newton-krylov" && method != "lbfgs" && method != "steepest-descent")
+    return bad("method must be gauss-newton, gauss-newton-krylov, lbfgs or steepest-descent");
+  if (!(smoothness_weight >= 0)) return bad("smoothness_weight must be >= 0");
+  if (smoothness_weight > 0 && method != "gauss-newton-krylov") return bad("the smoothness prior needs method gauss-newton-krylov");
+  if (!(max_krylov_iterations >= 1)) return bad("max_krylov_iterations must be >= 1");
   if (max_iterations < 0) return bad("max_iterations must be >= 0");
   if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
   for (double w : steepest_weights)
@@ -385,6 +388,184 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   obj.set_horizon(t_end);
 }
 
+// The smoothness prior ½ β Σ_chains Σ_j (x_{j+1} − x_j)² on x = log q: value, gradient, product.
+struct Smoothness {
+  double beta = 0.0;
+  std::vector<std::vector<int>> chains;
+  double value(const VectorXd& x) const {
+    double v = 0.0;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) v += std::pow(x[c[j + 1]] - x[c[j]], 2);
+    return 0.5 * beta * v;
+  }
+  // β LᵀL y
+  VectorXd apply(const VectorXd& y) const {
+    VectorXd out = VectorXd::Zero(y.size());
+    if (beta == 0.0) return out;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
+        const double d = y[c[j + 1]] - y[c[j]];
+        out[c[j + 1]] += beta * d;
+        out[c[j]] -= beta * d;
+      }
+    return out;
+  }
+};
+
+// Inexact Gauss–Newton–Krylov (docs/theory.md §7.7): the trust-region step from truncated
+// conjugate gradients on matrix-free products (Steihaug), stopped at ‖H δ + g‖ <= η ‖g‖ with the
+// Eisenstat–Walker forcing η = min(½, √(‖g‖/‖g₀‖)), at the region's boundary, or at negative
+// curvature. Each CG iteration costs one product (a tangent and a costate solve); the number of
+// iterations follows the directions the data inform, not P. Horizon continuation as for the
+// gradient methods (one extra state solve per accepted step while the horizon is short).
+void gauss_newton_krylov(Run& r, VectorXd x) {
+  Objective& obj = r.obj;
+  if (!obj.has_matrix_free_products())
+    throw std::invalid_argument("gauss-newton-krylov: velocity and acceleration sensors are not supported (use gauss-newton)");
+  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const Smoothness prior{r.opt.smoothness_weight, r.opt.smoothness_chains};
+  const bool continuation = r.opt.continuation;
+  auto full = [&]() { return obj.horizon() >= t_end; };
+  double J = 0.0, Jd = 0.0;  // total and data misfit
+  VectorXd gx;
+  auto eval = [&](const VectorXd& xx, double& Jt, double& Jdata, VectorXd& g) {
+    if (!r.eval_grad(xx, Jdata, g)) return false;
+    Jt = Jdata + prior.value(xx);
+    g += prior.apply(xx);
+    return true;
+  };
+  auto extend = [&](double T_new) {
+    if (full() || !(T_new > obj.horizon())) return false;
+    obj.set_horizon(T_new);
+    if (!eval(x, J, Jd, gx)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    return true;
+  };
+  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
+  obj.set_horizon(t_end);
+  bool start_ok = true;
+  if (continuation) {
+    try {
+      obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
+    } catch (const std::exception&) {
+      start_ok = false;
+    }
+  }
+  if (!start_ok || !eval(x, J, Jd, gx)) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.sum.q = x.array().exp();
+    obj.set_horizon(t_end);
+    return;
+  }
+  r.record(0, J, x.array().exp(), gx);
+  const double g0 = gx.norm();
+  double radius = r.opt.trust_radius;
+  int k = 0;
+  r.sum.termination = T::MaxIterations;
+  // H_x y = q ∘ H_q (q ∘ y) + β LᵀL y
+  auto product = [&](const VectorXd& y) {
+    const VectorXd q = x.array().exp();
+    return VectorXd(q.cwiseProduct(obj.gauss_newton_product(q, q.cwiseProduct(y))) + prior.apply(y));
+  };
+  try {
+    while (true) {
+      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
+        if (extend(doubled())) continue;
+        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+        break;
+      }
+      if (k >= r.opt.max_iterations) break;
+      // Steihaug–Toint CG on H δ = −g inside ‖δ‖ <= radius.
+      const double eta = std::min(0.5, std::sqrt(gx.norm() / std::max(g0, 1e-300)));
+      VectorXd delta = VectorXd::Zero(x.size()), res = gx, d = -gx;
+      bool boundary = false;
+      int cg = 0;
+      // In exact arithmetic CG ends within P iterations; beyond that the products' own error rules.
+      const int max_cg = std::min(r.opt.max_krylov_iterations, static_cast<int>(x.size()));
+      for (; cg < max_cg; ++cg) {
+        io::check_interrupt();
+        const VectorXd Hd = product(d);
+        ++r.sum.krylov_iterations;
+        const double curv = d.dot(Hd);
+        auto to_boundary = [&]() {
+          // τ >= 0 with ‖δ + τ d‖ = radius
+          const double a = d.squaredNorm(), b = 2 * delta.dot(d), c = delta.squaredNorm() - radius * radius;
+          const double tau = (-b + std::sqrt(std::max(0.0, b * b - 4 * a * c))) / (2 * a);
+          delta += tau * d;
+          res += tau * Hd;
+          boundary = true;
+        };
+        if (curv <= 0) {
+          to_boundary();
+          break;
+        }
+        const double alpha = res.squaredNorm() / curv;
+        if ((delta + alpha * d).norm() >= radius) {
+          to_boundary();
+          break;
+        }
+        const double rr = res.squaredNorm();
+        delta += alpha * d;
+        res += alpha * Hd;
+        if (res.norm() <= eta * gx.norm()) {
+          ++cg;
+          break;
+        }
+        d = -res + (res.squaredNorm() / rr) * d;
+      }
+      // m(0) − m(δ) = −(gᵀδ + ½ δᵀHδ) with Hδ = res − g.
+      const double predicted = -0.5 * (gx.dot(delta) + delta.dot(res));
+      double Jn = 0.0, Jdn = 0.0;
+      VectorXd gn;
+      const bool ok = eval(x + delta, Jn, Jdn, gn) && Jn < J;
+      const double rho = ok && predicted > 0 ? (J - Jn) / predicted : -1.0;
+      TrustRegionStep st;
+      st.delta = delta;
+      st.predicted = predicted;
+      st.on_boundary = boundary;
+      radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
+      if (!ok) {
+        if (radius < r.opt.step_tolerance) {
+          if (extend(doubled())) {
+            radius = r.opt.trust_radius;
+            continue;
+          }
+          r.sum.termination = T::StepTolerance;
+          r.sum.message = "no decrease along the truncated Gauss-Newton step: at the minimum to integration accuracy";
+          break;
+        }
+        continue;
+      }
+      const double step = delta.cwiseAbs().maxCoeff();
+      const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
+      const bool stalled = J - Jn <= stall * J;
+      x += delta;
+      J = Jn;
+      Jd = Jdn;
+      gx = gn;
+      ++k;
+      const bool extended = continuation && !full() && extend(r.horizon_from(obj.misfit_profile(x.array().exp()), obj.horizon()));
+      r.record(k, J, x.array().exp(), gx);
+      if (extended) continue;
+      if (step < r.opt.step_tolerance || stalled) {
+        if (extend(doubled())) continue;
+        r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+        break;
+      }
+    }
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    r.sum.termination = T::LineSearchFailed;
+    r.sum.message = e.what();
+  }
+  r.sum.iterations_done = k;
+  r.sum.q = x.array().exp();
+  r.sum.cost = J;
+  r.sum.prior_cost = J - Jd;
+  obj.set_horizon(t_end);
+}
+
 }  // namespace
 
 OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const OptimizerOptions& options,
@@ -400,6 +581,7 @@ OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const Optimi
     ~HorizonGuard() { o.set_horizon(o.data_end()); }
   } guard{objective};
   if (options.method == "gauss-newton") gauss_newton(r, x0);
+  else if (options.method == "gauss-newton-krylov") gauss_newton_krylov(r, x0);
   else lbfgs(r, x0, options.method == "steepest-descent");
   r.sum.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r.sum;

@@ -204,6 +204,53 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
   return fit_test(in);
 }
 
+namespace {
+
+// The smoothness weight by the discrepancy principle (docs/theory.md §7.8): β from 1 down by
+// factors of 10, each solve from the previous estimate, until the data misfit is within the
+// noise's expected misfit E J = ½ Σ_k R_k σ_k² E∫ñ² (Measurements::white_noise_integral: the
+// data's interpolant of white noise) plus two standard deviations of it as a χ² sum over the N
+// data values, E J (1 + 2 √(2/N)); that β (the largest meeting it) and its estimate are kept.
+// The stated noise levels are needed.
+OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r, OptimizerOptions oo,
+                                  const std::function<void(const IterationRecord&)>& progress, bool verbose) {
+  double expected = 0.0;
+  const auto& R = obj.weights();
+  for (std::size_t k = 0; k < R.size(); ++k) {
+    const double sd = k < p.noise_std.size() ? p.noise_std[k] : 0.0;
+    if (!(sd > 0.0))
+      io::fail_field(p.scenario.source, "identification.smoothness",
+                     "discrepancy needs every sensor's noise level stated (sensor '" + p.data.names[k] + "' has none)", "discrepancy");
+    expected += 0.5 * R[k] * sd * sd * p.data.white_noise_integral(obj.data_start(), obj.data_end());
+  }
+  expected *= 1.0 + 2.0 * std::sqrt(2.0 / static_cast<double>(std::max(1L, obj.data_points())));
+  r.smoothness_expected_misfit = expected;
+  VectorXd q = r.initial;
+  OptimizerSummary chosen;
+  bool have = false;
+  for (double beta = 1.0; beta >= 1e-10; beta /= 10.0) {
+    oo.smoothness_weight = beta;
+    OptimizerSummary s = minimize(obj, q, oo, progress);
+    const double misfit = s.cost - s.prior_cost;
+    r.smoothness_path.push_back({beta, misfit, s.prior_cost, s.iterations_done, s.converged()});
+    if (verbose)
+      std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
+                  to_string(s.termination));
+    if (s.q.allFinite()) q = s.q;
+    chosen = s;
+    r.smoothness_weight = beta;
+    have = true;
+    if (misfit <= expected) {
+      r.smoothness_met = true;
+      break;
+    }
+  }
+  if (!have) throw std::logic_error("discrepancy_path: no weight tried");
+  return chosen;
+}
+
+}  // namespace
+
 RunResult run_identification(Problem& p, const RunOptions& ro) {
   const auto t0 = std::chrono::steady_clock::now();
   RunResult r;
@@ -212,8 +259,18 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   r.initial = p.params->initial();
   r.truth = p.true_values;
   std::string method = ro.method.empty() ? p.scenario.identification.method : ro.method;
-  if (method == "auto") method = p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
+  const double smoothness = p.scenario.identification.smoothness;
+  if (method == "auto") method = smoothness != 0.0 ? "gauss-newton-krylov" : p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
   r.method = method;
+  std::vector<std::vector<int>> chains;
+  if (smoothness != 0.0) {
+    if (method != "gauss-newton-krylov")
+      io::fail_field(p.scenario.source, "identification.smoothness", "needs method gauss-newton-krylov (or auto)", method);
+    chains = section_families(r.names);
+    if (chains.empty())
+      io::fail_field(p.scenario.source, "identification.smoothness",
+                     "needs sectional parameters (X_1 ... X_N) among those estimated", "none");
+  }
 
   Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   OptimizerOptions oo;
@@ -234,7 +291,15 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     io::check_interrupt();
     if (ro.verbose) table.row(rec);
   };
-  r.summary = minimize(obj, r.initial, oo, progress);
+  oo.smoothness_chains = chains;
+  if (smoothness >= 0.0) {
+    oo.smoothness_weight = smoothness;
+    r.summary = minimize(obj, r.initial, oo, progress);
+    r.smoothness_weight = smoothness;
+  } else {
+    r.summary = discrepancy_path(p, obj, r, oo, progress, ro.verbose);
+    oo.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
+  }
   r.fit = test_fit(p, obj, r.summary.q);
   auto attempt_record = [&](const std::string& strategy, const std::string& how, const OptimizerSummary& s,
                             const FitTest& f, int iterations) {
@@ -299,6 +364,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
         Objective level(p.model(), tied, p.signals, p.data, p.objective_options);
         OptimizerOptions ol = oo;
         ol.method = "gauss-newton";
+        ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
         ol.continuation = p.scenario.identification.continuation_misfit > 0;
         const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
         const auto& c = level.counters();
@@ -478,6 +544,21 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
               return a;
             }()},
            {"cost", summary.cost},
+           {"smoothness", [&] {
+              nlohmann::json sm{{"weight", smoothness_weight}, {"prior_cost", summary.prior_cost}};
+              if (!smoothness_path.empty()) {
+                sm["rule"] = "discrepancy";
+                sm["expected_noise_misfit"] = smoothness_expected_misfit;
+                sm["discrepancy_met"] = smoothness_met;
+                nlohmann::json path = nlohmann::json::array();
+                for (const auto& e : smoothness_path)
+                  path.push_back({{"weight", e.weight}, {"data_misfit", e.data_misfit}, {"prior_cost", e.prior_cost},
+                                  {"iterations", e.iterations}, {"converged", e.converged}});
+                sm["path"] = path;
+              }
+              return sm;
+            }()},
+           {"krylov_iterations", summary.krylov_iterations},
            {"gradient_evaluations", counters.gradient_evaluations},
            {"forward_solves", counters.forward_solves},
            {"costate_solves", counters.costate_solves},

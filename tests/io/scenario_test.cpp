@@ -361,4 +361,13 @@ identification:
   EXPECT_NE(error_of(head + "  model_error: -0.01\n").find("identification.model_error"), std::string::npos);
   EXPECT_NE(error_of(head + "  model_error: .nan\n").find("identification.model_error"), std::string::npos);
   EXPECT_NE(error_of(head + "  restarts: 11\n").find("identification.restarts"), std::string::npos);
+  // The smoothness prior: off by default, a weight, or the discrepancy principle.
+  EXPECT_EQ(automatic.identification.smoothness, 0.0);
+  const Scenario weight = parse_scenario(head + "  smoothness: 0.01\n", "scenario 'x.yaml'");
+  EXPECT_DOUBLE_EQ(weight.identification.smoothness, 0.01);
+  const Scenario morozov = parse_scenario(head + "  smoothness: discrepancy\n", "scenario 'x.yaml'");
+  EXPECT_LT(morozov.identification.smoothness, 0.0);
+  EXPECT_EQ(to_json(morozov)["identification"]["smoothness"].get<std::string>(), "discrepancy");
+  EXPECT_NE(error_of(head + "  smoothness: -1\n").find("identification.smoothness"), std::string::npos);
+  EXPECT_NE(error_of(head + "  smoothness: lots\n").find("identification.smoothness"), std::string::npos);
 }

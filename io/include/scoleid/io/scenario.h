@@ -180,7 +180,7 @@ struct IdentificationSpec {
   int elements = 10;          // identifier mesh
   int sections = 0;           // equal sections carrying EI_k in the identifier (0 = the beam's own)
   int data_elements = 0;      // mesh that synthesises data; 0 = 2 x elements (at least 2x)
-  std::string method = "auto";  // auto | gauss-newton | lbfgs | steepest-descent
+  std::string method = "auto";  // auto | gauss-newton | gauss-newton-krylov | lbfgs | steepest-descent
   int max_iterations = 50;
   double gradient_tolerance = 1e-9;  // on the scaled gradient
   double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
@@ -201,6 +201,11 @@ struct IdentificationSpec {
   // Further attempts when the fit does not explain the data (coarse-to-fine over sections, a
   // slower horizon continuation); 0 = report the first attempt as it is.
   int restarts = 2;
+  // Smoothness prior on the logarithm of sectional parameters (EI_1 … EI_N and the like, neighbours
+  // tied by ½ β Σ (log q_{j+1} − log q_j)²; method gauss-newton-krylov): β >= 0, 0 = off (the
+  // default), < 0 ("discrepancy" in YAML) = β chosen by the discrepancy principle from the stated
+  // sensor noise (docs/theory.md §7.8).
+  double smoothness = 0.0;
 };
 
 struct TruthModelSpec {

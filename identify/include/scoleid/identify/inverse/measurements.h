@@ -18,6 +18,10 @@ struct Measurements {
   int sensors() const { return static_cast<int>(z.cols()); }
   // z̃(tt) into out (length sensors()); clamped beyond the ends.
   void eval(double tt, double* out) const;
+  // E ∫_{t0}^{T} ñ(t)² dt for unit white noise n at the samples and ñ its interpolant: the
+  // expected misfit noise adds to the cost per unit variance (≈ 0.776 (T − t0) for the cubic
+  // interpolant at uniform sampling; docs/theory.md §7.8).
+  double white_noise_integral(double t0, double T) const;
 };
 
 }  // namespace scoleid::identify

@@ -111,6 +111,12 @@ public:
   // Output sensitivities ∂(C u(t_i))/∂q at the sample times: (samples·sensors) × P, row-major by
   // sample. For Fisher information.
   MatrixXd output_sensitivities(const VectorXd& q);
+  // The Gauss–Newton matrix times v without forming it (docs/theory.md §7.7): one tangent solve
+  // along v (with the state) and one costate solve whose source is the tangent's output C S v in
+  // place of the residual; the gradient formula (Eq. 25) on that costate is H v. Two solves
+  // whatever the number of parameters. Displacement sensors only (has_matrix_free_products()).
+  VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v);
+  bool has_matrix_free_products() const { return C1_.size() == 0; }
 
   const ObjectiveCounters& counters() const { return counters_; }
   void reset_counters() { counters_ = {}; }
@@ -147,7 +153,17 @@ private:
     std::vector<VectorXd> db;
   };
   Derivative derivative(const Setup& s, int i) const;
-  Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, int i, double t_end) const;
+  // Σ_j dc_j ∂M/∂c_j etc.: the derivative along a direction dc of the model coefficients.
+  Derivative derivative_along(const VectorXd& dc) const;
+  Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, const Derivative& d,
+                         double t_end) const;
+  // The state and the tangents of the given derivatives (as solve_with_sensitivities).
+  std::vector<Trajectory> solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,
+                                         double tangent_end, Trajectory& u, const std::vector<Derivative>& d);
+  // Adds the quadrature point's share of ∂J/∂c (Eq. 25) to gc: weight wt, multiplier p (and ṗ for
+  // the mass term by parts when `by_parts_mass`), state x, v and acceleration a.
+  void add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
+                                const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const;
   // The state over [t0, state_end] and the sensitivities to parameters first … first + count − 1
   // (count < 0: to the last) over [t0, tangent_end] (tangent_end <= state_end).
   std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,

@@ -11,6 +11,12 @@
 //   gauss-newton      trust-region Gauss–Newton (Levenberg) on x from forward sensitivities;
 //                     see gauss_newton_step.h for the step and the radius, and below for the
 //                     horizon continuation.
+//   gauss-newton-krylov  inexact trust-region Gauss–Newton: the step from truncated conjugate
+//                     gradients (Steihaug) on matrix-free products H v (objective.h,
+//                     gauss_newton_product: one tangent and one costate solve each), stopped by the
+//                     Eisenstat–Walker forcing η = min(½, √(‖g‖/‖g₀‖)); the cost of a step follows
+//                     the number of directions the data inform, not P. Takes the optional
+//                     smoothness prior. Displacement sensors only. docs/theory.md §7.7–7.8.
 //
 // Horizon continuation (every method, `continuation`; described for Gauss–Newton, the gradient
 // methods do the same with a misfit-profile state solve after each accepted step while the
@@ -72,6 +78,13 @@ struct OptimizerOptions {
   double continuation_misfit = 0.05;        // bound on the relative mean-square misfit per sensor
   double continuation_min_fraction = 0.125;  // shortest horizon, as a fraction of the record
   double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
+  // gauss-newton-krylov: CG iterations per step (each one matrix-free product: two solves)
+  int max_krylov_iterations = 50;
+  // Smoothness prior on x = log q (gauss-newton-krylov only; docs/theory.md §7.8):
+  //   ½ β Σ_chains Σ_j (x_{c_{j+1}} − x_{c_j})²
+  // over chains of neighbouring sections (e.g. the indices of EI_1 … EI_N). β = 0: off.
+  double smoothness_weight = 0.0;
+  std::vector<std::vector<int>> smoothness_chains;
   bool IsValid(std::string* why) const;
 };
 
@@ -88,7 +101,9 @@ struct OptimizerSummary {
   Termination termination = Termination::MaxIterations;
   std::string message;
   VectorXd q;
-  double cost = 0.0;
+  double cost = 0.0;        // with the prior's share, if any
+  double prior_cost = 0.0;  // the smoothness prior's share of cost
+  long krylov_iterations = 0;  // gauss-newton-krylov: CG iterations (matrix-free products) in all
   std::vector<IterationRecord> iterations;
   int iterations_done = 0;
   double wall_seconds = 0.0;

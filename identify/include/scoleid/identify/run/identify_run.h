@@ -63,8 +63,20 @@ struct RunResult {
   };
   std::vector<Attempt> attempts;  // the first is the plain run
   int chosen_attempt = 0;
-  // The optimiser stopped on a convergence test and the model explains the data.
-  bool converged() const { return summary.converged() && fit.explains_data; }
+  // The smoothness prior (identification.smoothness): its weight, and with the discrepancy
+  // principle the weights tried, whether one met it, and the noise's expected misfit.
+  double smoothness_weight = 0.0;
+  struct SmoothnessStep {
+    double weight, data_misfit, prior_cost;
+    int iterations;
+    bool converged;
+  };
+  std::vector<SmoothnessStep> smoothness_path;
+  double smoothness_expected_misfit = 0.0;
+  bool smoothness_met = false;
+  // The optimiser stopped on a convergence test and the model explains the data (and, with the
+  // discrepancy principle, a weight met it).
+  bool converged() const { return summary.converged() && fit.explains_data && (smoothness_path.empty() || smoothness_met); }
   VectorXd half_record_estimate;
   bool half_record_converged = false;
   double wall_seconds = 0;
