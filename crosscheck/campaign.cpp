@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "scoleid/crosscheck/scenario_overlay.h"
+#include "study_yaml.h"
 #include "scoleid/crosscheck/table.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
@@ -22,27 +23,9 @@ using nlohmann::json;
 
 namespace {
 
-[[noreturn]] void bad(const std::string& file, const std::string& field, const std::string& what, const std::string& value) {
-  io::fail_field(file, field, what, value);
-  throw io::InputError(file);  // not reached
-}
-
-std::string text_of(const YAML::Node& n) {
-  YAML::Emitter e;
-  e << YAML::Flow << n;
-  return e.c_str();
-}
-
-double number_of(const YAML::Node& n, const std::string& file, const std::string& field) {
-  double v = std::nan("");
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    bad(file, field, "must be a number", n.IsScalar() ? "'" + n.Scalar() + "'" : text_of(n));
-  }
-  if (!std::isfinite(v)) bad(file, field, "must be finite", n.Scalar());
-  return v;
-}
+using study::bad;
+using study::number_of;
+using study::text_of;
 
 bool name_ok(const std::string& s, const char* extra) {
   if (s.empty()) return false;

@@ -13,6 +13,7 @@
 
 #include "scoleid/crosscheck/case_identification.h"
 #include "scoleid/crosscheck/scenario_overlay.h"
+#include "study_yaml.h"
 #include "scoleid/crosscheck/table.h"
 #include "scoleid/crosscheck/truth_levels.h"
 #include "scoleid/identify/run/identify_run.h"
@@ -26,27 +27,9 @@ using nlohmann::json;
 
 namespace {
 
-[[noreturn]] void bad(const std::string& file, const std::string& field, const std::string& what, const std::string& value) {
-  io::fail_field(file, field, what, value);
-  throw io::InputError(file);  // not reached
-}
-
-std::string text_of(const YAML::Node& n) {
-  YAML::Emitter e;
-  e << n;
-  return e.c_str();
-}
-
-double number_of(const YAML::Node& n, const std::string& file, const std::string& field) {
-  double v = std::nan("");
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    bad(file, field, "must be a number", n.IsScalar() ? "'" + n.Scalar() + "'" : "a " + std::string(n.IsMap() ? "map" : "list"));
-  }
-  if (!std::isfinite(v)) bad(file, field, "must be finite", n.Scalar());
-  return v;
-}
+using study::bad;
+using study::number_of;
+using study::text_of;
 
 std::pair<double, double> range_of(const YAML::Node& n, const std::string& file, const std::string& field) {
   if (!n.IsSequence() || n.size() != 2) bad(file, field, "must be [low, high]", text_of(n));

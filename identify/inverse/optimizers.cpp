@@ -83,6 +83,11 @@ struct Run {
     T = std::max(T, current);
     return T >= t_end - 1e-9 * (t_end - t0) ? t_end : T;
   }
+  // The relative decrease below which a Gauss–Newton step is indistinguishable from fitting noise
+  // (header: 1/N automatically).
+  double gauss_newton_stall() const {
+    return opt.cost_stall > 0 ? opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
+  }
   bool small_gradient(const VectorXd& gx, double J) const {
     return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
   }
@@ -217,8 +222,7 @@ void gauss_newton(Run& r, VectorXd x) {
       }
       x += delta;
       const double step = delta.cwiseAbs().maxCoeff();
-      const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
-      const bool stalled = J - Jn <= stall * J;
+      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
       J = Jn;
       gx = gn;
       Hx = Hn;
@@ -537,8 +541,7 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
         continue;
       }
       const double step = delta.cwiseAbs().maxCoeff();
-      const double stall = r.opt.cost_stall > 0 ? r.opt.cost_stall : 1.0 / static_cast<double>(std::max(1L, obj.data_points()));
-      const bool stalled = J - Jn <= stall * J;
+      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
       x += delta;
       J = Jn;
       Jd = Jdn;

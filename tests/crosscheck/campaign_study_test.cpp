@@ -14,19 +14,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
-int sh(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using scoleid::test::sh;
+using scoleid::test::slurp;
 nlohmann::json load(const fs::path& p) {
   std::ifstream in(p);
   return nlohmann::json::parse(in);

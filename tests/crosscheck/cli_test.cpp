@@ -17,25 +17,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
-int sh(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-fs::path scratch(const std::string& tag) {
-  const fs::path d = fs::temp_directory_path() / ("scoleid-xc-cli-" + tag + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using scoleid::test::sh;
+using scoleid::test::slurp;
+fs::path scratch(const std::string& tag) { return scoleid::test::scratch("xc-cli", tag); }
 const std::string exe = SCOLE_CROSSCHECK_EXE;
 }  // namespace
 
