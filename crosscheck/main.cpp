@@ -41,7 +41,7 @@ namespace fs = std::filesystem;
 
 namespace {
 const std::vector<std::string> kOutputs = {
-    "modes.csv",   "mac.csv",   "modes.json",   "trajectories.csv", "trajectories.json",   "overlay.csv",
+    "modes.csv",   "mac.csv",   "modes.json",  "modal-data.csv",   "trajectories.csv", "trajectories.json",   "overlay.csv",
     "identify.csv", "identify.json", "report.md", "modes_convergence.csv", "identify_convergence.csv",
     "modes.gp",    "modes.png", "overlay.gp",   "overlay.png",      "identify.gp",         "identify.png",
     "truths"};
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
   auto* modes = app.add_subcommand(
       "modes", "natural frequencies and mode shapes: the Simbody chain linearised at rest at n, 2n, 4n segments against "
                "the FE model at N, 2N, 4N elements and the analytic values where they exist; observed rates, Richardson "
-               "extrapolation of the chain, MAC matrix. Writes modes.csv, mac.csv, modes.json");
+               "extrapolation of the chain, MAC matrix. Writes modes.csv, mac.csv, modes.json, and modal-data.csv (the chain's modes at the scenario's displacement-type sensors, stds from its lumping error: measured modes for scole-identify --experiments)");
   common(modes);
   modes->add_option("--segments", mo.segments, "first chain resolution n (default: the scenario's truth.segments)");
   modes->add_option("--elements", mo.elements, "first FE resolution N (default: the scenario's identification.elements)");
@@ -338,6 +338,14 @@ int main(int argc, char** argv) {
       io::write_text_atomic(dir.path("modes.csv"), t.csv());
       io::write_text_atomic(dir.path("mac.csv"), m.csv());
       io::write_json_atomic(dir.path("modes.json"), crosscheck::to_json(r));
+      // The chain's modes as measured modes, for scole-identify --experiments (modes: {file}); a
+      // scenario without a displacement-type sensor has no shapes to write.
+      try {
+        io::write_modal_data(dir.path("modal-data.csv"),
+                             crosscheck::chain_modal_data(sc, r.segments.front(), static_cast<int>(r.modes.size())));
+      } catch (const io::InputError& e) {
+        std::fprintf(stderr, "scole-crosscheck: note: no modal-data.csv: %s\n", io::one_line(e.what()).c_str());
+      }
     }
     std::vector<crosscheck::TruthLevel> noise_free_truths;
     if (do_traj) {

@@ -359,4 +359,46 @@ nlohmann::json to_json(const ModesReport& r) {
   return j;
 }
 
+io::ModalData chain_modal_data(const io::Scenario& scenario, int segments, int count) {
+  const io::Scenario truth_sc = io::truth_scenario(scenario);
+  io::Scenario sc = truth_sc;
+  sc.sensors.clear();
+  for (const auto& s : truth_sc.sensors)
+    if (s.kind == "displacement" || s.kind == "rotation" || s.kind == "line_of_sight") sc.sensors.push_back(s);
+  if (sc.sensors.empty())
+    io::fail_field(scenario.source, "sensors", "needs a displacement, rotation or line-of-sight sensor for mode shapes", "none");
+  if (2 * segments > io::limits::kMaxSegments)
+    throw io::InputError("modal data: " + std::to_string(2 * segments) + " segments (the lumping estimate) > " +
+                         std::to_string(io::limits::kMaxSegments));
+  const std::vector<double> scale(sc.sensors.size(), 1.0);
+  const SideModes a = chain_modes(sc, scale, segments, count, false);
+  const SideModes b = chain_modes(sc, scale, 2 * segments, count, false);
+  io::ModalData d;
+  for (const auto& s : sc.sensors) d.stations.push_back(s.name);
+  // Mode i at n is compared with the mode at 2n of largest MAC (not the same index: close pairs,
+  // such as SCOLE's roll and pitch bending, can swap order between resolutions).
+  const Eigen::MatrixXd mac = mac_matrix(a.shapes, b.shapes);
+  const double largest = a.shapes.cwiseAbs().maxCoeff();
+  const std::size_t n = a.hz.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::VectorXd ya = a.shapes.col(static_cast<Eigen::Index>(i));
+    if (!(ya.norm() > 1e-8 * largest)) continue;  // not seen at any station: no shape to write
+    Eigen::Index j = 0;
+    mac.row(static_cast<Eigen::Index>(i)).maxCoeff(&j);
+    Eigen::VectorXd yb = b.shapes.col(j);
+    io::ModalData::Mode m;
+    m.label = static_cast<int>(i) + 1;
+    m.frequency_hz = a.hz[i];
+    m.frequency_std_hz = std::max(4.0 / 3.0 * std::abs(a.hz[i] - b.hz[static_cast<std::size_t>(j)]), 1e-7 * a.hz[i]);
+    normalise(ya);
+    normalise(yb);
+    if (ya.dot(yb) < 0) yb = -yb;
+    m.shape.assign(ya.data(), ya.data() + ya.size());
+    m.shape_std = std::max(4.0 / 3.0 * (ya - yb).norm() / std::sqrt(static_cast<double>(ya.size())), 1e-6);
+    d.modes.push_back(m);
+  }
+  d.source = "Simbody chain of " + scenario.name + ", " + std::to_string(segments) + " segments";
+  return d;
+}
+
 }  // namespace scoleid::crosscheck

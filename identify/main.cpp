@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
@@ -13,6 +14,73 @@
 
 using namespace scoleid;
 using Eigen::VectorXd;
+
+namespace {
+
+// scole-identify --experiments FILE: the joint identification (identify/run/experiments.h).
+int run_experiments_command(const std::string& file, std::string out, const std::string& method, int threads,
+                            int max_iterations, bool compute_std, bool verbose) {
+  const identify::ExperimentsSpec spec = identify::load_experiments(file);
+  if (out.empty()) out = "run/" + spec.name;
+  io::RunDirectory run_dir(out, identify::experiments_output_files(spec), "scole-identify");
+  auto ep = identify::make_experiments(spec);
+  identify::ExperimentsOptions eo;
+  eo.method = method;
+  eo.compute_std = compute_std;
+  eo.verbose = verbose;
+  if (threads >= 0) eo.threads = threads;
+  if (max_iterations >= 0) eo.max_iterations = max_iterations;
+  for (std::size_t i = 0; i < ep->runs.size(); ++i)
+    std::fprintf(stderr, "scole-identify: run %s: %s, %d elements, data: %s\n", spec.runs[i].name.c_str(),
+                 ep->runs[i]->scenario.name.c_str(), ep->runs[i]->structure->elements(), ep->runs[i]->data_source.c_str());
+  if (ep->modes)
+    std::fprintf(stderr, "scole-identify: modes: %zu measured modes from %s, model %s\n", ep->modes->modes.size(),
+                 spec.modes_file->c_str(), ep->modes_scenario->name.c_str());
+  const identify::ExperimentsResult r = identify::run_experiments(*ep, eo);
+  identify::write_experiments_outputs(run_dir, *ep, r);
+  run_dir.commit();
+  // The joint estimate, its std, and each experiment's std alone at the estimate.
+  std::printf("\n%-10s %14s %14s %12s %12s", "parameter", "estimate", "truth", "rel.error", "joint std");
+  for (const auto& e : r.experiments) std::printf(" %14s", ("std " + e.name).substr(0, 14).c_str());
+  std::printf("\n");
+  auto sd = [](const identify::Identifiability& id, std::size_t i) {
+    char buf[32];
+    if (id.identifiable.empty()) return std::string("-");
+    if (!id.identifiable[i]) return std::string("NOT IDENT.");
+    std::snprintf(buf, sizeof buf, "%.3e", id.std[static_cast<Eigen::Index>(i)]);
+    return std::string(buf);
+  };
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    const auto it = r.truth.find(r.names[i]);
+    if (it != r.truth.end())
+      std::printf("%-10s %14.7g %14.7g %12.3e %12s", r.names[i].c_str(), r.estimate[e], it->second,
+                  r.estimate[e] / it->second - 1.0, sd(r.ident, i).c_str());
+    else
+      std::printf("%-10s %14.7g %14s %12s %12s", r.names[i].c_str(), r.estimate[e], "-", "-", sd(r.ident, i).c_str());
+    for (const auto& x : r.experiments) std::printf(" %14s", sd(x.alone, i).c_str());
+    std::printf("\n");
+  }
+  std::printf("\n%-12s %-6s %10s %12s  %s\n", "experiment", "kind", "share", "data values", "fit");
+  for (const auto& x : r.experiments)
+    std::printf("%-12s %-6s %10.4f %12ld  %s\n", x.name.c_str(), x.kind.c_str(), x.share, x.data_values, x.fit_message.c_str());
+  std::printf("\n%s; %d thread%s; %.3f s\nwrote %s/identify.json\n", r.summary.BriefReport().c_str(), r.threads,
+              r.threads == 1 ? "" : "s", r.wall_seconds, out.c_str());
+  if (!r.summary.converged()) {
+    std::fprintf(stderr, "scole-identify: did not converge (%s: %s); outputs written with \"converged\": false\n",
+                 identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());
+    return 1;
+  }
+  if (!r.converged()) {
+    std::fprintf(stderr,
+                 "scole-identify: stopped at a point that does not explain the data of every experiment; outputs written "
+                 "with \"converged\": false\n");
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -26,7 +94,12 @@ int main(int argc, char** argv) {
       "the data (the fit test: residual beyond noise, discretisation and identification.model_error; its outputs\n"
       "are written, marked \"converged\": false); 2 bad usage or bad input (nothing written); 130/143 interrupted by\n"
       "SIGINT/SIGTERM (nothing written). The outputs of a run appear together or not at all: they are\n"
-      "written beside --out and moved into place as one directory at the end."};
+      "written beside --out and moved into place as one directory at the end.\n\n"
+      "With --experiments FILE, several runs (each its own scenario: inputs, sensors, data) and/or measured\n"
+      "modes (frequencies, damping ratios, shapes; CSV) are fitted with one parameter vector, the runs solved\n"
+      "concurrently (README \"Several experiments and modal data\"). Writes identify.json (joint estimate, joint\n"
+      "and per-experiment std, misfit share and residual RMS per experiment), fit-<run>.csv/.gp/.png per run and\n"
+      "modes-fit.csv (measured against matched model modes)."};
   std::string scenario = "paper-beam-1";
   std::string data, out, method;
   int max_iterations = -1;
@@ -46,6 +119,15 @@ int main(int argc, char** argv) {
                "skip the Fisher-information standard deviations and with them the identifiability flags "
                "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
+  std::string experiments;
+  int threads = -1;
+  auto* ex_opt = app.add_option("-e,--experiments", experiments,
+                                "experiments file (YAML: runs [{name, scenario, data}], modes {file, scenario}, threads)");
+  app.add_option("--threads", threads, "with --experiments: concurrent experiment solves (0 = the machine's threads)")
+      ->check(CLI::Range(0, 1024))
+      ->needs(ex_opt);
+  ex_opt->excludes(app.get_option("--scenario"));
+  ex_opt->excludes(app.get_option("--data"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -64,6 +146,7 @@ int main(int argc, char** argv) {
       std::fputs(io::builtin_scenario_listing().c_str(), stdout);
       return 0;
     }
+    if (!experiments.empty()) return run_experiments_command(experiments, out, method, threads, max_iterations, !no_std, !quiet);
     io::Scenario sc = io::load_scenario(scenario);
     identify::RunOptions ro;
     if (!data.empty()) ro.data_csv = data;

@@ -7,8 +7,19 @@
 
 namespace scoleid::identify {
 
-Identifiability analyse_identifiability(Objective& obj, const std::vector<io::SensorSpec>& sensors, const VectorXd& q) {
-  Identifiability id;
+FisherInformation& FisherInformation::operator+=(const FisherInformation& o) {
+  if (F.size() == 0) F = MatrixXd::Zero(o.F.rows(), o.F.cols());
+  F += o.F;
+  chi2 += o.chi2;
+  data_values += o.data_values;
+  systematic += o.systematic;
+  noise_std.insert(noise_std.end(), o.noise_std.begin(), o.noise_std.end());
+  stated_noise = stated_noise && o.stated_noise;
+  return *this;
+}
+
+FisherInformation fisher_information(Objective& obj, const std::vector<io::SensorSpec>& sensors, const VectorXd& q) {
+  FisherInformation id;
   const Measurements& data = obj.data();
   const int P = obj.size(), ns = data.sensors();
   const auto N = static_cast<Eigen::Index>(data.t.size());
@@ -27,8 +38,9 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
     }
     id.noise_std.push_back(sd);
   }
-  id.noise_source = from_scenario ? "scenario" : "residual";
-  MatrixXd F = MatrixXd::Zero(P, P);
+  id.stated_noise = from_scenario;
+  MatrixXd& F = id.F;
+  F = MatrixXd::Zero(P, P);
   id.chi2 = 0.0;
   for (Eigen::Index i = 0; i < N; ++i)
     for (int k = 0; k < ns; ++k) {
@@ -42,8 +54,19 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
   // Residual energy counted as model error: beyond the upper end of the χ² band of the stated noise
   // (N ± 2√(2N): white noise alone reaches it one time in forty), or all of it with no stated noise.
   const double Nd = static_cast<double>(id.data_values);
-  const double systematic = from_scenario ? std::max(0.0, id.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd)) : id.chi2;
+  id.systematic = from_scenario ? std::max(0.0, id.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd)) : id.chi2;
+  return id;
+}
 
+Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q) {
+  Identifiability id;
+  const int P = static_cast<int>(q.size());
+  const MatrixXd& F = fi.F;
+  const double systematic = fi.systematic;
+  id.chi2 = fi.chi2;
+  id.data_values = fi.data_values;
+  id.noise_std = fi.noise_std;
+  id.noise_source = fi.stated_noise ? "scenario" : "residual";
   const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
   Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
   const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
@@ -88,6 +111,10 @@ Identifiability analyse_identifiability(Objective& obj, const std::vector<io::Se
     }
   }
   return id;
+}
+
+Identifiability analyse_identifiability(Objective& obj, const std::vector<io::SensorSpec>& sensors, const VectorXd& q) {
+  return identifiability_from(fisher_information(obj, sensors, q), q);
 }
 
 }  // namespace scoleid::identify

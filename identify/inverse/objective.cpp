@@ -90,7 +90,7 @@ long Objective::data_points() const {
   return n * data_.sensors();
 }
 
-double Objective::MisfitProfile::longest_within(double bound) const {
+double Misfit::MisfitProfile::longest_within(double bound) const {
   double best = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < t.size(); ++i)
     if (misfit[i] <= bound) best = t[i];

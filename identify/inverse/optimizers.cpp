@@ -59,7 +59,7 @@ using Clock = std::chrono::steady_clock;
 using T = OptimizerSummary::Termination;
 
 struct Run {
-  Objective& obj;
+  Misfit& obj;
   const OptimizerOptions& opt;
   const std::function<void(const IterationRecord&)>& cb;
   OptimizerSummary sum;
@@ -71,7 +71,7 @@ struct Run {
   }
   // Horizon continuation: the longest T >= t0 + continuation_min_fraction·(t_end − t0) up to
   // which the misfit profile stays within the bound, never shorter than `current`.
-  double horizon_from(const Objective::MisfitProfile& p, double current) const {
+  double horizon_from(const Misfit::MisfitProfile& p, double current) const {
     const double t0 = obj.data_start(), t_end = obj.data_end();
     const double t_min = t0 + opt.continuation_min_fraction * (t_end - t0);
     double T = t_min;
@@ -110,13 +110,13 @@ struct Run {
 };
 
 void gauss_newton(Run& r, VectorXd x) {
-  Objective& obj = r.obj;
+  Misfit& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
-  auto choose_horizon = [&](const Objective::MisfitProfile& p, double current) { return r.horizon_from(p, current); };
+  auto choose_horizon = [&](const Misfit::MisfitProfile& p, double current) { return r.horizon_from(p, current); };
   const bool continuation = r.opt.continuation;
   auto full = [&]() { return obj.horizon() >= t_end; };
 
-  Objective::MisfitProfile prof;
+  Misfit::MisfitProfile prof;
   auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx, bool with_profile) {
     try {
       const VectorXd q = xx.array().exp();
@@ -251,7 +251,7 @@ void gauss_newton(Run& r, VectorXd x) {
 }
 
 void lbfgs(Run& r, VectorXd x, bool steepest) {
-  Objective& obj = r.obj;
+  Misfit& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
   // Horizon continuation as for Gauss–Newton (header, Run::horizon_from), from the misfit profile
   // of one extra state solve per accepted step while the horizon is short of the record.
@@ -423,7 +423,7 @@ struct Smoothness {
 // iterations follows the directions the data inform, not P. Horizon continuation as for the
 // gradient methods (one extra state solve per accepted step while the horizon is short).
 void gauss_newton_krylov(Run& r, VectorXd x) {
-  Objective& obj = r.obj;
+  Misfit& obj = r.obj;
   if (!obj.has_matrix_free_products())
     throw std::invalid_argument("gauss-newton-krylov: velocity and acceleration sensors are not supported (use gauss-newton)");
   const double t0 = obj.data_start(), t_end = obj.data_end();
@@ -571,7 +571,7 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
 
 }  // namespace
 
-OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const OptimizerOptions& options,
+OptimizerSummary minimize(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options,
                           const std::function<void(const IterationRecord&)>& on_iteration) {
   std::string why;
   if (!options.IsValid(&why)) throw std::invalid_argument("OptimizerOptions: " + why);
@@ -580,7 +580,7 @@ OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const Optimi
   const VectorXd x0 = q0.array().log();
   // Whatever happens inside, the objective is left on the whole record.
   struct HorizonGuard {
-    Objective& o;
+    Misfit& o;
     ~HorizonGuard() { o.set_horizon(o.data_end()); }
   } guard{objective};
   if (options.method == "gauss-newton") gauss_newton(r, x0);

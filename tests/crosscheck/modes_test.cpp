@@ -7,9 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
+#include "scoleid/identify/inverse/modal_misfit.h"
+#include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/io/scenario.h"
 
 using namespace scoleid;
@@ -116,5 +119,41 @@ TEST(Modes, ScoleModalDampingRatiosAgreeBetweenChainAndFE) {
     EXPECT_LT(std::abs(d), 0.01) << "mode " << m.index;
     EXPECT_GT(m.fe_zeta, 0.1 * sc.scole.zeta) << "mode " << m.index;
     EXPECT_LT(m.fe_zeta, 1.05 * sc.scole.zeta) << "mode " << m.index;
+  }
+}
+
+// The chain's modes as measured modes (crosscheck::chain_modal_data, docs/theory.md §6.6): the
+// stds are the chain's own lumping error, so the FE model at the truth's parameters explains them
+// (χ² within its band), and EI, ρA identified from them land within the lumping level.
+TEST(ChainModalData, StdsAreTheLumpingErrorAndTheModesIdentifyTheMast) {
+  const io::Scenario sc = io::load_scenario(std::string(SCOLEID_SOURCE_DIR) + "/identify/examples/modal/scole-modal.yaml");
+  const io::ModalData d = crosscheck::chain_modal_data(sc, sc.truth.segments, 6);
+  ASSERT_EQ(d.modes.size(), 6u);
+  ASSERT_EQ(d.stations.size(), 4u);
+  double worst = 0.0;  // largest relative frequency std
+  for (const auto& m : d.modes) {
+    EXPECT_GT(m.frequency_std_hz, 0.0);
+    EXPECT_GT(m.shape_std, 0.0);
+    worst = std::max(worst, m.frequency_std_hz / m.frequency_hz);
+  }
+  const auto fe = identify::make_structure(sc, sc.identification.elements);
+  const auto params = fe->parameterize(sc);
+  identify::ModalMisfit misfit(fe->model(), *params, d);
+  Eigen::VectorXd r;
+  misfit.residuals(params->truth(), r);
+  const double N = static_cast<double>(r.size());
+  std::printf("chain modal data: %zu modes, largest relative frequency std %.3e, chi2 at the truth %.3g (N = %g)\n",
+              d.modes.size(), worst, r.squaredNorm(), N);
+  EXPECT_LT(r.squaredNorm(), N + 3.0 * std::sqrt(2.0 * N));
+  identify::OptimizerOptions oo;
+  oo.method = "gauss-newton";
+  const auto s = identify::minimize(misfit, params->initial(), oo);
+  ASSERT_TRUE(s.converged()) << s.message;
+  const Eigen::VectorXd t = params->truth();
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double e = s.q[i] / t[i] - 1.0;
+    std::printf("  %s: relative error %.3e\n", params->names()[static_cast<std::size_t>(i)].c_str(), e);
+    // A frequency known to δ relative fixes a stiffness-to-mass ratio to 2δ.
+    EXPECT_LT(std::abs(e), 2.0 * worst);
   }
 }

@@ -708,3 +708,44 @@ TEST(ScoleIdentifyCli, TruthOverridesShapeTheSyntheticDataAndTheReportedTruth) {
   EXPECT_LT(std::abs(q1["relative_error"].get<double>()), 1e-3) << q1.dump();
   EXPECT_EQ(j["settings"]["truth"]["overrides"]["beam"]["EI"], nlohmann::json::array({25000.0}));
 }
+
+// ------------------------------------------------------------------------------ --experiments
+// Two runs of kGood's cantilever (the second with its sensor at mid-span and a longer record) and
+// measured modes: exit 0, the outputs of every experiment, shares summing to one; then the
+// input-error contract for a run whose data file lacks its sensor column, a mode file with a
+// negative frequency and one with a missing station value.
+TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
+  TempDir dir;
+  write_file(dir / "a.yaml", kGood);
+  write_file(dir / "b.yaml", good_with("{name: w_tip, at: beam, kind: displacement, location: 10}",
+                                       "{name: w_mid, at: beam, kind: displacement, location: 5}"));
+  write_file(dir / "e.yaml", "experiments: two\nruns:\n  - {name: a, scenario: a.yaml}\n  - {name: b, scenario: b.yaml}\n");
+  const fs::path out = dir / "out";
+  const Result r = run({"--experiments", (dir / "e.yaml").string(), "--out", out.string(), "-q", "--threads", "2"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  for (const char* f : {"identify.json", "fit-a.csv", "fit-b.csv", "fit-a.gp", "fit-b.gp"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto j = nlohmann::json::parse(read_file(out / "identify.json"));
+  EXPECT_TRUE(j["converged"].get<bool>());
+  ASSERT_EQ(j["per_experiment"].size(), 2u);
+  double share = 0;
+  for (const auto& e : j["per_experiment"]) share += e["misfit_share"].get<double>();
+  EXPECT_NEAR(share, 1.0, 1e-12);
+  for (const char* q : {"q1", "q2"})
+    EXPECT_NEAR(j["estimate"][q].get<double>() / j["truth"][q].get<double>(), 1.0, 1e-3) << q;
+
+  // A data file without the run's sensor column.
+  write_file(dir / "a.csv", "t,P,w_other\n0,10,0\n0.01,10,1e-6\n0.02,10,2e-6\n");
+  write_file(dir / "e2.yaml", "experiments: two\nruns:\n  - {name: a, scenario: a.yaml, data: a.csv}\n");
+  const fs::path out2 = dir / "out2";
+  expect_input_error(run({"--experiments", (dir / "e2.yaml").string(), "--out", out2.string(), "-q"}, dir), out2,
+                     {"a.csv", "w_tip"});
+  // Measured modes: a negative frequency, then a row short of a station value.
+  write_file(dir / "m.csv", "mode,frequency_hz,frequency_std_hz,shape_std,w_tip\n1,-0.3,0.001,0.01,1\n");
+  write_file(dir / "e3.yaml", "experiments: modes\nmodes: {file: m.csv, scenario: a.yaml}\n");
+  const fs::path out3 = dir / "out3";
+  expect_input_error(run({"--experiments", (dir / "e3.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
+                     {"m.csv", "frequency_hz", "-0.3"});
+  write_file(dir / "m.csv", "mode,frequency_hz,frequency_std_hz,shape_std,w_tip,w_mid\n1,0.3,0.001,0.01,1\n");
+  expect_input_error(run({"--experiments", (dir / "e3.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
+                     {"m.csv", "line 2"});
+}

@@ -30,6 +30,7 @@
 
 #include "scoleid/crosscheck/table.h"
 
+#include "scoleid/io/modal_data.h"
 #include "scoleid/io/scenario.h"
 
 namespace scoleid::crosscheck {
@@ -72,6 +73,17 @@ struct ModesReport {
 
 // io::InputError for a scenario either side cannot represent.
 ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& options);
+
+// The Simbody chain's first `count` flexible modes as measured modes (io/modal_data.h, the file
+// scole-identify takes beside or instead of time records; docs/theory.md §6.6): frequencies of the
+// chain at `segments` (the truth's resolution) and its shapes at the scenario's displacement,
+// rotation and line-of-sight sensors. Each value's stated std is the chain's own lumping error,
+// estimated from the same chain at 2·segments (mode i at n against the mode at 2n of largest MAC):
+// frequencies converge as n⁻² (docs/theory.md §9.1), so f(n) − f(∞) ≈ (4/3)(f(n) − f(2n)); a
+// shape's std is (4/3) the RMS difference of the unit shapes at n and 2n. A mode that no station
+// sees is left out (its label is skipped). Floors of 1e-7 (relative frequency) and 1e-6 (shape) keep a converged mode
+// from claiming exactness. io::InputError when the scenario has no such sensor.
+io::ModalData chain_modal_data(const io::Scenario& scenario, int segments, int count);
 
 // The frequency table (one row per mode), the MAC matrix, and everything as JSON.
 Table modes_table(const ModesReport& r);

@@ -42,7 +42,25 @@ struct Identifiability {
   std::string noise_source;       // "scenario" | "residual" (identify_run refines "scenario" to where each level came from)
 };
 
+// The Fisher information of one experiment at q and what goes with it: F = Gᵀ W G, the χ² of the
+// residual, the number of data values, the part of χ² counted as model error (beyond the band of
+// the stated noise, or all of it), and the noise levels used. Experiments with independent noise
+// add: F = Σ_e F_e, χ² = Σ χ²_e, systematic = Σ systematic_e (docs/theory.md §6.5).
+struct FisherInformation {
+  MatrixXd F;
+  double chi2 = 0;
+  long data_values = 0;
+  double systematic = 0;
+  std::vector<double> noise_std;
+  bool stated_noise = true;  // every level stated (scenario or truth.json), none from the residual
+  FisherInformation& operator+=(const FisherInformation& o);
+};
 // `sensors` supplies each sensor's stated noise_std (<= 0: unknown).
+FisherInformation fisher_information(Objective& objective, const std::vector<io::SensorSpec>& sensors, const VectorXd& q);
+// std, resolution, condition number and the flags from a Fisher information (one experiment's or
+// a sum of several).
+Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q);
+// fisher_information then identifiability_from.
 Identifiability analyse_identifiability(Objective& objective, const std::vector<io::SensorSpec>& sensors,
                                         const VectorXd& q);
 

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "scoleid/identify/inverse/measurements.h"
+#include "scoleid/identify/inverse/misfit.h"
 #include "scoleid/identify/inverse/parameterization.h"
 #include "scoleid/identify/time/second_order_solver.h"
 #include "scoleid/identify/fe/structural_model.h"
@@ -69,41 +70,35 @@ struct ObjectiveCounters {
   SolverSummary solver;  // accumulated over all solves
 };
 
-class Objective {
+class Objective : public Misfit {
 public:
   Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
             Measurements data, ObjectiveOptions options = {});
 
-  int size() const { return params_.size(); }
-  double horizon() const { return T_; }
-  double data_start() const { return data_.t.front(); }
-  double data_end() const { return data_.t.back(); }
+  int size() const override { return params_.size(); }
+  double horizon() const override { return T_; }
+  double data_start() const override { return data_.t.front(); }
+  double data_end() const override { return data_.t.back(); }
   // Restricts the cost to [t0, T] (clamped to the data span, at least two samples); T = data_end()
   // restores the whole span.
-  void set_horizon(double T);
+  void set_horizon(double T) override;
   // Number of data values (samples × sensors) on the horizon.
-  long data_points() const;
+  long data_points() const override;
 
-  // Relative mean-square misfit on [t0, t_i] for each sample time t_i (see the header comment).
-  struct MisfitProfile {
-    std::vector<double> t, misfit;
-    // The longest t_i with misfit <= bound (−inf if none).
-    double longest_within(double bound) const;
-  };
   const Parameterization& parameterization() const { return params_; }
   const StructuralModel& model() const { return model_; }
   const std::vector<double>& weights() const { return R_; }
 
   // J(q): one forward solve.
-  double cost(const VectorXd& q);
+  double cost(const VectorXd& q) override;
   // J and ∂J/∂q by the costate: one forward and one backward solve (two backward equations with
   // velocity or acceleration sensors, stepped together by esdirk), whatever the number of parameters.
-  double cost_and_gradient(const VectorXd& q, VectorXd& gradient);
+  double cost_and_gradient(const VectorXd& q, VectorXd& gradient) override;
   // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
   // the state is integrated over the whole data span and its misfit profile returned.
-  double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr);
+  double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr) override;
   // The misfit profile over the whole data span at q (one forward solve).
-  MisfitProfile misfit_profile(const VectorXd& q);
+  MisfitProfile misfit_profile(const VectorXd& q) override;
   // ∂J/∂q by central differences with relative step h (2P forward solves).
   VectorXd finite_difference_gradient(const VectorXd& q, double h = 1e-5);
   // Model outputs C u(t_i) at the sample times (samples × sensors).
@@ -115,8 +110,8 @@ public:
   // along v (with the state) and one costate solve whose source is the tangent's output C S v in
   // place of the residual; the gradient formula (Eq. 25) on that costate is H v. Two solves
   // whatever the number of parameters. Displacement sensors only (has_matrix_free_products()).
-  VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v);
-  bool has_matrix_free_products() const { return C1_.size() == 0; }
+  VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v) override;
+  bool has_matrix_free_products() const override { return C1_.size() == 0; }
 
   const ObjectiveCounters& counters() const { return counters_; }
   void reset_counters() { counters_ = {}; }

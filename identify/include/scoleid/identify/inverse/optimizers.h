@@ -117,7 +117,7 @@ struct OptimizerSummary {
 const char* to_string(OptimizerSummary::Termination t);
 
 // `on_iteration` is called after every accepted iterate (and for k = 0), for progress output.
-OptimizerSummary minimize(Objective& objective, const VectorXd& q0, const OptimizerOptions& options,
+OptimizerSummary minimize(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options,
                           const std::function<void(const IterationRecord&)>& on_iteration = {});
 
 }  // namespace scoleid::identify

@@ -1,0 +1,431 @@
+#include "scoleid/identify/inverse/modal_misfit.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "scoleid/identify/fe/modal.h"
+#include "scoleid/io/error.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+// The assignment of least total cost of rows to distinct columns (rows <= columns): the
+// Hungarian method with potentials, O(rows² · columns). Returns the column of each row.
+std::vector<int> least_cost_assignment(const MatrixXd& a) {
+  const int n = static_cast<int>(a.rows()), m = static_cast<int>(a.cols());
+  if (n == 0) return {};
+  if (n > m) throw std::domain_error("ModalMisfit: more measured modes than model candidates");
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(static_cast<std::size_t>(n) + 1, 0.0), v(static_cast<std::size_t>(m) + 1, 0.0);
+  std::vector<int> p(static_cast<std::size_t>(m) + 1, 0), way(static_cast<std::size_t>(m) + 1, 0);
+  for (int i = 1; i <= n; ++i) {
+    p[0] = i;
+    int j0 = 0;
+    std::vector<double> minv(static_cast<std::size_t>(m) + 1, inf);
+    std::vector<bool> used(static_cast<std::size_t>(m) + 1, false);
+    do {
+      used[static_cast<std::size_t>(j0)] = true;
+      const int i0 = p[static_cast<std::size_t>(j0)];
+      double delta = inf;
+      int j1 = 0;
+      for (int j = 1; j <= m; ++j) {
+        if (used[static_cast<std::size_t>(j)]) continue;
+        const double cur = a(i0 - 1, j - 1) - u[static_cast<std::size_t>(i0)] - v[static_cast<std::size_t>(j)];
+        if (cur < minv[static_cast<std::size_t>(j)]) {
+          minv[static_cast<std::size_t>(j)] = cur;
+          way[static_cast<std::size_t>(j)] = j0;
+        }
+        if (minv[static_cast<std::size_t>(j)] < delta) {
+          delta = minv[static_cast<std::size_t>(j)];
+          j1 = j;
+        }
+      }
+      for (int j = 0; j <= m; ++j) {
+        if (used[static_cast<std::size_t>(j)]) {
+          u[static_cast<std::size_t>(p[static_cast<std::size_t>(j)])] += delta;
+          v[static_cast<std::size_t>(j)] -= delta;
+        } else {
+          minv[static_cast<std::size_t>(j)] -= delta;
+        }
+      }
+      j0 = j1;
+    } while (p[static_cast<std::size_t>(j0)] != 0);
+    do {
+      const int j1 = way[static_cast<std::size_t>(j0)];
+      p[static_cast<std::size_t>(j0)] = p[static_cast<std::size_t>(j1)];
+      j0 = j1;
+    } while (j0 != 0);
+  }
+  std::vector<int> col(static_cast<std::size_t>(n), -1);
+  for (int j = 1; j <= m; ++j)
+    if (p[static_cast<std::size_t>(j)] > 0) col[static_cast<std::size_t>(p[static_cast<std::size_t>(j)] - 1)] = j - 1;
+  return col;
+}
+
+}  // namespace
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+// Singular values of a candidate's station shapes below this fraction of the largest station
+// amplitude of the candidates count as zero (a mode the stations do not see).
+constexpr double kShapeRankTolerance = 1e-8;
+
+// Σ_terms w_j A_j over the terms that carry a coefficient (constant terms have no derivative).
+SparseMatrix along(const std::vector<OperatorTerm>& terms, const VectorXd& dc, int ndof) {
+  SparseMatrix A(ndof, ndof);
+  for (const auto& t : terms)
+    if (t.coefficient >= 0 && dc[t.coefficient] != 0.0) A += dc[t.coefficient] * t.matrix;
+  A.makeCompressed();
+  return A;
+}
+
+}  // namespace
+
+ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& params, io::ModalData data,
+                         ModalMisfitOptions options)
+    : model_(model), params_(params), data_(std::move(data)), options_(options) {
+  if (data_.source.empty()) data_.source = "modal data";
+  io::validate_modal_data(data_);
+  const std::string& src = data_.source;
+  if (!(options_.extra_candidates >= 0))
+    io::fail_field(src, "extra_candidates", "must be >= 0", std::to_string(options_.extra_candidates));
+  if (!(options_.cluster_tolerance >= 0) || !std::isfinite(options_.cluster_tolerance))
+    io::fail_field(src, "cluster_tolerance", "must be a finite number >= 0",
+                   io::format_value(options_.cluster_tolerance));
+  // Stations: sensors acting on u.
+  Cs_ = MatrixXd::Zero(static_cast<Eigen::Index>(data_.stations.size()), model_.ndof);
+  for (std::size_t k = 0; k < data_.stations.size(); ++k) {
+    const std::string& name = data_.stations[k];
+    const ModelSensor* found = nullptr;
+    for (const auto& s : model_.sensors)
+      if (s.name == name) found = &s;
+    if (!found || found->order != 0)
+      io::fail_field(
+          src, "column '" + name + "'", "is not a displacement, rotation or line-of-sight sensor of the scenario",
+          "'" + name + "'" + (found ? " (its kind is " + found->kind + ")" : std::string(" (no such sensor)")));
+    Cs_.row(static_cast<Eigen::Index>(k)) = found->row;
+  }
+  if (data_.has_damping() && model_.damping.empty())
+    io::fail_field(src, "column 'damping_ratio'",
+                   "needs a model with damping terms (the scenario's structure model has none)",
+                   "damping data for " + std::to_string(data_.modes.size()) + " modes");
+  for (const auto& m : data_.modes) {
+    if (!data_.has_shapes()) break;
+    Eigen::Map<const VectorXd> s(m.shape.data(), static_cast<Eigen::Index>(m.shape.size()));
+    const double norm = s.norm();
+    if (!(norm > 0) || !std::isfinite(norm))
+      io::fail_field(src, "mode " + std::to_string(m.label) + " shape", "must not vanish at every station", "0");
+    measured_shape_.push_back(s / norm);
+  }
+  rows_per_mode_ = 1 + (data_.has_damping() ? 1 : 0) + static_cast<int>(data_.stations.size());
+}
+
+const ModalMisfit::Evaluation& ModalMisfit::evaluate(const VectorXd& q, bool derivatives) {
+  if (have_last_ && last_.q.size() == q.size() && (last_.q.array() == q.array()).all() &&
+      (last_.has_jacobian || !derivatives))
+    return last_;
+  have_last_ = false;
+  if (q.size() != params_.size())
+    throw std::invalid_argument("ModalMisfit: parameter vector of size " + std::to_string(q.size()) + ", expected " +
+                                std::to_string(params_.size()));
+  const int n = model_.ndof;
+  const int P = params_.size();
+  const bool damping = data_.has_damping(), shapes = data_.has_shapes();
+  const int nmeas = static_cast<int>(data_.modes.size());
+  const int ns = static_cast<int>(data_.stations.size());
+
+  VectorXd c;
+  MatrixXd dcdq;
+  params_.coefficients(q, c, dcdq);
+  if (!c.allFinite()) throw std::domain_error("ModalMisfit: model coefficients are not finite at this q");
+  const SparseMatrix M = model_.assemble(model_.mass, c);
+  const SparseMatrix D = model_.assemble(model_.damping, c);
+  const SparseMatrix K = model_.assemble(model_.stiffness, c);
+  const NaturalModes nm = natural_modes(M, K);
+  ++counters_.evaluations;
+  if (!nm.omega.allFinite() || !nm.vectors.allFinite())
+    throw std::domain_error("ModalMisfit: the eigenproblem has no finite solution at this q");
+  const MatrixXd& Phi = nm.vectors;
+  const VectorXd lambda = nm.omega.array().square();
+
+  // Flexible modes and their clusters (chained relative eigenvalue differences below the tolerance).
+  std::vector<int> flex;  // mode index of flexible mode f
+  for (int k = 0; k < n; ++k)
+    if (nm.omega[k] > nm.floor) flex.push_back(k);
+  const int nflex = static_cast<int>(flex.size());
+  if (nflex < nmeas)
+    throw std::domain_error("ModalMisfit: the model has " + std::to_string(nflex) + " flexible modes, the data " +
+                            std::to_string(nmeas));
+  std::vector<int> cluster_of(static_cast<std::size_t>(nflex));
+  std::vector<std::vector<int>> clusters;  // flexible indices of each cluster
+  for (int f = 0; f < nflex; ++f) {
+    const double lk = lambda[flex[static_cast<std::size_t>(f)]];
+    if (f > 0 && lk - lambda[flex[static_cast<std::size_t>(f) - 1]] < options_.cluster_tolerance * lk) {
+      clusters.back().push_back(f);
+    } else {
+      clusters.push_back({f});
+    }
+    cluster_of[static_cast<std::size_t>(f)] = static_cast<int>(clusters.size()) - 1;
+  }
+  const int ncand = std::min(nflex, nmeas + options_.extra_candidates);
+  const int ncl = cluster_of[static_cast<std::size_t>(ncand) - 1] + 1;  // clusters touched by the candidates
+
+  // Per cluster: mean eigenvalue, frequency, damping ratio, member vectors and station shapes.
+  struct Cluster {
+    std::vector<int> modes;  // mode indices (columns of Φ)
+    double lambda = 0, omega = 0, f = 0, zeta = 0;
+    MatrixXd Y;  // C_s Φ_c (stations × m)
+    Eigen::JacobiSVD<MatrixXd> svd;
+    int rank = 0;
+  };
+  std::vector<Cluster> cl(static_cast<std::size_t>(ncl));
+  MatrixXd Y;  // C_s Φ, all modes (for the shape derivatives)
+  if (shapes) Y = Cs_ * Phi;
+  double shape_scale = 0.0;
+  if (shapes)
+    for (int f = 0; f < ncand; ++f)
+      shape_scale = std::max(shape_scale, Y.col(flex[static_cast<std::size_t>(f)]).norm());
+  for (int j = 0; j < ncl; ++j) {
+    Cluster& C = cl[static_cast<std::size_t>(j)];
+    for (int f : clusters[static_cast<std::size_t>(j)]) C.modes.push_back(flex[static_cast<std::size_t>(f)]);
+    const int m = static_cast<int>(C.modes.size());
+    double tr_d = 0.0;
+    for (int k : C.modes) {
+      C.lambda += lambda[k] / m;
+      tr_d += Phi.col(k).dot(D * Phi.col(k));
+    }
+    C.omega = std::sqrt(C.lambda);
+    C.f = C.omega / kTwoPi;
+    C.zeta = tr_d / (2.0 * m * C.omega);
+    if (shapes) {
+      C.Y.resize(ns, m);
+      for (int i = 0; i < m; ++i) C.Y.col(i) = Y.col(C.modes[static_cast<std::size_t>(i)]);
+      C.svd.compute(C.Y, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      const VectorXd& sv = C.svd.singularValues();
+      for (int i = 0; i < sv.size(); ++i)
+        if (sv[i] > kShapeRankTolerance * shape_scale) ++C.rank;
+    }
+  }
+  // Projection of a measured (unit) shape onto a cluster's station span: the coefficients a and
+  // the MAC |P ψ_m|².
+  auto project = [&](const Cluster& C, const VectorXd& psi, VectorXd* a) {
+    const MatrixXd U = C.svd.matrixU().leftCols(C.rank);
+    const VectorXd ut = U.transpose() * psi;
+    if (a)
+      *a = C.svd.matrixV().leftCols(C.rank) * (C.svd.singularValues().head(C.rank).cwiseInverse().asDiagonal() * ut);
+    return ut.squaredNorm();
+  };
+
+  // One-to-one matching of least total cost (the assignment problem, solved exactly): cost
+  // 1 − MAC with shapes (relative frequency difference × 1e-6 breaks ties), the relative frequency
+  // difference without. Candidates a measured shape cannot be matched with (a cluster with no
+  // station amplitude) are not allowed.
+  constexpr double kForbidden = 1e30;
+  MatrixXd cost = MatrixXd::Constant(nmeas, ncand, kForbidden);
+  MatrixXd macs = MatrixXd::Constant(nmeas, ncand, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < nmeas; ++i) {
+    const double fm = data_.modes[static_cast<std::size_t>(i)].frequency_hz;
+    for (int f = 0; f < ncand; ++f) {
+      const Cluster& C = cl[static_cast<std::size_t>(cluster_of[static_cast<std::size_t>(f)])];
+      const double df = std::abs(C.f - fm) / fm;
+      if (!shapes) {
+        cost(i, f) = df;
+        continue;
+      }
+      if (C.rank == 0) continue;
+      macs(i, f) = project(C, measured_shape_[static_cast<std::size_t>(i)], nullptr);
+      cost(i, f) = (1.0 - macs(i, f)) + 1e-6 * df;
+    }
+  }
+  const std::vector<int> assigned = least_cost_assignment(cost);
+  std::vector<int> partner(static_cast<std::size_t>(nmeas), -1);
+  std::vector<double> mac_of(static_cast<std::size_t>(nmeas), std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < nmeas; ++i) {
+    const int f = assigned[static_cast<std::size_t>(i)];
+    if (f < 0 || !(cost(i, f) < kForbidden)) continue;
+    partner[static_cast<std::size_t>(i)] = f;
+    mac_of[static_cast<std::size_t>(i)] = macs(i, f);
+  }
+  for (int i = 0; i < nmeas; ++i)
+    if (partner[static_cast<std::size_t>(i)] < 0)
+      throw std::domain_error("ModalMisfit: measured mode " +
+                              std::to_string(data_.modes[static_cast<std::size_t>(i)].label) +
+                              " matches no model mode");
+
+  // Residuals.
+  Evaluation& e = last_;
+  e.q = q;
+  e.r.resize(static_cast<Eigen::Index>(rows_per_mode_) * nmeas);
+  e.matches.clear();
+  std::vector<VectorXd> coef(static_cast<std::size_t>(nmeas));  // a per measured mode
+  std::vector<VectorXd> unit(static_cast<std::size_t>(nmeas));  // ψ̂ per measured mode
+  std::vector<double> pnorm(static_cast<std::size_t>(nmeas), 0.0), sgn(static_cast<std::size_t>(nmeas), 1.0);
+  for (int i = 0; i < nmeas; ++i) {
+    const auto& md = data_.modes[static_cast<std::size_t>(i)];
+    const int f = partner[static_cast<std::size_t>(i)];
+    const Cluster& C = cl[static_cast<std::size_t>(cluster_of[static_cast<std::size_t>(f)])];
+    const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode_;
+    e.r[row] = (C.f - md.frequency_hz) / md.frequency_std_hz;
+    if (damping) e.r[row + 1] = (C.zeta - md.damping_ratio) / md.damping_std;
+    if (shapes) {
+      const VectorXd& psim = measured_shape_[static_cast<std::size_t>(i)];
+      VectorXd a;
+      project(C, psim, &a);
+      const VectorXd p = C.Y * a;
+      const double pn = p.norm();
+      if (!(pn > 0)) throw std::domain_error("ModalMisfit: a matched model shape vanishes at the stations");
+      const VectorXd ph = p / pn;
+      const double s = psim.dot(ph) < 0 ? -1.0 : 1.0;
+      e.r.segment(row + (damping ? 2 : 1), ns) = (s * ph - psim) / md.shape_std;
+      coef[static_cast<std::size_t>(i)] = a;
+      unit[static_cast<std::size_t>(i)] = ph;
+      pnorm[static_cast<std::size_t>(i)] = pn;
+      sgn[static_cast<std::size_t>(i)] = s;
+    }
+    e.matches.push_back({i, f, static_cast<int>(C.modes.size()), mac_of[static_cast<std::size_t>(i)], C.f, C.zeta});
+  }
+  e.J = 0.5 * e.r.squaredNorm();
+  e.has_jacobian = false;
+  e.jacobian.resize(0, 0);
+  if (!std::isfinite(e.J)) throw std::domain_error("ModalMisfit: the misfit is not finite at this q");
+
+  if (derivatives) {
+    e.jacobian = MatrixXd::Zero(e.r.size(), P);
+    // The clusters that carry a match, with what their derivatives need once per evaluation.
+    std::vector<int> used;
+    for (int i = 0; i < nmeas; ++i) {
+      const int j = cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
+      if (std::find(used.begin(), used.end(), j) == used.end()) used.push_back(j);
+    }
+    std::vector<MatrixXd> W(used.size());  // Φᵀ D Φ_c, for tr(Φ_cᵀ D dΦ_c)
+    if (damping)
+      for (std::size_t u = 0; u < used.size(); ++u) {
+        const Cluster& C = cl[static_cast<std::size_t>(used[u])];
+        MatrixXd DPc(n, static_cast<Eigen::Index>(C.modes.size()));
+        for (std::size_t i = 0; i < C.modes.size(); ++i)
+          DPc.col(static_cast<Eigen::Index>(i)) = D * Phi.col(C.modes[i]);
+        W[u] = Phi.transpose() * DPc;
+      }
+    struct ClusterDerivative {
+      double dlambda = 0, domega = 0, df = 0, dzeta = 0;
+      MatrixXd dY;  // C_s dΦ_c
+    };
+    std::vector<ClusterDerivative> cd(used.size());
+    for (int p = 0; p < P; ++p) {
+      const VectorXd dc = dcdq.col(p);
+      if (dc.cwiseAbs().maxCoeff() == 0.0) continue;
+      const SparseMatrix dM = along(model_.mass, dc, n);
+      const SparseMatrix dK = along(model_.stiffness, dc, n);
+      const SparseMatrix dD = damping ? along(model_.damping, dc, n) : SparseMatrix(n, n);
+      for (std::size_t u = 0; u < used.size(); ++u) {
+        const Cluster& C = cl[static_cast<std::size_t>(used[u])];
+        const int m = static_cast<int>(C.modes.size());
+        ClusterDerivative& d = cd[u];
+        // Coefficients of dΦ_c in the basis Φ: E (n × m).
+        MatrixXd Mc(n, m);  // M' Φ_c
+        MatrixXd E = MatrixXd::Zero(n, m);
+        d.dlambda = 0.0;
+        double tr_dD = 0.0;
+        for (int i = 0; i < m; ++i) {
+          const int k = C.modes[static_cast<std::size_t>(i)];
+          const VectorXd phi = Phi.col(k);
+          Mc.col(i) = dM * phi;
+          const VectorXd v = dK * phi - lambda[k] * Mc.col(i);
+          d.dlambda += phi.dot(v) / m;
+          if (damping) tr_dD += phi.dot(dD * phi);
+          const VectorXd G = Phi.transpose() * v;
+          for (int j = 0; j < n; ++j) {
+            if (std::find(C.modes.begin(), C.modes.end(), j) != C.modes.end()) continue;
+            E(j, i) = G[j] / (lambda[k] - lambda[j]);
+          }
+        }
+        // −½ Φ_c (Φ_cᵀ M' Φ_c): the normalisation, within the span.
+        for (int i = 0; i < m; ++i)
+          for (int l = 0; l < m; ++l)
+            E(C.modes[static_cast<std::size_t>(l)], i) -=
+                0.5 * Phi.col(C.modes[static_cast<std::size_t>(l)]).dot(Mc.col(i));
+        d.domega = d.dlambda / (2.0 * C.omega);
+        d.df = d.domega / kTwoPi;
+        if (damping) {
+          double tr_DdPhi = 0.0;
+          for (int i = 0; i < m; ++i) tr_DdPhi += W[u].col(i).dot(E.col(i));
+          d.dzeta = (tr_dD + 2.0 * tr_DdPhi) / (2.0 * m * C.omega) - C.zeta * d.domega / C.omega;
+        }
+        if (shapes) d.dY = Y * E;
+      }
+      for (int i = 0; i < nmeas; ++i) {
+        const auto& md = data_.modes[static_cast<std::size_t>(i)];
+        const int j = cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
+        const std::size_t u = static_cast<std::size_t>(std::find(used.begin(), used.end(), j) - used.begin());
+        const ClusterDerivative& d = cd[u];
+        const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode_;
+        e.jacobian(row, p) = d.df / md.frequency_std_hz;
+        if (damping) e.jacobian(row + 1, p) = d.dzeta / md.damping_std;
+        if (shapes) {
+          const std::size_t ii = static_cast<std::size_t>(i);
+          const VectorXd dp = d.dY * coef[ii];
+          const VectorXd dph = (dp - unit[ii] * unit[ii].dot(dp)) / pnorm[ii];
+          e.jacobian.block(row + (damping ? 2 : 1), p, ns, 1) = sgn[ii] * dph / md.shape_std;
+        }
+      }
+    }
+    e.has_jacobian = true;
+    if (!e.jacobian.allFinite()) throw std::domain_error("ModalMisfit: the Jacobian is not finite at this q");
+  }
+  have_last_ = true;
+  return e;
+}
+
+double ModalMisfit::residuals(const VectorXd& q, VectorXd& r, MatrixXd* jacobian) {
+  const Evaluation& e = evaluate(q, jacobian != nullptr);
+  r = e.r;
+  if (jacobian) *jacobian = e.jacobian;
+  return e.J;
+}
+
+double ModalMisfit::cost(const VectorXd& q) { return evaluate(q, false).J; }
+
+double ModalMisfit::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
+  const Evaluation& e = evaluate(q, true);
+  gradient = e.jacobian.transpose() * e.r;
+  return e.J;
+}
+
+double ModalMisfit::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  const Evaluation& e = evaluate(q, true);
+  gradient = e.jacobian.transpose() * e.r;
+  H = e.jacobian.transpose() * e.jacobian;
+  if (profile) {
+    profile->t = {1.0};
+    profile->misfit = {2.0 * e.J / static_cast<double>(std::max(1L, data_points()))};
+  }
+  return e.J;
+}
+
+Misfit::MisfitProfile ModalMisfit::misfit_profile(const VectorXd& q) {
+  const Evaluation& e = evaluate(q, false);
+  MisfitProfile p;
+  p.t = {1.0};
+  p.misfit = {2.0 * e.J / static_cast<double>(std::max(1L, data_points()))};
+  return p;
+}
+
+VectorXd ModalMisfit::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
+  const Evaluation& e = evaluate(q, true);
+  return e.jacobian.transpose() * (e.jacobian * v);
+}
+
+MatrixXd ModalMisfit::fisher(const VectorXd& q) {
+  const Evaluation& e = evaluate(q, true);
+  return e.jacobian.transpose() * e.jacobian;
+}
+
+std::vector<ModalMisfit::Match> ModalMisfit::matches(const VectorXd& q) { return evaluate(q, false).matches; }
+
+}  // namespace scoleid::identify

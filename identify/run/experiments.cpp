@@ -1,0 +1,458 @@
+#include "scoleid/identify/run/experiments.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+#include <set>
+
+#include "scoleid/identify/inverse/joint_misfit.h"
+#include "scoleid/identify/inverse/modal_misfit.h"
+#include "scoleid/identify/run/fit_plot.h"
+#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
+#include <stdexcept>
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/validation.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void bad(const std::string& file, const std::string& field, const std::string& what, const std::string& value) {
+  io::fail_field(file, field, what, value);
+  throw io::InputError(file);  // not reached
+}
+
+std::string scalar(const YAML::Node& n, const std::string& file, const std::string& field) {
+  if (!n.IsScalar()) bad(file, field, "must be a text value", YAML::Dump(n));
+  return n.Scalar();
+}
+
+// A scenario reference: a built-in name, or a file relative to the experiments file.
+std::string resolve(const std::string& value, const std::string& file) {
+  if (!io::builtin_scenario_yaml(value).empty()) return value;
+  const fs::path p(value);
+  return p.is_absolute() ? value : (fs::path(file).parent_path() / p).string();
+}
+
+std::string relative_path(const std::string& value, const std::string& file) {
+  const fs::path p(value);
+  return p.is_absolute() ? value : (fs::path(file).parent_path() / p).string();
+}
+
+}  // namespace
+
+ExperimentsSpec load_experiments(const std::string& path) {
+  ExperimentsSpec s;
+  s.source = path;
+  if (!fs::is_regular_file(path)) bad(path, "file", "does not exist or is not a file", path);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    bad(path, "yaml", "is not valid YAML", io::one_line(e.what()));
+  }
+  if (!root.IsMap()) bad(path, "document", "must be a mapping with experiments, runs and/or modes", YAML::Dump(root));
+  for (const auto& kv : root) {
+    const std::string key = kv.first.Scalar();
+    if (key != "experiments" && key != "description" && key != "threads" && key != "runs" && key != "modes")
+      bad(path, key, "is not a field of an experiments file (experiments, description, threads, runs, modes)", key);
+  }
+  if (!root["experiments"]) bad(path, "experiments", "is required (the name of the run)", "missing");
+  s.name = scalar(root["experiments"], path, "experiments");
+  if (!std::regex_match(s.name, std::regex("[A-Za-z0-9][A-Za-z0-9_.-]*")))
+    bad(path, "experiments", "must start with a letter or digit, then letters, digits, '_', '-' or '.'", s.name);
+  if (root["description"]) s.description = scalar(root["description"], path, "description");
+  if (root["threads"]) {
+    try {
+      s.threads = root["threads"].as<int>();
+    } catch (const YAML::Exception&) {
+      bad(path, "threads", "must be an integer >= 0", scalar(root["threads"], path, "threads"));
+    }
+    if (s.threads < 0) bad(path, "threads", "must be an integer >= 0", std::to_string(s.threads));
+  }
+  std::set<std::string> names;
+  if (root["runs"]) {
+    if (!root["runs"].IsSequence()) bad(path, "runs", "must be a list of {name, scenario, data}", YAML::Dump(root["runs"]));
+    int i = 0;
+    for (const auto& r : root["runs"]) {
+      const std::string f = "runs[" + std::to_string(i++) + "]";
+      if (!r.IsMap()) bad(path, f, "must be a mapping {name, scenario, data}", YAML::Dump(r));
+      for (const auto& kv : r) {
+        const std::string key = kv.first.Scalar();
+        if (key != "name" && key != "scenario" && key != "data")
+          bad(path, f + "." + key, "is not a field of a run (name, scenario, data)", key);
+      }
+      ExperimentsSpec::Run run;
+      if (!r["name"]) bad(path, f + ".name", "is required", "missing");
+      run.name = scalar(r["name"], path, f + ".name");
+      if (!std::regex_match(run.name, std::regex("[A-Za-z0-9_-]+")))
+        bad(path, f + ".name", "must be letters, digits, '_' or '-' (it names the run's output files)", run.name);
+      if (!names.insert(run.name).second) bad(path, f + ".name", "is used by two runs", run.name);
+      if (run.name == "modes") bad(path, f + ".name", "is reserved for the modal data", run.name);
+      if (!r["scenario"]) bad(path, f + ".scenario", "is required (a built-in name or a YAML file)", "missing");
+      run.scenario = resolve(scalar(r["scenario"], path, f + ".scenario"), path);
+      if (r["data"]) run.data = relative_path(scalar(r["data"], path, f + ".data"), path);
+      s.runs.push_back(run);
+    }
+  }
+  if (root["modes"]) {
+    const YAML::Node m = root["modes"];
+    if (!m.IsMap()) bad(path, "modes", "must be a mapping {file, scenario}", YAML::Dump(m));
+    for (const auto& kv : m) {
+      const std::string key = kv.first.Scalar();
+      if (key != "file" && key != "scenario") bad(path, "modes." + key, "is not a field of modes (file, scenario)", key);
+    }
+    if (!m["file"]) bad(path, "modes.file", "is required (the measured modes, CSV)", "missing");
+    s.modes_file = relative_path(scalar(m["file"], path, "modes.file"), path);
+    if (m["scenario"]) s.modes_scenario = resolve(scalar(m["scenario"], path, "modes.scenario"), path);
+  }
+  if (s.runs.empty() && !s.modes_file) bad(path, "runs", "at least one run or a modes file is needed", "none");
+  if (s.runs.empty() && s.modes_scenario.empty())
+    bad(path, "modes.scenario", "is required when there are no runs (the model the modes are compared with)", "missing");
+  return s;
+}
+
+std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec) {
+  auto ep = std::make_unique<ExperimentsProblem>();
+  ep->spec = spec;
+  const std::vector<std::string>* names = nullptr;
+  VectorXd initial;
+  std::string lead;
+  auto same_parameters = [&](const Parameterization& p, const std::string& field) {
+    if (!names) {
+      names = &p.names();
+      initial = p.initial();
+      lead = field;
+      return;
+    }
+    if (p.names() != *names)
+      bad(spec.source, field, "must estimate the same parameters as " + lead, [&] {
+        std::string s;
+        for (const auto& n : p.names()) s += (s.empty() ? "" : ",") + n;
+        return s;
+      }());
+    const VectorXd q0 = p.initial();
+    for (Eigen::Index i = 0; i < q0.size(); ++i)
+      if (!(std::abs(q0[i] - initial[i]) <= 1e-12 * std::abs(initial[i])))
+        bad(spec.source, field, "must start from the same values as " + lead + " (" + (*names)[static_cast<std::size_t>(i)] + ")",
+            std::to_string(q0[i]));
+  };
+  for (std::size_t i = 0; i < spec.runs.size(); ++i) {
+    const auto& r = spec.runs[i];
+    io::Scenario sc = io::load_scenario(r.scenario);
+    io::validate_scenario(sc);
+    if (sc.identification.smoothness != 0.0)
+      bad(spec.source, "runs[" + std::to_string(i) + "].scenario", "sets identification.smoothness, which a joint run does not take",
+          r.scenario);
+    ep->runs.push_back(make_problem(sc, r.data));
+    same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
+  }
+  if (spec.modes_file) {
+    ep->modes = io::read_modal_data(*spec.modes_file);
+    ep->modes_scenario = std::make_unique<io::Scenario>(spec.modes_scenario.empty() ? ep->runs.front()->scenario
+                                                                                      : io::load_scenario(spec.modes_scenario));
+    io::validate_scenario(*ep->modes_scenario);
+    ep->modes_structure = make_structure(*ep->modes_scenario, ep->modes_scenario->identification.elements);
+    ep->modes_params = ep->modes_structure->parameterize(*ep->modes_scenario);
+    same_parameters(*ep->modes_params, "modes.scenario");
+  }
+  // Likelihood weights (header): with modal data beside time runs every run needs stated noise.
+  bool all_stated = !ep->runs.empty();
+  for (std::size_t i = 0; i < ep->runs.size(); ++i)
+    for (std::size_t k = 0; k < ep->runs[i]->noise_std.size(); ++k)
+      if (!(ep->runs[i]->noise_std[k] > 0)) {
+        all_stated = false;
+        if (spec.modes_file)
+          bad(spec.source, "runs[" + std::to_string(i) + "] (" + spec.runs[i].name + ")",
+              "sensor has no stated noise level (noise_std), needed to weigh its data against the modal data",
+              ep->runs[i]->data.names[k]);
+      }
+  if (all_stated)
+    for (auto& p : ep->runs) {
+      const double W = p->data.white_noise_integral(p->data.t.front(), p->data.t.back());
+      const auto n = static_cast<double>(p->data.t.size());
+      p->objective_options.weights.clear();
+      for (double sd : p->noise_std) p->objective_options.weights.push_back(n / (sd * sd * W));
+    }
+  // Modal data the model cannot be compared with at the start (fewer flexible modes than measured,
+  // a measured mode no model mode can be matched to) are bad input, not a failed run.
+  if (ep->modes) {
+    try {
+      ModalMisfit probe(ep->modes_structure->model(), *ep->modes_params, *ep->modes);
+      probe.cost(ep->modes_params->initial());
+    } catch (const std::domain_error& e) {
+      bad(*spec.modes_file, "modes", "cannot be compared with the model of " + ep->modes_scenario->name + " at the starting values",
+          io::one_line(e.what()));
+    }
+  }
+  return ep;
+}
+
+bool ExperimentsResult::converged() const {
+  if (!summary.converged()) return false;
+  for (const auto& e : experiments)
+    if (!e.explains_data) return false;
+  return true;
+}
+
+ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo) {
+  const auto t_start = std::chrono::steady_clock::now();
+  ExperimentsResult r;
+  r.name = ep.spec.name;
+  const io::Scenario& lead = ep.runs.empty() ? *ep.modes_scenario : ep.runs.front()->scenario;
+  const Parameterization& params = ep.runs.empty() ? *ep.modes_params : *ep.runs.front()->params;
+  r.names = params.names();
+  r.initial = params.initial();
+  // The true values where the data's origin states them (synthetic runs, truth.json beside a data
+  // file); measured modes carry none.
+  if (!ep.runs.empty()) r.truth = ep.runs.front()->true_values;
+  r.weighting = !ep.runs.empty() && !ep.runs.front()->objective_options.weights.empty() ? "likelihood" : "relative";
+  if (ep.runs.empty()) r.weighting = "likelihood";
+
+  std::vector<std::unique_ptr<Objective>> objs;
+  std::vector<JointMisfit::Component> parts;
+  for (std::size_t i = 0; i < ep.runs.size(); ++i) {
+    Problem& p = *ep.runs[i];
+    objs.push_back(std::make_unique<Objective>(p.model(), *p.params, p.signals, p.data, p.objective_options));
+    parts.push_back({ep.spec.runs[i].name, objs.back().get()});
+  }
+  std::unique_ptr<ModalMisfit> modal;
+  if (ep.modes) {
+    modal = std::make_unique<ModalMisfit>(ep.modes_structure->model(), *ep.modes_params, *ep.modes);
+    parts.push_back({"modes", modal.get()});
+  }
+  JointMisfitOptions jo;
+  jo.threads = eo.threads.value_or(ep.spec.threads);
+  JointMisfit joint(parts, jo);
+  r.threads = joint.threads();
+
+  std::string method = eo.method.empty() ? lead.identification.method : eo.method;
+  if (method == "auto") method = params.size() <= 16 ? "gauss-newton" : "lbfgs";
+  if (method == "gauss-newton-krylov" && !joint.has_matrix_free_products())
+    bad(ep.spec.source, "method", "gauss-newton-krylov needs displacement sensors only in every run", method);
+  r.method = method;
+  OptimizerOptions oo;
+  oo.method = method;
+  oo.max_iterations = eo.max_iterations.value_or(lead.identification.max_iterations);
+  oo.gradient_tolerance = lead.identification.gradient_tolerance;
+  oo.step_tolerance = lead.identification.step_tolerance;
+  oo.continuation = lead.identification.continuation_misfit > 0;
+  if (oo.continuation) oo.continuation_misfit = lead.identification.continuation_misfit;
+  if (eo.verbose) {
+    std::printf("%5s", "iter");
+    for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) std::printf(" %13s", r.names[i].c_str());
+    std::printf(" %13s %8s\n", "cost", "horizon");
+  }
+  auto progress = [&](const IterationRecord& rec) {
+    io::check_interrupt();
+    if (!eo.verbose) return;
+    std::printf("%5d", rec.k);
+    for (Eigen::Index i = 0; i < rec.q.size() && i < 6; ++i) std::printf(" %13.6g", rec.q[i]);
+    std::printf(" %13.6e %8.4g\n", rec.cost, rec.horizon);
+    std::fflush(stdout);
+  };
+  r.summary = minimize(joint, r.initial, oo, progress);
+  r.estimate = r.summary.q;
+  joint.set_horizon(1.0);
+  double J = 0.0;
+  try {
+    J = joint.cost(r.estimate);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("the model cannot be evaluated at the estimate (" + io::one_line(e.what()) + ")");
+  }
+  r.summary.cost = J;
+
+  FisherInformation total;
+  for (int e = 0; e < joint.components(); ++e) {
+    ExperimentsResult::Experiment x;
+    x.name = joint.name(e);
+    x.cost = joint.last_costs()[static_cast<std::size_t>(e)];
+    x.share = J > 0 ? x.cost / J : 0.0;
+    FisherInformation fi;
+    if (e < static_cast<int>(ep.runs.size())) {
+      Problem& p = *ep.runs[static_cast<std::size_t>(e)];
+      Objective& obj = *objs[static_cast<std::size_t>(e)];
+      x.kind = "time";
+      x.data_source = p.data_source;
+      x.data_values = static_cast<long>(p.data.t.size()) * p.data.sensors();
+      const FitTest f = test_fit(p, obj, r.estimate);
+      x.explains_data = f.explains_data;
+      x.fit_message = f.message;
+      for (const auto& s : f.sensors) {
+        x.channels.push_back(s.name);
+        x.residual_rms.push_back(s.rms_residual);
+      }
+      if (eo.compute_std) {
+        std::vector<io::SensorSpec> sensors = p.scenario.sensors;
+        for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
+        fi = fisher_information(obj, sensors, r.estimate);
+      }
+      x.counters = obj.counters();
+    } else {
+      x.kind = "modal";
+      x.data_source = *ep.spec.modes_file;
+      VectorXd res;
+      modal->residuals(r.estimate, res);
+      const auto N = static_cast<double>(res.size());
+      x.data_values = static_cast<long>(res.size());
+      const double chi2 = res.squaredNorm();
+      x.explains_data = chi2 <= N + 3.0 * std::sqrt(2.0 * N);
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "chi2 %.4g over %ld modal residuals (band up to %.4g)%s", chi2, x.data_values,
+                    N + 3.0 * std::sqrt(2.0 * N), x.explains_data ? "" : ": the modes are not explained within their stated uncertainties");
+      x.fit_message = buf;
+      x.channels.push_back("all (in stated stds)");
+      x.residual_rms.push_back(N > 0 ? std::sqrt(chi2 / N) : 0.0);
+      if (eo.compute_std) {
+        fi.F = modal->fisher(r.estimate);
+        fi.chi2 = chi2;
+        fi.data_values = x.data_values;
+        fi.systematic = std::max(0.0, chi2 - N - 2.0 * std::sqrt(2.0 * N));
+        fi.stated_noise = true;
+        fi.noise_std.clear();
+      }
+    }
+    if (eo.compute_std) {
+      x.alone = identifiability_from(fi, r.estimate);
+      if (x.kind == "modal") x.alone.noise_source = "the modal data file's stds";
+      total += fi;
+    }
+    r.experiments.push_back(std::move(x));
+  }
+  if (eo.compute_std) {
+    r.ident = identifiability_from(total, r.estimate);
+    if (r.weighting == "relative")
+      r.std_note = "some noise levels are not stated: the runs are weighed by their relative misfit, not by the likelihood, "
+                   "so the std (the Cramér-Rao bound with noise levels from the residual) may be optimistic";
+  }
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return r;
+}
+
+nlohmann::json ExperimentsResult::to_json() const {
+  using nlohmann::json;
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  auto per_param = [&](const VectorXd& v) {
+    json o = json::object();
+    for (std::size_t i = 0; i < names.size(); ++i)
+      o[names[i]] = static_cast<Eigen::Index>(i) < v.size() ? finite(v[static_cast<Eigen::Index>(i)]) : json(nullptr);
+    return o;
+  };
+  auto ident_json = [&](const Identifiability& id) {
+    if (id.identifiable.empty()) return json{{"assessed", false}};
+    json flags = json::object();
+    for (std::size_t i = 0; i < names.size(); ++i) flags[names[i]] = id.identifiable[i] ? json(true) : json(id.reason[i]);
+    return json{{"assessed", true},        {"std", per_param(id.std)},     {"resolution", per_param(id.resolution)},
+                {"identifiable", flags},    {"condition_number", finite(id.condition_number)},
+                {"chi2", id.chi2},          {"data_values", id.data_values}, {"noise_source", id.noise_source}};
+  };
+  json out;
+  out["experiments"] = name;
+  out["method"] = method;
+  out["weighting"] = weighting;
+  out["threads"] = threads;
+  out["converged"] = converged();
+  out["optimizer_converged"] = summary.converged();
+  out["termination"] = to_string(summary.termination);
+  out["message"] = summary.message;
+  out["iterations"] = summary.iterations_done;
+  out["cost"] = summary.cost;
+  out["initial"] = per_param(initial);
+  out["estimate"] = per_param(estimate);
+  json t = json::object();
+  for (const auto& [k, v] : truth) t[k] = v;
+  out["truth"] = t;
+  out["identifiability"] = ident_json(ident);
+  if (!ident.identifiable.empty()) {
+    out["identifiability"]["std_note"] = std_note;
+    out["identifiability"]["interval"] =
+        "not assessed in a joint run (no half-record refit, no consider terms): std and resolution are the Fisher "
+        "information's of all experiments together";
+  }
+  json ex = json::array();
+  for (const auto& e : experiments) {
+    json rms = json::object();
+    for (std::size_t k = 0; k < e.channels.size(); ++k) rms[e.channels[k]] = finite(e.residual_rms[k]);
+    ex.push_back({{"name", e.name},
+                  {"kind", e.kind},
+                  {"data", e.data_source},
+                  {"cost", e.cost},
+                  {"misfit_share", e.share},
+                  {"data_values", e.data_values},
+                  {"residual_rms", rms},
+                  {"explains_data", e.explains_data},
+                  {"fit_message", e.fit_message},
+                  {"alone_at_joint_estimate", ident_json(e.alone)},
+                  {"solves", {{"forward", e.counters.forward_solves},
+                              {"costate", e.counters.costate_solves},
+                              {"sensitivity", e.counters.sensitivity_solves}}}});
+  }
+  out["per_experiment"] = ex;
+  json hist = json::array();
+  for (const auto& it : summary.iterations) hist.push_back({{"k", it.k}, {"cost", it.cost}, {"q", per_param(it.q)}, {"horizon", it.horizon}});
+  out["history"] = hist;
+  out["wall_seconds"] = wall_seconds;
+  return out;
+}
+
+std::vector<std::string> experiments_output_files(const ExperimentsSpec& spec) {
+  std::vector<std::string> f = {"identify.json"};
+  for (const auto& r : spec.runs)
+    for (const char* ext : {".csv", ".gp", ".png"}) f.push_back("fit-" + r.name + ext);
+  if (spec.modes_file) f.push_back("modes-fit.csv");
+  return f;
+}
+
+void write_experiments_outputs(io::RunDirectory& dir, ExperimentsProblem& ep, const ExperimentsResult& r) {
+  std::vector<std::pair<int, double>> cost;
+  for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
+  for (std::size_t i = 0; i < ep.runs.size(); ++i) {
+    Problem& p = *ep.runs[i];
+    const std::string base = "fit-" + ep.spec.runs[i].name;
+    Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+    const MatrixXd Y = obj.predict(r.estimate);
+    io::DataTable tab;
+    tab.t = p.data.t;
+    for (int k = 0; k < p.data.sensors(); ++k) {
+      const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+      std::vector<double> m(p.data.t.size()), y(p.data.t.size()), e(p.data.t.size());
+      for (std::size_t j = 0; j < p.data.t.size(); ++j) {
+        m[j] = p.data.z(static_cast<Eigen::Index>(j), k);
+        y[j] = Y(static_cast<Eigen::Index>(j), k);
+        e[j] = y[j] - m[j];
+      }
+      tab.names.insert(tab.names.end(), {n + "_measured", n + "_predicted", n + "_residual"});
+      tab.columns.insert(tab.columns.end(), {m, y, e});
+    }
+    io::write_csv(dir.path(base + ".csv"), tab);
+    io::write_text_atomic(dir.path(base + ".gp"), fit_plot_script(p.data.names, cost, base + ".csv", base + ".png"));
+    if (render_gnuplot(dir.staging(), base + ".gp") == RenderStatus::Failed)
+      std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s.png\n", base.c_str());
+  }
+  if (ep.modes) {
+    ModalMisfit modal(ep.modes_structure->model(), *ep.modes_params, *ep.modes);
+    const auto matches = modal.matches(r.estimate);
+    std::string csv = "mode,frequency_hz_measured,frequency_hz_model,model_mode,mac,damping_ratio_measured,damping_ratio_model\n";
+    char buf[400];
+    for (const auto& m : matches) {
+      const auto& meas = ep.modes->modes[static_cast<std::size_t>(m.measured)];
+      std::snprintf(buf, sizeof buf, "%d,%.17g,%.17g,%d,%.17g,%.17g,%.17g\n", meas.label, meas.frequency_hz, m.frequency_hz,
+                    m.model + 1, m.mac, meas.damping_ratio, m.damping_ratio);
+      csv += buf;
+    }
+    io::write_text_atomic(dir.path("modes-fit.csv"), csv);
+  }
+  io::write_json_atomic(dir.path("identify.json"), r.to_json());
+}
+
+}  // namespace scoleid::identify
