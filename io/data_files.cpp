@@ -45,7 +45,6 @@ double DataTable::interpolate(int j, double tt) const {
   return (1.0 - a) * v[k - 1] + a * v[k];
 }
 
-namespace {
 std::vector<std::string> split_csv_line(const std::string& line) {
   std::vector<std::string> out;
   std::string cur;
@@ -65,7 +64,6 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   }
   return out;
 }
-}  // namespace
 
 DataTable read_csv(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

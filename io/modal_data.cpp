@@ -35,27 +35,6 @@ bool is_reserved(const std::string& name) {
          name == kShapeStd;
 }
 
-// Fields of one CSV line, trimmed of blanks and quotes (as data_files.cpp reads truth.csv).
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : line) {
-    if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-    } else if (c != '\r') {
-      cur.push_back(c);
-    }
-  }
-  out.push_back(cur);
-  for (auto& s : out) {
-    const auto b = s.find_first_not_of(" \t\"");
-    const auto e = s.find_last_not_of(" \t\"");
-    s = (b == std::string::npos) ? std::string() : s.substr(b, e - b + 1);
-  }
-  return out;
-}
-
 bool blank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
 
 struct Reader {
@@ -109,7 +88,7 @@ ModalData read_modal_data_text(const std::string& text, const std::string& sourc
                               ",<station>,...]'"));
   const std::size_t header_line = lineno;
   check_utf8(line, rd.prefix + ": line " + std::to_string(lineno));
-  const std::vector<std::string> header = split_fields(line);
+  const std::vector<std::string> header = split_csv_line(line);
   int i_mode = -1, i_f = -1, i_fs = -1, i_z = -1, i_zs = -1, i_ss = -1;
   std::vector<int> i_station;
   for (std::size_t j = 0; j < header.size(); ++j) {
@@ -152,7 +131,7 @@ ModalData read_modal_data_text(const std::string& text, const std::string& sourc
   while (std::getline(in, line)) {
     ++lineno;
     if (blank(line) || line[0] == '#') continue;
-    const std::vector<std::string> f = split_fields(line);
+    const std::vector<std::string> f = split_csv_line(line);
     if (f.size() != header.size())
       rd.fail(lineno,
               "expected " + std::to_string(header.size()) + " fields (one per header column" +

@@ -420,20 +420,7 @@ void write_experiments_outputs(io::RunDirectory& dir, ExperimentsProblem& ep, co
     Problem& p = *ep.runs[i];
     const std::string base = "fit-" + ep.spec.runs[i].name;
     Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
-    const MatrixXd Y = obj.predict(r.estimate);
-    io::DataTable tab;
-    tab.t = p.data.t;
-    for (int k = 0; k < p.data.sensors(); ++k) {
-      const std::string& n = p.data.names[static_cast<std::size_t>(k)];
-      std::vector<double> m(p.data.t.size()), y(p.data.t.size()), e(p.data.t.size());
-      for (std::size_t j = 0; j < p.data.t.size(); ++j) {
-        m[j] = p.data.z(static_cast<Eigen::Index>(j), k);
-        y[j] = Y(static_cast<Eigen::Index>(j), k);
-        e[j] = y[j] - m[j];
-      }
-      tab.names.insert(tab.names.end(), {n + "_measured", n + "_predicted", n + "_residual"});
-      tab.columns.insert(tab.columns.end(), {m, y, e});
-    }
+    const io::DataTable tab = fit_table(p.data, obj.predict(r.estimate));
     io::write_csv(dir.path(base + ".csv"), tab);
     io::write_text_atomic(dir.path(base + ".gp"), fit_plot_script(p.data.names, cost, base + ".csv", base + ".png"));
     if (render_gnuplot(dir.staging(), base + ".gp") == RenderStatus::Failed)

@@ -612,27 +612,27 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
   return out;
 }
 
-void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
-  // fit.csv: measured, predicted and residual per sensor at the sample times.
-  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
-  const MatrixXd Y = obj.predict(r.estimate);
+io::DataTable fit_table(const Measurements& data, const MatrixXd& Y) {
   io::DataTable tab;
-  tab.t = p.data.t;
-  for (int k = 0; k < p.data.sensors(); ++k) {
-    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
-    tab.names.push_back(n + "_measured");
-    tab.names.push_back(n + "_predicted");
-    tab.names.push_back(n + "_residual");
-    std::vector<double> m(p.data.t.size()), y(p.data.t.size()), e(p.data.t.size());
-    for (std::size_t i = 0; i < p.data.t.size(); ++i) {
-      m[i] = p.data.z(static_cast<Eigen::Index>(i), k);
+  tab.t = data.t;
+  for (int k = 0; k < data.sensors(); ++k) {
+    const std::string& n = data.names[static_cast<std::size_t>(k)];
+    std::vector<double> m(data.t.size()), y(data.t.size()), e(data.t.size());
+    for (std::size_t i = 0; i < data.t.size(); ++i) {
+      m[i] = data.z(static_cast<Eigen::Index>(i), k);
       y[i] = Y(static_cast<Eigen::Index>(i), k);
       e[i] = y[i] - m[i];
     }
-    tab.columns.push_back(m);
-    tab.columns.push_back(y);
-    tab.columns.push_back(e);
+    tab.names.insert(tab.names.end(), {n + "_measured", n + "_predicted", n + "_residual"});
+    tab.columns.insert(tab.columns.end(), {m, y, e});
   }
+  return tab;
+}
+
+void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
+  // fit.csv: measured, predicted and residual per sensor at the sample times.
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+  const io::DataTable tab = fit_table(p.data, obj.predict(r.estimate));
   io::write_csv(dir.path("fit.csv"), tab);
   // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
   std::vector<std::pair<int, double>> cost;

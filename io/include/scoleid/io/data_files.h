@@ -37,6 +37,8 @@ DataTable read_csv_text(const std::string& text, const std::string& path);
 DataTable read_csv_stream(std::istream& in, const std::string& path);
 // 17 significant digits; atomic.
 void write_csv(const std::string& path, const DataTable& table);
+// The fields of one CSV line, each trimmed of blanks and double quotes ('\r' dropped).
+std::vector<std::string> split_csv_line(const std::string& line);
 
 struct ColumnMeta {
   std::string name;

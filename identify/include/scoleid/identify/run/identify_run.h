@@ -28,6 +28,7 @@
 #include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
+#include "scoleid/io/data_files.h"
 #include "scoleid/io/run_directory.h"
 
 namespace scoleid::identify {
@@ -91,6 +92,10 @@ double model_error(const Problem& problem);
 // The fit test at q (one forward solve on the identifier's model, one on twice its elements at
 // a quarter of its step for the discretisation estimate; skipped if that model cannot be built).
 FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q);
+
+// The fit table: per sensor <name>_measured, <name>_predicted (Y, samples × sensors) and
+// <name>_residual (predicted − measured) at the sample times.
+io::DataTable fit_table(const Measurements& data, const MatrixXd& Y);
 
 // Writes identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's
 // staging area; the caller commits them as one unit (io/run_directory.h).
