@@ -52,6 +52,11 @@ constexpr double kEI0 = 23000.0;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// Part 1 options passed on to the child processes: each sensor's noise std (m; 0 = noise-free
+// data) and the smoothness prior (identification.smoothness: < 0 = the discrepancy principle).
+double g_noise = 0.0;
+double g_smoothness = 0.0;
+
 // The true stiffness profile of part 1, EI(x) = 23000 (1 + 0.3 sin(πx/L) + 0.1 cos(3πx/L)).
 double ei_profile(double x) { return kEI0 * (1.0 + 0.3 * std::sin(M_PI * x / kLength) + 0.1 * std::cos(3.0 * M_PI * x / kLength)); }
 
@@ -87,6 +92,8 @@ scoleid::io::Scenario part1_scenario(int N) {
   sc.identification.elements = 64;
   sc.identification.data_elements = 128;
   sc.identification.time_step = 0.0;  // automatic: what is being measured
+  for (auto& sensor : sc.sensors) sensor.noise_std = g_noise;
+  sc.identification.smoothness = g_smoothness;
   return sc;
 }
 
@@ -182,6 +189,8 @@ json run_child(int N, const std::string& method, bool compute_std, double timeou
     close(fd[1]);
     std::vector<const char*> argv = {"scole-sections-bench", "--case", n_arg.c_str(), "--method", method.c_str()};
     if (!compute_std) argv.push_back("--no-std");
+    const std::string noise = std::to_string(g_noise), smooth = std::to_string(g_smoothness);
+    argv.insert(argv.end(), {"--noise", noise.c_str(), "--smoothness-weight", smooth.c_str()});
     argv.push_back(nullptr);
     execv("/proc/self/exe", const_cast<char* const*>(argv.data()));
     _exit(127);
@@ -249,6 +258,9 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
   std::printf("Part 1. EI(x) on N sections: 64 elements, data on 128, 16 sensors, 10 s at 0.01 s, automatic step,\n"
               "        start EI = 30000, one child process per case (timeout %.0f s, std %s)\n\n",
               timeout_s, compute_std ? "on" : "off");
+  if (g_noise > 0 || g_smoothness != 0)
+    std::printf("        sensor noise std %.3g m (stated), smoothness prior %s\n\n", g_noise,
+                g_smoothness < 0 ? "by the discrepancy principle" : std::to_string(g_smoothness).c_str());
   std::printf("%4s %-13s %5s %-18s %9s %10s %8s %8s %8s %10s %10s %6s %9s\n", "N", "method", "iter", "termination",
               "wall[s]", "step h", "forward", "costate", "sensit.", "RMS err", "max err", "ident", "RSS[MB]");
   json rows = json::array();
@@ -455,13 +467,15 @@ std::vector<std::string> split(const std::string& s) {
 
 const char* kUsage =
     "usage: scole-sections-bench [--part 1|2] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
-    "                            [--timeout S] [--no-std] [--json PATH]\n"
+    "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
     "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step), each (N, method) in a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
     "  Part 2: EI_1..EI_4 + rho_A from the analytic modal series, Gauss-Newton from 10 starts.\n"
     "  Both parts run unless --part selects one. --no-std skips identifiability in part 1.\n"
-    "  --json PATH writes the results as JSON (temp file, then renamed).\n";
+    "  --json PATH writes the results as JSON (temp file, then renamed).\n"
+    "  --noise SD gives every sensor of part 1 a stated noise std SD [m] (noisy synthetic data);\n"
+    "  --smoothness discrepancy|BETA sets part 1's smoothness prior (docs/theory.md §7.8).\n";
 
 }  // namespace
 
@@ -501,6 +515,15 @@ int main(int argc, char** argv) {
         timeout_s = std::stod(value());
       } else if (a == "--no-std") {
         compute_std = false;
+      } else if (a == "--noise") {
+        g_noise = std::stod(value());
+        if (!(g_noise >= 0)) throw std::invalid_argument("--noise must be >= 0");
+      } else if (a == "--smoothness") {
+        const std::string v = value();
+        g_smoothness = v == "discrepancy" ? -1.0 : std::stod(v);
+        if (!(g_smoothness >= 0 || v == "discrepancy")) throw std::invalid_argument("--smoothness: discrepancy or >= 0");
+      } else if (a == "--smoothness-weight") {  // hidden: as passed to a child (-1 = discrepancy)
+        g_smoothness = std::stod(value());
       } else if (a == "--json") {
         json_path = value();
       } else if (a == "--case") {  // hidden: one part-1 case, JSON line on stdout
