@@ -429,12 +429,24 @@ void write_experiments_outputs(io::RunDirectory& dir, ExperimentsProblem& ep, co
   if (ep.modes) {
     ModalMisfit modal(ep.modes_structure->model(), *ep.modes_params, *ep.modes);
     const auto matches = modal.matches(r.estimate);
-    std::string csv = "mode,frequency_hz_measured,frequency_hz_model,model_mode,mac,damping_ratio_measured,damping_ratio_model\n";
+    const bool damping = ep.modes->has_damping(), shapes = ep.modes->has_shapes();
+    std::string csv = "mode,frequency_hz_measured,frequency_hz_model,model_mode";
+    if (shapes) csv += ",mac";
+    csv += damping ? ",damping_ratio_measured,damping_ratio_model\n" : ",damping_ratio_model\n";
     char buf[400];
     for (const auto& m : matches) {
       const auto& meas = ep.modes->modes[static_cast<std::size_t>(m.measured)];
-      std::snprintf(buf, sizeof buf, "%d,%.17g,%.17g,%d,%.17g,%.17g,%.17g\n", meas.label, meas.frequency_hz, m.frequency_hz,
-                    m.model + 1, m.mac, meas.damping_ratio, m.damping_ratio);
+      std::snprintf(buf, sizeof buf, "%d,%.17g,%.17g,%d", meas.label, meas.frequency_hz, m.frequency_hz, m.model + 1);
+      csv += buf;
+      if (shapes) {
+        std::snprintf(buf, sizeof buf, ",%.17g", m.mac);
+        csv += buf;
+      }
+      if (damping) {
+        std::snprintf(buf, sizeof buf, ",%.17g", meas.damping_ratio);
+        csv += buf;
+      }
+      std::snprintf(buf, sizeof buf, ",%.17g\n", m.damping_ratio);
       csv += buf;
     }
     io::write_text_atomic(dir.path("modes-fit.csv"), csv);

@@ -748,4 +748,28 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   write_file(dir / "m.csv", "mode,frequency_hz,frequency_std_hz,shape_std,w_tip,w_mid\n1,0.3,0.001,0.01,1\n");
   expect_input_error(run({"--experiments", (dir / "e3.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
                      {"m.csv", "line 2"});
+
+  // The cantilever's first two frequencies alone (closed form, f_k = λ_k² √(EI/ρA) / (2π L²)):
+  // they fix q1 = EI/ρA and say nothing of q2 = 1/ρA, which the Fisher test flags.
+  const double q1 = 23000.0 / 67.0, L = 10.0;
+  char m[256];
+  std::snprintf(m, sizeof m, "mode,frequency_hz,frequency_std_hz\n1,%.15g,1e-5\n2,%.15g,1e-4\n",
+                std::pow(1.8751040687119611, 2) * std::sqrt(q1) / (2 * M_PI * L * L),
+                std::pow(4.6940911329741745, 2) * std::sqrt(q1) / (2 * M_PI * L * L));
+  write_file(dir / "m.csv", m);
+  const fs::path out4 = dir / "out4";
+  const Result rm = run({"--experiments", (dir / "e3.yaml").string(), "--out", out4.string(), "-q"}, dir);
+  ASSERT_EQ(rm.code, 0) << rm.err << rm.out;
+  const auto jm = nlohmann::json::parse(read_file(out4 / "identify.json"));
+  EXPECT_EQ(jm["per_experiment"][0]["kind"], "modal");
+  EXPECT_NEAR(jm["estimate"]["q1"].get<double>() / q1, 1.0, 1e-4);
+  EXPECT_TRUE(jm["identifiability"]["identifiable"]["q1"].is_boolean());
+  EXPECT_TRUE(jm["identifiability"]["identifiable"]["q2"].is_string()) << jm["identifiability"].dump();
+  std::vector<std::string> header;
+  const auto cols = csv_columns(read_file(out4 / "modes-fit.csv"), header);
+  ASSERT_GE(header.size(), 4u);
+  EXPECT_EQ(header[3], "model_mode");
+  ASSERT_EQ(cols[3].size(), 2u);
+  EXPECT_EQ(cols[3][0], 1.0);
+  EXPECT_EQ(cols[3][1], 2.0);
 }
