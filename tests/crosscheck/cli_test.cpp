@@ -173,3 +173,43 @@ TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
   EXPECT_TRUE(fs::exists(out / "suite.gp"));
   fs::remove_all(d);
 }
+
+// End to end (docs/theory.md §6.6): `modes` writes the Simbody chain's modes as modal-data.csv, and
+// scole-identify --experiments fits the mast's EI and ρA to them alone, within the chain's lumping
+// level (a frequency known to δ relative fixes a stiffness-to-mass ratio to about 2δ).
+TEST(CrosscheckCli, ChainModesFileIdentifiesTheMastThroughScoleIdentify) {
+  const fs::path d = scratch("modal");
+  const std::string src = std::string(SCOLEID_SOURCE_DIR) + "/identify/examples/modal/";
+  ASSERT_EQ(sh(exe + " modes --scenario " + src + "scole-modal.yaml --count 6 --quiet --out " + (d / "xc").string() + " > /dev/null"), 0);
+  ASSERT_TRUE(fs::exists(d / "xc" / "modal-data.csv"));
+  fs::create_directories(d / "in");
+  for (const char* f : {"scole-modal.yaml", "modes-only.yaml"}) fs::copy_file(src + f, d / "in" / f);
+  fs::copy_file(d / "xc" / "modal-data.csv", d / "in" / "modal-data.csv");
+  ASSERT_EQ(sh(std::string(SCOLE_IDENTIFY_EXE) + " --experiments " + (d / "in" / "modes-only.yaml").string() + " -q --out " +
+               (d / "id").string() + " > /dev/null 2>&1"),
+            0);
+  std::ifstream in(d / "id" / "identify.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["converged"].get<bool>());
+  // The largest relative frequency std in the file: the chain's lumping level.
+  double worst = 0;
+  {
+    std::ifstream m(d / "in" / "modal-data.csv");
+    std::string line;
+    std::getline(m, line);
+    while (std::getline(m, line)) {
+      std::stringstream ss(line);
+      std::string label, f, sd;
+      std::getline(ss, label, ',');
+      std::getline(ss, f, ',');
+      std::getline(ss, sd, ',');
+      worst = std::max(worst, std::stod(sd) / std::stod(f));
+    }
+  }
+  const double EI = j["estimate"]["EI"].get<double>(), rho_A = j["estimate"]["rho_A"].get<double>();
+  std::printf("chain modes -> EI %.4e (%.2e), rho_A %.5g (%.2e); lumping level %.2e\n", EI, EI / 4.0e7 - 1, rho_A,
+              rho_A / 0.0956 - 1, worst);
+  EXPECT_LT(std::abs(EI / 4.0e7 - 1.0), 2.0 * worst);  // the scenario's (default) mast: EI 4e7, rho_A 0.0956
+  EXPECT_LT(std::abs(rho_A / 0.0956 - 1.0), 2.0 * worst);
+  fs::remove_all(d);
+}
