@@ -306,10 +306,16 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
       const auto N = static_cast<double>(res.size());
       x.data_values = static_cast<long>(res.size());
       const double chi2 = res.squaredNorm();
-      x.explains_data = chi2 <= N + 3.0 * std::sqrt(2.0 * N);
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "chi2 %.4g over %ld modal residuals (band up to %.4g)%s", chi2, x.data_values,
-                    N + 3.0 * std::sqrt(2.0 * N), x.explains_data ? "" : ": the modes are not explained within their stated uncertainties");
+      // Degrees of freedom: a unit-normalised shape's residual has one component fewer than its
+      // stations (it is orthogonal to the shape to first order); with the modes the only data the
+      // P fitted parameters take P more.
+      const double shapes = ep.modes->has_shapes() ? static_cast<double>(ep.modes->modes.size()) : 0.0;
+      const double nu = std::max(1.0, N - shapes - (joint.components() == 1 ? static_cast<double>(params.size()) : 0.0));
+      x.explains_data = chi2 <= nu + 3.0 * std::sqrt(2.0 * nu);
+      char buf[240];
+      std::snprintf(buf, sizeof buf, "chi2 %.4g over %ld modal residuals, %.0f degrees of freedom (band up to %.4g)%s", chi2,
+                    x.data_values, nu, nu + 3.0 * std::sqrt(2.0 * nu),
+                    x.explains_data ? "" : ": the modes are not explained within their stated uncertainties");
       x.fit_message = buf;
       x.channels.push_back("all (in stated stds)");
       x.residual_rms.push_back(N > 0 ? std::sqrt(chi2 / N) : 0.0);
@@ -317,7 +323,7 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
         fi.F = modal->fisher(r.estimate);
         fi.chi2 = chi2;
         fi.data_values = x.data_values;
-        fi.systematic = std::max(0.0, chi2 - N - 2.0 * std::sqrt(2.0 * N));
+        fi.systematic = std::max(0.0, chi2 - nu - 2.0 * std::sqrt(2.0 * nu));
         fi.stated_noise = true;
         fi.noise_std.clear();
       }

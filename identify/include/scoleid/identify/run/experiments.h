@@ -26,7 +26,8 @@
 // the fit (method, tolerances, continuation) is the first run's (or the modes scenario's).
 //
 // Convergence: the optimiser stopped on a convergence test AND every experiment explains its data
-// (a time run by its fit test, fit_test.h; modal data when their χ² lies within N + 3√(2N)).
+// (a time run by its fit test, fit_test.h; modal data when their χ² lies within ν + 3√(2ν), ν the
+// residuals less one per unit-normalised shape, less P when the modes are the only data).
 // Identifiability: the Fisher informations add (independent noise), so the joint std comes from
 // Σ_e F_e; each experiment's own F_e at the joint estimate tells what it determines alone. No
 // half-record refit and no consider terms are run (the single-run interval, interval.h).
