@@ -128,7 +128,16 @@ int run_case(int N, const std::string& method, bool compute_std) {
     out["wall_seconds"] = seconds_since(t1);
     const auto [rms, mx] = rel_errors(*p, r.estimate);
     out["method_used"] = r.method;
-    out["iterations"] = r.summary.iterations_done;
+    // Iterations of the whole run: with the discrepancy principle, of every weight tried (the
+    // summary holds the chosen weight's only).
+    int iterations = r.summary.iterations_done;
+    if (!r.smoothness_path.empty()) {
+      iterations = 0;
+      for (const auto& st : r.smoothness_path) iterations += st.iterations;
+    }
+    out["iterations"] = iterations;
+    out["smoothness_weight"] = r.smoothness_weight;
+    out["smoothness_met"] = r.smoothness_met;
     out["termination"] = to_string(r.summary.termination);
     out["converged"] = r.converged();
     out["optimizer_converged"] = r.summary.converged();
