@@ -138,6 +138,12 @@ int run_case(int N, const std::string& method, bool compute_std) {
     out["iterations"] = iterations;
     out["smoothness_weight"] = r.smoothness_weight;
     out["smoothness_met"] = r.smoothness_met;
+    out["smoothness_expected_misfit"] = r.smoothness_expected_misfit;
+    json path = json::array();
+    for (const auto& st : r.smoothness_path)
+      path.push_back({{"weight", st.weight}, {"data_misfit", st.data_misfit}, {"prior_cost", st.prior_cost},
+                      {"iterations", st.iterations}, {"converged", st.converged}});
+    out["smoothness_path"] = path;
     out["termination"] = to_string(r.summary.termination);
     out["converged"] = r.converged();
     out["optimizer_converged"] = r.summary.converged();

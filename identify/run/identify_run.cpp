@@ -211,9 +211,9 @@ namespace {
 // residual must hold anyway: the noise's expected misfit E J = ½ Σ_k R_k σ_k² E∫ñ²
 // (Measurements::white_noise_integral: the data's interpolant of white noise) plus two standard
 // deviations of it as a χ² sum over the N data values, E J (1 + 2 √(2/N)), plus the floor of the
-// fit test (fit_test.h) beyond noise, ½ Σ_k R_k (d_k² + (m z_k)²)(T − t0): the discretisation
-// estimate d_k (at the first weight's estimate) and the declared model error m of the RMS signal
-// z_k. That β (the largest meeting it) and its estimate are kept. The stated noise levels are
+// fit test (fit_test.h) beyond noise, ½ Σ_k R_k ((2 d_k)² + (m z_k)²)(T − t0): its allowance for
+// the discretisation estimate d_k (at the first weight's estimate) and the declared model error m
+// of the RMS signal z_k — a weight is chosen only if its fit would pass the fit test. That β (the largest meeting it) and its estimate are kept. The stated noise levels are
 // needed.
 OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r, OptimizerOptions oo,
                                   const std::function<void(const IterationRecord&)>& progress, bool verbose) {
@@ -242,9 +242,10 @@ OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r
       const double span = obj.data_end() - obj.data_start();
       double floor = 0.0;
       for (std::size_t k = 0; k < R.size() && k < f.sensors.size(); ++k) {
+        // The fit test's allowance beyond noise (fit_test.h): (2 d_k)² + (m z_k)².
         const double d = std::isfinite(f.sensors[k].discretisation) ? f.sensors[k].discretisation : 0.0;
         const double m = f.model_error * f.sensors[k].rms_signal;
-        floor += 0.5 * R[k] * (d * d + m * m) * span;
+        floor += 0.5 * R[k] * (4.0 * d * d + m * m) * span;
       }
       r.smoothness_expected_misfit = expected += floor;
       if (verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
