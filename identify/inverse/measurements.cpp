@@ -1,5 +1,7 @@
 #include "scoleid/identify/inverse/measurements.h"
 
+#include <array>
+
 #include <algorithm>
 
 namespace scoleid::identify {
@@ -72,6 +74,27 @@ double Measurements::white_noise_integral(double t0, double T) const {
     }
   }
   return sum;
+}
+
+double Measurements::white_noise_integral_variance(double t0, double T) const {
+  static const double gx[5] = {0.04691007703066800, 0.2307653449471585, 0.5, 0.7692346550528415, 0.9530899229693320};
+  static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832, 0.1184634425280945};
+  // Q is banded: a stencil spans 4 consecutive samples, so |a − b| <= 3. Row a holds Q_{a, a+d}, d = 0..3.
+  std::vector<std::array<double, 4>> Q(t.size(), {0.0, 0.0, 0.0, 0.0});
+  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
+    const double a = std::max(t[i], t0), b = std::min(t[i + 1], T);
+    if (!(b > a)) continue;
+    for (int g = 0; g < 5; ++g) {
+      std::size_t s0 = 0;
+      double w[4];
+      const int m = stencil(t, a + gx[g] * (b - a), s0, w);
+      for (int p = 0; p < m; ++p)
+        for (int q = p; q < m; ++q) Q[s0 + static_cast<std::size_t>(p)][static_cast<std::size_t>(q - p)] += gw[g] * (b - a) * w[p] * w[q];
+    }
+  }
+  double sum = 0.0;
+  for (const auto& row : Q) sum += row[0] * row[0] + 2.0 * (row[1] * row[1] + row[2] * row[2] + row[3] * row[3]);
+  return 2.0 * sum;
 }
 
 }  // namespace scoleid::identify

@@ -208,25 +208,31 @@ namespace {
 
 // The smoothness weight by the discrepancy principle (docs/theory.md §7.8): β from 1 down by
 // factors of 10, each solve from the previous estimate, until the data misfit is within what the
-// residual must hold anyway: the noise's expected misfit E J = ½ Σ_k R_k σ_k² E∫ñ²
-// (Measurements::white_noise_integral: the data's interpolant of white noise) plus two standard
-// deviations of it as a χ² sum over the N data values, E J (1 + 2 √(2/N)), plus the floor of the
-// fit test (fit_test.h) beyond noise, ½ Σ_k R_k ((2 d_k)² + (m z_k)²)(T − t0): its allowance for
-// the discretisation estimate d_k (at the first weight's estimate) and the declared model error m
-// of the RMS signal z_k — a weight is chosen only if its fit would pass the fit test. That β (the largest meeting it) and its estimate are kept. The stated noise levels are
-// needed.
+// residual holds anyway: the noise's expected misfit E J = Σ_k c_k W, c_k = ½ R_k σ_k², W = E∫ñ²
+// (Measurements::white_noise_integral: the data's interpolant of unit white noise), plus two of
+// its standard deviations √(Σ_k c_k² V), V = Var ∫ñ² (white_noise_integral_variance: the weights
+// R_k differ by sensor, so a few sensors can carry most of J and the band is wider than that of N
+// equal terms); plus the floor of the fit test beyond noise, ½ Σ_k R_k ((2 d_k)² + (m z_k)²)(T − t0)
+// (fit_test.h: the discretisation estimate d_k at the first weight's estimate and the declared
+// model error m of the RMS signal z_k — a weight is chosen only if its fit would pass the fit
+// test); plus the interpolation floor (Objective::interpolation_misfit at that estimate). That β
+// (the largest meeting it) and its estimate are kept. The stated noise levels are needed.
 OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r, OptimizerOptions oo,
                                   const std::function<void(const IterationRecord&)>& progress, bool verbose) {
-  double expected = 0.0;
+  double expected = 0.0, variance = 0.0;
   const auto& R = obj.weights();
+  const double W = p.data.white_noise_integral(obj.data_start(), obj.data_end());
+  const double V = p.data.white_noise_integral_variance(obj.data_start(), obj.data_end());
   for (std::size_t k = 0; k < R.size(); ++k) {
     const double sd = k < p.noise_std.size() ? p.noise_std[k] : 0.0;
     if (!(sd > 0.0))
       io::fail_field(p.scenario.source, "identification.smoothness",
                      "discrepancy needs every sensor's noise level stated (sensor '" + p.data.names[k] + "' has none)", "discrepancy");
-    expected += 0.5 * R[k] * sd * sd * p.data.white_noise_integral(obj.data_start(), obj.data_end());
+    const double c = 0.5 * R[k] * sd * sd;
+    expected += c * W;
+    variance += c * c * V;
   }
-  expected *= 1.0 + 2.0 * std::sqrt(2.0 / static_cast<double>(std::max(1L, obj.data_points())));
+  expected += 2.0 * std::sqrt(variance);
   r.smoothness_expected_misfit = expected;
   VectorXd q = r.initial;
   OptimizerSummary chosen;
@@ -247,6 +253,8 @@ OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r
         const double m = f.model_error * f.sensors[k].rms_signal;
         floor += 0.5 * R[k] * (4.0 * d * d + m * m) * span;
       }
+      // And what sampling leaves between the samples of a perfect fit (objective.h).
+      floor += obj.interpolation_misfit(s.q);
       r.smoothness_expected_misfit = expected += floor;
       if (verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
     }

@@ -22,6 +22,11 @@ struct Measurements {
   // expected misfit noise adds to the cost per unit variance (≈ 0.776 (T − t0) for the cubic
   // interpolant at uniform sampling; docs/theory.md §7.8).
   double white_noise_integral(double t0, double T) const;
+  // Var ∫_{t0}^{T} ñ(t)² dt for the same unit white noise: ∫ñ² = nᵀ Q n with Q_ab = ∫ w_a w_b dt
+  // (w the interpolant's sample weights), so the mean is tr Q (white_noise_integral) and the
+  // variance 2 Σ_ab Q_ab² — larger than the 2 Σ_a Q_aa² of independent samples, since
+  // neighbouring samples share each interval.
+  double white_noise_integral_variance(double t0, double T) const;
 };
 
 }  // namespace scoleid::identify

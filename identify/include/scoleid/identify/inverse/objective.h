@@ -103,6 +103,11 @@ public:
   VectorXd finite_difference_gradient(const VectorXd& q, double h = 1e-5);
   // Model outputs C u(t_i) at the sample times (samples × sensors).
   MatrixXd predict(const VectorXd& q);
+  // ½ Σ_k R_k ∫ (y_k − ỹ_k)² dt over [t0, T] at q: y the model's output, ỹ the cubic interpolant of
+  // its own samples (measurements.h). The part of the cost sampling alone leaves whatever the
+  // parameters and the noise: data that the model fits exactly still differ from the model between
+  // samples by the interpolant's error (docs/theory.md §7.8). One forward solve.
+  double interpolation_misfit(const VectorXd& q);
   // Output sensitivities ∂(C u(t_i))/∂q at the sample times: (samples·sensors) × P, row-major by
   // sample. For Fisher information.
   MatrixXd output_sensitivities(const VectorXd& q);
