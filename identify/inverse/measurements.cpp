@@ -55,12 +55,14 @@ void Measurements::eval(double tt, double* out) const {
   }
 }
 
-double Measurements::white_noise_integral(double t0, double T) const {
-  // ∫ Σ_a w_a(t)² dt, 5-point Gauss–Legendre per sample interval (the integrand is a polynomial of
-  // degree 6 on each).
+namespace {
+// Calls f(weight, s0, w, m) at the 5-point Gauss–Legendre nodes of every sample interval within
+// [t0, T] with the interpolant's stencil there (the products of two stencil weights are
+// polynomials of degree 6 on an interval, which the rule integrates exactly).
+template <class F>
+void for_each_node(const std::vector<double>& t, double t0, double T, F&& f) {
   static const double gx[5] = {0.04691007703066800, 0.2307653449471585, 0.5, 0.7692346550528415, 0.9530899229693320};
   static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832, 0.1184634425280945};
-  double sum = 0.0;
   for (std::size_t i = 0; i + 1 < t.size(); ++i) {
     const double a = std::max(t[i], t0), b = std::min(t[i + 1], T);
     if (!(b > a)) continue;
@@ -68,30 +70,28 @@ double Measurements::white_noise_integral(double t0, double T) const {
       std::size_t s0 = 0;
       double w[4];
       const int m = stencil(t, a + gx[g] * (b - a), s0, w);
-      double q = 0.0;
-      for (int k = 0; k < m; ++k) q += w[k] * w[k];
-      sum += gw[g] * (b - a) * q;
+      f(gw[g] * (b - a), s0, w, m);
     }
   }
+}
+}  // namespace
+
+double Measurements::white_noise_integral(double t0, double T) const {
+  // ∫ Σ_a w_a(t)² dt.
+  double sum = 0.0;
+  for_each_node(t, t0, T, [&](double wt, std::size_t, const double* w, int m) {
+    for (int k = 0; k < m; ++k) sum += wt * w[k] * w[k];
+  });
   return sum;
 }
 
 double Measurements::white_noise_integral_variance(double t0, double T) const {
-  static const double gx[5] = {0.04691007703066800, 0.2307653449471585, 0.5, 0.7692346550528415, 0.9530899229693320};
-  static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832, 0.1184634425280945};
   // Q is banded: a stencil spans 4 consecutive samples, so |a − b| <= 3. Row a holds Q_{a, a+d}, d = 0..3.
   std::vector<std::array<double, 4>> Q(t.size(), {0.0, 0.0, 0.0, 0.0});
-  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
-    const double a = std::max(t[i], t0), b = std::min(t[i + 1], T);
-    if (!(b > a)) continue;
-    for (int g = 0; g < 5; ++g) {
-      std::size_t s0 = 0;
-      double w[4];
-      const int m = stencil(t, a + gx[g] * (b - a), s0, w);
-      for (int p = 0; p < m; ++p)
-        for (int q = p; q < m; ++q) Q[s0 + static_cast<std::size_t>(p)][static_cast<std::size_t>(q - p)] += gw[g] * (b - a) * w[p] * w[q];
-    }
-  }
+  for_each_node(t, t0, T, [&](double wt, std::size_t s0, const double* w, int m) {
+    for (int p = 0; p < m; ++p)
+      for (int q = p; q < m; ++q) Q[s0 + static_cast<std::size_t>(p)][static_cast<std::size_t>(q - p)] += wt * w[p] * w[q];
+  });
   double sum = 0.0;
   for (const auto& row : Q) sum += row[0] * row[0] + 2.0 * (row[1] * row[1] + row[2] * row[2] + row[3] * row[3]);
   return 2.0 * sum;

@@ -178,6 +178,11 @@ std::vector<double> Objective::union_grid(const std::vector<const std::vector<do
 }
 
 double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const {
+  return misfit_against(s, solver, u, data_);
+}
+
+double Objective::misfit_against(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u,
+                                 const Measurements& z_of) const {
   const int n = model_.ndof, ns = data_.sensors();
   const auto grid = union_grid({&u.times()}, T_);
   VectorXd x(n), v(n), z(ns);
@@ -187,7 +192,7 @@ double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const
     for (int g = 0; g < 3; ++g) {
       const double t = grid[k] + kGx[g] * h;
       u.eval(t, x.data(), v.data());
-      data_.eval(t, z.data());
+      z_of.eval(t, z.data());
       const VectorXd r = output_at(s, solver, t, x, v) - z;
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
@@ -197,33 +202,20 @@ double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const
   return J;
 }
 
+
 double Objective::interpolation_misfit(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   // The whole record: the interpolant near T uses samples beyond it.
   const Trajectory u = forward(solver, s, data_.t.back());
   const int n = model_.ndof, ns = data_.sensors();
-  VectorXd x(n), v(n), z(ns);
+  VectorXd x(n), v(n);
   Measurements own{data_.names, data_.t, MatrixXd(static_cast<Eigen::Index>(data_.t.size()), ns)};
   for (std::size_t i = 0; i < data_.t.size(); ++i) {
     u.eval(data_.t[i], x.data(), v.data());
     own.z.row(static_cast<Eigen::Index>(i)) = output_at(s, solver, data_.t[i], x, v).transpose();
   }
-  const auto grid = union_grid({&u.times()}, T_);
-  double J = 0.0;
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int g = 0; g < 3; ++g) {
-      const double t = grid[k] + kGx[g] * h;
-      u.eval(t, x.data(), v.data());
-      own.eval(t, z.data());
-      const VectorXd r = output_at(s, solver, t, x, v) - z;
-      double e = 0.0;
-      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-      J += 0.5 * kGw[g] * h * e;
-    }
-  }
-  return J;
+  return misfit_against(s, solver, u, own);
 }
 
 Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,

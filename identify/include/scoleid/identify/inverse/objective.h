@@ -135,6 +135,8 @@ private:
   Setup setup(const VectorXd& q) const;
   Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
   double cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  // ½ Σ_k R_k ∫ (y_k − z̃_k)² over [t0, T] against the interpolant of `z` (the data, or other samples).
+  double misfit_against(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u, const Measurements& z) const;
   MisfitProfile misfit_profile(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
   // Outputs at t from the state (x, v): C_0 x + C_1 v + C_2 a, a from the equation of motion
   // (returned through `a` when a sensor reads it).
