@@ -260,9 +260,125 @@ double Objective::cost(const VectorXd& q) {
   return J;
 }
 
+std::size_t Objective::checkpoint_spacing(const SecondOrderSolver& solver) const {
+  if (!solver.can_resume() || C1_.size() != 0) return 0;
+  const double t0 = data_.t.front();
+  const double h = options_.solver.step > 0 ? options_.solver.step : (T_ - t0) / 2000.0;
+  const double points = (T_ - t0) / h + 1.0 + 2.0 * static_cast<double>(breakpoints_.size());
+  if (options_.checkpoint_points > 0) return static_cast<std::size_t>(options_.checkpoint_points);
+  if (points * model_.ndof * 3.0 * sizeof(double) <= options_.trajectory_bytes) return 0;
+  return static_cast<std::size_t>(std::max(2.0, std::ceil(std::sqrt(points / 3.0))));
+}
+
+double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out,
+                                        bool residual, std::vector<Checkpoint> ckpts, std::size_t spacing,
+                                        VectorXd& gc) {
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t0 = data_.t.front();
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
+  const SecondOrderSolver::Forcing force = state_forcing(s);
+  CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
+  std::vector<double> bp_tau;
+  for (double b : breakpoints_)
+    if (b < T_) bp_tau.push_back(T_ - b);
+  std::sort(bp_tau.begin(), bp_tau.end());
+  // Costate source from the recorded outputs: C x(t) is the Hermite interpolant of (C x_k, C v_k),
+  // the same numbers as C times the state's interpolant.
+  VectorXd yb(ns), ydb(ns), zb(ns);
+  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
+    const double t = T_ - tau;
+    out.eval(t, yb.data(), ydb.data());
+    if (residual) {
+      data_.eval(t, zb.data());
+      yb -= zb;
+    }
+    Eigen::Map<VectorXd>(F, n).noalias() = -CtR * yb;
+  };
+  double J = 0.0;
+  VectorXd x(n), xv(n), a(n), p(n), pd(n), z(ns), r(ns);
+  std::vector<double> grid;
+  double quadrature = 0.0;
+  // Each costate window [τa, τb] is t in [T − τb, T − τa]: the state there from its checkpoints.
+  WindowedSink windows(n, spacing, [&](const Trajectory& P) {
+    const auto tq = Clock::now();
+    const double ta = std::max(t0, T_ - P.t_end()), tb = std::min(T_, T_ - P.t_begin());
+    if (!(tb > ta)) return;
+    state.cover(ta, tb);
+    grid.clear();
+    for (double tau : P.times()) grid.push_back(T_ - tau);
+    state.times_in(ta, tb, grid);
+    for (double t : data_.t)
+      if (t >= ta && t <= tb) grid.push_back(t);
+    grid.push_back(ta);
+    grid.push_back(tb);
+    std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+    grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
+    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+      const double h = grid[k + 1] - grid[k];
+      for (int gq = 0; gq < 3; ++gq) {
+        const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
+        state.eval(t, x.data(), xv.data());
+        P.eval(T_ - t, p.data(), pd.data());
+        pd = -pd;  // ṗ(t) = −P'(T − t)
+        if (residual) {
+          data_.eval(t, z.data());
+          r.noalias() = C_ * x;
+          r -= z;
+          double e = 0.0;
+          for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+          J += 0.5 * wt * e;
+        }
+        add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
+      }
+    }
+    quadrature += since(tq);
+  });
+  const auto tc = Clock::now();
+  SolverSummary sum;
+  solver.stream(0.0, T_ - t0, g, bp_tau, [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum);
+  windows.finish();
+  counters_.solver.Accumulate(sum);
+  counters_.solver.Accumulate(state.summary());
+  ++counters_.costate_solves;
+  ++counters_.checkpointed_passes;
+  counters_.checkpoint_resolves += state.resolves();
+  counters_.costate_seconds += since(tc) - quadrature;
+  counters_.quadrature_seconds += quadrature;
+  return J;
+}
+
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  if (const std::size_t L = checkpoint_spacing(solver); L > 0) {
+    // Checkpointed (docs/theory.md §7.9): the forward run keeps its outputs and every L-th point.
+    const int n = model_.ndof, ns = data_.sensors();
+    const auto tf = Clock::now();
+    CheckpointRecorder ck(n, L);
+    Trajectory out(ns);
+    VectorXd y(ns), yv(ns), ya(ns);
+    SolverSummary sum;
+    solver.stream(data_.t.front(), T_, state_forcing(s), breakpoints_,
+                  [&](const SecondOrderSolver::Point& pt) {
+                    ck(pt);
+                    const Eigen::Map<const VectorXd> X(pt.x, n), V(pt.v, n), A(pt.a, n);
+                    y.noalias() = C_ * X;
+                    yv.noalias() = C_ * V;
+                    ya.noalias() = C_ * A;
+                    out.push(pt.t, y.data(), yv.data(), ya.data());
+                  },
+                  &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    counters_.forward_seconds += since(tf);
+    VectorXd gc = VectorXd::Zero(model_.ncoef);
+    const double J = backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
+    gradient = s.dcdq.transpose() * gc;
+    ++counters_.gradient_evaluations;
+    return J;
+  }
   const Trajectory u = forward(solver, s, T_);
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
@@ -617,14 +733,19 @@ VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {
 MatrixXd Objective::predict(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s, data_.t.back());
-  const int n = model_.ndof;
+  // Streamed: only the outputs at the sample times are kept (the fit test predicts on a finer mesh
+  // and step, whose whole state would be the largest array of the run).
+  const auto t0 = Clock::now();
   MatrixXd Y(static_cast<Eigen::Index>(data_.t.size()), data_.sensors());
-  VectorXd x(n), v(n);
-  for (std::size_t k = 0; k < data_.t.size(); ++k) {
-    u.eval(data_.t[k], x.data(), v.data());
-    Y.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
-  }
+  SolverSummary sum;
+  sample_streamed(solver, data_.t.front(), data_.t.back(), state_forcing(s), breakpoints_, data_.t,
+                  [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
+                    Y.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
+                  },
+                  &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.forward_seconds += since(t0);
   return Y;
 }
 
@@ -665,6 +786,45 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
+  if (const std::size_t L = checkpoint_spacing(solver); L > 0) {
+    // Checkpointed (docs/theory.md §7.9): the tangent's outputs and every L-th state point are kept.
+    const Derivative dv = derivative_along(s.dcdq * v);
+    std::vector<double> f(inputs_.size());
+    SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* xv, const double* a, double* Gp) {
+      const Eigen::Map<const VectorXd> X(x, n), V(xv, n), A(a, n);
+      Eigen::Map<VectorXd> Gi(Gp, n);
+      Gi.noalias() -= dv.dM * A;
+      Gi.noalias() -= dv.dD * V;
+      Gi.noalias() -= dv.dK * X;
+      for (std::size_t k = 0; k < inputs_.size(); ++k) {
+        const double fk = inputs_[k](t);
+        if (fk != 0.0) Gi += fk * dv.db[k];
+      }
+    };
+    const auto ts = Clock::now();
+    CheckpointRecorder ck(n, L);
+    Trajectory out(ns);
+    VectorXd y(ns), yv(ns), ya(ns);
+    SolverSummary sum;
+    solver.stream_tangent(t0, T_, state_forcing(s), 1, G, T_, breakpoints_,
+                          [&](const SecondOrderSolver::Point& pt) {
+                            ck(pt);
+                            if (pt.columns < 2) throw std::logic_error("gauss_newton_product: the tangent stopped early");
+                            const Eigen::Map<const VectorXd> X(pt.x + n, n), V(pt.v + n, n), A(pt.a + n, n);
+                            y.noalias() = C_ * X;
+                            yv.noalias() = C_ * V;
+                            ya.noalias() = C_ * A;
+                            out.push(pt.t, y.data(), yv.data(), ya.data());
+                          },
+                          &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    ++counters_.sensitivity_solves;
+    counters_.sensitivity_seconds += since(ts);
+    VectorXd gc = VectorXd::Zero(model_.ncoef);
+    backward_checkpointed(s, solver, out, false, std::move(ck.checkpoints()), L, gc);
+    return s.dcdq.transpose() * gc;
+  }
   // Tangent along v: M Ṡ̈ + D Ṡ + K S = −(∂_v M ü + ∂_v D u̇ + ∂_v K u − ∂_v B f), ∂_v = Σ v_i ∂_i.
   Trajectory u;
   const std::vector<Trajectory> S = solve_tangents(solver, s, T_, T_, u, {derivative_along(s.dcdq * v)});

@@ -1,4 +1,5 @@
 #include "scoleid/identify/run/problem.h"
+#include "scoleid/identify/time/checkpoints.h"
 
 #include <algorithm>
 #include <cmath>
@@ -262,16 +263,15 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
   for (const auto& s : signals)
     for (double b : s.breakpoints()) bps.push_back(b);
   const auto times = sample_times(sc);
-  const Trajectory u = solver.solve(0.0, times.back(), f, bps);
   Measurements m;
   m.t = times;
-  // y = C_0 u + C_1 u̇ + C_2 ü, ü from the equation of motion at the sample time.
+  // y = C_0 u + C_1 u̇ + C_2 ü, ü from the equation of motion at the sample time; streamed, so only
+  // the samples are kept (the finer mesh at the finer step would otherwise be the run's largest array).
   const MatrixXd C = model.output_matrix(0), C1 = model.output_matrix(1), C2 = model.output_matrix(2);
   const bool rates = model.has_rate_outputs();
   m.z.resize(static_cast<Eigen::Index>(times.size()), C.rows());
-  VectorXd x(n), v(n), a(n), F(n);
-  for (std::size_t k = 0; k < times.size(); ++k) {
-    u.eval(times[k], x.data(), v.data());
+  VectorXd a(n), F(n);
+  sample_streamed(solver, 0.0, times.back(), f, bps, times, [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
     VectorXd y = C * x;
     if (rates) {
       F.setZero();
@@ -280,7 +280,7 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
       y += C1 * v + C2 * a;
     }
     m.z.row(static_cast<Eigen::Index>(k)) = y.transpose();
-  }
+  });
   for (const auto& s : sc.sensors) m.names.push_back(s.name);
   // Sensor errors of the truth's sensors (truth.overrides.sensors), as the Simbody truth adds them.
   for (std::size_t j = 0; j < sc.sensors.size(); ++j)

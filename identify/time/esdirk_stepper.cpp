@@ -57,6 +57,36 @@ EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const
 EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const std::vector<double>& stops_in,
                                          const Forcing& forcing, int P, const TangentForcing* tangent,
                                          double tangent_end) const {
+  const int n = static_cast<int>(M_.rows());
+  Result res;
+  res.state = Trajectory(n);
+  res.tangents.assign(static_cast<std::size_t>(std::max(P, 0)), Trajectory(n));
+  // Recorded points: one per step and two per breakpoint, plus the start.
+  if (h > 0.0 && t1 > t0) {
+    auto points = [&](double t_end) {
+      return static_cast<std::size_t>(std::ceil((std::min(t_end, t1) - t0) / h)) + 3 * stops_in.size() + 4;
+    };
+    res.state.reserve(points(t1));
+    for (auto& tr : res.tangents) tr.reserve(points(tangent_end + h));
+  }
+  const Sink record = [&](const Point& pt) {
+    res.state.push(pt.t, pt.x, pt.v, pt.a);
+    const std::size_t stride = static_cast<std::size_t>(n);
+    for (int i = 1; i < pt.columns; ++i)
+      res.tangents[static_cast<std::size_t>(i - 1)].push(pt.t, pt.x + i * stride, pt.v + i * stride, pt.a + i * stride);
+  };
+  res.counters = stream(t0, t1, h, stops_in, forcing, record, P, tangent, tangent_end);
+  return res;
+}
+
+StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std::vector<double>& stops_in,
+                                      const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
+                                      double tangent_end, const Start* start, double until) const {
+  if (start) {
+    if (P != 0) throw std::invalid_argument("EsdirkStepper: a resumed run steps the state only");
+    if (h != start->h) throw std::invalid_argument("EsdirkStepper: a resumed run must keep its step");
+    t0 = start->t;
+  }
   if (!(h > 0.0)) throw std::invalid_argument("EsdirkStepper: step must be > 0");
   if (!(t1 > t0)) throw std::invalid_argument("EsdirkStepper: t1 must exceed t0");
   if (P < 0 || (P > 0 && !tangent)) throw std::invalid_argument("EsdirkStepper: tangents need their forcing");
@@ -74,16 +104,7 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
   MatrixXd G(n, std::max(P, 1));
   VectorXd F(n), X0(n);
 
-  Result res;
-  res.state = Trajectory(n);
-  res.tangents.assign(static_cast<std::size_t>(P), Trajectory(n));
-  // Recorded points: one per step and two per breakpoint, plus the start.
-  auto points = [&](double t_end) {
-    return static_cast<std::size_t>(std::ceil((std::min(t_end, t1) - t0) / h)) + 3 * stops.size() + 4;
-  };
-  res.state.reserve(points(t1));
-  for (auto& tr : res.tangents) tr.reserve(points(tangent_end + h));
-  StepperCounters& cnt = res.counters;
+  StepperCounters cnt;
 
   // Tangent forcing of every tangent column from column 0 at (t, x0, v0, a0), into r's columns 1..P
   // (less D ṽ + K w, the parts the caller sets up).
@@ -110,10 +131,18 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
       cnt.linear_solves += P;
     }
   };
-  auto record = [&](double t) {
-    res.state.push(t, x.col(0).data(), v.col(0).data(), a.col(0).data());
-    for (int i = 1; i < m; ++i)
-      res.tangents[static_cast<std::size_t>(i - 1)].push(t, x.col(i).data(), v.col(i).data(), a.col(i).data());
+  double origin = t0;
+  auto record = [&](double t, bool resumable) {
+    Point pt;
+    pt.t = t;
+    pt.columns = m;
+    pt.x = x.data();
+    pt.v = v.data();
+    pt.a = a.data();
+    pt.origin = origin;
+    pt.h = h;
+    pt.resumable = resumable;
+    sink(pt);
   };
   auto drop_tangents = [&]() {
     m = 1;
@@ -176,8 +205,16 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
     else accelerate(tn + hs);
   };
 
-  accelerate(t0);
-  record(t0);
+  if (start) {
+    x.col(0) = Eigen::Map<const VectorXd>(start->x, n);
+    v.col(0) = Eigen::Map<const VectorXd>(start->v, n);
+    a.col(0) = Eigen::Map<const VectorXd>(start->a, n);
+    origin = start->origin;
+  } else {
+    accelerate(t0);
+  }
+  record(t0, true);
+  if (t0 >= until) return cnt;
   bool tangents_on = m > 1;
   if (tangents_on && t0 >= tangent_end) {
     drop_tangents();
@@ -186,11 +223,11 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
   double t = t0;
   for (std::size_t seg = 0; seg < stops.size(); ++seg) {
     const double stop = stops[seg];
-    const double start = t;
     const double snap = 1e-12 * std::max(1.0, std::abs(stop));
-    long k = 0;
+    // Steps end at origin + k h: a resumed run continues the original run's count.
+    long k = std::max(0L, std::lround((t - origin) / h));
     while (t < stop) {
-      double tnext = start + static_cast<double>(k + 1) * h;
+      double tnext = origin + static_cast<double>(k + 1) * h;
       if (tnext > stop - snap) tnext = stop;  // land on the stop (no micro-step)
       step(t, tnext - t);
       t = tnext;
@@ -198,18 +235,22 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
       ++cnt.steps;
       const bool at_break = t == stop && seg + 1 < stops.size();
       if (at_break) accelerate(std::nextafter(t, -std::numeric_limits<double>::infinity()));  // left limit
-      record(t);
+      record(t, !at_break);
+      if (!at_break && t >= until) return cnt;
       if (tangents_on && t >= tangent_end) {
         drop_tangents();
         tangents_on = false;
       }
       if (at_break) {
         accelerate(t);  // right limit: restart from it
-        record(t);
+        origin = t;
+        record(t, true);
+        if (t >= until) return cnt;
       }
     }
+    origin = t;
   }
-  return res;
+  return cnt;
 }
 
 }  // namespace scoleid::identify

@@ -286,6 +286,59 @@ SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, d
   return {std::move(r.state), std::move(r.tangents)};
 }
 
+namespace {
+void fill_summary(SolverSummary* summary, const StepperCounters& c, long factorizations,
+                  std::chrono::steady_clock::time_point wall0) {
+  if (!summary) return;
+  *summary = {};
+  summary->ok = true;
+  summary->steps = c.steps;
+  summary->rhs_evaluations = c.stage_forcings;
+  summary->linear_solves = c.linear_solves;
+  summary->factorizations = factorizations;
+  summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+}
+}  // namespace
+
+void SecondOrderSolver::stream(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
+                               const Sink& sink, SolverSummary* summary, const Start* start, double until) const {
+  const Impl& s = *impl_;
+  if (!s.stepper) {
+    if (start) throw std::logic_error("SecondOrderSolver::stream: only the esdirk integrator resumes a run");
+    const Trajectory u = solve(t0, t1, forcing, breakpoints, summary);
+    Point pt;
+    pt.resumable = false;
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      pt.t = u.times()[k];
+      pt.x = u.x(k).data();
+      pt.v = u.v(k).data();
+      pt.a = u.a(k).data();
+      sink(pt);
+      if (pt.t >= until) break;
+    }
+    return;
+  }
+  io::check_interrupt();
+  const auto wall0 = std::chrono::steady_clock::now();
+  const long f0 = s.newton->factorizations();
+  const double h = start ? start->h : (s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0);
+  const StepperCounters c = s.stepper->stream(t0, t1, h, breakpoints, forcing, sink, 0, nullptr, 0.0, start, until);
+  fill_summary(summary, c, s.newton->factorizations() - f0, wall0);
+}
+
+void SecondOrderSolver::stream_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
+                                       double tangent_end, const std::vector<double>& breakpoints, const Sink& sink,
+                                       SolverSummary* summary) const {
+  const Impl& s = *impl_;
+  if (!s.stepper) throw std::logic_error("stream_tangent: only the esdirk integrator steps tangents with the state");
+  io::check_interrupt();
+  const auto wall0 = std::chrono::steady_clock::now();
+  const long f0 = s.newton->factorizations();
+  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
+  const StepperCounters c = s.stepper->stream(t0, t1, h, breakpoints, forcing, sink, P, &tangent, tangent_end);
+  fill_summary(summary, c, s.newton->factorizations() - f0, wall0);
+}
+
 void SecondOrderSolver::acceleration(const double* F, const double* x, const double* v, double* a) const {
   impl_->acceleration(F, x, v, a);
 }

@@ -12,11 +12,13 @@ void Trajectory::push(double t, const double* x, const double* v, const double* 
 }
 
 namespace {
-// Per-thread pool of large arrays (see the header). Bounded, so it holds at most a few dozen
-// trajectories' worth of memory.
+// Per-thread pool of large arrays (see the header). Bounded in entries and in bytes, so it never
+// holds more than a few trajectories' worth of memory (a finished large solve is freed, not kept).
 constexpr std::size_t kPoolEntries = 48;
-constexpr std::size_t kPoolMinimum = 1 << 14;  // doubles; smaller arrays are not worth keeping
+constexpr std::size_t kPoolMinimum = 1 << 14;            // doubles; smaller arrays are not worth keeping
+constexpr std::size_t kPoolDoubles = (64u << 20) / 8u;   // at most 64 MiB pooled per thread
 thread_local std::vector<std::vector<double>> pool;
+thread_local std::size_t pooled = 0;  // doubles held by the pool
 
 void take(std::vector<double>& v, std::size_t need) {
   if (v.capacity() >= need) return;
@@ -24,6 +26,7 @@ void take(std::vector<double>& v, std::size_t need) {
   for (std::size_t i = 0; i < pool.size(); ++i)
     if (pool[i].capacity() >= need && (best == pool.size() || pool[i].capacity() < pool[best].capacity())) best = i;
   if (best < pool.size() && v.empty()) {
+    pooled -= pool[best].capacity();
     v.swap(pool[best]);
     v.clear();
     pool[best].swap(pool.back());
@@ -34,14 +37,19 @@ void take(std::vector<double>& v, std::size_t need) {
 }
 
 void give(std::vector<double>& v) {
-  if (v.capacity() < kPoolMinimum) return;
-  if (pool.size() >= kPoolEntries) {
-    // Replace the smallest pooled array if this one is larger.
+  const std::size_t c = v.capacity();
+  if (c < kPoolMinimum || c > kPoolDoubles) return;
+  // Make room: drop the smallest pooled arrays while the pool is full and they are smaller.
+  while (!pool.empty() && (pool.size() >= kPoolEntries || pooled + c > kPoolDoubles)) {
     auto it = std::min_element(pool.begin(), pool.end(), [](const auto& a, const auto& b) { return a.capacity() < b.capacity(); });
-    if (it->capacity() >= v.capacity()) return;
-    it->swap(v);
-    return;
+    if (it->capacity() >= c) return;
+    pooled -= it->capacity();
+    std::vector<double>().swap(*it);
+    it->swap(pool.back());
+    pool.pop_back();
   }
+  if (pooled + c > kPoolDoubles) return;
+  pooled += c;
   pool.emplace_back();
   pool.back().swap(v);
 }

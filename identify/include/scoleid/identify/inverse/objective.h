@@ -41,6 +41,7 @@
 #include "scoleid/identify/inverse/measurements.h"
 #include "scoleid/identify/inverse/misfit.h"
 #include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/time/checkpoints.h"
 #include "scoleid/identify/time/second_order_solver.h"
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/io/signal.h"
@@ -51,10 +52,17 @@ namespace scoleid::identify {
 // step the P tangents in blocks that fit in it (the state re-solved with each block), so memory
 // does not grow with steps × DOFs × P.
 inline constexpr double kSensitivityBlockBytes = 128.0 * 1024 * 1024;
+// A recorded state longer than this is checkpointed in the gradient and the Gauss–Newton products
+// (time/checkpoints.h, docs/theory.md §7.9): esdirk and displacement sensors only.
+inline constexpr double kTrajectoryBytes = 32.0 * 1024 * 1024;
 
 struct ObjectiveOptions {
   SolverOptions solver;
   double sensitivity_block_bytes = kSensitivityBlockBytes;
+  double trajectory_bytes = kTrajectoryBytes;
+  // Checkpoint spacing L in recorded points: 0 = automatic (√(points/3) when the state exceeds
+  // trajectory_bytes, else the whole state is stored); > 0 = always checkpoint every L points.
+  long checkpoint_points = 0;
   std::vector<double> weights;  // R_kk; empty = 1/(T mean z_k²)
 };
 
@@ -67,6 +75,8 @@ struct ObjectiveCounters {
   double costate_seconds = 0.0;
   double sensitivity_seconds = 0.0;
   double quadrature_seconds = 0.0;
+  long checkpointed_passes = 0;   // gradients and products whose state was checkpointed
+  long checkpoint_resolves = 0;   // state segments re-solved from checkpoints
   SolverSummary solver;  // accumulated over all solves
 };
 
@@ -174,6 +184,13 @@ private:
   // least 1, at most P).
   int sensitivity_block(double t_end) const;
   void default_weights();
+  // The checkpoint spacing for a state over [t0, T] with this solver; 0 = store the whole state.
+  std::size_t checkpoint_spacing(const SecondOrderSolver& solver) const;
+  // The backward pass on a checkpointed state (docs/theory.md §7.9): the costate with source
+  // −Cᵀ R y(t) (y = out(t), minus the data when `residual`), streamed in windows, and the Eq. 25
+  // quadrature into gc with the state re-solved from `ckpts`. Returns the cost when `residual`.
+  double backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out, bool residual,
+                               std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc);
 
   // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
   // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.

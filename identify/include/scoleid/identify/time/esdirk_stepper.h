@@ -30,6 +30,7 @@
 // the breakpoint; at a breakpoint the left limit (forcing evaluated just before it) and the right
 // limit are both recorded and stepping restarts from the right limit.
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,31 @@ public:
   // those outside (t0, t1) ignored). P tangents (0 = state only) up to tangent_end.
   Result run(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing, int P = 0,
              const TangentForcing* tangent = nullptr, double tangent_end = 0.0) const;
+
+  // Streaming: every recorded point goes to `sink` instead of into trajectories, so a solve needs
+  // memory for one step whatever its length. The point carries what a restart needs: the step
+  // grid's origin (the last breakpoint passed, or t0) and h; steps end at origin + k h.
+  struct Point {
+    double t = 0.0;
+    int columns = 1;  // 1 + the tangents still stepped (they stop after tangent_end)
+    const double *x = nullptr, *v = nullptr, *a = nullptr;  // n × columns, column-major
+    double origin = 0.0, h = 0.0;
+    bool resumable = true;  // false for the left limit at a breakpoint (the run goes on from the right one)
+  };
+  using Sink = std::function<void(const Point&)>;
+  // A state (column 0 only) to resume from: a resumable Point's t, origin, h and column-0 x, v, a.
+  // Resuming reproduces the original run's later points bit for bit.
+  struct Start {
+    double t = 0.0, origin = 0.0, h = 0.0;
+    const double *x = nullptr, *v = nullptr, *a = nullptr;
+  };
+  // As run(), but the points go to `sink`; from rest at t0 or, with `start`, from start->t (then t0
+  // is ignored, h must equal start->h and P must be 0). The run ends early after the first
+  // resumable point at or beyond `until` (the grid is still that of [t0, t1]).
+  StepperCounters stream(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing,
+                         const Sink& sink, int P = 0, const TangentForcing* tangent = nullptr, double tangent_end = 0.0,
+                         const Start* start = nullptr,
+                         double until = std::numeric_limits<double>::infinity()) const;
 
 private:
   const SparseMatrix &M_, &D_, &K_;

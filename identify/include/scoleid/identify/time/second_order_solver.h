@@ -38,11 +38,13 @@
 // response to the largest forcing (see reference_scales), so no absolute tolerance has to be
 // guessed by the user.
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/identify/time/esdirk_stepper.h"
 #include "scoleid/identify/time/trajectory.h"
 
 namespace scoleid::identify {
@@ -102,6 +104,22 @@ public:
   TangentSolution solve_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
                                 double tangent_end, const std::vector<double>& breakpoints,
                                 SolverSummary* summary = nullptr) const;
+  // Streaming solves: every recorded point goes to `sink` and nothing is stored, so the memory is
+  // that of one step (esdirk_stepper.h, Point). With esdirk a run can resume from a recorded
+  // resumable point (`start`, state only) and end early at `until`, reproducing the original run's
+  // points bit for bit: the basis of checkpointing (objective.h). The other integrators stream a
+  // stored solution and cannot resume (can_resume() is false; `start` then throws logic_error).
+  using Point = EsdirkStepper::Point;
+  using Sink = EsdirkStepper::Sink;
+  using Start = EsdirkStepper::Start;
+  bool can_resume() const { return has_tangent_solve(); }
+  void stream(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints, const Sink& sink,
+              SolverSummary* summary = nullptr, const Start* start = nullptr,
+              double until = std::numeric_limits<double>::infinity()) const;
+  // State and P tangents streamed together (esdirk only, as solve_tangent).
+  void stream_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
+                      double tangent_end, const std::vector<double>& breakpoints, const Sink& sink,
+                      SolverSummary* summary = nullptr) const;
   // ẍ = M⁻¹ (F − D v − K x)
   void acceleration(const double* F, const double* x, const double* v, double* a) const;
 

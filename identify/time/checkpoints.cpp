@@ -1,0 +1,126 @@
+#include "scoleid/identify/time/checkpoints.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace scoleid::identify {
+
+using Eigen::VectorXd;
+
+void CheckpointRecorder::operator()(const SecondOrderSolver::Point& pt) {
+  if (!pt.resumable) return;
+  if (!ckpts_.empty() && ++since_ < spacing_) return;
+  since_ = 0;
+  Checkpoint c;
+  c.t = pt.t;
+  c.origin = pt.origin;
+  c.h = pt.h;
+  c.x = Eigen::Map<const VectorXd>(pt.x, n_);
+  c.v = Eigen::Map<const VectorXd>(pt.v, n_);
+  c.a = Eigen::Map<const VectorXd>(pt.a, n_);
+  ckpts_.push_back(std::move(c));
+}
+
+WindowedSink::WindowedSink(int n, std::size_t points, Visit visit)
+    : n_(n), points_(std::max<std::size_t>(points, 2)), visit_(std::move(visit)), window_(n) {}
+
+void WindowedSink::operator()(const SecondOrderSolver::Point& pt) {
+  if (window_.size() >= points_ && pt.t > window_.t_end()) {
+    visit_(window_);
+    Trajectory next(n_);
+    const std::size_t k = window_.size() - 1;
+    next.push(window_.t_end(), window_.x(k).data(), window_.v(k).data(), window_.a(k).data());
+    window_ = std::move(next);
+  }
+  window_.push(pt.t, pt.x, pt.v, pt.a);
+}
+
+void WindowedSink::finish() {
+  if (window_.size() > 0) visit_(window_);
+  window_ = Trajectory(n_);
+}
+
+void sample_streamed(const SecondOrderSolver& solver, double t0, double t1, const SecondOrderSolver::Forcing& forcing,
+                     const std::vector<double>& breakpoints, const std::vector<double>& times, const SampleVisit& at,
+                     SolverSummary* summary, std::size_t points) {
+  const int n = solver.dim();
+  VectorXd x(n), v(n);
+  std::size_t next = 0;
+  bool last = false;
+  WindowedSink sink(n, points, [&](const Trajectory& w) {
+    while (next < times.size() && (last || times[next] <= w.t_end())) {
+      w.eval(times[next], x.data(), v.data());
+      at(next, x, v);
+      ++next;
+    }
+  });
+  solver.stream(t0, t1, forcing, breakpoints, [&](const SecondOrderSolver::Point& pt) { sink(pt); }, summary);
+  last = true;  // the final window also takes the times beyond the run (clamped)
+  sink.finish();
+}
+
+CheckpointedState::CheckpointedState(const SecondOrderSolver& solver, const SecondOrderSolver::Forcing& forcing,
+                                     std::vector<double> breakpoints, double t_end, std::vector<Checkpoint> checkpoints)
+    : solver_(solver), forcing_(forcing), breakpoints_(std::move(breakpoints)), t_end_(t_end), ckpts_(std::move(checkpoints)) {
+  if (ckpts_.empty()) throw std::invalid_argument("CheckpointedState: no checkpoints");
+}
+
+const CheckpointedState::Segment& CheckpointedState::segment(std::size_t c) {
+  for (int i = 0; i < 2; ++i)
+    if (seg_[i].index == c) {
+      next_ = 1 - i;  // least recently used next
+      return seg_[i];
+    }
+  Segment& s = seg_[next_];
+  next_ = 1 - next_;
+  s.index = c;
+  const Checkpoint& k = ckpts_[c];
+  const double until = c + 1 < ckpts_.size() ? ckpts_[c + 1].t : t_end_;
+  s.u = Trajectory(k.x.size());
+  SecondOrderSolver::Start start{k.t, k.origin, k.h, k.x.data(), k.v.data(), k.a.data()};
+  Trajectory& u = s.u;
+  SolverSummary sum;
+  if (k.t < t_end_) {
+    solver_.stream(k.t, t_end_, forcing_, breakpoints_,
+                   [&u](const SecondOrderSolver::Point& pt) { u.push(pt.t, pt.x, pt.v, pt.a); }, &sum, &start, until);
+  } else {
+    u.push(k.t, k.x.data(), k.v.data(), k.a.data());
+  }
+  summary_.Accumulate(sum);
+  ++resolves_;
+  return s;
+}
+
+void CheckpointedState::cover(double ta, double tb) {
+  // Checkpoint c holds [t_c, t_{c+1}]; the ones meeting [ta, tb].
+  auto first = std::upper_bound(ckpts_.begin(), ckpts_.end(), ta, [](double t, const Checkpoint& k) { return t < k.t; });
+  std::size_t c0 = first == ckpts_.begin() ? 0 : static_cast<std::size_t>(first - ckpts_.begin()) - 1;
+  std::size_t c1 = c0;
+  while (c1 + 1 < ckpts_.size() && ckpts_[c1 + 1].t < tb) ++c1;
+  if (c1 > c0 + 1)
+    throw std::logic_error("CheckpointedState: a window spans more than two checkpoint segments");
+  covered_.clear();
+  // The later segment first, so that moving backward keeps it and re-solves only the earlier one.
+  const Segment& hi = segment(c1);
+  if (c1 != c0) {
+    const Segment& lo = segment(c0);
+    covered_.push_back(&lo.u);
+  }
+  covered_.push_back(&hi.u);
+}
+
+void CheckpointedState::eval(double t, double* x, double* v, double* a) const {
+  for (const Trajectory* u : covered_)
+    if (t <= u->t_end() || u == covered_.back()) {
+      u->eval(t, x, v, a);
+      return;
+    }
+}
+
+void CheckpointedState::times_in(double ta, double tb, std::vector<double>& out) const {
+  for (const Trajectory* u : covered_)
+    for (double t : u->times())
+      if (t >= ta && t <= tb) out.push_back(t);
+}
+
+}  // namespace scoleid::identify
