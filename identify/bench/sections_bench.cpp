@@ -1,5 +1,6 @@
-// scole-sections-bench: how the identifier scales with the number of EI sections, and how robust
-// Gauss–Newton is from nearby starts. Two parts, both printed as tables (and written to --json PATH):
+// scole-sections-bench: how the identifier scales with the number of EI sections, how robust
+// Gauss–Newton is from nearby starts, and what checkpointing costs. Three parts, printed as tables
+// (and written to --json PATH):
 //   1. EI(x) on N sections (N = 2, 8, 32, 64 by default), Gauss–Newton and L-BFGS: a simply
 //      supported beam, 64 identifier elements, synthetic data on 128 elements, two loads, 16
 //      displacement sensors, 10 s at 0.01 s, the identifier's automatic time step (from what the
@@ -13,6 +14,8 @@
 //      every parameter not flagged (false convergence). The antisymmetric combination of the
 //      sections is invisible to the one midspan sensor under the midspan load: the Fisher test
 //      flags it, and an error there is not a false claim.
+//   3. Checkpointing (docs/theory.md §7.9): part 1's problem, a fixed workload of gradients and
+//      Gauss–Newton products at several checkpoint spacings, peak RSS against wall time.
 // Wall times are single runs (steady_clock), not minima over repetitions.
 #include <sys/resource.h>
 #include <sys/types.h>
@@ -30,6 +33,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -56,6 +60,17 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // data) and the smoothness prior (identification.smoothness: < 0 = the discrepancy principle).
 double g_noise = 0.0;
 double g_smoothness = 0.0;
+// Checkpoint spacing of the objective (ObjectiveOptions::checkpoint_points): −1 = the default
+// (checkpoint beyond the trajectory budget), 0 = always store the whole state, L > 0 = every L points.
+long g_checkpoint = -1;
+// Seed of part 1's noise (the scenario's simulation.seed); < 0 = the scenario's own.
+long g_seed = -1;
+
+void apply_checkpoint(ObjectiveOptions& o, long L) {
+  if (L < 0) return;
+  o.checkpoint_points = L;
+  if (L == 0) o.trajectory_bytes = std::numeric_limits<double>::infinity();
+}
 
 // The true stiffness profile of part 1, EI(x) = 23000 (1 + 0.3 sin(πx/L) + 0.1 cos(3πx/L)).
 double ei_profile(double x) { return kEI0 * (1.0 + 0.3 * std::sin(M_PI * x / kLength) + 0.1 * std::cos(3.0 * M_PI * x / kLength)); }
@@ -93,6 +108,7 @@ scoleid::io::Scenario part1_scenario(int N) {
   sc.identification.data_elements = 128;
   sc.identification.time_step = 0.0;  // automatic: what is being measured
   for (auto& sensor : sc.sensors) sensor.noise_std = g_noise;
+  if (g_seed >= 0) sc.simulation.seed = static_cast<unsigned>(g_seed);
   sc.identification.smoothness = g_smoothness;
   return sc;
 }
@@ -118,6 +134,7 @@ int run_case(int N, const std::string& method, bool compute_std) {
   try {
     const auto t0 = Clock::now();
     auto p = make_problem(part1_scenario(N), std::nullopt);
+    apply_checkpoint(p->objective_options, g_checkpoint);
     out["setup_seconds"] = seconds_since(t0);
     RunOptions ro;
     ro.method = method;
@@ -160,6 +177,7 @@ int run_case(int N, const std::string& method, bool compute_std) {
     out["forward_solves"] = r.counters.forward_solves;
     out["costate_solves"] = r.counters.costate_solves;
     out["sensitivity_solves"] = r.counters.sensitivity_solves;
+    out["checkpointed_passes"] = r.counters.checkpointed_passes;
     out["optimizer_seconds"] = r.summary.wall_seconds;
     out["identifiability_seconds"] = r.identifiability_seconds;
     out["rms_error"] = rms;
@@ -179,16 +197,16 @@ int run_case(int N, const std::string& method, bool compute_std) {
   return out.contains("error") ? 1 : 0;
 }
 
-// Runs `--case N --method M` in a child process; peak RSS from wait4, killed after timeout_s.
-json run_child(int N, const std::string& method, bool compute_std, double timeout_s) {
-  json row{{"N", N}, {"method", method}};
+// Runs this program with `args` in a child process: its last JSON line as the row, peak RSS from
+// wait4, killed after timeout_s.
+json run_child_args(const std::vector<std::string>& args, double timeout_s) {
+  json row = json::object();
   int fd[2];
   if (pipe(fd) != 0) {
     row["status"] = "error";
     row["error"] = std::string("pipe: ") + std::strerror(errno);
     return row;
   }
-  const std::string n_arg = std::to_string(N);
   const auto t0 = Clock::now();
   const pid_t pid = fork();
   if (pid < 0) {
@@ -202,10 +220,8 @@ json run_child(int N, const std::string& method, bool compute_std, double timeou
     dup2(fd[1], STDOUT_FILENO);
     close(fd[0]);
     close(fd[1]);
-    std::vector<const char*> argv = {"scole-sections-bench", "--case", n_arg.c_str(), "--method", method.c_str()};
-    if (!compute_std) argv.push_back("--no-std");
-    const std::string noise = std::to_string(g_noise), smooth = std::to_string(g_smoothness);
-    argv.insert(argv.end(), {"--noise", noise.c_str(), "--smoothness-weight", smooth.c_str()});
+    std::vector<const char*> argv = {"scole-sections-bench"};
+    for (const auto& a : args) argv.push_back(a.c_str());
     argv.push_back(nullptr);
     execv("/proc/self/exe", const_cast<char* const*>(argv.data()));
     _exit(127);
@@ -264,6 +280,18 @@ json run_child(int N, const std::string& method, bool compute_std, double timeou
   return row;
 }
 
+// `--case N --method M` in a child process.
+json run_child(int N, const std::string& method, bool compute_std, double timeout_s) {
+  std::vector<std::string> args{"--case", std::to_string(N), "--method", method, "--noise", std::to_string(g_noise),
+                                "--smoothness-weight", std::to_string(g_smoothness),
+                                "--checkpoint", std::to_string(g_checkpoint), "--seed", std::to_string(g_seed)};
+  if (!compute_std) args.push_back("--no-std");
+  json row = run_child_args(args, timeout_s);
+  row["N"] = N;
+  row["method"] = method;
+  return row;
+}
+
 double num(const json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
@@ -274,7 +302,7 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
               "        start EI = 30000, one child process per case (timeout %.0f s, std %s)\n\n",
               timeout_s, compute_std ? "on" : "off");
   if (g_noise > 0 || g_smoothness != 0)
-    std::printf("        sensor noise std %.3g m (stated), smoothness prior %s\n\n", g_noise,
+    std::printf("        sensor noise std %.3g m (stated, seed %ld), smoothness prior %s\n\n", g_noise, g_seed,
                 g_smoothness < 0 ? "by the discrepancy principle" : std::to_string(g_smoothness).c_str());
   std::printf("%4s %-13s %5s %-18s %9s %10s %8s %8s %8s %10s %10s %6s %9s\n", "N", "method", "iter", "termination",
               "wall[s]", "step h", "forward", "costate", "sensit.", "RMS err", "max err", "ident", "RSS[MB]");
@@ -339,6 +367,93 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
   }
   std::printf("\n");
   return {{"cases", rows}, {"scaling", scaling}, {"timeout_seconds", timeout_s}, {"compute_std", compute_std}};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Part 3: the memory/recompute curve of checkpointing (docs/theory.md §7.9)
+
+constexpr int kCurveEvaluations = 3;  // gradients and Gauss–Newton products each, per case
+
+// The hidden --curve-case mode: part 1's problem on N sections, then kCurveEvaluations gradients
+// and products at the start with checkpoint spacing L (−2 = set-up only, the floor of the RSS).
+int run_curve_case(int N, long L) {
+  json out{{"N", N}, {"L", L}};
+  try {
+    auto p = make_problem(part1_scenario(N), std::nullopt);
+    apply_checkpoint(p->objective_options, L);
+    Objective o(p->model(), *p->params, p->signals, p->data, p->objective_options);
+    const VectorXd q = p->params->initial();
+    const double h = p->objective_options.solver.step;
+    out["points"] = std::ceil((p->data.t.back() - p->data.t.front()) / h) + 1.0;
+    out["dof"] = p->model().ndof;
+    if (L != -2) {
+      const auto t0 = Clock::now();
+      VectorXd g, sum = VectorXd::Zero(q.size());
+      for (int k = 0; k < kCurveEvaluations; ++k) {
+        o.cost_and_gradient(q, g);
+        VectorXd v = VectorXd::Zero(q.size());
+        v[k % q.size()] = q[k % q.size()];
+        sum += o.gauss_newton_product(q, v);
+      }
+      out["wall_seconds"] = seconds_since(t0);
+      out["gradient_norm"] = g.norm();
+      out["product_sum_norm"] = sum.norm();
+      const auto& c = o.counters();
+      out["forward_solves"] = c.forward_solves;
+      out["costate_solves"] = c.costate_solves;
+      out["checkpointed_passes"] = c.checkpointed_passes;
+      out["checkpoint_resolves"] = c.checkpoint_resolves;
+    }
+  } catch (const std::exception& e) {
+    out["error"] = e.what();
+  }
+  std::fflush(stdout);
+  std::printf("%s\n", out.dump().c_str());
+  std::fflush(stdout);
+  return out.contains("error") ? 1 : 0;
+}
+
+json part3(int N, double timeout_s) {
+  std::printf("Part 3. Checkpointing: memory against recomputation. Part 1's problem with N = %d, %d gradients and %d\n"
+              "        Gauss-Newton products at the start, one child process per spacing L (points between\n"
+              "        checkpoints); 'stored' keeps the whole state, 'default' is the trajectory-budget rule,\n"
+              "        'set-up' only builds the problem (the RSS floor: data synthesis, model).\n\n",
+              N, kCurveEvaluations, kCurveEvaluations);
+  std::printf("%-9s %9s %9s %10s %9s %9s %12s %12s\n", "L", "wall[s]", "vs stored", "re-solves", "RSS[MB]",
+              "above", "model[MB]", "|g| rel.dev");
+  json rows = json::array();
+  double stored_wall = NAN, stored_g = NAN, floor = NAN;
+  for (long L : {-2L, 0L, -1L, 3000L, 1000L, 300L, 100L, 30L, 10L}) {
+    json r = run_child_args({"--curve-case", std::to_string(N), "--checkpoint", std::to_string(L)}, timeout_s);
+    r["L"] = L;
+    const std::string label = L == -2 ? "set-up" : L == 0 ? "stored" : L == -1 ? "default" : std::to_string(L);
+    const double rss = num(r, "peak_rss_mb");
+    if (L == -2) floor = rss;
+    if (r["status"] != "ok") {
+      std::printf("%-9s %s %s\n", label.c_str(), r["status"].get<std::string>().c_str(), r.value("error", std::string()).c_str());
+      rows.push_back(r);
+      continue;
+    }
+    if (L == 0) {
+      stored_wall = num(r, "wall_seconds");
+      stored_g = num(r, "gradient_norm");
+    }
+    // The trajectories' model: stored = state + costate (+ tangent in a product) whole; checkpointed
+    // = points/L checkpoints + 2 state segments + 1 costate window, plus the outputs (16 sensors).
+    const double pts = num(r, "points"), n = num(r, "dof"), row = n * 3.0 * 8.0 / 1048576.0;
+    double model = NAN;
+    if (L == 0) model = 3.0 * pts * row;
+    else if (L > 0) model = (pts / static_cast<double>(L) + 3.0 * static_cast<double>(L)) * row + pts * 16 * 3 * 8 / 1048576.0;
+    const double w = num(r, "wall_seconds");
+    std::printf("%-9s %9.2f %9.3f %10.0f %9.1f %9.1f %12.2f %12.1e\n", label.c_str(), w, w / stored_wall,
+                num(r, "checkpoint_resolves"), rss, rss - floor, model,
+                L == -2 ? NAN : std::abs(num(r, "gradient_norm") / stored_g - 1.0));
+    r["model_mb"] = model;
+    rows.push_back(r);
+    std::fflush(stdout);
+  }
+  std::printf("\n");
+  return {{"N", N}, {"evaluations", kCurveEvaluations}, {"cases", rows}};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -481,21 +596,27 @@ std::vector<std::string> split(const std::string& s) {
 }
 
 const char* kUsage =
-    "usage: scole-sections-bench [--part 1|2] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
+    "usage: scole-sections-bench [--part 1|2|3] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
     "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
+    "                            [--checkpoint L]\n"
     "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step), each (N, method) in a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
     "  Part 2: EI_1..EI_4 + rho_A from the analytic modal series, Gauss-Newton from 10 starts.\n"
-    "  Both parts run unless --part selects one. --no-std skips identifiability in part 1.\n"
+    "  Part 3: checkpointing's memory/recompute curve: part 1's problem on the last --sections N (64),\n"
+    "          3 gradients + 3 Gauss-Newton products per checkpoint spacing L, wall and peak RSS.\n"
+    "  All parts run unless --part selects one. --no-std skips identifiability in part 1.\n"
+    "  --checkpoint L sets part 1's checkpoint spacing: 0 = store the whole state, L > 0 = every L\n"
+    "  points, -1 (default) = checkpoint when the state exceeds the trajectory budget (32 MiB).\n"
     "  --json PATH writes the results as JSON (temp file, then renamed).\n"
     "  --noise SD gives every sensor of part 1 a stated noise std SD [m] (noisy synthetic data);\n"
-    "  --smoothness discrepancy|BETA sets part 1's smoothness prior (docs/theory.md §7.8).\n";
+    "  --smoothness discrepancy|BETA sets part 1's smoothness prior (docs/theory.md §7.8).\n"
+    "  --seed K seeds part 1's noise (default: the scenario's simulation.seed).\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int part = 0, case_n = -1;
+  int part = 0, case_n = -1, curve_n = -1;
   std::vector<int> sections = {2, 8, 32, 64};
   std::vector<std::string> methods = {"gauss-newton", "lbfgs"};
   std::string method = "gauss-newton", json_path;
@@ -513,7 +634,7 @@ int main(int argc, char** argv) {
         return 0;
       } else if (a == "--part") {
         part = std::stoi(value());
-        if (part != 1 && part != 2) throw std::invalid_argument("--part must be 1 or 2");
+        if (part < 1 || part > 3) throw std::invalid_argument("--part must be 1, 2 or 3");
       } else if (a == "--sections") {
         sections.clear();
         for (const auto& s : split(value())) {
@@ -543,6 +664,13 @@ int main(int argc, char** argv) {
         json_path = value();
       } else if (a == "--case") {  // hidden: one part-1 case, JSON line on stdout
         case_n = std::stoi(value());
+      } else if (a == "--checkpoint") {
+        g_checkpoint = std::stol(value());
+        if (g_checkpoint < -2) throw std::invalid_argument("--checkpoint must be >= 0 (or -1: the default)");
+      } else if (a == "--seed") {
+        g_seed = std::stol(value());
+      } else if (a == "--curve-case") {  // hidden: one part-3 case, JSON line on stdout
+        curve_n = std::stoi(value());
       } else if (a == "--method") {  // hidden, with --case
         method = value();
       } else {
@@ -554,12 +682,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (case_n > 0) return run_case(case_n, method, compute_std);
+  if (curve_n > 0) return run_curve_case(curve_n, g_checkpoint);
 
   std::printf("scole-sections-bench (wall clock, single runs)\n\n");
   json out = json::object();
   try {
     if (part == 0 || part == 1) out["part1"] = part1(sections, methods, compute_std, timeout_s);
     if (part == 0 || part == 2) out["part2"] = part2();
+    if (part == 0 || part == 3) out["part3"] = part3(sections.empty() ? 64 : sections.back(), timeout_s);
     if (!json_path.empty()) write_json(json_path, out);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "scole-sections-bench: %s\n", e.what());

@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/objective.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -602,6 +603,24 @@ std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSol
   return solve_tangents(solver, s, state_end, tangent_end, u, d);
 }
 
+SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<Derivative>& d) const {
+  const int n = model_.ndof;
+  auto f = std::make_shared<std::vector<double>>(inputs_.size());
+  return [this, &d, n, f](double t, const double* x, const double* v, const double* a, double* Gp) {
+    const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
+    for (std::size_t k = 0; k < inputs_.size(); ++k) (*f)[k] = inputs_[k](t);
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      Eigen::Map<VectorXd> Gi(Gp + i * static_cast<std::size_t>(n), n);
+      const Derivative& di = d[i];
+      Gi.noalias() -= di.dM * A;
+      Gi.noalias() -= di.dD * V;
+      Gi.noalias() -= di.dK * X;
+      for (std::size_t k = 0; k < f->size(); ++k)
+        if ((*f)[k] != 0.0) Gi += (*f)[k] * di.db[k];
+    }
+  };
+}
+
 std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,
                                                   double tangent_end, Trajectory& u, const std::vector<Derivative>& d) {
   const int n = model_.ndof;
@@ -609,20 +628,7 @@ std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solve
   const auto ts = Clock::now();
   std::vector<Trajectory> S;
   if (solver.has_tangent_solve()) {
-    std::vector<double> f(inputs_.size());
-    SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* v, const double* a, double* Gp) {
-      const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
-      for (std::size_t k = 0; k < inputs_.size(); ++k) f[k] = inputs_[k](t);
-      for (int i = 0; i < count; ++i) {
-        Eigen::Map<VectorXd> Gi(Gp + static_cast<std::size_t>(i) * n, n);
-        const Derivative& di = d[static_cast<std::size_t>(i)];
-        Gi.noalias() -= di.dM * A;
-        Gi.noalias() -= di.dD * V;
-        Gi.noalias() -= di.dK * X;
-        for (std::size_t k = 0; k < f.size(); ++k)
-          if (f[k] != 0.0) Gi += f[k] * di.db[k];
-      }
-    };
+    const SecondOrderSolver::TangentForcing G = tangent_forcing(d);
     SolverSummary sum;
     auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), count, G, tangent_end, breakpoints_, &sum);
     counters_.solver.Accumulate(sum);
@@ -754,10 +760,63 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
   const double t_end = data_.t.back();
-  // In blocks of tangents (as gauss_newton): memory O(block · steps · DOF + samples · sensors · P).
-  const int B = sensitivity_block(t_end);
   MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
   VectorXd x(n), v(n), a(n), ux(n), uv(n);
+  if (solver.has_tangent_solve()) {
+    // Streamed (docs/theory.md §7.9): all P tangents stepped with the state in one pass, the
+    // outputs at the sample times interpolated between consecutive points as Trajectory::eval
+    // does; memory O(P · DOF + samples · sensors · P), nothing O(steps).
+    const auto ts = Clock::now();
+    std::vector<Derivative> d;
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
+    const int m = 1 + P;
+    MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m);
+    double t_prev = 0.0;
+    bool have_prev = false;
+    std::size_t next = 0;
+    auto visit = [&](const SecondOrderSolver::Point& pt) {
+      if (pt.columns < m) throw std::logic_error("output_sensitivities: the tangents stopped early");
+      const Eigen::Map<const MatrixXd> X1(pt.x, n, m), V1(pt.v, n, m), A1(pt.a, n, m);
+      while (next < data_.t.size() && data_.t[next] <= pt.t) {
+        const double t = data_.t[next];
+        const double h = have_prev ? pt.t - t_prev : 0.0;
+        if (h > 0) {
+          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
+          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+          Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
+          Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
+        } else {
+          Xs = X1;
+          Vs = V1;
+        }
+        ux = Xs.col(0);
+        uv = Vs.col(0);
+        if (accelerations_) output_at(s, solver, t, ux, uv, &a);
+        for (int i = 0; i < P; ++i) {
+          x = Xs.col(1 + i);
+          v = Vs.col(1 + i);
+          G.block(static_cast<Eigen::Index>(next) * ns, i, ns, 1) =
+              tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, ux, uv, a, x, v);
+        }
+        ++next;
+      }
+      X0 = X1;
+      V0 = V1;
+      A0 = A1;
+      t_prev = pt.t;
+      have_prev = true;
+    };
+    SolverSummary sum;
+    solver.stream_tangent(data_.t.front(), t_end, state_forcing(s), P, Gf, t_end, breakpoints_, visit, &sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    counters_.sensitivity_solves += P;
+    counters_.sensitivity_seconds += since(ts);
+    return G;
+  }
+  // Without a tangent stepper: in blocks (as gauss_newton), memory O(block · steps · DOF + samples · sensors · P).
+  const int B = sensitivity_block(t_end);
   for (int first = 0; first < P; first += B) {
     const int count = std::min(B, P - first);
     Trajectory u;
@@ -788,19 +847,8 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   const double t0 = data_.t.front();
   if (const std::size_t L = checkpoint_spacing(solver); L > 0) {
     // Checkpointed (docs/theory.md §7.9): the tangent's outputs and every L-th state point are kept.
-    const Derivative dv = derivative_along(s.dcdq * v);
-    std::vector<double> f(inputs_.size());
-    SecondOrderSolver::TangentForcing G = [&](double t, const double* x, const double* xv, const double* a, double* Gp) {
-      const Eigen::Map<const VectorXd> X(x, n), V(xv, n), A(a, n);
-      Eigen::Map<VectorXd> Gi(Gp, n);
-      Gi.noalias() -= dv.dM * A;
-      Gi.noalias() -= dv.dD * V;
-      Gi.noalias() -= dv.dK * X;
-      for (std::size_t k = 0; k < inputs_.size(); ++k) {
-        const double fk = inputs_[k](t);
-        if (fk != 0.0) Gi += fk * dv.db[k];
-      }
-    };
+    const std::vector<Derivative> dv{derivative_along(s.dcdq * v)};
+    const SecondOrderSolver::TangentForcing G = tangent_forcing(dv);
     const auto ts = Clock::now();
     CheckpointRecorder ck(n, L);
     Trajectory out(ns);
