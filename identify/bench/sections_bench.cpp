@@ -666,7 +666,7 @@ int main(int argc, char** argv) {
         case_n = std::stoi(value());
       } else if (a == "--checkpoint") {
         g_checkpoint = std::stol(value());
-        if (g_checkpoint < -2) throw std::invalid_argument("--checkpoint must be >= 0 (or -1: the default)");
+        if (g_checkpoint < -2) throw std::invalid_argument("--checkpoint must be >= 0 (or -1: the default; -2: set-up only)");
       } else if (a == "--seed") {
         g_seed = std::stol(value());
       } else if (a == "--curve-case") {  // hidden: one part-3 case, JSON line on stdout

@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/interval.h"
 
 #include <cmath>
+#include <string>
 
 namespace scoleid::identify {
 
@@ -10,11 +11,15 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
   UncertaintyInterval u;
   u.half_width = u.noise = u.residual = u.noise_and_residual = u.half_record_shift = u.consider =
       VectorXd::Constant(P, nan);
+  const bool smoothing = in.smoothing_estimate.size() == P;
+  u.smoothing_shift = smoothing ? VectorXd((in.estimate - in.smoothing_estimate).cwiseAbs()) : VectorXd::Zero(P);
   u.too_wide.assign(static_cast<std::size_t>(P), false);
   u.terms = in.consider;
   const bool refit = in.half_record_estimate.size() == P;
   if (!refit) u.note = "no half-record refit: interval not assessed";
   else if (!in.half_record_converged) u.note = "the half-record refit did not converge: its shift is where it stopped";
+  if (smoothing && !in.smoothing_converged)
+    u.note += std::string(u.note.empty() ? "" : "; ") + "the refit at a tenth of the smoothness weight did not converge: its shift is where it stopped";
   for (Eigen::Index i = 0; i < P; ++i) {
     double c = 0.0;
     for (const auto& t : in.consider) c += std::abs(t.shift[i]);
@@ -26,7 +31,7 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
     u.noise_and_residual[i] = 2.0 * std::hypot(sd, res);
     if (!refit) continue;
     u.half_record_shift[i] = std::abs(in.estimate[i] - in.half_record_estimate[i]);
-    u.half_width[i] = u.noise_and_residual[i] + u.half_record_shift[i] + c;
+    u.half_width[i] = u.noise_and_residual[i] + u.half_record_shift[i] + c + u.smoothing_shift[i];
     u.too_wide[static_cast<std::size_t>(i)] = !(u.half_width[i] <= 0.5 * std::abs(in.estimate[i]));
   }
   return u;

@@ -299,13 +299,15 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   double J = 0.0;
   VectorXd x(n), xv(n), a(n), p(n), pd(n), z(ns), r(ns);
   std::vector<double> grid;
-  double quadrature = 0.0;
+  double quadrature = 0.0, resolve = 0.0;
   // Each costate window [τa, τb] is t in [T − τb, T − τa]: the state there from its checkpoints.
   WindowedSink windows(n, spacing, [&](const Trajectory& P) {
-    const auto tq = Clock::now();
     const double ta = std::max(t0, T_ - P.t_end()), tb = std::min(T_, T_ - P.t_begin());
     if (!(tb > ta)) return;
+    const auto tr = Clock::now();
     state.cover(ta, tb);
+    const auto tq = Clock::now();
+    resolve += std::chrono::duration<double>(tq - tr).count();
     grid.clear();
     for (double tau : P.times()) grid.push_back(T_ - tau);
     state.times_in(ta, tb, grid);
@@ -345,7 +347,8 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   ++counters_.costate_solves;
   ++counters_.checkpointed_passes;
   counters_.checkpoint_resolves += state.resolves();
-  counters_.costate_seconds += since(tc) - quadrature;
+  counters_.costate_seconds += since(tc) - quadrature - resolve;
+  counters_.forward_seconds += resolve;  // the state's segments re-solved from checkpoints
   counters_.quadrature_seconds += quadrature;
   return J;
 }
@@ -649,9 +652,10 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
   const double state_end = profile ? data_.t.back() : T_;
-  // The tangents in blocks of at most sensitivity_block() trajectories, the state re-solved with
-  // each block; their outputs C S at the quadrature points are kept (quadrature points × sensors ×
-  // P numbers), not the trajectories.
+  if (solver.has_tangent_solve()) return gauss_newton_streamed(s, solver, state_end, gradient, H, profile);
+  // Without a tangent stepper: the tangents in blocks of at most sensitivity_block() trajectories,
+  // the state re-solved with each block; their outputs C S at the quadrature points are kept
+  // (quadrature points × sensors × P numbers), not the trajectories.
   const int B = sensitivity_block(state_end);
   Trajectory u;
   std::vector<double> grid;
@@ -711,6 +715,95 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   }
   if (profile) *profile = misfit_profile(s, solver, u);
   counters_.quadrature_seconds += since(tq);
+  return J;
+}
+
+double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end,
+                                        VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  // All P tangents stepped with the state in one pass (docs/theory.md §7.9); between consecutive
+  // recorded points the union grid's intervals (the points' and the data's times, clipped to
+  // [t0, T]) are integrated at once, with x, v and the tangents interpolated as Trajectory::eval
+  // does: g, H and J accumulate on the fly, so memory is O(P · DOF + P²) whatever the record's
+  // length, and the state is stored only for the misfit profile.
+  const int P = size(), n = model_.ndof, ns = data_.sensors(), m = 1 + P;
+  const double t0 = data_.t.front();
+  const auto ts = Clock::now();
+  std::vector<Derivative> d;
+  for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+  const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  gradient = VectorXd::Zero(P);
+  H = MatrixXd::Zero(P, P);
+  double J = 0.0, quadrature = 0.0;
+  Trajectory u(n);
+  MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
+  VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
+  double t_prev = 0.0;
+  bool have_prev = false;
+  std::size_t next_data = 0;  // first data time not below t_prev
+  std::vector<double> cuts;
+  auto visit = [&](const SecondOrderSolver::Point& pt) {
+    if (profile) u.push(pt.t, pt.x, pt.v, pt.a);
+    const int cols = pt.columns;
+    const Eigen::Map<const MatrixXd> X1(pt.x, n, cols), V1(pt.v, n, cols), A1(pt.a, n, cols);
+    const double a_end = std::max(t_prev, t0), b_end = std::min(pt.t, T_);
+    if (have_prev && pt.t > t_prev && b_end > a_end) {
+      if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
+      const auto tq = Clock::now();
+      const double h = pt.t - t_prev;
+      cuts.assign(1, a_end);
+      while (next_data < data_.t.size() && data_.t[next_data] <= a_end) ++next_data;
+      for (std::size_t k = next_data; k < data_.t.size() && data_.t[k] < b_end; ++k) cuts.push_back(data_.t[k]);
+      cuts.push_back(b_end);
+      for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+        const double hk = cuts[k + 1] - cuts[k];
+        for (int gq = 0; gq < 3; ++gq) {
+          const double t = cuts[k] + kGx[gq] * hk, wt = kGw[gq] * hk;
+          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
+          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+          Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
+          Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
+          x = Xs.col(0);
+          v = Vs.col(0);
+          data_.eval(t, z.data());
+          const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
+          for (int i = 0; i < P; ++i) {
+            si = Xs.col(1 + i);
+            svi = Vs.col(1 + i);
+            CS.col(i) = tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, x, v, a,
+                                          si, svi);
+          }
+          const MatrixXd RCS = Rv.asDiagonal() * CS;
+          double e = 0.0;
+          for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+          J += 0.5 * wt * e;
+          gradient += wt * RCS.transpose() * r;
+          H += wt * CS.transpose() * RCS;
+        }
+      }
+      quadrature += since(tq);
+    }
+    if (cols == m) {
+      X0 = X1;
+      V0 = V1;
+      A0 = A1;
+    } else {  // the tangents have stopped (beyond the horizon): only the state moves on
+      X0.col(0) = X1.col(0);
+      V0.col(0) = V1.col(0);
+      A0.col(0) = A1.col(0);
+    }
+    t_prev = pt.t;
+    have_prev = true;
+  };
+  SolverSummary sum;
+  solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.sensitivity_solves += P;
+  counters_.sensitivity_seconds += since(ts) - quadrature;
+  const auto tq = Clock::now();
+  if (profile) *profile = misfit_profile(s, solver, u);
+  counters_.quadrature_seconds += quadrature + since(tq);
   return J;
 }
 

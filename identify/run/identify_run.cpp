@@ -461,6 +461,15 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
       r.half_record_estimate = ii.half_record_estimate = s.q;
       r.half_record_converged = ii.half_record_converged = s.converged();
     }
+    // The smoothing shift (interval.h): the refit at a tenth of the prior's weight, from q̂.
+    if (oo.smoothness_weight > 0.0) {
+      OptimizerOptions os = oo;
+      os.smoothness_weight = oo.smoothness_weight / 10.0;
+      os.continuation = false;
+      const OptimizerSummary s = minimize(obj, r.estimate, os, [&](const IterationRecord&) { io::check_interrupt(); });
+      ii.smoothing_estimate = s.q;
+      ii.smoothing_converged = s.converged();
+    }
     ii.consider = consider_terms(p, obj, r.ident, r.estimate);
     r.interval = uncertainty_interval(r.ident, ii);
     for (std::size_t i = 0; i < r.names.size(); ++i)
@@ -514,6 +523,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
         json comp{{"noise_2std", interval.noise[ie]},
                   {"residual_2resolution", interval.residual[ie]},
                   {"half_record_shift", interval.half_record_shift[ie]},
+                  {"smoothing_shift", interval.smoothing_shift[ie]},
                   {"consider", interval.consider[ie]}};
         e["interval"] = {{"half_width", hw}, {"low", estimate[ie] - hw}, {"high", estimate[ie] + hw},
                          {"relative_half_width", hw / std::abs(estimate[ie])}, {"components", comp}};

@@ -65,20 +65,11 @@ CheckpointedState::CheckpointedState(const SecondOrderSolver& solver, const Seco
   if (ckpts_.empty()) throw std::invalid_argument("CheckpointedState: no checkpoints");
 }
 
-const CheckpointedState::Segment& CheckpointedState::segment(std::size_t c) {
-  for (int i = 0; i < 2; ++i)
-    if (seg_[i].index == c) {
-      next_ = 1 - i;  // least recently used next
-      return seg_[i];
-    }
-  Segment& s = seg_[next_];
-  next_ = 1 - next_;
-  s.index = c;
+Trajectory CheckpointedState::solve_segment(std::size_t c) {
   const Checkpoint& k = ckpts_[c];
   const double until = c + 1 < ckpts_.size() ? ckpts_[c + 1].t : t_end_;
-  s.u = Trajectory(k.x.size());
+  Trajectory u(static_cast<int>(k.x.size()));
   SecondOrderSolver::Start start{k.t, k.origin, k.h, k.x.data(), k.v.data(), k.a.data()};
-  Trajectory& u = s.u;
   SolverSummary sum;
   if (k.t < t_end_) {
     solver_.stream(k.t, t_end_, forcing_, breakpoints_,
@@ -88,38 +79,35 @@ const CheckpointedState::Segment& CheckpointedState::segment(std::size_t c) {
   }
   summary_.Accumulate(sum);
   ++resolves_;
-  return s;
+  return u;
 }
 
 void CheckpointedState::cover(double ta, double tb) {
-  // Checkpoint c holds [t_c, t_{c+1}]; the ones meeting [ta, tb].
+  // Segment c holds [t_c, t_{c+1}]; the ones meeting [ta, tb] (any number: short segments around
+  // breakpoints can make a window span several).
   auto first = std::upper_bound(ckpts_.begin(), ckpts_.end(), ta, [](double t, const Checkpoint& k) { return t < k.t; });
-  std::size_t c0 = first == ckpts_.begin() ? 0 : static_cast<std::size_t>(first - ckpts_.begin()) - 1;
+  const std::size_t c0 = first == ckpts_.begin() ? 0 : static_cast<std::size_t>(first - ckpts_.begin()) - 1;
   std::size_t c1 = c0;
   while (c1 + 1 < ckpts_.size() && ckpts_[c1 + 1].t < tb) ++c1;
-  if (c1 > c0 + 1)
-    throw std::logic_error("CheckpointedState: a window spans more than two checkpoint segments");
-  covered_.clear();
-  // The later segment first, so that moving backward keeps it and re-solves only the earlier one.
-  const Segment& hi = segment(c1);
-  if (c1 != c0) {
-    const Segment& lo = segment(c0);
-    covered_.push_back(&lo.u);
-  }
-  covered_.push_back(&hi.u);
+  for (auto it = segments_.begin(); it != segments_.end();) it = it->first < c0 || it->first > c1 ? segments_.erase(it) : std::next(it);
+  for (std::size_t c = c0; c <= c1; ++c)
+    if (!segments_.count(c)) segments_.emplace(c, solve_segment(c));
 }
 
 void CheckpointedState::eval(double t, double* x, double* v, double* a) const {
-  for (const Trajectory* u : covered_)
-    if (t <= u->t_end() || u == covered_.back()) {
-      u->eval(t, x, v, a);
-      return;
-    }
+  // The first covered segment that reaches t (segments are in time order).
+  const Trajectory* u = nullptr;
+  for (const auto& [c, seg] : segments_) {
+    u = &seg;
+    if (t <= seg.t_end()) break;
+  }
+  if (!u) throw std::logic_error("CheckpointedState::eval before cover()");
+  u->eval(t, x, v, a);
 }
 
 void CheckpointedState::times_in(double ta, double tb, std::vector<double>& out) const {
-  for (const Trajectory* u : covered_)
-    for (double t : u->times())
+  for (const auto& [c, u] : segments_)
+    for (double t : u.times())
       if (t >= ta && t <= tb) out.push_back(t);
 }
 

@@ -39,16 +39,21 @@ void take(std::vector<double>& v, std::size_t need) {
 void give(std::vector<double>& v) {
   const std::size_t c = v.capacity();
   if (c < kPoolMinimum || c > kPoolDoubles) return;
-  // Make room: drop the smallest pooled arrays while the pool is full and they are smaller.
-  while (!pool.empty() && (pool.size() >= kPoolEntries || pooled + c > kPoolDoubles)) {
-    auto it = std::min_element(pool.begin(), pool.end(), [](const auto& a, const auto& b) { return a.capacity() < b.capacity(); });
-    if (it->capacity() >= c) return;
-    pooled -= it->capacity();
-    std::vector<double>().swap(*it);
-    it->swap(pool.back());
-    pool.pop_back();
+  const auto fits = [&] { return pool.size() < kPoolEntries && pooled + c <= kPoolDoubles; };
+  if (!fits()) {
+    // Make room by dropping smaller pooled arrays, smallest first, only if that is enough.
+    std::size_t smaller = 0, count = 0;
+    for (const auto& a : pool)
+      if (a.capacity() < c) smaller += a.capacity(), ++count;
+    if (pooled - smaller + c > kPoolDoubles || pool.size() - count >= kPoolEntries) return;
+    while (!fits()) {
+      auto it = std::min_element(pool.begin(), pool.end(), [](const auto& a, const auto& b) { return a.capacity() < b.capacity(); });
+      pooled -= it->capacity();
+      std::vector<double>().swap(*it);
+      it->swap(pool.back());
+      pool.pop_back();
+    }
   }
-  if (pooled + c > kPoolDoubles) return;
   pooled += c;
   pool.emplace_back();
   pool.back().swap(v);

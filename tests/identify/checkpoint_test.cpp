@@ -2,7 +2,8 @@
 // resumable point reproduces the original points bit for bit (breakpoints included); windows share
 // their boundaries and keep a breakpoint's two limits together; the gradient and the Gauss–Newton
 // product on a checkpointed state equal the ones on the stored state to rounding, for several
-// spacings, with each state segment re-solved once and the memory measured in recorded points.
+// spacings, with each state segment re-solved once; streamed samples equal the stored solution's
+// interpolant bit for bit (on breakpoints and beyond the run too) whatever the window.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -180,4 +181,62 @@ TEST(Checkpoints, AutomaticSpacingOnlyBeyondTheTrajectoryBudget) {
   Objective big(p->model(), *p->params, p->signals, p->data, p->objective_options);
   big.cost_and_gradient(q, g);
   EXPECT_EQ(big.counters().checkpointed_passes, 0);
+}
+
+TEST(Checkpoints, StreamedSamplesEqualTheStoredSolutionsInterpolant) {
+  const auto p = ei8();
+  const auto& M = p->model();
+  VectorXd c;
+  MatrixXd dc;
+  p->params->coefficients(p->params->initial(), c, dc);
+  const AssembledModel ops = assemble(M, c);
+  SecondOrderSolver solver(ops.M, ops.D, ops.K, M.dof_group, p->objective_options.solver);
+  const int n = M.ndof;
+  SecondOrderSolver::Forcing f = [&](double t, double* F) {
+    Eigen::Map<VectorXd> Fm(F, n);
+    for (std::size_t i = 0; i < ops.loads.size(); ++i) Fm += p->signals[i](t) * ops.loads[i];
+  };
+  std::vector<double> bps, times = p->data.t;
+  for (const auto& s : p->signals)
+    for (double b : s.breakpoints()) bps.push_back(b), times.push_back(b);  // samples on the breakpoints too
+  times.push_back(p->data.t.back() + 1.0);  // beyond the run: clamped
+  std::sort(times.begin(), times.end());
+  const double T = p->data.t.back();
+  const Trajectory u = solver.solve(0.0, T, f, bps);
+  VectorXd x(n), v(n);
+  for (std::size_t window : {2u, 3u, 256u}) {
+    std::size_t seen = 0;
+    double worst = 0.0;
+    sample_streamed(solver, 0.0, T, f, bps, times, [&](std::size_t k, const VectorXd& xs, const VectorXd& vs) {
+      ASSERT_EQ(k, seen++);
+      u.eval(times[k], x.data(), v.data());
+      worst = std::max({worst, (xs - x).cwiseAbs().maxCoeff(), (vs - v).cwiseAbs().maxCoeff()});
+    }, nullptr, window);
+    EXPECT_EQ(seen, times.size());
+    EXPECT_EQ(worst, 0.0) << "window " << window;
+  }
+}
+
+TEST(Checkpoints, OnePointSpacingWhereWindowsSpanSeveralSegments) {
+  // L = 1: a costate window (at least 2 points) and the state's one-step segments have no slack,
+  // and T − (T − t) differs from t by an ulp, so a window can meet three segments (h = 1 ms here).
+  const auto p = ei8();
+  ObjectiveOptions base = p->objective_options;
+  base.solver.step = 0.001;
+  const VectorXd q = p->params->initial() * 0.97;
+  Objective whole(p->model(), *p->params, p->signals, p->data, base);
+  VectorXd g0, g;
+  const double J0 = whole.cost_and_gradient(q, g0);
+  VectorXd v = VectorXd::Ones(q.size());
+  const VectorXd Hv0 = whole.gauss_newton_product(q, v);
+  for (long L : {1L, 2L}) {
+    ObjectiveOptions oo = base;
+    oo.checkpoint_points = L;
+    Objective ck(p->model(), *p->params, p->signals, p->data, oo);
+    const double J = ck.cost_and_gradient(q, g);
+    const VectorXd Hv = ck.gauss_newton_product(q, v);
+    EXPECT_LT(std::abs(J / J0 - 1.0), 1e-12) << "L = " << L;
+    EXPECT_LT((g - g0).norm(), 1e-10 * g0.norm()) << "L = " << L;
+    EXPECT_LT((Hv - Hv0).norm(), 1e-10 * Hv0.norm()) << "L = " << L;
+  }
 }

@@ -107,32 +107,34 @@ TEST(MatrixFree, TaylorRemaindersFallAtSecondAndThirdOrder) {
 namespace {
 // EI on 16 sections of a simply supported beam (a smooth profile), 4 displacement sensors, 1 % noise
 // stated to the identifier: the sections between sensors are poorly seen.
-scoleid::io::Scenario sixteen_sections(const std::string& smoothness) {
+scoleid::io::Scenario sections_scenario(const std::string& smoothness, int N, int sensors, double noise) {
   auto sc = scoleid::io::load_scenario("beam-ei8");
-  const int N = 16;
   sc.beam.EI.resize(N);
   for (int k = 0; k < N; ++k) {
     const double x = (k + 0.5) * sc.beam.length / N;
     sc.beam.EI[static_cast<std::size_t>(k)] =
         23000.0 * (1.0 + 0.3 * std::sin(M_PI * x / sc.beam.length) + 0.1 * std::cos(3.0 * M_PI * x / sc.beam.length));
   }
-  sc.sensors.resize(4);
-  for (int i = 0; i < 4; ++i) {
+  const auto sensor = sc.sensors.front();
+  sc.sensors.assign(static_cast<std::size_t>(sensors), sensor);
+  for (int i = 0; i < sensors; ++i) {
     sc.sensors[static_cast<std::size_t>(i)].name = "w" + std::to_string(i + 1);
-    sc.sensors[static_cast<std::size_t>(i)].location = (i + 0.5) * sc.beam.length / 4;
+    sc.sensors[static_cast<std::size_t>(i)].location = (i + 0.5) * sc.beam.length / sensors;
   }
   sc.simulation.duration = 4.0;
   sc.simulation.seed = 3;
   sc.identification.estimate.clear();
   for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
   sc.identification.method = "gauss-newton-krylov";
-  // Noise of 1 % of each sensor's RMS, from the noise-free data.
+  // Noise of `noise` times each sensor's RMS, from the noise-free data.
   const auto clean = make_problem(sc, std::nullopt);
-  for (int i = 0; i < 4; ++i)
-    sc.sensors[static_cast<std::size_t>(i)].noise_std = 0.01 * std::sqrt(clean->data.z.col(i).squaredNorm() / clean->data.z.rows());
+  for (int i = 0; i < sensors; ++i)
+    sc.sensors[static_cast<std::size_t>(i)].noise_std = noise * std::sqrt(clean->data.z.col(i).squaredNorm() / clean->data.z.rows());
   sc.identification.smoothness = smoothness == "discrepancy" ? -1.0 : std::stod(smoothness);
   return sc;
 }
+// EI on 16 sections, 4 sensors, 1 % noise.
+scoleid::io::Scenario sixteen_sections(const std::string& smoothness) { return sections_scenario(smoothness, 16, 4, 0.01); }
 double rms_error(const RunResult& r) {
   double s = 0;
   for (std::size_t i = 0; i < r.names.size(); ++i) s += std::pow(r.estimate[static_cast<Eigen::Index>(i)] / r.truth.at(r.names[i]) - 1.0, 2);
@@ -201,4 +203,42 @@ TEST(NoiseIntegral, MeanAndVarianceMatchMonteCarlo) {
   EXPECT_NEAR(mean, W, 4.0 * std::sqrt(V / draws));
   EXPECT_NEAR(var / V, 1.0, 0.12);  // sampling error of a variance from 4000 draws: ~ 2.2 % · √(kurtosis/2)
   EXPECT_GT(V, 2.0 * W * W / N);
+}
+
+// The prior's bias in the interval (interval.h, smoothing shift): with the discrepancy weight the
+// sections are pulled together by more than the data's std (the std is the data's alone); the
+// refit at a tenth of the weight measures that pull, and the interval that includes it covers
+// every section the Fisher test does not flag.
+TEST(SmoothnessPrior, IntervalHoldsThePriorsBias) {
+  RunOptions ro;
+  ro.verbose = false;
+  ro.compute_std = true;
+  // EI on 8 sections seen by 8 sensors at 0.1 % noise: the data's std is small beside the pull.
+  auto p = make_problem(sections_scenario("discrepancy", 8, 8, 1e-3), std::nullopt);
+  const RunResult r = run_identification(*p, ro);
+  ASSERT_TRUE(r.smoothness_met);
+  ASSERT_GT(r.smoothness_weight, 0.0);
+  int covered = 0, assessed = 0, beyond_std = 0, covered_without = 0;
+  double largest_shift = 0.0;
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto ie = static_cast<Eigen::Index>(i);
+    const double truth = r.truth.at(r.names[i]), err = std::abs(r.estimate[ie] - truth);
+    const double hw = r.interval.half_width[ie], shift = r.interval.smoothing_shift[ie];
+    std::printf("%-6s error %.3e  2 std %.3e  smoothing shift %.3e  half-width %.3e  %s\n", r.names[i].c_str(),
+                err / truth, r.interval.noise[ie] / truth, shift / truth, hw / truth,
+                r.ident.identifiable[i] ? "" : "(flagged)");
+    largest_shift = std::max(largest_shift, shift / truth);
+    if (!r.ident.identifiable[i] || !std::isfinite(hw)) continue;
+    ++assessed;
+    covered += err <= hw;
+    covered_without += err <= hw - shift;
+    beyond_std += err > r.interval.noise[ie];
+  }
+  std::printf("weight %.0e: %d of %d assessed sections covered (%d without the smoothing shift); %d beyond 2 std; "
+              "largest smoothing shift %.3e\n",
+              r.smoothness_weight, covered, assessed, covered_without, beyond_std, largest_shift);
+  ASSERT_GT(assessed, 0);
+  EXPECT_GT(beyond_std, 0) << "the prior's pull should exceed the data's 2 std somewhere in this case";
+  EXPECT_EQ(covered, assessed);
+  EXPECT_LT(covered_without, assessed);  // the term is what makes the interval hold
 }

@@ -10,6 +10,7 @@
 //   half_width_i = 2·√(std_i² + resolution_i²)   noise (95 %) and the visible systematic residual
 //                + |q̂_i − q̂_i^(T/2)|               the shift of a refit on the first half of the record
 //                + Σ_j |∂q̂_i/∂θ_j| Δθ_j            declared uncertainties Δθ_j of fixed quantities
+//                + |q̂_i − q̂_i(β/10)|               with a smoothness prior of weight β: its bias
 //
 //   resolution_i (identifiability.h): std_i·‖e‖_W, the change of q_i whose output effect equals
 //     the residual left beyond the χ² band of the stated noise.
@@ -23,6 +24,10 @@
 //     enters the interval.
 //     A mismatch that the data cannot tell from a parameter change (a reflector mass error looks
 //     like a mast mass error) leaves no residual: only a declared uncertainty can cover it.
+//   Smoothing shift: a smoothness prior (docs/theory.md §7.8) pulls the sections towards each
+//     other by an amount the data's std does not contain (the std is the data's alone). The refit
+//     with the weight lowered tenfold, from q̂, moves the estimate by about 90 % of that bias when
+//     the bias is linear in β (small β); its size enters the interval.
 //
 // A parameter whose half-width exceeds 0.5 of its value is flagged not identifiable.
 #include <string>
@@ -44,6 +49,8 @@ struct IntervalInputs {
   VectorXd half_record_estimate;       // empty: no refit (then the term is NaN and the interval too)
   bool half_record_converged = true;
   std::vector<ConsiderTerm> consider;
+  VectorXd smoothing_estimate;         // the refit at a tenth of the prior's weight; empty: no prior
+  bool smoothing_converged = true;
 };
 
 struct UncertaintyInterval {
@@ -53,6 +60,7 @@ struct UncertaintyInterval {
   VectorXd noise_and_residual;  // 2·√(std² + resolution²)
   VectorXd half_record_shift;   // |q̂ − q̂^(T/2)|
   VectorXd consider;            // Σ_j |shift_j|
+  VectorXd smoothing_shift;     // |q̂ − q̂(β/10)|; 0 without a prior
   std::vector<ConsiderTerm> terms;  // the declared tolerances and their shifts
   std::vector<bool> too_wide;   // half-width > 0.5·|q̂|
   std::string note;             // why the interval is weaker than stated, "" if it is not

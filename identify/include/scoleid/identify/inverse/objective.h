@@ -187,6 +187,9 @@ private:
   // least 1, at most P).
   int sensitivity_block(double t_end) const;
   void default_weights();
+  // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly.
+  double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
+                               MatrixXd& H, MisfitProfile* profile);
   // The checkpoint spacing for a state over [t0, T] with this solver; 0 = store the whole state.
   std::size_t checkpoint_spacing(const SecondOrderSolver& solver) const;
   // The backward pass on a checkpointed state (docs/theory.md §7.9): the costate with source

@@ -12,6 +12,7 @@
 // segment is re-solved once as the backward pass moves through it).
 #include <Eigen/Dense>
 #include <functional>
+#include <map>
 #include <vector>
 
 #include "scoleid/identify/time/second_order_solver.h"
@@ -63,7 +64,8 @@ void sample_streamed(const SecondOrderSolver& solver, double t0, double t1, cons
                      SolverSummary* summary = nullptr, std::size_t points = 256);
 
 // The state between checkpoints, re-solved on demand: cover(ta, tb) makes the segments that hold
-// [ta, tb] available (the two most recently used are kept), then eval/times_in read them.
+// [ta, tb] available, keeping only those (a backward pass moving to earlier windows then re-solves
+// each segment once), and eval/times_in read them.
 class CheckpointedState {
 public:
   CheckpointedState(const SecondOrderSolver& solver, const SecondOrderSolver::Forcing& forcing,
@@ -77,19 +79,13 @@ public:
   const SolverSummary& summary() const { return summary_; }
 
 private:
-  struct Segment {
-    std::size_t index = static_cast<std::size_t>(-1);
-    Trajectory u;
-  };
-  const Segment& segment(std::size_t c);
+  Trajectory solve_segment(std::size_t c);
   const SecondOrderSolver& solver_;
   const SecondOrderSolver::Forcing& forcing_;
   std::vector<double> breakpoints_;
   double t_end_;
   std::vector<Checkpoint> ckpts_;
-  Segment seg_[2];
-  int next_ = 0;  // the slot to overwrite next
-  std::vector<const Trajectory*> covered_;
+  std::map<std::size_t, Trajectory> segments_;  // segment c: checkpoint c to checkpoint c + 1
   long resolves_ = 0;
   SolverSummary summary_;
 };
