@@ -364,11 +364,13 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
     const std::string& how = strategies[k];
     // Restarts answer a false convergence: the optimiser stopped on a convergence test where the
-    // model does not explain the data (a run that ran out of iterations is reported as such).
-    // Coarse to fine is tried whenever the residual exceeds noise and discretisation (a local
-    // minimum of a sectional profile may still fit within a declared model error); the others
-    // only when the fit does not explain the data.
-    if (!r.summary.converged()) break;
+    // model does not explain the data. Coarse to fine is tried whenever the residual exceeds noise
+    // and discretisation (a local minimum of a sectional profile may still fit within a declared
+    // model error), and also after a run that used up its iterations (sections the sensors barely
+    // see wander through any budget: EI on 64 sections, docs/theory.md §7.8); the others only when
+    // a converged fit does not explain the data.
+    const bool out_of_iterations = r.summary.termination == OptimizerSummary::Termination::MaxIterations;
+    if (!r.summary.converged() && !(how == "coarse-to-fine" && out_of_iterations)) break;
     if (how == "coarse-to-fine" ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
     if (ro.verbose)
       std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
@@ -402,6 +404,8 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
         extra.costate_seconds += c.costate_seconds;
         extra.sensitivity_seconds += c.sensitivity_seconds;
         extra.quadrature_seconds += c.quadrature_seconds;
+        extra.checkpointed_passes += c.checkpointed_passes;
+        extra.checkpoint_resolves += c.checkpoint_resolves;
         extra.solver.Accumulate(c.solver);
         iterations += sl.iterations_done;
         if (sl.q.allFinite()) q = tied.expand(sl.q);
@@ -492,6 +496,8 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   r.counters.costate_seconds += extra.costate_seconds;
   r.counters.sensitivity_seconds += extra.sensitivity_seconds;
   r.counters.quadrature_seconds += extra.quadrature_seconds;
+  r.counters.checkpointed_passes += extra.checkpointed_passes;
+  r.counters.checkpoint_resolves += extra.checkpoint_resolves;
   r.counters.solver.Accumulate(extra.solver);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -599,6 +605,8 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"forward_solves", counters.forward_solves},
            {"costate_solves", counters.costate_solves},
            {"sensitivity_solves", counters.sensitivity_solves},
+           {"checkpointed_passes", counters.checkpointed_passes},
+           {"checkpoint_resolves", counters.checkpoint_resolves},
            {"wall_seconds", wall_seconds},
            {"timing_seconds",
             {{"forward", counters.forward_seconds},

@@ -211,6 +211,25 @@ TEST(Identification, SectionalLocalMinimumIsNotReportedAsConverged) {
   EXPECT_EQ(r.attempts.size(), 1u);
 }
 
+TEST(Identification, RunOutOfIterationsOnSectionsGetsTheCoarseToFineAttempt) {
+  // The same start with an iteration budget the plain run uses up: the coarse-to-fine attempt still
+  // runs (its levels under the same budget) and the result is reported by its own merit.
+  auto p = four_sections(23000 * 0.85, 67 * 1.15, 2);
+  p->scenario.identification.max_iterations = 4;
+  RunOptions ro;
+  ro.verbose = false;
+  ro.compute_std = false;
+  const RunResult r = run_identification(*p, ro);
+  ASSERT_GE(r.attempts.size(), 2u);
+  std::printf("attempt 1: %s (%d iterations); chosen: %s, converged %d, worst error %.3g\n",
+              r.attempts[0].termination.c_str(), r.attempts[0].iterations,
+              r.attempts[static_cast<std::size_t>(r.chosen_attempt)].strategy.c_str(), r.converged(), worst(*p, r.estimate));
+  EXPECT_EQ(r.attempts[0].termination, "max_iterations");
+  EXPECT_NE(r.attempts[1].strategy.find("coarse-to-fine"), std::string::npos);
+  EXPECT_TRUE(r.converged());
+  EXPECT_LT(worst(*p, r.estimate), 1e-2);
+}
+
 TEST(Identification, CoarseToFineRestartRecoversFourSectionsFromStartsFifteenAndThirtyPercentOff) {
   for (const auto& [fe, fr] : std::vector<std::pair<double, double>>{{0.85, 1.15}, {0.7, 1.3}, {1.3, 0.7}}) {
     auto p = four_sections(23000 * fe, 67 * fr, 2);
