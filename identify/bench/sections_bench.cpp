@@ -128,6 +128,14 @@ std::pair<double, double> rel_errors(const Problem& p, const VectorXd& q) {
   return {n ? std::sqrt(sum / n) : NAN, n ? worst : NAN};
 }
 
+// A child's result: one JSON line on stdout (the parent reads the last); exit 1 on an error.
+int emit(const json& out) {
+  std::fflush(stdout);
+  std::printf("%s\n", out.dump().c_str());
+  std::fflush(stdout);
+  return out.contains("error") ? 1 : 0;
+}
+
 // The hidden --case mode: one identification, one JSON line on stdout.
 int run_case(int N, const std::string& method, bool compute_std) {
   json out{{"N", N}, {"method", method}};
@@ -191,10 +199,7 @@ int run_case(int N, const std::string& method, bool compute_std) {
   } catch (const std::exception& e) {
     out["error"] = e.what();
   }
-  std::fflush(stdout);
-  std::printf("%s\n", out.dump().c_str());
-  std::fflush(stdout);
-  return out.contains("error") ? 1 : 0;
+  return emit(out);
 }
 
 // Runs this program with `args` in a child process: its last JSON line as the row, peak RSS from
@@ -407,10 +412,7 @@ int run_curve_case(int N, long L) {
   } catch (const std::exception& e) {
     out["error"] = e.what();
   }
-  std::fflush(stdout);
-  std::printf("%s\n", out.dump().c_str());
-  std::fflush(stdout);
-  return out.contains("error") ? 1 : 0;
+  return emit(out);
 }
 
 json part3(int N, double timeout_s) {

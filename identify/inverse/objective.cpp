@@ -12,6 +12,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// Appends the outputs (C x, C v, C a) at t to `out`: what a checkpointed costate reads (§7.9).
+void push_outputs(const Eigen::MatrixXd& C, Trajectory& out, double t, const double* x, const double* v, const double* a) {
+  const auto n = C.cols();
+  const Eigen::VectorXd y = C * Eigen::Map<const Eigen::VectorXd>(x, n), yv = C * Eigen::Map<const Eigen::VectorXd>(v, n),
+                        ya = C * Eigen::Map<const Eigen::VectorXd>(a, n);
+  out.push(t, y.data(), yv.data(), ya.data());
+}
+
 // 3-point Gauss–Legendre on [0, 1]
 constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
 constexpr double kGw[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
@@ -362,16 +370,11 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     const auto tf = Clock::now();
     CheckpointRecorder ck(n, L);
     Trajectory out(ns);
-    VectorXd y(ns), yv(ns), ya(ns);
     SolverSummary sum;
     solver.stream(data_.t.front(), T_, state_forcing(s), breakpoints_,
                   [&](const SecondOrderSolver::Point& pt) {
                     ck(pt);
-                    const Eigen::Map<const VectorXd> X(pt.x, n), V(pt.v, n), A(pt.a, n);
-                    y.noalias() = C_ * X;
-                    yv.noalias() = C_ * V;
-                    ya.noalias() = C_ * A;
-                    out.push(pt.t, y.data(), yv.data(), ya.data());
+                    push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
                   },
                   &sum);
     counters_.solver.Accumulate(sum);
@@ -626,7 +629,6 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
 
 std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,
                                                   double tangent_end, Trajectory& u, const std::vector<Derivative>& d) {
-  const int n = model_.ndof;
   const int count = static_cast<int>(d.size());
   const auto ts = Clock::now();
   std::vector<Trajectory> S;
@@ -945,17 +947,12 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
     const auto ts = Clock::now();
     CheckpointRecorder ck(n, L);
     Trajectory out(ns);
-    VectorXd y(ns), yv(ns), ya(ns);
     SolverSummary sum;
     solver.stream_tangent(t0, T_, state_forcing(s), 1, G, T_, breakpoints_,
                           [&](const SecondOrderSolver::Point& pt) {
                             ck(pt);
                             if (pt.columns < 2) throw std::logic_error("gauss_newton_product: the tangent stopped early");
-                            const Eigen::Map<const VectorXd> X(pt.x + n, n), V(pt.v + n, n), A(pt.a + n, n);
-                            y.noalias() = C_ * X;
-                            yv.noalias() = C_ * V;
-                            ya.noalias() = C_ * A;
-                            out.push(pt.t, y.data(), yv.data(), ya.data());
+                            push_outputs(C_, out, pt.t, pt.x + n, pt.v + n, pt.a + n);  // the tangent's column
                           },
                           &sum);
     counters_.solver.Accumulate(sum);
