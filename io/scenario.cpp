@@ -456,6 +456,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.rtol = r.positive("rtol", id.rtol);
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
+  id.start = r.choice("start", id.start, {"auto", "plain", "coarse-to-fine"});
   if (r.has("smoothness")) {
     const YAML::Node m = r.child("smoothness");
     if (m.IsScalar() && m.Scalar() == "discrepancy")
@@ -725,7 +726,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
-                         {"restarts", id.restarts},
+                         {"restarts", id.restarts}, {"start", id.start},
                          {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};
   if (!id.uncertain.empty()) {
     json u = json::object();

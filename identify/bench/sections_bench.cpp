@@ -153,12 +153,13 @@ int run_case(int N, const std::string& method, bool compute_std) {
     out["wall_seconds"] = seconds_since(t1);
     const auto [rms, mx] = rel_errors(*p, r.estimate);
     out["method_used"] = r.method;
-    // Iterations of the whole run: with the discrepancy principle, of every weight tried (the
-    // summary holds the chosen weight's only).
-    int iterations = r.summary.iterations_done;
+    // Iterations of the whole run: every attempt's, with its coarse-to-fine levels; with the
+    // discrepancy principle, of every weight tried (the first attempt counts the chosen weight's).
+    int iterations = 0;
+    for (const auto& a : r.attempts) iterations += a.iterations;
     if (!r.smoothness_path.empty()) {
-      iterations = 0;
       for (const auto& st : r.smoothness_path) iterations += st.iterations;
+      iterations -= r.smoothness_path.back().iterations;
     }
     out["iterations"] = iterations;
     out["smoothness_weight"] = r.smoothness_weight;
@@ -180,6 +181,7 @@ int run_case(int N, const std::string& method, bool compute_std) {
       att.push_back({{"strategy", a.strategy}, {"termination", a.termination}, {"cost", a.cost}, {"iterations", a.iterations},
                      {"explains_data", a.explains_data}, {"fit_message", a.fit_message}});
     out["attempt_list"] = att;
+    out["chosen_strategy"] = r.attempts.empty() ? "" : r.attempts[static_cast<std::size_t>(r.chosen_attempt)].strategy;
     out["cost"] = r.summary.cost;
     out["step"] = p->objective_options.solver.step;
     out["forward_solves"] = r.counters.forward_solves;
@@ -309,8 +311,9 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
   if (g_noise > 0 || g_smoothness != 0)
     std::printf("        sensor noise std %.3g m (stated, seed %ld), smoothness prior %s\n\n", g_noise, g_seed,
                 g_smoothness < 0 ? "by the discrepancy principle" : std::to_string(g_smoothness).c_str());
-  std::printf("%4s %-13s %5s %-18s %9s %10s %8s %8s %8s %10s %10s %6s %9s\n", "N", "method", "iter", "termination",
-              "wall[s]", "step h", "forward", "costate", "sensit.", "RMS err", "max err", "ident", "RSS[MB]");
+  std::printf("%4s %-24s %5s %-18s %9s %10s %8s %8s %8s %10s %10s %6s %9s  %s\n", "N", "method", "iter", "termination",
+              "wall[s]", "step h", "forward", "costate", "sensit.", "RMS err", "max err", "ident", "RSS[MB]",
+              "chosen attempt");
   json rows = json::array();
   for (int N : sections)
     for (const auto& m : methods) {
@@ -320,13 +323,13 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
         const std::string ident = r.contains("identifiable")
                                       ? std::to_string(r["identifiable"].get<int>()) + "/" + std::to_string(N)
                                       : "-";
-        std::printf("%4d %-13s %5d %-18s %9.2f %10.3e %8ld %8ld %8ld %10.3e %10.3e %6s %9.1f\n", N, label.c_str(),
+        std::printf("%4d %-24s %5d %-18s %9.2f %10.3e %8ld %8ld %8ld %10.3e %10.3e %6s %9.1f  %s\n", N, label.c_str(),
                     r["iterations"].get<int>(), r["termination"].get<std::string>().c_str(), num(r, "wall_seconds"),
                     num(r, "step"), r["forward_solves"].get<long>(), r["costate_solves"].get<long>(),
                     r["sensitivity_solves"].get<long>(), num(r, "rms_error"), num(r, "max_error"), ident.c_str(),
-                    num(r, "peak_rss_mb"));
+                    num(r, "peak_rss_mb"), r.value("chosen_strategy", std::string()).c_str());
       } else {
-        std::printf("%4d %-13s %5s %-18s %9.2f %10s %8s %8s %8s %10s %10s %6s %9.1f  %s\n", N, label.c_str(), "-",
+        std::printf("%4d %-24s %5s %-18s %9.2f %10s %8s %8s %8s %10s %10s %6s %9.1f  %s\n", N, label.c_str(), "-",
                     r["status"].get<std::string>().c_str(), num(r, "elapsed_seconds"), "-", "-", "-", "-", "-", "-",
                     "-", num(r, "peak_rss_mb"), r.value("error", std::string()).c_str());
       }
@@ -351,7 +354,7 @@ json part1(const std::vector<int>& sections, const std::vector<std::string>& met
     const bool ok = ra && rb && (*ra)["status"] == "ok" && (*rb)["status"] == "ok";
     const double ratio = ok ? num(*rb, "wall_seconds") / num(*ra, "wall_seconds") : NAN;
     const double rss = rb ? num(*rb, "peak_rss_mb") : NAN;
-    std::printf("   %-13s ratio %8.2f%s   peak RSS %8.1f MB%s\n", m.c_str(), ratio, ok ? "" : " (n/a)", rss,
+    std::printf("   %-24s ratio %8.2f%s   peak RSS %8.1f MB%s\n", m.c_str(), ratio, ok ? "" : " (n/a)", rss,
                 rb && (*rb)["status"] != "ok" ? (" (" + (*rb)["status"].get<std::string>() + ")").c_str() : "");
     scaling[m] = {{"N_low", a}, {"N_high", b}, {"wall_ratio", ratio}, {"peak_rss_mb_high", rss}};
   }

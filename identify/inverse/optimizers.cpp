@@ -18,7 +18,8 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   if (method != "gauss-newton" && method != "gauss-newton-krylov" && method != "lbfgs" && method != "steepest-descent")
     return bad("method must be gauss-newton, gauss-newton-krylov, lbfgs or steepest-descent");
   if (!(smoothness_weight >= 0)) return bad("smoothness_weight must be >= 0");
-  if (smoothness_weight > 0 && method != "gauss-newton-krylov") return bad("the smoothness prior needs method gauss-newton-krylov");
+  if (smoothness_weight > 0 && method != "gauss-newton-krylov" && method != "gauss-newton")
+    return bad("the smoothness prior needs method gauss-newton or gauss-newton-krylov");
   if (!(max_krylov_iterations >= 1)) return bad("max_krylov_iterations must be >= 1");
   if (max_iterations < 0) return bad("max_iterations must be >= 0");
   if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
@@ -109,6 +110,44 @@ struct Run {
   }
 };
 
+// The smoothness prior ½ β Σ_chains Σ_j (x_{j+1} − x_j)² on x = log q: value, gradient, product.
+struct Smoothness {
+  double beta = 0.0;
+  std::vector<std::vector<int>> chains;
+  double value(const VectorXd& x) const {
+    double v = 0.0;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) v += std::pow(x[c[j + 1]] - x[c[j]], 2);
+    return 0.5 * beta * v;
+  }
+  // β LᵀL (P × P), for the explicit Gauss–Newton matrix
+  MatrixXd matrix(Eigen::Index P) const {
+    MatrixXd A = MatrixXd::Zero(P, P);
+    if (beta == 0.0) return A;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
+        const int a = c[j], b = c[j + 1];
+        A(a, a) += beta;
+        A(b, b) += beta;
+        A(a, b) -= beta;
+        A(b, a) -= beta;
+      }
+    return A;
+  }
+  // β LᵀL y
+  VectorXd apply(const VectorXd& y) const {
+    VectorXd out = VectorXd::Zero(y.size());
+    if (beta == 0.0) return out;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
+        const double d = y[c[j + 1]] - y[c[j]];
+        out[c[j + 1]] += beta * d;
+        out[c[j]] -= beta * d;
+      }
+    return out;
+  }
+};
+
 void gauss_newton(Run& r, VectorXd x) {
   Misfit& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
@@ -117,14 +156,18 @@ void gauss_newton(Run& r, VectorXd x) {
   auto full = [&]() { return obj.horizon() >= t_end; };
 
   Misfit::MisfitProfile prof;
+  // With a smoothness prior (§7.8) its value, gradient and (constant) matrix are added to the
+  // data's: the Gauss–Newton model of the whole cost.
+  const Smoothness prior{r.opt.smoothness_weight, r.opt.smoothness_chains};
+  const MatrixXd prior_matrix = prior.matrix(x.size());
   auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx, bool with_profile) {
     try {
       const VectorXd q = xx.array().exp();
       VectorXd g;
       MatrixXd H;
-      J = obj.gauss_newton(q, g, H, with_profile ? &prof : nullptr);
-      gx = q.cwiseProduct(g);
-      Hx = q.asDiagonal() * H * q.asDiagonal();
+      J = obj.gauss_newton(q, g, H, with_profile ? &prof : nullptr) + prior.value(xx);
+      gx = q.cwiseProduct(g) + prior.apply(xx);
+      Hx = q.asDiagonal() * H * q.asDiagonal() + prior_matrix;
       return std::isfinite(J) && gx.allFinite() && Hx.allFinite();
     } catch (const io::Interrupted&) {
       throw;
@@ -197,7 +240,7 @@ void gauss_newton(Run& r, VectorXd x) {
         for (double a = 2.0; a <= r.opt.max_extrapolation && a * st.delta.norm() <= r.opt.max_trust_radius; a *= 2.0) {
           double Ja = 0.0;
           try {
-            Ja = obj.cost((x + a * st.delta).array().exp());
+            Ja = obj.cost((x + a * st.delta).array().exp()) + prior.value(x + a * st.delta);
           } catch (const std::exception&) {
             break;
           }
@@ -247,6 +290,7 @@ void gauss_newton(Run& r, VectorXd x) {
   r.sum.iterations_done = k;
   r.sum.q = x.array().exp();
   r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
+  r.sum.prior_cost = prior.value(x);
   obj.set_horizon(t_end);
 }
 
@@ -391,30 +435,6 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
   obj.set_horizon(t_end);
 }
-
-// The smoothness prior ½ β Σ_chains Σ_j (x_{j+1} − x_j)² on x = log q: value, gradient, product.
-struct Smoothness {
-  double beta = 0.0;
-  std::vector<std::vector<int>> chains;
-  double value(const VectorXd& x) const {
-    double v = 0.0;
-    for (const auto& c : chains)
-      for (std::size_t j = 0; j + 1 < c.size(); ++j) v += std::pow(x[c[j + 1]] - x[c[j]], 2);
-    return 0.5 * beta * v;
-  }
-  // β LᵀL y
-  VectorXd apply(const VectorXd& y) const {
-    VectorXd out = VectorXd::Zero(y.size());
-    if (beta == 0.0) return out;
-    for (const auto& c : chains)
-      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
-        const double d = y[c[j + 1]] - y[c[j]];
-        out[c[j + 1]] += beta * d;
-        out[c[j]] -= beta * d;
-      }
-    return out;
-  }
-};
 
 // Inexact Gauss–Newton–Krylov (docs/theory.md §7.7): the trust-region step from truncated
 // conjugate gradients on matrix-free products (Steihaug), stopped at ‖H δ + g‖ <= η ‖g‖ with the

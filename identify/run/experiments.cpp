@@ -152,6 +152,9 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     if (sc.identification.smoothness != 0.0)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario", "sets identification.smoothness, which a joint run does not take",
           r.scenario);
+    if (sc.identification.start != "auto")
+      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+          "sets identification.start, which a joint run does not take (it starts plain, without restarts)", r.scenario);
     ep->runs.push_back(make_problem(sc, r.data));
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
   }

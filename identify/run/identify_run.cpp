@@ -217,7 +217,7 @@ namespace {
 // model error m of the RMS signal z_k — a weight is chosen only if its fit would pass the fit
 // test); plus the interpolation floor (Objective::interpolation_misfit at that estimate). That β
 // (the largest meeting it) and its estimate are kept. The stated noise levels are needed.
-OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r, OptimizerOptions oo,
+OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r, const VectorXd& start, OptimizerOptions oo,
                                   const std::function<void(const IterationRecord&)>& progress, bool verbose) {
   double expected = 0.0, variance = 0.0;
   const auto& R = obj.weights();
@@ -234,7 +234,7 @@ OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r
   }
   expected += 2.0 * std::sqrt(variance);
   r.smoothness_expected_misfit = expected;
-  VectorXd q = r.initial;
+  VectorXd q = start;
   OptimizerSummary chosen;
   bool have = false;
   bool floor_added = false;
@@ -275,6 +275,62 @@ OptimizerSummary discrepancy_path(const Problem& p, Objective& obj, RunResult& r
   return chosen;
 }
 
+// More parameters than this: `auto` leaves the explicit Gauss–Newton matrix (P tangent solves per
+// iteration) for products (docs/theory.md §7.7), and a sectional family starts from the
+// coarse-to-fine ladder (§7.6).
+constexpr int kExplicitGaussNewtonParameters = 16;
+
+// The coarse-to-fine ladder (docs/theory.md §7.6): every sectional family tied into B = 1, 2, 4, …
+// contiguous blocks, each level solved from the end of the previous one, until a level's fit is
+// within noise and discretisation on the full model (finer levels would only refit what the data
+// already hold) or B reaches the sections. Each level has its own automatic step (§5.2 for the
+// level's P tied parameters: modes up to P + 2, never finer than the full run's; unless the scenario
+// fixes the step or BDF chooses it): the coarse levels need only the low modes. Returns the start
+// of the full parameterization's run.
+struct Ladder {
+  VectorXd q;
+  int iterations = 0;
+  std::string label;
+  std::vector<RunResult::Attempt::Level> levels;
+};
+Ladder coarse_to_fine(const Problem& p, Objective& obj, const std::vector<std::string>& names,
+                      const std::vector<std::vector<int>>& families, const VectorXd& start, const OptimizerOptions& oo,
+                      ObjectiveCounters& extra, bool verbose) {
+  std::size_t N = 0;
+  for (const auto& f : families) N = std::max(N, f.size());
+  Ladder out;
+  out.q = start;
+  out.label = "coarse-to-fine over";
+  for (int B = 1; B < static_cast<int>(N); B *= 2) {
+    auto [group, gnames] = block_grouping(names, families, B);
+    TiedParameterization tied(*p.params, out.q, group, gnames);
+    ObjectiveOptions lo = p.objective_options;
+    // (BDF chooses its own steps: the level keeps the full run's options.)
+    if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
+        lo.solver.integrator != SolverOptions::Integrator::Bdf)
+      lo.solver.step = std::max(lo.solver.step, identifier_step(p.scenario, p.model(), tied, p.signals));
+    Objective level(p.model(), tied, p.signals, p.data, lo);
+    OptimizerOptions ol = oo;
+    ol.method = tied.size() <= kExplicitGaussNewtonParameters || !level.has_matrix_free_products() ? "gauss-newton"
+                                                                                                    : "gauss-newton-krylov";
+    ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
+    ol.smoothness_chains.clear();
+    ol.continuation = p.scenario.identification.continuation_misfit > 0;
+    const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
+    extra.Accumulate(level.counters());
+    out.iterations += sl.iterations_done;
+    if (sl.q.allFinite()) out.q = tied.expand(sl.q);
+    out.label += " " + std::to_string(B);
+    const bool explained = sl.q.allFinite() && test_fit(p, obj, out.q).within_noise_and_discretisation;
+    out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
+    if (verbose)
+      std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,
+                  sl.BriefReport().c_str(), explained ? "; the fit is within noise and discretisation" : "");
+    if (explained) break;
+  }
+  out.label += " blocks, then " + std::to_string(N) + " sections";
+  return out;
+}
 }  // namespace
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
@@ -286,19 +342,26 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   r.truth = p.true_values;
   std::string method = ro.method.empty() ? p.scenario.identification.method : ro.method;
   const double smoothness = p.scenario.identification.smoothness;
-  if (method == "auto") method = smoothness != 0.0 ? "gauss-newton-krylov" : p.params->size() <= 16 ? "gauss-newton" : "lbfgs";
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+  // auto (docs/theory.md §7.7): the explicit Gauss–Newton matrix up to its parameter limit; beyond
+  // it matrix-free products with a prior (displacement sensors only: with rate sensors the explicit
+  // matrix), else L-BFGS.
+  if (method == "auto")
+    method = p.params->size() <= kExplicitGaussNewtonParameters ? "gauss-newton"
+             : smoothness != 0.0 ? (obj.has_matrix_free_products() ? "gauss-newton-krylov" : "gauss-newton")
+                                 : "lbfgs";
   r.method = method;
   std::vector<std::vector<int>> chains;
   if (smoothness != 0.0) {
-    if (method != "gauss-newton-krylov")
-      io::fail_field(p.scenario.source, "identification.smoothness", "needs method gauss-newton-krylov (or auto)", method);
+    if (method != "gauss-newton-krylov" && method != "gauss-newton")
+      io::fail_field(p.scenario.source, "identification.smoothness", "needs method gauss-newton or gauss-newton-krylov (or auto)",
+                     method);
     chains = section_families(r.names);
     if (chains.empty())
       io::fail_field(p.scenario.source, "identification.smoothness",
                      "needs sectional parameters (X_1 ... X_N) among those estimated", "none");
   }
 
-  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   OptimizerOptions oo;
   oo.method = method;
   oo.max_iterations = ro.max_iterations.value_or(p.scenario.identification.max_iterations);
@@ -312,18 +375,43 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
                    "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
                    std::to_string(oo.steepest_weights.size()) + " values");
   Table table(*p.params, p.params->names().size() <= 3 && p.params->paper_form());
-  if (ro.verbose) table.header();
   auto progress = [&](const IterationRecord& rec) {
     io::check_interrupt();
     if (ro.verbose) table.row(rec);
   };
   oo.smoothness_chains = chains;
+  // identification.start: auto starts a sectional family of more sections than the explicit
+  // Gauss–Newton limit from the coarse-to-fine ladder: from the uniform start, its plain run stalls
+  // (docs/theory.md §7.6).
+  const auto families = section_families(r.names);
+  std::size_t sections = 0;
+  for (const auto& f : families) sections = std::max(sections, f.size());
+  const std::string& start_how = p.scenario.identification.start;
+  if (start_how == "coarse-to-fine" && families.empty())
+    io::fail_field(p.scenario.source, "identification.start", "needs sectional parameters (X_1 ... X_N) among those estimated",
+                   start_how);
+  const bool ladder_first = start_how == "coarse-to-fine" ||
+                            (start_how == "auto" && sections > static_cast<std::size_t>(kExplicitGaussNewtonParameters));
+  ObjectiveCounters extra;  // solves of the tied levels' objectives
+  VectorXd start = r.initial;
+  std::string first_label = "plain " + method;
+  int first_iterations = 0;
+  std::vector<RunResult::Attempt::Level> first_levels;
+  if (ladder_first) {
+    if (ro.verbose) std::printf("%zu sections: coarse to fine from the start\n", sections);
+    const Ladder lad = coarse_to_fine(p, obj, r.names, families, r.initial, oo, extra, ro.verbose);
+    start = lad.q;
+    first_label = lad.label;
+    first_iterations = lad.iterations;
+    first_levels = lad.levels;
+  }
+  if (ro.verbose) table.header();
   if (smoothness >= 0.0) {
     oo.smoothness_weight = smoothness;
-    r.summary = minimize(obj, r.initial, oo, progress);
+    r.summary = minimize(obj, start, oo, progress);
     r.smoothness_weight = smoothness;
   } else {
-    r.summary = discrepancy_path(p, obj, r, oo, progress, ro.verbose);
+    r.summary = discrepancy_path(p, obj, r, start, oo, progress, ro.verbose);
     oo.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
   r.fit = test_fit(p, obj, r.summary.q);
@@ -348,7 +436,8 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     a.fit_message = f.message;
     return a;
   };
-  r.attempts.push_back(attempt_record("plain " + method, method, r.summary, r.fit, r.summary.iterations_done));
+  r.attempts.push_back(attempt_record(first_label, method, r.summary, r.fit, first_iterations + r.summary.iterations_done));
+  r.attempts.back().levels = first_levels;
   // Rank of an attempt: converged and explaining the data, then explaining it, then the cost.
   auto better = [](const RunResult::Attempt& a, const RunResult::Attempt& b) {
     const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
@@ -356,22 +445,25 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     return ra != rb ? ra > rb : a.cost < b.cost;
   };
   // Further attempts when the model at the estimate does not explain the data.
-  const auto families = section_families(r.names);
+  // The second of the two starts of a sectional family: coarse to fine after a plain run, the plain
+  // run after the ladder (a coarse level can land in a basin the full profile does not leave:
+  // beam-ei8 started coarse to fine stops at J = 0.099 where the plain run reaches 4e-8).
   std::vector<std::string> strategies;
-  if (!families.empty()) strategies.push_back("coarse-to-fine");
+  if (!families.empty()) strategies.push_back(ladder_first ? "plain" : "coarse-to-fine");
   strategies.push_back("cautious-continuation");
-  ObjectiveCounters extra;  // solves of the tied levels' objectives
   for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
     const std::string& how = strategies[k];
     // Restarts answer a false convergence: the optimiser stopped on a convergence test where the
-    // model does not explain the data. Coarse to fine is tried whenever the residual exceeds noise
-    // and discretisation (a local minimum of a sectional profile may still fit within a declared
-    // model error), and also after a run that used up its iterations (sections the sensors barely
-    // see wander through any budget: EI on 64 sections, docs/theory.md §7.8); the others only when
-    // a converged fit does not explain the data.
+    // model does not explain the data. The other start of a sectional family (coarse to fine, or
+    // plain after the ladder) is tried whenever the residual exceeds noise and discretisation (a
+    // local minimum of a sectional profile may still fit within a declared model error), and also
+    // after a run that used up its iterations (sections the sensors barely see wander through any
+    // budget: EI on 64 sections, docs/theory.md §7.8); the cautious continuation only when a
+    // converged fit does not explain the data.
+    const bool other_start = how == "coarse-to-fine" || how == "plain";
     const bool out_of_iterations = r.summary.termination == OptimizerSummary::Termination::MaxIterations;
-    if (!r.summary.converged() && !(how == "coarse-to-fine" && out_of_iterations)) break;
-    if (how == "coarse-to-fine" ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
+    if (!r.summary.converged() && !(other_start && out_of_iterations)) break;
+    if (other_start ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
     if (ro.verbose)
       std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
                   r.fit.explains_data ? "the residual exceeds noise and discretisation" : r.fit.message.c_str(), k + 1,
@@ -379,42 +471,18 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     OptimizerSummary s;
     int iterations = 0;
     std::string label;
+    std::vector<RunResult::Attempt::Level> levels;
     if (how == "coarse-to-fine") {
-      // Levels of 1, 2, 4, … blocks per sectional family, each from the end of the previous one,
-      // then the full parameterization.
-      std::size_t N = 0;
-      for (const auto& f : families) N = std::max(N, f.size());
-      VectorXd q = r.initial;
-      label = "coarse-to-fine over";
-      for (int B = 1; B < static_cast<int>(N); B *= 2) {
-        auto [group, gnames] = block_grouping(r.names, families, B);
-        TiedParameterization tied(*p.params, q, group, gnames);
-        Objective level(p.model(), tied, p.signals, p.data, p.objective_options);
-        OptimizerOptions ol = oo;
-        ol.method = "gauss-newton";
-        ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
-        ol.continuation = p.scenario.identification.continuation_misfit > 0;
-        const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
-        const auto& c = level.counters();
-        extra.forward_solves += c.forward_solves;
-        extra.costate_solves += c.costate_solves;
-        extra.sensitivity_solves += c.sensitivity_solves;
-        extra.gradient_evaluations += c.gradient_evaluations;
-        extra.forward_seconds += c.forward_seconds;
-        extra.costate_seconds += c.costate_seconds;
-        extra.sensitivity_seconds += c.sensitivity_seconds;
-        extra.quadrature_seconds += c.quadrature_seconds;
-        extra.checkpointed_passes += c.checkpointed_passes;
-        extra.checkpoint_resolves += c.checkpoint_resolves;
-        extra.solver.Accumulate(c.solver);
-        iterations += sl.iterations_done;
-        if (sl.q.allFinite()) q = tied.expand(sl.q);
-        label += " " + std::to_string(B);
-        if (ro.verbose) std::printf("  %d block%s per family: %s\n", B, B > 1 ? "s" : "", sl.BriefReport().c_str());
-      }
-      label += " blocks, then " + std::to_string(N) + " sections";
+      const Ladder lad = coarse_to_fine(p, obj, r.names, families, r.initial, oo, extra, ro.verbose);
+      iterations += lad.iterations;
+      label = lad.label;
+      levels = lad.levels;
       if (ro.verbose) table.header();
-      s = minimize(obj, q, oo, progress);
+      s = minimize(obj, lad.q, oo, progress);
+    } else if (how == "plain") {
+      label = "plain " + method;
+      if (ro.verbose) table.header();
+      s = minimize(obj, r.initial, oo, progress);
     } else {
       OptimizerOptions oc = oo;  // the run's own method, with a four times more cautious continuation
       oc.continuation = true;
@@ -427,6 +495,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     iterations += s.iterations_done;
     const FitTest f = test_fit(p, obj, s.q);
     r.attempts.push_back(attempt_record(label, method, s, f, iterations));
+    r.attempts.back().levels = levels;
     if (better(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
       r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
       r.summary = s;
@@ -488,17 +557,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();
-  r.counters.forward_solves += extra.forward_solves;
-  r.counters.costate_solves += extra.costate_solves;
-  r.counters.sensitivity_solves += extra.sensitivity_solves;
-  r.counters.gradient_evaluations += extra.gradient_evaluations;
-  r.counters.forward_seconds += extra.forward_seconds;
-  r.counters.costate_seconds += extra.costate_seconds;
-  r.counters.sensitivity_seconds += extra.sensitivity_seconds;
-  r.counters.quadrature_seconds += extra.quadrature_seconds;
-  r.counters.checkpointed_passes += extra.checkpointed_passes;
-  r.counters.checkpoint_resolves += extra.checkpoint_resolves;
-  r.counters.solver.Accumulate(extra.solver);
+  r.counters.Accumulate(extra);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -577,12 +636,18 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
             }()},
            {"attempts", [&] {
               nlohmann::json a = nlohmann::json::array();
-              for (std::size_t k = 0; k < attempts.size(); ++k)
+              for (std::size_t k = 0; k < attempts.size(); ++k) {
                 a.push_back({{"strategy", attempts[k].strategy}, {"method", attempts[k].method},
                              {"termination", attempts[k].termination}, {"optimizer_converged", attempts[k].optimizer_converged},
                              {"cost", std::isfinite(attempts[k].cost) ? nlohmann::json(attempts[k].cost) : nlohmann::json(nullptr)},
                              {"iterations", attempts[k].iterations}, {"explains_data", attempts[k].explains_data},
                              {"fit_message", attempts[k].fit_message}, {"chosen", static_cast<int>(k) == chosen_attempt}});
+                for (const auto& l : attempts[k].levels)
+                  a.back()["levels"].push_back({{"blocks", l.blocks}, {"step", l.step},
+                                                {"cost", std::isfinite(l.cost) ? nlohmann::json(l.cost) : nlohmann::json(nullptr)},
+                                                {"iterations", l.iterations}, {"termination", l.termination},
+                                                {"explained", l.explained}});
+              }
               return a;
             }()},
            {"cost", summary.cost},
@@ -601,6 +666,13 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
               return sm;
             }()},
            {"krylov_iterations", summary.krylov_iterations},
+           // Every attempt's iterations with its coarse-to-fine levels (`iterations` is the chosen
+           // run's history alone).
+           {"iterations_all_attempts", [&] {
+              int n = 0;
+              for (const auto& a : attempts) n += a.iterations;
+              return n;
+            }()},
            {"gradient_evaluations", counters.gradient_evaluations},
            {"forward_solves", counters.forward_solves},
            {"costate_solves", counters.costate_solves},

@@ -489,7 +489,9 @@ TEST(ScoleIdentifyHardening, OutDirectoryWithQuotesAndSemicolonsRunsNothingAndSt
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_FALSE(fs::exists(dir / "pwned")) << "the --out text ran a command";
   EXPECT_TRUE(fs::exists(out / "identify.json"));
-  if (have_gnuplot()) EXPECT_TRUE(fs::exists(out / "fit.png")) << "no plot in a directory whose name holds a quote";
+  if (have_gnuplot()) {
+    EXPECT_TRUE(fs::exists(out / "fit.png")) << "no plot in a directory whose name holds a quote";
+  }
 }
 
 TEST(ScoleIdentifyHardening, SensorNameWithShellOrGnuplotSyntaxIsRefused) {

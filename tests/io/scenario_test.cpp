@@ -370,4 +370,10 @@ identification:
   EXPECT_EQ(to_json(morozov)["identification"]["smoothness"].get<std::string>(), "discrepancy");
   EXPECT_NE(error_of(head + "  smoothness: -1\n").find("identification.smoothness"), std::string::npos);
   EXPECT_NE(error_of(head + "  smoothness: lots\n").find("identification.smoothness"), std::string::npos);
+  // How the first attempt starts: auto, plain or coarse-to-fine.
+  EXPECT_EQ(automatic.identification.start, "auto");
+  const Scenario ladder = parse_scenario(head + "  start: coarse-to-fine\n", "scenario 'x.yaml'");
+  EXPECT_EQ(ladder.identification.start, "coarse-to-fine");
+  EXPECT_EQ(to_json(ladder)["identification"]["start"].get<std::string>(), "coarse-to-fine");
+  EXPECT_NE(error_of(head + "  start: random\n").find("identification.start"), std::string::npos);
 }

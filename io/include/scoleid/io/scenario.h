@@ -198,11 +198,15 @@ struct IdentificationSpec {
   // < 0 = automatic: 0 for data the scenario synthesises from its own model (no truth.overrides),
   // 0.01 for anything else (a data file, a truth with overrides).
   double model_error = -1.0;
-  // Further attempts when the fit does not explain the data (coarse-to-fine over sections, a
-  // slower horizon continuation); 0 = report the first attempt as it is.
+  // Further attempts when the fit does not explain the data (the other start of sectional
+  // parameters, a slower horizon continuation); 0 = report the first attempt as it is.
   int restarts = 2;
+  // How the first attempt starts (docs/theory.md §7.6): "plain" from the initial values,
+  // "coarse-to-fine" from the ladder over sectional parameters, "auto" = the ladder for a family of
+  // more than 16 sections, plain otherwise.
+  std::string start = "auto";
   // Smoothness prior on the logarithm of sectional parameters (EI_1 … EI_N and the like, neighbours
-  // tied by ½ β Σ (log q_{j+1} − log q_j)²; method gauss-newton-krylov): β >= 0, 0 = off (the
+  // tied by ½ β Σ (log q_{j+1} − log q_j)²; method gauss-newton or gauss-newton-krylov): β >= 0, 0 = off (the
   // default), < 0 ("discrepancy" in YAML) = β chosen by the discrepancy principle from the stated
   // sensor noise (docs/theory.md §7.8).
   double smoothness = 0.0;

@@ -78,6 +78,20 @@ struct ObjectiveCounters {
   long checkpointed_passes = 0;   // gradients and products whose state was checkpointed
   long checkpoint_resolves = 0;   // state segments re-solved from checkpoints
   SolverSummary solver;  // accumulated over all solves
+  // Adds another objective's counts and times (the tied levels of coarse to fine).
+  void Accumulate(const ObjectiveCounters& o) {
+    forward_solves += o.forward_solves;
+    costate_solves += o.costate_solves;
+    sensitivity_solves += o.sensitivity_solves;
+    gradient_evaluations += o.gradient_evaluations;
+    forward_seconds += o.forward_seconds;
+    costate_seconds += o.costate_seconds;
+    sensitivity_seconds += o.sensitivity_seconds;
+    quadrature_seconds += o.quadrature_seconds;
+    checkpointed_passes += o.checkpointed_passes;
+    checkpoint_resolves += o.checkpoint_resolves;
+    solver.Accumulate(o.solver);
+  }
 };
 
 class Objective : public Misfit {

@@ -10,7 +10,8 @@
 //                     one costate gradient per trial point.
 //   gauss-newton      trust-region Gauss–Newton (Levenberg) on x from forward sensitivities;
 //                     see gauss_newton_step.h for the step and the radius, and below for the
-//                     horizon continuation.
+//                     horizon continuation. Takes the optional smoothness prior (its matrix
+//                     added to the data's).
 //   gauss-newton-krylov  inexact trust-region Gauss–Newton: the step from truncated conjugate
 //                     gradients (Steihaug) on matrix-free products H v (objective.h,
 //                     gauss_newton_product: one tangent and one costate solve each), stopped by the
@@ -80,7 +81,7 @@ struct OptimizerOptions {
   double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
   // gauss-newton-krylov: CG iterations per step (each one matrix-free product: two solves)
   int max_krylov_iterations = 50;
-  // Smoothness prior on x = log q (gauss-newton-krylov only; docs/theory.md §7.8):
+  // Smoothness prior on x = log q (gauss-newton and gauss-newton-krylov; docs/theory.md §7.8):
   //   ½ β Σ_chains Σ_j (x_{c_{j+1}} − x_{c_j})²
   // over chains of neighbouring sections (e.g. the indices of EI_1 … EI_N). β = 0: off.
   double smoothness_weight = 0.0;

@@ -5,11 +5,12 @@
 // The fit test (fit_test.h, docs/theory.md §7.6): the run is converged only when the optimiser
 // stopped on a convergence test AND the model at the estimate explains the data. When it does not,
 // although the optimiser stopped on a convergence test (a false convergence), up to
-// identification.restarts further attempts are made from the starting point — coarse to fine over
-// sectional parameters (tied_parameterization.h), then the run's method with a horizon
-// continuation four times as cautious — and the best attempt (converged and explaining the data,
-// else explaining it, else the lowest cost over the whole record) is the result; every attempt is
-// reported.
+// identification.restarts further attempts are made from the starting point — the other start of
+// sectional parameters (coarse to fine over tied blocks, tied_parameterization.h, after a plain
+// first attempt; the plain run after a coarse-to-fine one: identification.start), then the run's
+// method with a horizon continuation four times as cautious — and the best attempt (converged and
+// explaining the data, else explaining it, else the lowest cost over the whole record) is the
+// result; every attempt is reported.
 //
 // Identifiability (identifiability.h): Fisher-information std, resolution and the flags, at the
 // estimate; the uncertainty interval (interval.h) from them, a refit on the first half of the
@@ -61,8 +62,19 @@ struct RunResult {
     int iterations = 0;
     bool explains_data = false;
     std::string fit_message;
+    // The coarse-to-fine levels before the full run (docs/theory.md §7.6), if any: blocks per
+    // family, the level's time step, iterations, its cost, and whether its fit was within noise and
+    // discretisation on the full model (which ends the ladder).
+    struct Level {
+      int blocks = 0;
+      double step = 0, cost = 0;
+      int iterations = 0;
+      std::string termination;
+      bool explained = false;
+    };
+    std::vector<Level> levels;
   };
-  std::vector<Attempt> attempts;  // the first is the plain run
+  std::vector<Attempt> attempts;  // the first is the plain run, or the coarse-to-fine ladder's
   int chosen_attempt = 0;
   // The smoothness prior (identification.smoothness): its weight, and with the discrepancy
   // principle the weights tried, whether one met it, and the noise's expected misfit.
