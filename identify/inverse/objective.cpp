@@ -20,6 +20,20 @@ void push_outputs(const Eigen::MatrixXd& C, Trajectory& out, double t, const dou
   out.push(t, y.data(), yv.data(), ya.data());
 }
 
+// One Gauss point of weight wt in the Gauss–Newton sums (§7.1): with residual r, output
+// sensitivities CS (sensors × P) and the sensors' weights R,
+//   J += ½ wt rᵀ R r,   g += wt (CS)ᵀ R r,   H += wt (CS)ᵀ R (CS).
+void add_gauss_newton_point(double wt, const Eigen::VectorXd& r, const Eigen::Ref<const Eigen::MatrixXd>& CS,
+                            const Eigen::Ref<const Eigen::VectorXd>& R, double& J, Eigen::VectorXd& gradient,
+                            Eigen::MatrixXd& H) {
+  const Eigen::MatrixXd RCS = R.asDiagonal() * CS;
+  double e = 0.0;
+  for (Eigen::Index j = 0; j < r.size(); ++j) e += R[j] * r[j] * r[j];
+  J += 0.5 * wt * e;
+  gradient += wt * RCS.transpose() * r;
+  H += wt * CS.transpose() * RCS;
+}
+
 // 3-point Gauss–Legendre on [0, 1]
 constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
 constexpr double kGw[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
@@ -706,13 +720,7 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
       u.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
       const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-      const auto CS = CSall.middleRows(row, ns);
-      const MatrixXd RCS = Rv.asDiagonal() * CS;
-      double e = 0.0;
-      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-      J += 0.5 * wt * e;
-      gradient += wt * RCS.transpose() * r;
-      H += wt * CS.transpose() * RCS;
+      add_gauss_newton_point(wt, r, CSall.middleRows(row, ns), Rv, J, gradient, H);
     }
   }
   if (profile) *profile = misfit_profile(s, solver, u);
@@ -775,12 +783,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
             CS.col(i) = tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, x, v, a,
                                           si, svi);
           }
-          const MatrixXd RCS = Rv.asDiagonal() * CS;
-          double e = 0.0;
-          for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-          J += 0.5 * wt * e;
-          gradient += wt * RCS.transpose() * r;
-          H += wt * CS.transpose() * RCS;
+          add_gauss_newton_point(wt, r, CS, Rv, J, gradient, H);
         }
       }
       quadrature += since(tq);
