@@ -254,6 +254,11 @@ int main(int argc, char** argv) {
   traj->add_option("--elements", to.elements, "FE elements (default: 4 x identification.elements)");
   traj->add_option("--fe-step", to.fe_step, "FE time step (default: resolve the first 5 flexible modes with omega h <= 0.03)");
   traj->add_option("--levels", to.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
+  traj->add_flag("--nonlinear", to.nonlinear,
+                 "SCOLE: also the nonlinear FE model (finite shuttle rotation, the mast in the rotating frame), its "
+                 "difference to the chain beside the linear model's");
+  traj->add_option("--nonlinear-elements", to.nonlinear_elements,
+                   "elements of the nonlinear FE model (default: as the linear one)");
   auto* ident = app.add_subcommand(
       "identify", "the identifier on the Simbody truth at n, 2n, 4n segments, the estimates' errors against the "
                   "truth's values, their extrapolation in n, and the FE-on-FE result beside them. Writes identify.csv, "

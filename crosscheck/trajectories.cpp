@@ -6,6 +6,8 @@
 #include <stdexcept>
 
 #include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/fe/scole_nonlinear.h"
+#include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
@@ -27,6 +29,7 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
   if (elements < 0 || elements > io::limits::kMaxElements) return fail("elements must be in [1, " + std::to_string(io::limits::kMaxElements) + "] (0 = 4 x the identifier's)");
   if (levels < 1 || levels > 4) return fail("levels must be in [1, 4]");
   if (!(fe_step >= 0 && fe_step < 1e6)) return fail("fe_step must be >= 0 (0 = automatic)");
+  if (nonlinear_elements < 0 || nonlinear_elements > io::limits::kMaxElements) return fail("nonlinear_elements must be in [1, " + std::to_string(io::limits::kMaxElements) + "] (0 = the linear comparison's)");
   return true;
 }
 
@@ -50,8 +53,19 @@ double fe_reference_step(const identify::Problem& p) {
   return w > 0 ? std::min(h, kPhaseStep / w) : h;
 }
 
-FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
-  io::Scenario sc = io::truth_scenario(scenario);
+namespace {
+// The FE problem of io::truth_scenario(scenario) on `elements` elements with every parameter at
+// the truth file's value and the scenario's exact input signals.
+struct AtTruth {
+  io::Scenario sc;
+  std::unique_ptr<identify::Problem> p;
+  identify::VectorXd q;
+};
+
+AtTruth at_truth(const io::Scenario& scenario, const std::string& csv, int elements) {
+  AtTruth a;
+  a.sc = io::truth_scenario(scenario);
+  io::Scenario& sc = a.sc;
   if (sc.structure == "scole" && sc.scole.actuator_lag > 0)
     io::fail_field(scenario.source, "truth.overrides.scole.actuator_lag",
                    "is a servo lag of the Simbody truth only: the finite-element model cannot follow it, so the "
@@ -64,28 +78,53 @@ FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int
   // the others from the structure, not from the identifier's starting guesses.
   sc.identification.initial.clear();
   for (auto& in : sc.inputs) in.signal_from = "scenario";
-  auto p = identify::make_problem(sc, csv);
-  const auto& names = p->params->names();
-  identify::VectorXd q(static_cast<Eigen::Index>(names.size()));
+  a.p = identify::make_problem(sc, csv);
+  const auto& names = a.p->params->names();
+  a.q.resize(static_cast<Eigen::Index>(names.size()));
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const auto it = p->true_values.find(names[i]);
-    if (it == p->true_values.end())
+    const auto it = a.p->true_values.find(names[i]);
+    if (it == a.p->true_values.end())
       throw io::InputError("truth file '" + csv + "': no true value for parameter '" + names[i] + "'");
-    q[static_cast<Eigen::Index>(i)] = it->second;
+    a.q[static_cast<Eigen::Index>(i)] = it->second;
   }
-  auto& so = p->objective_options.solver;
-  so.integrator = identify::SolverOptions::Integrator::Esdirk;
-  so.step = step > 0 ? step : fe_reference_step(*p);
-  identify::Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  return a;
+}
+
+FeResponse response_of(const AtTruth& a, identify::MatrixXd fe) {
   FeResponse r;
-  r.t = p->data.t;
-  r.fe = obj.predict(q);
-  r.measured = p->data.z;
-  for (const auto& s : p->model().sensors) {
+  r.t = a.p->data.t;
+  r.fe = std::move(fe);
+  r.measured = a.p->data.z;
+  for (const auto& s : a.p->model().sensors) {
     r.sensors.push_back(s.name);
     r.kinds.push_back(s.kind);
   }
   return r;
+}
+}  // namespace
+
+FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
+  AtTruth a = at_truth(scenario, csv, elements);
+  auto& so = a.p->objective_options.solver;
+  so.integrator = identify::SolverOptions::Integrator::Esdirk;
+  so.step = step > 0 ? step : fe_reference_step(*a.p);
+  identify::Objective obj(a.p->model(), *a.p->params, a.p->signals, a.p->data, a.p->objective_options);
+  return response_of(a, obj.predict(a.q));
+}
+
+FeResponse nonlinear_fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
+  const AtTruth a = at_truth(scenario, csv, elements);
+  if (a.sc.structure != "scole")
+    io::fail_field(scenario.source, "structure", "has no nonlinear model (scole only)", "'" + a.sc.structure + "'");
+  identify::VectorXd c;
+  identify::MatrixXd dcdq;
+  a.p->params->coefficients(a.q, c, dcdq);
+  const identify::ScoleFE fe = identify::build_scole(a.sc.scole, elements, a.sc.inputs, a.sc.sensors, a.sc.source);
+  const identify::ScoleNonlinear nl(fe, a.sc.inputs, a.sc.sensors);
+  identify::NonlinearForwardOptions opt;
+  opt.max_step = step > 0 ? step : fe_reference_step(*a.p);
+  const auto r = identify::simulate_nonlinear(nl.at(c), a.p->signals, a.p->data.t, opt);
+  return response_of(a, r.outputs);
 }
 
 TrajectoryReport compare_trajectories(const io::Scenario& scenario, const TrajectoryOptions& opt,
@@ -106,8 +145,17 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
   // The FE response does not depend on the level: computed once, on the first level's times.
   const FeResponse fe = fe_response(scenario, rep.truths.front().csv, rep.elements, opt.fe_step);
   rep.fe_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
+  FeResponse nl;
+  if (opt.nonlinear) {
+    rep.nonlinear_elements = opt.nonlinear_elements > 0 ? opt.nonlinear_elements : rep.elements;
+    if (opt.progress)
+      std::fprintf(stderr, "scole-crosscheck: nonlinear FE model, %d elements\n", rep.nonlinear_elements);
+    const auto tn = std::chrono::steady_clock::now();
+    nl = nonlinear_fe_response(scenario, rep.truths.front().csv, rep.nonlinear_elements, opt.fe_step);
+    rep.nonlinear_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tn).count();
+  }
   const int ns = static_cast<int>(fe.sensors.size());
-  for (int k = 0; k < ns; ++k) rep.sensors.push_back({fe.sensors[static_cast<std::size_t>(k)], fe.kinds[static_cast<std::size_t>(k)], {}, std::numeric_limits<double>::quiet_NaN()});
+  for (int k = 0; k < ns; ++k) rep.sensors.push_back({fe.sensors[static_cast<std::size_t>(k)], fe.kinds[static_cast<std::size_t>(k)], {}, std::numeric_limits<double>::quiet_NaN(), {}});
   for (std::size_t l = 0; l < rep.truths.size(); ++l) {
     // The FE part does not depend on the level; each level contributes its measured columns.
     Eigen::MatrixXd measured = fe.measured;
@@ -126,11 +174,17 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
     for (int k = 0; k < ns; ++k) {
       const double num = (measured.col(k) - fe.fe.col(k)).norm(), den = measured.col(k).norm();
       rep.sensors[static_cast<std::size_t>(k)].relative_rms.push_back(den > 0 ? num / den : std::numeric_limits<double>::quiet_NaN());
+      if (opt.nonlinear) {
+        const double d = (measured.col(k) - nl.fe.col(k)).norm();
+        rep.sensors[static_cast<std::size_t>(k)].nonlinear_relative_rms.push_back(
+            den > 0 ? d / den : std::numeric_limits<double>::quiet_NaN());
+      }
     }
     if (l + 1 == rep.truths.size()) {
       rep.t = fe.t;
       rep.chain = measured;
       rep.fe = fe.fe;
+      if (opt.nonlinear) rep.nonlinear = nl.fe;
     }
   }
   for (auto& s : rep.sensors) {
@@ -148,10 +202,17 @@ Table trajectories_table(const TrajectoryReport& r) {
   t.header = {"sensor", "kind"};
   for (int n : r.segments) t.header.push_back("n=" + std::to_string(n));
   t.header.push_back("rate");
+  const bool nl = r.nonlinear_elements > 0;
+  if (nl) {
+    t.title += "; nonlinear FE (N=" + std::to_string(r.nonlinear_elements) + ") beside it";
+    for (int n : r.segments) t.header.push_back("nonlinear n=" + std::to_string(n));
+  }
   for (const auto& s : r.sensors) {
     std::vector<std::string> row{s.name, s.kind};
     for (double d : s.relative_rms) row.push_back(percent(d, 3));
     row.push_back(number(s.rate, 3));
+    if (nl)
+      for (double d : s.nonlinear_relative_rms) row.push_back(percent(d, 3));
     t.rows.push_back(row);
   }
   return t;
@@ -164,6 +225,7 @@ Table overlay_table(const TrajectoryReport& r) {
     t.header.push_back(s.name + "_chain");
     t.header.push_back(s.name + "_fe");
     t.header.push_back(s.name + "_residual");
+    if (r.nonlinear.size() != 0) t.header.push_back(s.name + "_nonlinear");
   }
   for (std::size_t i = 0; i < r.t.size(); ++i) {
     std::vector<std::string> row{number(r.t[i], 10)};
@@ -172,6 +234,7 @@ Table overlay_table(const TrajectoryReport& r) {
       row.push_back(number(r.chain(ii, k), 10));
       row.push_back(number(r.fe(ii, k), 10));
       row.push_back(number(r.chain(ii, k) - r.fe(ii, k), 6));
+      if (r.nonlinear.size() != 0) row.push_back(number(r.nonlinear(ii, k), 10));
     }
     t.rows.push_back(row);
   }
@@ -195,6 +258,11 @@ nlohmann::json to_json(const TrajectoryReport& r) {
     for (double v : s.relative_rms) d.push_back(num(v));
     e["relative_rms"] = d;
     e["rate"] = num(s.rate);
+    if (r.nonlinear_elements > 0) {
+      nlohmann::json dn = nlohmann::json::array();
+      for (double v : s.nonlinear_relative_rms) dn.push_back(num(v));
+      e["nonlinear_relative_rms"] = dn;
+    }
     j["sensors"].push_back(e);
   }
   nlohmann::json tr = nlohmann::json::array();
@@ -202,6 +270,10 @@ nlohmann::json to_json(const TrajectoryReport& r) {
     tr.push_back({{"segments", l.segments}, {"file", "truths/n" + std::to_string(l.segments) + "/truth.csv"}, {"seconds", l.seconds}, {"integrator", l.summary.integrator}});
   j["truths"] = tr;
   j["fe_seconds"] = r.fe_seconds;
+  if (r.nonlinear_elements > 0) {
+    j["nonlinear_elements"] = r.nonlinear_elements;
+    j["nonlinear_seconds"] = r.nonlinear_seconds;
+  }
   j["seconds"] = r.seconds;
   return j;
 }

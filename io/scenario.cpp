@@ -457,6 +457,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
   id.start = r.choice("start", id.start, {"auto", "plain", "coarse-to-fine"});
+  id.model = r.choice("model", id.model, {"linear", "nonlinear"});
   if (r.has("smoothness")) {
     const YAML::Node m = r.child("smoothness");
     if (m.IsScalar() && m.Scalar() == "discrepancy")
@@ -581,6 +582,8 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     parse_sensors(r.child("sensors"), sc);
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
+    if (sc.identification.model == "nonlinear" && sc.structure != "scole")
+      fail_field(source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'nonlinear'");
     for (const auto& u : sc.identification.uncertain) {
       const std::string field = "identification.uncertain." + u.field;
       if (u.is_switch) {
@@ -726,7 +729,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
-                         {"restarts", id.restarts}, {"start", id.start},
+                         {"restarts", id.restarts}, {"start", id.start}, {"model", id.model},
                          {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};
   if (!id.uncertain.empty()) {
     json u = json::object();

@@ -334,6 +334,7 @@ Ladder coarse_to_fine(const Problem& p, Objective& obj, const std::vector<std::s
 }  // namespace
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
+  if (p.scenario.identification.model == "nonlinear") return run_nonlinear_identification(p, ro);
   const auto t0 = std::chrono::steady_clock::now();
   RunResult r;
   r.scenario = p.scenario.name;
@@ -614,6 +615,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                      {"gradient_norm", it.gradient_norm}, {"horizon", it.horizon}});
   }
   json out{{"scenario", scenario},
+           {"model", model},
            {"method", method},
            {"parameters", params},
            {"physical_estimate", p.params->physical(estimate)},
@@ -747,8 +749,12 @@ io::DataTable fit_table(const Measurements& data, const MatrixXd& Y) {
 
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.csv: measured, predicted and residual per sensor at the sample times.
-  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
-  const io::DataTable tab = fit_table(p.data, obj.predict(r.estimate));
+  MatrixXd predicted = r.predicted;
+  if (predicted.size() == 0) {
+    Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+    predicted = obj.predict(r.estimate);
+  }
+  const io::DataTable tab = fit_table(p.data, predicted);
   io::write_csv(dir.path("fit.csv"), tab);
   // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
   std::vector<std::pair<int, double>> cost;

@@ -9,6 +9,7 @@
 
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/scole_model.h"
+#include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/structure_parameters.h"
@@ -246,6 +247,26 @@ void check_step(const io::Scenario& sc, const StructuralModel& model, const Para
 }
 }  // namespace
 
+namespace {
+// Names, the truth's sensor errors (truth.overrides.sensors: bias and drift, as the Simbody truth
+// adds them) and, if asked, each sensor's seeded Gaussian noise.
+void add_sensor_errors(const io::Scenario& sc, bool add_noise, Measurements& m) {
+  for (const auto& s : sc.sensors) m.names.push_back(s.name);
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+    for (Eigen::Index k = 0; k < m.z.rows(); ++k)
+      m.z(k, static_cast<Eigen::Index>(j)) += sc.sensors[j].bias + sc.sensors[j].drift * m.t[static_cast<std::size_t>(k)];
+  if (add_noise) {
+    std::mt19937_64 rng(sc.simulation.seed);
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+      const double sd = sc.sensors[j].noise_std;
+      if (sd <= 0) continue;
+      std::normal_distribution<double> N(0.0, sd);
+      for (Eigen::Index k = 0; k < m.z.rows(); ++k) m.z(k, static_cast<Eigen::Index>(j)) += N(rng);
+    }
+  }
+}
+}  // namespace
+
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
   const auto [model, coefficients] = true_model(sc, elements);
   const AssembledModel ops = assemble(model, coefficients);
@@ -281,21 +302,30 @@ Measurements synthesize(const io::Scenario& sc, int elements, double rtol, doubl
     }
     m.z.row(static_cast<Eigen::Index>(k)) = y.transpose();
   });
-  for (const auto& s : sc.sensors) m.names.push_back(s.name);
-  // Sensor errors of the truth's sensors (truth.overrides.sensors), as the Simbody truth adds them.
-  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
-    for (Eigen::Index k = 0; k < m.z.rows(); ++k)
-      m.z(k, static_cast<Eigen::Index>(j)) += sc.sensors[j].bias + sc.sensors[j].drift * times[static_cast<std::size_t>(k)];
-  if (add_noise) {
-    std::mt19937_64 rng(sc.simulation.seed);
-    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-      const double sd = sc.sensors[j].noise_std;
-      if (sd <= 0) continue;
-      std::normal_distribution<double> N(0.0, sd);
-      for (Eigen::Index k = 0; k < m.z.rows(); ++k) m.z(k, static_cast<Eigen::Index>(j)) += N(rng);
-    }
-  }
+  add_sensor_errors(sc, add_noise, m);
   return m;
+}
+
+Measurements synthesize_nonlinear(const io::Scenario& sc, int elements, double step, bool add_noise) {
+  const auto [model, coefficients] = true_model(sc, elements);
+  const ScoleNonlinear nl = scole_nonlinear(sc, elements);
+  NonlinearForwardOptions o;
+  o.max_step = step;
+  Measurements m;
+  m.t = sample_times(sc);
+  m.z = simulate_nonlinear(nl.at(coefficients), scenario_signals(sc), m.t, o).outputs;
+  add_sensor_errors(sc, add_noise, m);
+  return m;
+}
+
+ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
+  if (sc.structure != "scole")
+    fail_field(sc.source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'" + sc.structure + "'");
+  if (sc.identification.sections > 0)
+    fail_field(sc.source, "identification.sections", "is not available with the nonlinear model (model: nonlinear)",
+               std::to_string(sc.identification.sections));
+  const ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
+  return ScoleNonlinear(fe, sc.inputs, sc.sensors);
 }
 
 std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
@@ -420,7 +450,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
                  "is a servo lag of the Simbody truth only: the finite-element synthesis cannot produce it (generate the "
                  "data with scole-truth and pass them with --data)",
                  io::format_value(truth_sc.scole.actuator_lag));
-    p->data = synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
+    p->data = id.model == "nonlinear" ? synthesize_nonlinear(truth_sc, data_elements, step / 4.0, true)
+                                      : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
     p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
     set_true_values(truth_sc);
   }

@@ -376,4 +376,21 @@ identification:
   EXPECT_EQ(ladder.identification.start, "coarse-to-fine");
   EXPECT_EQ(to_json(ladder)["identification"]["start"].get<std::string>(), "coarse-to-fine");
   EXPECT_NE(error_of(head + "  start: random\n").find("identification.start"), std::string::npos);
+  // The identifier's model: linear by default; nonlinear is SCOLE's only.
+  EXPECT_EQ(automatic.identification.model, "linear");
+  EXPECT_EQ(to_json(automatic)["identification"]["model"].get<std::string>(), "linear");
+  EXPECT_NE(error_of(head + "  model: nonlinear\n").find("identification.model"), std::string::npos);
+  EXPECT_NE(error_of(head + "  model: quadratic\n").find("identification.model"), std::string::npos);
+  const std::string scole = R"(structure: scole
+inputs:
+  - {name: M, at: shuttle, kind: moment, direction: x, signal: {type: bangbang, amplitude: 100, t0: 0, width: 2}}
+sensors:
+  - {name: tip, at: mast, location: 130, direction: y}
+identification:
+  estimate: [EI]
+  model: nonlinear
+)";
+  const Scenario nonlinear = parse_scenario(scole, "scenario 'x.yaml'");
+  EXPECT_EQ(nonlinear.identification.model, "nonlinear");
+  EXPECT_EQ(to_json(nonlinear)["identification"]["model"].get<std::string>(), "nonlinear");
 }

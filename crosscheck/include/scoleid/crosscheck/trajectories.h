@@ -8,6 +8,7 @@
 // input signals (not the sampled input columns), so the difference is the chain's lumping plus the
 // FE's own discretisation, and nothing else. Per sensor k and level n:
 //     d_k(n) = ‖y_k^chain(n) − y_k^FE‖₂ / ‖y_k^chain(n)‖₂   over the sample times,
+// (and, for SCOLE on request, the same for the nonlinear FE model beside the linear one),
 // with the observed rate log2(d_k(n) / d_k(2n)) from the two finest levels (2 for the chain's
 // lumping as long as the FE's error is smaller).
 #include <string>
@@ -27,6 +28,10 @@ struct TrajectoryOptions {
   int levels = 3;        // n, 2n, 4n
   int elements = 0;      // FE mesh; 0 = 4 × identification.elements
   double fe_step = 0.0;  // FE time step; 0 = resolve the first 5 flexible modes with ω h <= 0.03
+  // SCOLE: also the nonlinear FE model (fe/scole_nonlinear.h) on `nonlinear_elements` elements
+  // (0 = the linear comparison's), stepped at the linear comparison's step (time/nonlinear_forward.h).
+  bool nonlinear = false;
+  int nonlinear_elements = 0;
   bool progress = false;
   bool IsValid(std::string* why) const;
 };
@@ -35,20 +40,22 @@ struct SensorAgreement {
   std::string name, kind;
   std::vector<double> relative_rms;   // per level
   double rate = 0.0;                  // log2 of the ratio of the two finest levels (NaN with one)
+  std::vector<double> nonlinear_relative_rms;  // per level, the nonlinear FE model (when run)
 };
 
 struct TrajectoryReport {
   std::string scenario;
   bool truth_overrides = false;
   int elements = 0;
+  int nonlinear_elements = 0;  // 0: the nonlinear model was not run
   std::vector<int> segments;
   std::vector<std::string> input_kinds;   // e.g. "actuator1 force"
   std::vector<SensorAgreement> sensors;
   // The finest level's records for the overlay plot (samples × sensors).
   std::vector<double> t;
-  Eigen::MatrixXd chain, fe;
+  Eigen::MatrixXd chain, fe, nonlinear;  // nonlinear: empty unless run
   std::vector<TruthLevel> truths;
-  double fe_seconds = 0.0, seconds = 0.0;
+  double fe_seconds = 0.0, nonlinear_seconds = 0.0, seconds = 0.0;
 };
 
 // Truth files go to `truth_root`/n<segments>/.
@@ -65,6 +72,9 @@ struct FeResponse {
 };
 // `step` 0: automatic, as TrajectoryOptions::fe_step.
 FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step);
+// The same with the nonlinear SCOLE model at a step of at most `step` (0: automatic, as fe_response);
+// other structures are refused.
+FeResponse nonlinear_fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step);
 
 Table trajectories_table(const TrajectoryReport& r);
 // t, then <sensor>_chain, <sensor>_fe, <sensor>_residual per sensor (finest level).

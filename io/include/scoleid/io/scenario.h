@@ -205,6 +205,10 @@ struct IdentificationSpec {
   // "coarse-to-fine" from the ladder over sectional parameters, "auto" = the ladder for a family of
   // more than 16 sections, plain otherwise.
   std::string start = "auto";
+  // The identifier's model (docs/theory.md §3.8): "linear" (small motions, the default) or
+  // "nonlinear" (SCOLE only: finite shuttle rotation, the mast's deflection in the shuttle's
+  // rotating frame; for slews).
+  std::string model = "linear";
   // Smoothness prior on the logarithm of sectional parameters (EI_1 … EI_N and the like, neighbours
   // tied by ½ β Σ (log q_{j+1} − log q_j)²; method gauss-newton or gauss-newton-krylov): β >= 0, 0 = off (the
   // default), < 0 ("discrepancy" in YAML) = β chosen by the discrepancy principle from the stated

@@ -44,6 +44,7 @@ struct RunOptions {
 
 struct RunResult {
   std::string scenario;
+  std::string model = "linear";  // identification.model
   std::string method;
   std::vector<std::string> names;
   VectorXd initial, estimate;
@@ -94,10 +95,15 @@ struct RunResult {
   bool half_record_converged = false;
   double wall_seconds = 0;
   double identifiability_seconds = 0;
+  MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
   nlohmann::json to_json(const Problem& p) const;
 };
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
+// identification.model: nonlinear (nonlinear_run.cpp; run_identification hands over to it): the
+// optimiser, the fit test and one cautious restart on the nonlinear SCOLE model; no Fisher
+// analysis (the parameters are reported as not assessed).
+RunResult run_nonlinear_identification(Problem& problem, const RunOptions& options);
 
 // identification.model_error, with the automatic value resolved (io/scenario.h).
 double model_error(const Problem& problem);

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "scoleid/identify/fe/scole_nonlinear.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/measurements.h"
 #include "scoleid/identify/inverse/objective.h"
@@ -73,6 +74,11 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
+// The same from the nonlinear SCOLE model (identification.model: nonlinear) at a step of at most `step`.
+Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, double step, bool add_noise);
+// The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for a beam or
+// sectional parameters, which it does not have).
+ScoleNonlinear scole_nonlinear(const io::Scenario& scenario, int elements);
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
                          const std::vector<io::Signal>& signals, double t_end, double sample_interval);
 // The identifier's fixed time step: identification.time_step if set, else

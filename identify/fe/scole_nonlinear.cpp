@@ -1,0 +1,470 @@
+#include "scoleid/identify/fe/scole_nonlinear.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "scoleid/identify/fe/rotation_vector.h"
+
+namespace scoleid::identify {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+namespace {
+
+Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+Matrix3d inertia_matrix(const io::RigidBodySpec& b) {
+  // Products as the off-diagonal entries, as the linear model and Simbody's Inertia take them.
+  Matrix3d I;
+  I << b.Ixx, b.Ixy, b.Ixz, b.Ixy, b.Iyy, b.Iyz, b.Ixz, b.Iyz, b.Izz;
+  return I;
+}
+
+// State views: y = [X, φ, e, V, Ω, ė].
+struct StateView {
+  StateView(const double* y, int ne)
+      : X(y), phi(y + 3), e(y + 6, ne), V(y + 6 + ne), Omega(y + 9 + ne), edot(y + 12 + ne, ne),
+        u(y + 6 + ne, 6 + ne) {}
+  Eigen::Map<const Vector3d> X, phi;
+  Eigen::Map<const VectorXd> e;
+  Eigen::Map<const Vector3d> V, Omega;
+  Eigen::Map<const VectorXd> edot, u;
+};
+
+}  // namespace
+
+ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs,
+                               const std::vector<io::SensorSpec>& sensors) {
+  const StructuralModel& m = fe.model;
+  const int n = m.ndof;
+  ne_ = n - 6;
+  ncoef_ = m.ncoef;
+  for (int i = 0; i < 6; ++i)
+    if (fe.shuttle_dof(i) != ne_ + i) throw std::logic_error("ScoleNonlinear: the shuttle DOFs must come last");
+  if (inputs.size() != m.inputs.size() || sensors.size() != m.sensors.size())
+    throw std::logic_error("ScoleNonlinear: inputs and sensors must be the linear model's");
+  const io::ScoleSpec& sc = fe.spec;
+  const double L = sc.length, h = L / fe.elements;
+  const Vector3d root = vec3(sc.mast_root);
+  auto point = [&](double s) { return Vector3d(root - s * Vector3d::UnitZ()); };
+  auto on_e = [&](const MatrixXd& rows) { return MatrixXd(rows.leftCols(ne_)); };
+
+  G_ = MatrixXd::Zero(n, 6 + ne_);
+  for (int k = 0; k < 3; ++k) {
+    G_.col(k) = fe.rigid_motion(Vector3d::Unit(k), Vector3d::Zero());
+    G_.col(3 + k) = fe.rigid_motion(Vector3d::Zero(), Vector3d::Unit(k));
+  }
+  G_.block(0, 6, ne_, ne_).setIdentity();
+
+  // Mast: ρA at four Gauss points per element (degree 7: exact for products of Hermite cubics),
+  // ρI_ψ at three (degree 5: exact for the slopes' and the linear twist's products).
+  const double a4 = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2)), b4 = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
+  const double wa = (18.0 + std::sqrt(30.0)) / 36.0, wb = (18.0 - std::sqrt(30.0)) / 36.0;
+  const double x4[4] = {0.5 * (1 - b4), 0.5 * (1 - a4), 0.5 * (1 + a4), 0.5 * (1 + b4)};
+  const double w4[4] = {0.5 * wb, 0.5 * wa, 0.5 * wa, 0.5 * wb};
+  const double g3 = 0.5 * std::sqrt(0.6);
+  const double x3[3] = {0.5 - g3, 0.5, 0.5 + g3}, w3[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  const double bend = sc.bending_rotary_inertia ? 0.5 : 0.0;
+  for (int el = 0; el < fe.elements; ++el) {
+    for (int q = 0; q < 4; ++q) {
+      const double s = (el + x4[q]) * h;
+      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA});
+    }
+    for (int q = 0; q < 3; ++q) {
+      const double s = (el + x3[q]) * h;
+      rotors_.push_back({w3[q] * h * Vector3d(bend, bend, 1.0).asDiagonal().toDenseMatrix(), on_e(fe.mast_rotation(s)),
+                         ScoleFE::kRhoIPsi});
+    }
+  }
+  // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
+  points_.push_back({point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0), on_e(fe.reflector_displacement()), 1.0,
+                     ScoleFE::kMReflector});
+  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1});
+  // Shuttle.
+  points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1});
+  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1});
+  // Proof masses: their own lateral DOFs, axially with the mast.
+  for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
+    MatrixXd N = MatrixXd::Zero(3, ne_);
+    N(0, fe.proof_mass_dof(static_cast<int>(k), 0)) = 1.0;
+    N(1, fe.proof_mass_dof(static_cast<int>(k), 1)) = 1.0;
+    points_.push_back({point(sc.actuator_locations[k]), N, sc.actuator_mass, -1});
+  }
+
+  for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
+  for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
+
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto& spec = inputs[i];
+    Input in;
+    in.q0 = G_.transpose() * m.inputs[i].vector;
+    in.coefficient = m.inputs[i].coefficient;
+    if (spec.kind == "force" && (spec.at == "mast" || spec.at == "reflector")) {
+      in.arm = true;
+      in.N = spec.at == "mast" ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
+      in.d = vec3(spec.direction);
+    }
+    inputs_.push_back(std::move(in));
+  }
+
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const auto& spec = sensors[k];
+    const ModelSensor& ms = m.sensors[k];
+    using K = Sensor::Kind;
+    Sensor s;
+    s.d = vec3(spec.direction);
+    if (spec.at == "shuttle") {
+      s.kind = spec.kind == "rotation"       ? K::ShuttleRotation
+               : spec.kind == "velocity"     ? K::ShuttleVelocity
+               : spec.kind == "acceleration" ? K::ShuttleAcceleration
+                                             : K::ShuttleDisplacement;
+    } else if (spec.kind == "acceleration") {
+      s.kind = K::PointAcceleration;
+      const bool mast = spec.at == "mast";
+      s.p = mast ? point(spec.location) : point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
+      s.N = mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
+    } else {
+      // Relative to S: the linear rows restricted to e (they vanish on rigid motion).
+      s.kind = ms.order == 1 ? K::RateRow : K::Row;
+      s.row = ms.row.head(ne_);
+    }
+    sensors_.push_back(std::move(s));
+    sensor_names_.push_back(ms.name);
+  }
+}
+
+ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants) const {
+  if (c.size() != ncoef_) throw std::invalid_argument("ScoleNonlinear::at: coefficient vector of the wrong size");
+  Dynamics d;
+  d.g_ = this;
+  d.constants_ = constants;
+  auto scale = [&](int k) { return k >= 0 ? c[k] : constants; };
+  const int nu = speeds();
+  d.Mconst_ = MatrixXd::Zero(nu, nu);
+  for (const auto& p : points_) {
+    const double mi = p.weight * scale(p.coefficient);
+    d.mass_.push_back(mi);
+    d.Mconst_.block<3, 3>(0, 0) += mi * Matrix3d::Identity();
+    d.Mconst_.block(0, 6, 3, ne_) += mi * p.N;
+    d.Mconst_.block(6, 6, ne_, ne_) += mi * p.N.transpose() * p.N;
+  }
+  for (const auto& r : rotors_) {
+    const Matrix3d J = r.J * scale(r.coefficient);
+    d.J_.push_back(J);
+    d.Mconst_.block<3, 3>(3, 3) += J;
+    d.Mconst_.block(3, 6, 3, ne_) += J * r.Theta;
+    d.Mconst_.block(6, 6, ne_, ne_) += r.Theta.transpose() * J * r.Theta;
+  }
+  d.Mconst_.block(6, 0, ne_, 3) = d.Mconst_.block(0, 6, 3, ne_).transpose();
+  d.Mconst_.block(6, 3, ne_, 3) = d.Mconst_.block(3, 6, 3, ne_).transpose();
+  d.K_ = MatrixXd::Zero(ne_, ne_);
+  d.D_ = MatrixXd::Zero(ne_, ne_);
+  for (const auto& t : stiffness_) d.K_ += scale(t.coefficient) * MatrixXd(t.matrix);
+  for (const auto& t : damping_) d.D_ += scale(t.coefficient) * MatrixXd(t.matrix);
+  return d;
+}
+
+MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
+  const int ne = g_->ne_;
+  MatrixXd M = Mconst_;
+  Matrix3d VO = Matrix3d::Zero(), OO = Matrix3d::Zero();
+  MatrixXd Oe = MatrixXd::Zero(3, ne);
+  for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+    const auto& p = g_->points_[i];
+    const double mi = mass_[i];
+    if (mi == 0.0) continue;
+    const Matrix3d Rx = skew(p.p + p.N * e);
+    VO -= mi * Rx;
+    OO += mi * Rx.transpose() * Rx;
+    Oe.noalias() += mi * Rx * p.N;
+  }
+  M.block<3, 3>(0, 3) += VO;
+  M.block<3, 3>(3, 0) += VO.transpose();
+  M.block<3, 3>(3, 3) += OO;
+  M.block(3, 6, 3, ne) += Oe;
+  M.block(6, 3, ne, 3) += Oe.transpose();
+  return M;
+}
+
+VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e) const {
+  const int ne = g_->ne_;
+  const Vector3d V = u.head<3>(), W = u.segment<3>(3);
+  const VectorXd ed = u.tail(ne);
+  VectorXd b = VectorXd::Zero(6 + ne);
+  for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+    const auto& p = g_->points_[i];
+    const double mi = mass_[i];
+    if (mi == 0.0) continue;
+    const Vector3d r = p.p + p.N * e, w = p.N * ed;
+    const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w));
+    b.head<3>() += f;
+    b.segment<3>(3) += r.cross(f);
+    b.tail(ne).noalias() += p.N.transpose() * f;
+  }
+  for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
+    const Vector3d omega = W + g_->rotors_[j].Theta * ed;
+    b.segment<3>(3) += W.cross(J_[j] * omega);
+  }
+  b.tail(ne).noalias() += D_ * ed + K_ * e;
+  return b;
+}
+
+VectorXd ScoleNonlinear::Dynamics::load(const VectorXd& f, const VectorXd& e) const {
+  VectorXd Q = VectorXd::Zero(g_->speeds());
+  for (std::size_t i = 0; i < g_->inputs_.size(); ++i) {
+    const auto& in = g_->inputs_[i];
+    const double fi = f[static_cast<Eigen::Index>(i)];
+    if (fi == 0.0) continue;
+    // Loads carry no coefficient in this model's derivative (constants = 0 drops nothing here).
+    Q += fi * in.q0;
+    if (in.arm) Q.segment<3>(3) += fi * Vector3d(in.N * e).cross(in.d);
+  }
+  return Q;
+}
+
+void ScoleNonlinear::Dynamics::derivative(const double* y, const VectorXd& f, double* ydot, VectorXd* udot) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  Eigen::Map<Vector3d> Xdot(ydot), phidot(ydot + 3);
+  Eigen::Map<VectorXd> edot(ydot + 6, ne), accel(ydot + 6 + ne, 6 + ne);
+  Xdot = rotation_matrix(s.phi) * s.V;
+  phidot = right_jacobian_inverse(s.phi) * s.Omega;
+  edot = s.edot;
+  const VectorXd e = s.e, u = s.u;
+  const VectorXd a = mass(e).ldlt().solve(load(f, e) - internal(u, e));
+  accel = a;
+  if (udot) *udot = a;
+}
+
+VectorXd ScoleNonlinear::Dynamics::residual(const double* y, const VectorXd& udot, const VectorXd& f) const {
+  const StateView s(y, g_->ne_);
+  const VectorXd e = s.e, u = s.u;
+  return mass(e) * udot + internal(u, e) - load(f, e);
+}
+
+VectorXd ScoleNonlinear::Dynamics::outputs(const double* y, const VectorXd& udot) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  const Vector3d Vd = udot.head<3>(), Wd = udot.segment<3>(3);
+  const VectorXd edd = udot.tail(ne);
+  VectorXd z(g_->sensors());
+  using K = Sensor::Kind;
+  for (int k = 0; k < g_->sensors(); ++k) {
+    const auto& se = g_->sensors_[static_cast<std::size_t>(k)];
+    double v = 0.0;
+    switch (se.kind) {
+      case K::ShuttleRotation: v = s.phi.dot(se.d); break;
+      case K::ShuttleDisplacement: v = s.X.dot(se.d); break;
+      case K::ShuttleVelocity: v = (rotation_matrix(s.phi) * s.V).dot(se.d); break;
+      case K::ShuttleAcceleration: v = (rotation_matrix(s.phi) * (Vd + s.Omega.cross(s.V))).dot(se.d); break;
+      case K::Row: v = se.row.dot(s.e); break;
+      case K::RateRow: v = se.row.dot(s.edot); break;
+      case K::PointAcceleration: {
+        const Vector3d r = se.p + se.N * s.e;
+        const Vector3d a = Vd + Wd.cross(r) + Vector3d(se.N * edd) + s.Omega.cross(s.V) + s.Omega.cross(s.Omega.cross(r)) +
+                           2.0 * s.Omega.cross(Vector3d(se.N * s.edot));
+        v = a.dot(se.d);
+        break;
+      }
+    }
+    z[k] = v;
+  }
+  return z;
+}
+
+double ScoleNonlinear::Dynamics::energy(const double* y) const {
+  const StateView s(y, g_->ne_);
+  const VectorXd e = s.e, u = s.u;
+  return 0.5 * u.dot(mass(e) * u) + 0.5 * e.dot(K_ * e);
+}
+
+Vector3d ScoleNonlinear::Dynamics::momentum(const double* y) const {
+  const StateView s(y, g_->ne_);
+  const VectorXd e = s.e, u = s.u;
+  const VectorXd h = mass(e) * u;
+  return rotation_matrix(s.phi) * h.head<3>();
+}
+
+Vector3d ScoleNonlinear::Dynamics::angular_momentum(const double* y) const {
+  const StateView s(y, g_->ne_);
+  const VectorXd e = s.e, u = s.u;
+  const VectorXd h = mass(e) * u;
+  const Matrix3d R = rotation_matrix(s.phi);
+  const Vector3d X = s.X;
+  return X.cross(R * h.head<3>()) + R * h.segment<3>(3);
+}
+
+}  // namespace scoleid::identify
+
+namespace scoleid::identify {
+
+// s = μᵀ (M(e) a + b(u, e) + D ė + K e − Q(t, e)), term by term (docs/theory.md §6.7). Per mass
+// point, with w = L μ = μ_V + μ_Ω × r + N μ_e and the point's force f = m (L a + γ), s_i = wᵀ f:
+//   ∂s_i/∂r = f × μ_Ω + m (w × a_Ω + Ω × (Ω × w))                      (∂/∂e = Nᵀ ∂/∂r)
+//   ∂s_i/∂V = m w × Ω,   ∂s_i/∂ė = 2 m Nᵀ (w × Ω),
+//   ∂s_i/∂Ω = m (V × w + w (Ω·r) + r (w·Ω) − 2 (w·r) Ω + 2 (N ė) × w).
+// Per rotor, ω = Ω + Θ ė:  s_j = (μ_Ω + Θ μ_e)ᵀ J (a_Ω + Θ a_e) + μ_Ω · (Ω × J ω):
+//   ∂s_j/∂Ω = J ω × μ_Ω + J (μ_Ω × Ω),   ∂s_j/∂ė = Θᵀ J (μ_Ω × Ω).
+// Elastic: ∂/∂ė = D μ_e, ∂/∂e = K μ_e. A force's arm: ∂/∂e of −f μ_Ω · ((N e) × d) = −f Nᵀ (d × μ_Ω).
+void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu,
+                                            const VectorXd& fin, VectorXd& de, VectorXd& du, VectorXd* dc) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  const Vector3d V = s.V, W = s.Omega;
+  const Vector3d aV = a.head<3>(), aW = a.segment<3>(3);
+  const VectorXd ae = a.tail(ne);
+  const Vector3d muV = mu.head<3>(), muW = mu.segment<3>(3);
+  const VectorXd mue = mu.tail(ne);
+  de = VectorXd::Zero(ne);
+  du = VectorXd::Zero(6 + ne);
+  if (dc) *dc = VectorXd::Zero(g_->ncoef_);
+  for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+    const auto& p = g_->points_[i];
+    const double m = mass_[i];
+    if (m == 0.0 && !(dc && p.coefficient >= 0)) continue;
+    const Vector3d r = p.p + p.N * s.e, n = p.N * s.edot;
+    const Vector3d w = muV + muW.cross(r) + p.N * mue;
+    const Vector3d acc = aV + aW.cross(r) + p.N * ae + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n);
+    if (dc && p.coefficient >= 0) (*dc)[p.coefficient] += p.weight * w.dot(acc);
+    if (m == 0.0) continue;
+    const Vector3d f = m * acc;
+    const Vector3d ds_dr = f.cross(muW) + m * (w.cross(aW) + W.cross(W.cross(w)));
+    de.noalias() += p.N.transpose() * ds_dr;
+    du.head<3>() += m * w.cross(W);
+    du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
+    du.tail(ne).noalias() += 2.0 * m * (p.N.transpose() * w.cross(W));
+  }
+  for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
+    const auto& rt = g_->rotors_[j];
+    const Matrix3d& J = J_[j];
+    const Vector3d omega = W + rt.Theta * s.edot;
+    if (dc && rt.coefficient >= 0) {
+      const Vector3d lhs = muW + rt.Theta * mue, alpha = aW + rt.Theta * ae;
+      (*dc)[rt.coefficient] += lhs.dot(rt.J * alpha) + muW.dot(W.cross(rt.J * omega));
+    }
+    du.segment<3>(3) += (J * omega).cross(muW) + J * muW.cross(W);
+    du.tail(ne).noalias() += rt.Theta.transpose() * (J * muW.cross(W));
+  }
+  de.noalias() += K_ * mue;
+  du.tail(ne).noalias() += D_ * mue;
+  if (dc) {
+    for (const auto& t : g_->stiffness_)
+      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.e);
+    for (const auto& t : g_->damping_)
+      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.edot);
+  }
+  for (std::size_t i = 0; i < g_->inputs_.size(); ++i) {
+    const auto& in = g_->inputs_[i];
+    const double fi = fin[static_cast<Eigen::Index>(i)];
+    if (fi == 0.0) continue;
+    if (in.arm) de.noalias() -= fi * (in.N.transpose() * in.d.cross(muW));
+    if (dc && in.coefficient >= 0) {
+      double q = mu.dot(in.q0);
+      if (in.arm) q += muW.dot(Vector3d(in.N * s.e).cross(in.d));
+      (*dc)[in.coefficient] -= fi * q;
+    }
+  }
+}
+
+// f = [R V; J_r⁻¹ Ω; ė; a], a = M⁻¹ (Q − b − D ė − K e): with μ = M⁻¹ λ_u (M symmetric),
+// λ_uᵀ da = −ds for s = μᵀ R(y, a) at fixed a, so (∂f/∂y)ᵀ λ =
+//   X: 0;   φ: J_rᵀ [V]× Rᵀ λ_X + ∇_φ (λ_φᵀ J_r⁻¹(φ) Ω);   e: −∂s/∂e;
+//   V: Rᵀ λ_X − ∂s/∂V;   Ω: J_r⁻ᵀ λ_φ − ∂s/∂Ω;   ė: λ_e − ∂s/∂ė.
+// The φ-gradient of λ_φᵀ J_r⁻¹(φ) Ω is taken by central differences (3 × 3 evaluations; relative
+// error ~1e-10).
+VectorXd ScoleNonlinear::Dynamics::derivative_vjp(const double* y, const VectorXd& fin, const VectorXd& ydot,
+                                                  const VectorXd& lambda) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  const Vector3d lX = lambda.head<3>(), lphi = lambda.segment<3>(3);
+  const VectorXd le = lambda.segment(6, ne), lu = lambda.tail(6 + ne);
+  const VectorXd e = s.e;
+  const VectorXd a = ydot.tail(6 + ne);
+  const VectorXd mu = mass(e).ldlt().solve(lu);
+  VectorXd de, du;
+  residual_vjp(y, a, mu, fin, de, du, nullptr);
+  const Matrix3d R = rotation_matrix(s.phi);
+  VectorXd out = VectorXd::Zero(g_->state_size());
+  Vector3d gphi = right_jacobian(s.phi).transpose() * (skew(s.V) * (R.transpose() * lX));
+  const double h = 1e-6 * std::max(1.0, s.phi.norm());
+  for (int k = 0; k < 3; ++k) {
+    const Vector3d dp = h * Vector3d::Unit(k);
+    const Vector3d phi = s.phi;
+    gphi[k] += lphi.dot((right_jacobian_inverse(phi + dp) - right_jacobian_inverse(phi - dp)) * s.Omega) / (2 * h);
+  }
+  out.segment<3>(3) = gphi;
+  out.segment(6, ne) = -de;
+  out.segment<3>(6 + ne) = R.transpose() * lX - du.head<3>();
+  out.segment<3>(9 + ne) = right_jacobian_inverse(s.phi).transpose() * lphi - du.segment<3>(3);
+  out.tail(ne) = le - du.tail(ne);
+  return out;
+}
+
+VectorXd ScoleNonlinear::Dynamics::coefficient_vjp(const double* y, const VectorXd& fin, const VectorXd& ydot,
+                                                   const VectorXd& lambda) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  const VectorXd e = s.e;
+  const VectorXd mu = mass(e).ldlt().solve(VectorXd(lambda.tail(6 + ne)));
+  VectorXd de, du, dc;
+  residual_vjp(y, ydot.tail(6 + ne), mu, fin, de, du, &dc);
+  return -dc;
+}
+
+// Per sensor, ρ_k times (see outputs()):
+//   shuttle rotation φ·d: ∂φ = d;  displacement X·d: ∂X = d;  velocity (R V)·d: ∂V = Rᵀd,
+//   ∂φ = J_rᵀ [V]× Rᵀ d;  acceleration (R q)·d, q = V̇ + Ω × V: ∂φ = J_rᵀ [q]× Rᵀ d and, with
+//   w = Rᵀ d, ∂V̇ = w, ∂Ω = V × w, ∂V = w × Ω;  rows on e or ė: the row;
+//   point acceleration d·(V̇ + Ω̇ × r + N ë + Ω × V + Ω × (Ω × r) + 2 Ω × N ė):
+//   ∂V̇ = d, ∂Ω̇ = r × d, ∂ë = Nᵀd, ∂V = d × Ω, ∂Ω = V × d + d (Ω·r) + r (d·Ω) − 2 (d·r) Ω + 2 (N ė) × d,
+//   ∂ė = 2 Nᵀ (d × Ω), ∂e = Nᵀ (d × Ω̇ + Ω × (Ω × d)).
+void ScoleNonlinear::Dynamics::outputs_vjp(const double* y, const VectorXd& udot, const VectorXd& rho, VectorXd& dy,
+                                           VectorXd& da) const {
+  const int ne = g_->ne_;
+  const StateView s(y, ne);
+  dy = VectorXd::Zero(g_->state_size());
+  da = VectorXd::Zero(6 + ne);
+  const Vector3d V = s.V, W = s.Omega, Vd = udot.head<3>(), Wd = udot.segment<3>(3);
+  using K = Sensor::Kind;
+  for (int k = 0; k < g_->sensors(); ++k) {
+    const auto& se = g_->sensors_[static_cast<std::size_t>(k)];
+    const double c = rho[k];
+    if (c == 0.0) continue;
+    const Vector3d d = c * se.d;
+    switch (se.kind) {
+      case K::ShuttleRotation: dy.segment<3>(3) += d; break;
+      case K::ShuttleDisplacement: dy.head<3>() += d; break;
+      case K::ShuttleVelocity: {
+        const Matrix3d R = rotation_matrix(s.phi);
+        dy.segment<3>(6 + ne) += R.transpose() * d;
+        dy.segment<3>(3) += right_jacobian(s.phi).transpose() * (skew(V) * (R.transpose() * d));
+        break;
+      }
+      case K::ShuttleAcceleration: {
+        const Matrix3d R = rotation_matrix(s.phi);
+        const Vector3d q = Vd + W.cross(V), w = R.transpose() * d;
+        dy.segment<3>(3) += right_jacobian(s.phi).transpose() * (skew(q) * w);
+        da.head<3>() += w;
+        dy.segment<3>(9 + ne) += V.cross(w);
+        dy.segment<3>(6 + ne) += w.cross(W);
+        break;
+      }
+      case K::Row: dy.segment(6, ne) += c * se.row.transpose(); break;
+      case K::RateRow: dy.tail(ne) += c * se.row.transpose(); break;
+      case K::PointAcceleration: {
+        const Vector3d r = se.p + se.N * s.e, n = se.N * s.edot;
+        da.head<3>() += d;
+        da.segment<3>(3) += r.cross(d);
+        da.tail(ne) += se.N.transpose() * d;
+        dy.segment<3>(6 + ne) += d.cross(W);
+        dy.segment<3>(9 + ne) += V.cross(d) + d * W.dot(r) + r * d.dot(W) - 2.0 * d.dot(r) * W + 2.0 * n.cross(d);
+        dy.tail(ne) += 2.0 * (se.N.transpose() * d.cross(W));
+        dy.segment(6, ne) += se.N.transpose() * (d.cross(Wd) + W.cross(W.cross(d)));
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,148 @@
+#pragma once
+// Nonlinear SCOLE for large slews (docs/theory.md §3.8): the shuttle turns through finite
+// angles, the mast's elastic deflection stays small and is measured in the shuttle's rotating
+// frame S (a floating frame of reference), with the inertial coupling of that frame's motion.
+//
+// Coordinates  q = (X, φ, e): X the shuttle CM in ground, φ the rotation vector of R = R_GS
+//              (rotation_vector.h), e the elastic DOFs: the linear model's DOF vector
+//              (scole_model.h) without its six shuttle entries, i.e. the node fields
+//              (u_x, u_x', u_y, u_y', ψ) and the proof masses' lateral positions, all relative to S.
+// Speeds       u = (V, Ω, ė): V = Rᵀ Ẋ the CM velocity in S, Ω the body angular velocity.
+// Kinematics   Ẋ = R V,  φ̇ = J_r(φ)⁻¹ Ω,  d(e)/dt = ė.
+// Mass points  (Kane's equations) m_i at r_i = p_i + N_i e in S (p_i undeformed, N_i the linear
+//              model's displacement rows on e):  velocity v_i = V + Ω × r_i + N_i ė = L_i u,
+//              L_i = [I, −[r_i]×, N_i];  inertial acceleration in S  a_i = L_i u̇ + γ_i,
+//              γ_i = Ω × V + Ω × (Ω × r_i) + 2 Ω × N_i ė  (transport, centrifugal, Coriolis).
+//              The mast's ρA by four Gauss points per element (exact for the Hermite consistent
+//              mass), the reflector's and proof masses' CMs, the shuttle's CM.
+// Rotors       inertia J_j constant in S, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
+//              linear model's rotation rows); kinetic energy ½ ω_jᵀ J_j ω_j, whose generalized
+//              inertia force (Boltzmann–Hamel) is L_jᵀ J_j L_j u̇ + [0; Ω × J_j ω_j; 0]. The
+//              shuttle, the reflector about its CM, and the section's ρI_ψ (three Gauss points
+//              per element). The rotor's own elastic rotation is not applied to J_j: an O(|Θ|)
+//              relative change of a term that is itself O(|Ω|²), which keeps the kinetic energy
+//              exact in form, so energy and momentum are conserved exactly by the equations.
+// Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e] = Q(t, e),
+//              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J_j L_j,   b = Σ m_i L_iᵀ γ_i + Σ [0; Ω × J_j ω_j; 0],
+//              K, D the linear model's elastic blocks (they see only the deformation relative
+//              to S), every term affine in the coefficients c (scole_model.h), so ∂/∂c_k of the
+//              residual is the residual of c = e_k without the constant terms.
+// Inputs       f(t) d with d fixed in S, as the truth applies them: shuttle force/moment, mast or
+//              reflector moment, actuator slider forces: the linear model's generalized load
+//              G ᵀb (G maps (X, θ, e) to the linear DOFs); a force at a mast station or the
+//              reflector CM also turns with its arm: Q_Ω = (p + N e) × d f.
+// Sensors      shuttle rotation φ·d (the angle–axis read-out), shuttle displacement X·d, velocity
+//              (R V)·d, acceleration (R (V̇ + Ω × V))·d, all in ground; mast and reflector
+//              displacement, rotation, line of sight and velocity: the linear model's rows on e
+//              or ė (relative to S, in S); an acceleration: the point's inertial acceleration in
+//              S along d, a_i · d.
+// At rest (q = 0, u = 0) the linearisation is the linear model in the coordinates (X, θ, e):
+// M(0) = Gᵀ M_lin G, the same K, D, loads and sensor rows.
+#include <string>
+#include <vector>
+
+#include "scoleid/identify/fe/scole_model.h"
+
+namespace scoleid::identify {
+
+class ScoleNonlinear {
+public:
+  // Built on the linear model's discretisation of the same scenario (the same elements,
+  // inputs and sensors, in the same order).
+  ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs,
+                 const std::vector<io::SensorSpec>& sensors);
+
+  int elastic() const { return ne_; }            // dim e
+  int speeds() const { return 6 + ne_; }         // dim u
+  int state_size() const { return 12 + 2 * ne_; } // y = [X, φ, e, V, Ω, ė]
+  int inputs() const { return static_cast<int>(inputs_.size()); }
+  int sensors() const { return static_cast<int>(sensors_.size()); }
+  int coefficients() const { return ncoef_; }
+  const std::vector<std::string>& sensor_names() const { return sensor_names_; }
+
+  // The operators at coefficients c. `constants` scales the terms without a coefficient (1 for
+  // the model; 0 with c = e_k gives ∂/∂c_k of the residual, the loads excluded).
+  class Dynamics {
+  public:
+    const ScoleNonlinear& model() const { return *g_; }
+    MatrixXd mass(const VectorXd& e) const;
+    // b(u, e) + [0; 0; D ė + K e]
+    VectorXd internal(const VectorXd& u, const VectorXd& e) const;
+    // Q(t, e) for the input values f_i(t).
+    VectorXd load(const VectorXd& f, const VectorXd& e) const;
+    // ẏ for input values f; u̇ returned in `udot` if given.
+    void derivative(const double* y, const VectorXd& f, double* ydot, VectorXd* udot = nullptr) const;
+    // The residual R = M u̇ + internal − Q at a state and u̇ (zero on the motion).
+    VectorXd residual(const double* y, const VectorXd& udot, const VectorXd& f) const;
+    // Sensor read-outs at a state, u̇ the accelerations there.
+    VectorXd outputs(const double* y, const VectorXd& udot) const;
+    // Products with the transposed derivatives (for the costate, docs/theory.md §6.7), at a state y
+    // with input values f and ydot = f(t, y) already evaluated:
+    //   (∂f/∂y)ᵀ λ,   and λᵀ ∂f/∂c (one entry per coefficient).
+    VectorXd derivative_vjp(const double* y, const VectorXd& f, const VectorXd& ydot, const VectorXd& lambda) const;
+    VectorXd coefficient_vjp(const double* y, const VectorXd& f, const VectorXd& ydot, const VectorXd& lambda) const;
+    // ρᵀ z(y, u̇) differentiated: ∂/∂y at fixed u̇ (dy) and ∂/∂u̇ (da).
+    void outputs_vjp(const double* y, const VectorXd& udot, const VectorXd& rho, VectorXd& dy, VectorXd& da) const;
+    // Kinetic + strain energy, linear momentum and angular momentum about the ground origin.
+    double energy(const double* y) const;
+    Eigen::Vector3d momentum(const double* y) const;
+    Eigen::Vector3d angular_momentum(const double* y) const;
+
+  private:
+    friend class ScoleNonlinear;
+    // s = μᵀ R(y, a) (R the residual at accelerations a): ∂s/∂e, ∂s/∂u, and per coefficient
+    // ∂s/∂c_k (the loads' coefficient-free part excluded).
+    void residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu, const VectorXd& f, VectorXd& de,
+                      VectorXd& du, VectorXd* dc) const;
+    const ScoleNonlinear* g_ = nullptr;
+    std::vector<double> mass_;            // per mass point
+    std::vector<Eigen::Matrix3d> J_;      // per rotor
+    MatrixXd Mconst_;                     // the e-independent part of M
+    MatrixXd K_, D_;                      // elastic blocks
+    double constants_ = 1.0;
+  };
+  Dynamics at(const VectorXd& c, double constants = 1.0) const;
+
+  // The map G: (X, θ, e) → the linear model's DOFs (for the linearisation check).
+  const MatrixXd& linear_map() const { return G_; }
+
+private:
+  struct MassPoint {
+    Eigen::Vector3d p;
+    MatrixXd N;        // 3 × ne
+    double weight = 0; // mass = weight · c[coefficient] (or · constants)
+    int coefficient = -1;
+  };
+  struct Rotor {
+    Eigen::Matrix3d J;
+    MatrixXd Theta;    // 3 × ne
+    int coefficient = -1;
+  };
+  struct Input {
+    VectorXd q0;         // Gᵀ b at e = 0 (speeds())
+    bool arm = false;    // a force at a point: Q_Ω += (N e) × d f
+    MatrixXd N;
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    int coefficient = -1;
+  };
+  struct Sensor {
+    enum class Kind { ShuttleRotation, ShuttleDisplacement, ShuttleVelocity, ShuttleAcceleration, Row, RateRow,
+                      PointAcceleration };
+    Kind kind = Kind::Row;
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    Eigen::RowVectorXd row;  // on e or ė
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    MatrixXd N;
+  };
+
+  int ne_ = 0, ncoef_ = 0;
+  std::vector<MassPoint> points_;
+  std::vector<Rotor> rotors_;
+  std::vector<OperatorTerm> stiffness_, damping_;  // e-blocks
+  std::vector<Input> inputs_;
+  std::vector<Sensor> sensors_;
+  std::vector<std::string> sensor_names_;
+  MatrixXd G_;
+};
+
+}  // namespace scoleid::identify
