@@ -25,6 +25,7 @@ slow: build
 
 bench: build
 	$(BUILD)/identify/scole-identify-bench
+	$(BUILD)/identify/scole-nonlinear-bench
 	$(BUILD)/identify/scole-experiments-bench
 	$(BUILD)/crosscheck/scole-crosscheck-bench
 

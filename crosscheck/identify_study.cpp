@@ -139,7 +139,11 @@ Table identify_table(const IdentifyStudy& s) {
     row.push_back(percent(2.0 * p.std.front() / std::abs(p.truth), 3));
     row.push_back(std::isfinite(p.std.front()) ? (p.covered(0) ? "yes" : "no") : "no std");
     row.push_back(percent(p.half_width.front() / std::abs(p.truth), 3));
-    row.push_back(std::isfinite(p.half_width.front()) ? (p.interval_covered(0) ? "yes" : "no") : "flagged");
+    // No interval: a flagged parameter still has its std; without one it was not assessed (--no-std,
+    // or the nonlinear model, which has no Fisher analysis).
+    row.push_back(std::isfinite(p.half_width.front()) ? (p.interval_covered(0) ? "yes" : "no")
+                  : std::isfinite(p.std.front())     ? "flagged"
+                                                     : "not assessed");
     t.rows.push_back(row);
   }
   return t;

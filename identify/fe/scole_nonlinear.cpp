@@ -34,6 +34,29 @@ struct StateView {
 
 }  // namespace
 
+ScoleNonlinear::Rows3 ScoleNonlinear::Rows3::of(const MatrixXd& dense) {
+  Rows3 r;
+  for (Eigen::Index j = 0; j < dense.cols(); ++j)
+    if (dense.col(j).cwiseAbs().maxCoeff() != 0.0) r.cols.push_back(static_cast<int>(j));
+  r.v.resize(3, static_cast<Eigen::Index>(r.cols.size()));
+  for (std::size_t k = 0; k < r.cols.size(); ++k) r.v.col(static_cast<Eigen::Index>(k)) = dense.col(r.cols[k]);
+  return r;
+}
+
+Vector3d ScoleNonlinear::Rows3::times(const VectorXd& x) const {
+  Vector3d out = Vector3d::Zero();
+  for (std::size_t k = 0; k < cols.size(); ++k) out += v.col(static_cast<Eigen::Index>(k)) * x[cols[k]];
+  return out;
+}
+
+void ScoleNonlinear::Rows3::add_transposed(const Vector3d& w, VectorXd& out) const {
+  for (std::size_t k = 0; k < cols.size(); ++k) out[cols[k]] += v.col(static_cast<Eigen::Index>(k)).dot(w);
+}
+
+void ScoleNonlinear::Rows3::add_left(const Matrix3d& A, MatrixXd& out) const {
+  for (std::size_t k = 0; k < cols.size(); ++k) out.col(cols[k]) += A * v.col(static_cast<Eigen::Index>(k));
+}
+
 ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs,
                                const std::vector<io::SensorSpec>& sensors) {
   const StructuralModel& m = fe.model;
@@ -69,29 +92,31 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
   for (int el = 0; el < fe.elements; ++el) {
     for (int q = 0; q < 4; ++q) {
       const double s = (el + x4[q]) * h;
-      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA});
+      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA, {}});
     }
     for (int q = 0; q < 3; ++q) {
       const double s = (el + x3[q]) * h;
       rotors_.push_back({w3[q] * h * Vector3d(bend, bend, 1.0).asDiagonal().toDenseMatrix(), on_e(fe.mast_rotation(s)),
-                         ScoleFE::kRhoIPsi});
+                         ScoleFE::kRhoIPsi, {}});
     }
   }
   // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
   points_.push_back({point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0), on_e(fe.reflector_displacement()), 1.0,
-                     ScoleFE::kMReflector});
-  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1});
+                     ScoleFE::kMReflector, {}});
+  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}});
   // Shuttle.
-  points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1});
-  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1});
+  points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}});
+  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}});
   // Proof masses: their own lateral DOFs, axially with the mast.
   for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
     MatrixXd N = MatrixXd::Zero(3, ne_);
     N(0, fe.proof_mass_dof(static_cast<int>(k), 0)) = 1.0;
     N(1, fe.proof_mass_dof(static_cast<int>(k), 1)) = 1.0;
-    points_.push_back({point(sc.actuator_locations[k]), N, sc.actuator_mass, -1});
+    points_.push_back({point(sc.actuator_locations[k]), N, sc.actuator_mass, -1, {}});
   }
 
+  for (auto& p : points_) p.n = Rows3::of(p.N);
+  for (auto& r : rotors_) r.th = Rows3::of(r.Theta);
   for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
   for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
 
@@ -158,6 +183,14 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   }
   d.Mconst_.block(6, 0, ne_, 3) = d.Mconst_.block(0, 6, 3, ne_).transpose();
   d.Mconst_.block(6, 3, ne_, 3) = d.Mconst_.block(3, 6, 3, ne_).transpose();
+  for (const auto& in : inputs_) d.input_scale_.push_back(in.coefficient >= 0 ? c[in.coefficient] : 1.0);
+  {
+    SparseMatrix C = d.Mconst_.block(6, 6, ne_, ne_).sparseView();
+    C.makeCompressed();
+    d.C_ = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>(C);
+    if (d.C_->info() != Eigen::Success)
+      throw std::invalid_argument("ScoleNonlinear::at: the elastic mass block is not positive definite");
+  }
   d.K_ = MatrixXd::Zero(ne_, ne_);
   d.D_ = MatrixXd::Zero(ne_, ne_);
   for (const auto& t : stiffness_) d.K_ += scale(t.coefficient) * MatrixXd(t.matrix);
@@ -165,26 +198,56 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   return d;
 }
 
-MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
+void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const {
   const int ne = g_->ne_;
-  MatrixXd M = Mconst_;
+  A = Mconst_.topLeftCorner<6, 6>();
+  B = Mconst_.block(0, 6, 6, ne);
   Matrix3d VO = Matrix3d::Zero(), OO = Matrix3d::Zero();
   MatrixXd Oe = MatrixXd::Zero(3, ne);
   for (std::size_t i = 0; i < g_->points_.size(); ++i) {
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
-    const Matrix3d Rx = skew(p.p + p.N * e);
+    const Matrix3d Rx = skew(p.p + p.n.times(e));
     VO -= mi * Rx;
     OO += mi * Rx.transpose() * Rx;
-    Oe.noalias() += mi * Rx * p.N;
+    p.n.add_left(mi * Rx, Oe);
   }
-  M.block<3, 3>(0, 3) += VO;
-  M.block<3, 3>(3, 0) += VO.transpose();
-  M.block<3, 3>(3, 3) += OO;
-  M.block(3, 6, 3, ne) += Oe;
-  M.block(6, 3, ne, 3) += Oe.transpose();
+  A.block<3, 3>(0, 3) += VO;
+  A.block<3, 3>(3, 0) += VO.transpose();
+  A.block<3, 3>(3, 3) += OO;
+  B.bottomRows<3>() += Oe;
+}
+
+MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
+  const int ne = g_->ne_;
+  Eigen::Matrix<double, 6, 6> A;
+  MatrixXd B;
+  rigid_rows(e, A, B);
+  MatrixXd M = Mconst_;
+  M.topLeftCorner<6, 6>() = A;
+  M.block(0, 6, 6, ne) = B;
+  M.block(6, 0, ne, 6) = B.transpose();
   return M;
+}
+
+// M x = r by the Schur complement on the rigid rows: M = [A B; Bᵀ C] with C = M_ee constant
+// (factorised once per coefficient set, sparse: the elements' band and the proof masses):
+// S = A − B C⁻¹ Bᵀ (6 × 6), x_r = S⁻¹ (r_r − B C⁻¹ r_e), x_e = C⁻¹ (r_e − Bᵀ x_r).
+VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd& r) const {
+  const int ne = g_->ne_;
+  Eigen::Matrix<double, 6, 6> A;
+  MatrixXd B;
+  rigid_rows(e, A, B);
+  const MatrixXd Y = C_->solve(MatrixXd(B.transpose()));  // C⁻¹ Bᵀ
+  const Eigen::Matrix<double, 6, 6> S = A - B * Y;
+  const VectorXd re = r.tail(ne);
+  const VectorXd Cre = C_->solve(re);
+  const Eigen::Matrix<double, 6, 1> xr = S.ldlt().solve(Eigen::Matrix<double, 6, 1>(r.head<6>() - B * Cre));
+  VectorXd x(6 + ne);
+  x.head<6>() = xr;
+  x.tail(ne) = Cre - Y * xr;
+  return x;
 }
 
 VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e) const {
@@ -196,14 +259,16 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
-    const Vector3d r = p.p + p.N * e, w = p.N * ed;
+    const Vector3d r = p.p + p.n.times(e), w = p.n.times(ed);
     const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w));
     b.head<3>() += f;
     b.segment<3>(3) += r.cross(f);
-    b.tail(ne).noalias() += p.N.transpose() * f;
+    VectorXd be = b.tail(ne);
+    p.n.add_transposed(f, be);
+    b.tail(ne) = be;
   }
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
-    const Vector3d omega = W + g_->rotors_[j].Theta * ed;
+    const Vector3d omega = W + g_->rotors_[j].th.times(ed);
     b.segment<3>(3) += W.cross(J_[j] * omega);
   }
   b.tail(ne).noalias() += D_ * ed + K_ * e;
@@ -216,9 +281,11 @@ VectorXd ScoleNonlinear::Dynamics::load(const VectorXd& f, const VectorXd& e) co
     const auto& in = g_->inputs_[i];
     const double fi = f[static_cast<Eigen::Index>(i)];
     if (fi == 0.0) continue;
-    // Loads carry no coefficient in this model's derivative (constants = 0 drops nothing here).
-    Q += fi * in.q0;
-    if (in.arm) Q.segment<3>(3) += fi * Vector3d(in.N * e).cross(in.d);
+    // An input with a coefficient is scaled by it (γ_i, structural_model.h); the loads are not
+    // part of the residual's coefficient derivative, so `constants` does not touch them.
+    const double gi = fi * input_scale_[i];
+    Q += gi * in.q0;
+    if (in.arm) Q.segment<3>(3) += gi * Vector3d(in.N * e).cross(in.d);
   }
   return Q;
 }
@@ -232,7 +299,7 @@ void ScoleNonlinear::Dynamics::derivative(const double* y, const VectorXd& f, do
   phidot = right_jacobian_inverse(s.phi) * s.Omega;
   edot = s.edot;
   const VectorXd e = s.e, u = s.u;
-  const VectorXd a = mass(e).ldlt().solve(load(f, e) - internal(u, e));
+  const VectorXd a = solve_mass(e, load(f, e) - internal(u, e));
   accel = a;
   if (udot) *udot = a;
 }
@@ -316,38 +383,41 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
   const VectorXd ae = a.tail(ne);
   const Vector3d muV = mu.head<3>(), muW = mu.segment<3>(3);
   const VectorXd mue = mu.tail(ne);
+  const VectorXd e = s.e, edot = s.edot;
   de = VectorXd::Zero(ne);
   du = VectorXd::Zero(6 + ne);
+  VectorXd due = VectorXd::Zero(ne);  // ∂s/∂ė, gathered apart and added to du at the end
   if (dc) *dc = VectorXd::Zero(g_->ncoef_);
   for (std::size_t i = 0; i < g_->points_.size(); ++i) {
     const auto& p = g_->points_[i];
     const double m = mass_[i];
     if (m == 0.0 && !(dc && p.coefficient >= 0)) continue;
-    const Vector3d r = p.p + p.N * s.e, n = p.N * s.edot;
-    const Vector3d w = muV + muW.cross(r) + p.N * mue;
-    const Vector3d acc = aV + aW.cross(r) + p.N * ae + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n);
+    const Vector3d r = p.p + p.n.times(e), n = p.n.times(edot);
+    const Vector3d w = muV + muW.cross(r) + p.n.times(mue);
+    const Vector3d acc = aV + aW.cross(r) + p.n.times(ae) + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n);
     if (dc && p.coefficient >= 0) (*dc)[p.coefficient] += p.weight * w.dot(acc);
     if (m == 0.0) continue;
     const Vector3d f = m * acc;
     const Vector3d ds_dr = f.cross(muW) + m * (w.cross(aW) + W.cross(W.cross(w)));
-    de.noalias() += p.N.transpose() * ds_dr;
+    p.n.add_transposed(ds_dr, de);
     du.head<3>() += m * w.cross(W);
     du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
-    du.tail(ne).noalias() += 2.0 * m * (p.N.transpose() * w.cross(W));
+    p.n.add_transposed(2.0 * m * w.cross(W), due);
   }
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& rt = g_->rotors_[j];
     const Matrix3d& J = J_[j];
-    const Vector3d omega = W + rt.Theta * s.edot;
+    const Vector3d omega = W + rt.th.times(edot);
     if (dc && rt.coefficient >= 0) {
-      const Vector3d lhs = muW + rt.Theta * mue, alpha = aW + rt.Theta * ae;
+      const Vector3d lhs = muW + rt.th.times(mue), alpha = aW + rt.th.times(ae);
       (*dc)[rt.coefficient] += lhs.dot(rt.J * alpha) + muW.dot(W.cross(rt.J * omega));
     }
     du.segment<3>(3) += (J * omega).cross(muW) + J * muW.cross(W);
-    du.tail(ne).noalias() += rt.Theta.transpose() * (J * muW.cross(W));
+    rt.th.add_transposed(J * muW.cross(W), due);
   }
   de.noalias() += K_ * mue;
-  du.tail(ne).noalias() += D_ * mue;
+  due.noalias() += D_ * mue;
+  du.tail(ne) += due;
   if (dc) {
     for (const auto& t : g_->stiffness_)
       if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.e);
@@ -358,7 +428,7 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     const auto& in = g_->inputs_[i];
     const double fi = fin[static_cast<Eigen::Index>(i)];
     if (fi == 0.0) continue;
-    if (in.arm) de.noalias() -= fi * (in.N.transpose() * in.d.cross(muW));
+    if (in.arm) de.noalias() -= fi * input_scale_[i] * (in.N.transpose() * in.d.cross(muW));
     if (dc && in.coefficient >= 0) {
       double q = mu.dot(in.q0);
       if (in.arm) q += muW.dot(Vector3d(in.N * s.e).cross(in.d));
@@ -381,7 +451,7 @@ VectorXd ScoleNonlinear::Dynamics::derivative_vjp(const double* y, const VectorX
   const VectorXd le = lambda.segment(6, ne), lu = lambda.tail(6 + ne);
   const VectorXd e = s.e;
   const VectorXd a = ydot.tail(6 + ne);
-  const VectorXd mu = mass(e).ldlt().solve(lu);
+  const VectorXd mu = solve_mass(e, lu);
   VectorXd de, du;
   residual_vjp(y, a, mu, fin, de, du, nullptr);
   const Matrix3d R = rotation_matrix(s.phi);
@@ -406,7 +476,7 @@ VectorXd ScoleNonlinear::Dynamics::coefficient_vjp(const double* y, const Vector
   const int ne = g_->ne_;
   const StateView s(y, ne);
   const VectorXd e = s.e;
-  const VectorXd mu = mass(e).ldlt().solve(VectorXd(lambda.tail(6 + ne)));
+  const VectorXd mu = solve_mass(e, VectorXd(lambda.tail(6 + ne)));
   VectorXd de, du, dc;
   residual_vjp(y, ydot.tail(6 + ne), mu, fin, de, du, &dc);
   return -dc;

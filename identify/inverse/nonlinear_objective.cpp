@@ -97,15 +97,12 @@ Misfit::MisfitProfile NonlinearObjective::profile_of(const NonlinearResponse& r)
       num[j] += tau * (e0 * e0 + e1 * e1);
       den[j] += tau * (z0 * z0 + z1 * z1);
     }
+    // The mean over all sensors (a sensor whose data are still zero counts 0), as objective.h.
     double m = 0.0;
-    int counted = 0;
     for (Eigen::Index j = 0; j < ns; ++j)
-      if (den[j] > 0) {
-        m += num[j] / den[j];
-        ++counted;
-      }
+      if (den[j] > 0) m += num[j] / den[j];
     p.t.push_back(data_.t[static_cast<std::size_t>(k)]);
-    p.misfit.push_back(counted ? m / counted : 0.0);
+    p.misfit.push_back(ns > 0 ? m / static_cast<double>(ns) : 0.0);
   }
   return p;
 }
@@ -207,16 +204,18 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
           L = lu.solve(rhs);
           double prev = std::numeric_limits<double>::infinity();
           for (int m = 0; m < kMaxDefect; ++m) {
-            const VectorXd res = rhs - L + h * gamma * JT(L);
+            // The correction, not the residual, is measured: with stiff modes (hγ‖J‖ ≫ 1) the
+            // residual's rounding floor lies far above the solution's.
+            const VectorXd dL = lu.solve(VectorXd(rhs - L + h * gamma * JT(L)));
+            L += dL;
             ++sum.defect_iterations;
-            const double size = res.cwiseAbs().maxCoeff() / rhs_size;
+            const double size = dL.cwiseAbs().maxCoeff() / std::max(L.cwiseAbs().maxCoeff(), 1e-300);
             if (size <= kDefectTol) {
               done = true;
               break;
             }
             if (m > 0 && size > kDefectContraction * prev) break;
             prev = size;
-            L += lu.solve(res);
           }
           if (!done) refresh(st.Y[iu], st.inputs[iu], h);
         }
@@ -286,14 +285,18 @@ double NonlinearObjective::gauss_newton(const VectorXd& q, VectorXd& gradient, M
 }
 
 Misfit::MisfitProfile NonlinearObjective::misfit_profile(const VectorXd& q) {
-  const double keep = T_;
+  // Over the whole record; the horizon is restored whatever happens (a trial point whose forward
+  // run fails must not leave the continuation on the full record).
+  struct Restore {
+    NonlinearObjective& o;
+    double T;
+    ~Restore() { o.set_horizon(T); }
+  } restore{*this, T_};
   set_horizon(data_.t.back());
   VectorXd c;
   MatrixXd dcdq;
   params_.coefficients(q, c, dcdq);
-  const MisfitProfile p = profile_of(forward(c, false));
-  set_horizon(keep);
-  return p;
+  return profile_of(forward(c, false));
 }
 
 VectorXd NonlinearObjective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {

@@ -690,9 +690,10 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
              {"optimizer_total", summary.wall_seconds},
              {"identifiability", identifiability_seconds}}},
            {"integrator",
-            {{"name", integrator_name(p.objective_options.solver.integrator)},
-             {"step", p.objective_options.solver.step},
-             {"rtol", p.objective_options.solver.rtol},
+            {{"name", model == "nonlinear" ? std::string("esdirk-newton (nonlinear model)")
+                                            : std::string(integrator_name(p.objective_options.solver.integrator))},
+             {"step", model == "nonlinear" ? integrator_step : p.objective_options.solver.step},
+             {"rtol", model == "nonlinear" ? json(nullptr) : json(p.objective_options.solver.rtol)},
              {"steps", counters.solver.steps},
              {"resolved_modes", p.content.mode},
              {"modes_below_nyquist", p.content.modes_below_nyquist},
@@ -720,7 +721,10 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                                }()},
                               {"interval_note", interval.note}};
   } else {
-    out["identifiability"] = {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
+    out["identifiability"] = {
+        {"assessed", false},
+        {"why", model == "nonlinear" ? "the nonlinear model has no Fisher analysis: no standard deviations, no identifiability flags"
+                                     : "run with --no-std: no standard deviations, no identifiability flags"}};
   }
   if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0)
     out["data_columns"] = {{"sensors", p.columns.sensors},

@@ -115,8 +115,18 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
     a.method = o.method;
     a.termination = to_string(s.termination);
     a.optimizer_converged = s.converged();
+    // J over the whole record from the fit test's prediction (a point whose forward run fails
+    // has none: infinite cost, not an aborted run).
     obj.set_horizon(obj.data_end());
-    a.cost = s.q.allFinite() ? obj.cost(s.q) : INFINITY;
+    a.cost = INFINITY;
+    if (pred.allFinite()) {
+      try {
+        a.cost = obj.cost(s.q);
+      } catch (const io::Interrupted&) {
+        throw;
+      } catch (const std::exception&) {
+      }
+    }
     if (!std::isfinite(a.cost)) a.cost = INFINITY;
     a.iterations = s.iterations_done;
     a.explains_data = f.explains_data;
@@ -155,6 +165,7 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
     std::printf("identifiability: not assessed (no Fisher analysis for the nonlinear model): no standard deviation or "
                 "interval is given\n");
   r.counters = obj.counters();
+  r.integrator_step = fo.max_step;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -17,7 +17,7 @@ constexpr int kMaxNewton = 6;
 // The Newton matrix is refactorised (same Jacobian) when the step changes by more than this.
 constexpr double kRefactorStep = 0.05;
 // A component's scale never counts below this (states in ft, rad, ft/s, rad/s): a component that
-// is zero to rounding converges with any correction below 1e-16 times the tolerance.
+// is zero to rounding converges with any correction below 1e-6 times the tolerance.
 constexpr double kAbsoluteFloor = 1e-6;
 
 class Stepper {
@@ -47,14 +47,17 @@ public:
     return d;
   }
 
-  // One step from (t, y) of length h; F0 = f at the step's start (right limit). With `rec`, the
-  // stages are recorded.
-  VectorXd step(double t, double h, const VectorXd& y, const VectorXd& F0, NonlinearStep* rec = nullptr) {
+  // One step from (t, y) to t_end = t + h (given, so that it lands on the grid point exactly);
+  // F0 = f at the step's start (right limit). The inputs are evaluated strictly inside the step:
+  // a stage at either end sees the neighbouring representable time, i.e. the right limit at the
+  // start and the left limit at the end. With `rec`, the stages are recorded.
+  VectorXd step(double t, double t_end, const VectorXd& y, const VectorXd& F0, NonlinearStep* rec = nullptr) {
     scale_ = scale_.cwiseMax(y.cwiseAbs());
+    const double h = t_end - t;
     const int s = tab_.stages;
     std::vector<VectorXd> F(static_cast<std::size_t>(s));
     F[0] = F0;
-    const double lo = t + 1e-12 * h, hi = t + h - 1e-12 * h;
+    const double lo = std::nextafter(t, t_end), hi = std::nextafter(t_end, t);
     VectorXd Y = y;
     for (int i = 1; i < s; ++i) {
       VectorXd z = y;
@@ -83,7 +86,8 @@ public:
           if (k > 0 && size > kRefreshContraction * prev) break;
           prev = size;
         }
-        if (!done) refresh(ti, Y, h);
+        // A fresh Jacobian where the iteration started (the failed iterate may not be finite).
+        if (!done) refresh(ti, Y.allFinite() ? Y : start, h);
         else F[static_cast<std::size_t>(i)] = fY;
       }
       if (done && rec) {
@@ -217,21 +221,21 @@ NonlinearResponse simulate_nonlinear(const ScoleNonlinear::Dynamics& dynamics, c
     const int m = std::max(1, static_cast<int>(std::ceil((b - a) / h_max - 1e-9)));
     const double h = (b - a) / m;
     for (int k = 0; k < m; ++k) {
-      const double t = a + k * h;
-      if (fresh) F = st.f(t + 1e-12 * h, y);
+      const double t = a + k * h, t_end = k + 1 == m ? b : a + (k + 1) * h;
+      if (fresh) F = st.f(std::nextafter(t, t_end), y);
       NonlinearStep* rec = nullptr;
       if (keep_steps) {
         r.steps.emplace_back();
         rec = &r.steps.back();
       }
-      y = st.step(t, h, y, F, rec);
+      y = st.step(t, t_end, y, F, rec);
       F = st.last_derivative();
       fresh = false;
     }
     if (is_break[g + 1]) fresh = true;
     if (next_sample < times.size() && std::abs(times[next_sample] - b) <= 1e-12 * std::max(1.0, std::abs(b))) {
       if (keep_steps) r.steps.back().sample = static_cast<int>(next_sample);
-      record(next_sample++, b - 1e-12 * h, y);
+      record(next_sample++, b, y);
     }
   }
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();

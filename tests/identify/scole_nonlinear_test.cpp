@@ -434,14 +434,19 @@ TEST(ScoleNonlinearCostate, GradientMatchesCentralDifferencesForEveryCoefficient
 
 namespace {
 // Paper Case I (its sensors, q1 = EI/ρA and q2 = 1/ρA from the paper's start) driven by the
-// 20° roll slew of scole-slew.
+// 20° roll slew of scole-slew: the built-in scole-slew-case1, checked to be exactly that.
 scoleid::io::Scenario case_one_on_the_slew() {
-  auto sc = builtin("scole-slew");
-  const auto case1 = builtin("paper-scole-1");
-  sc.name = "case1-slew";
-  sc.sensors = case1.sensors;
-  sc.identification = case1.identification;
-  sc.identification.model = "nonlinear";
+  auto sc = builtin("scole-slew-case1");
+  const auto slew = builtin("scole-slew"), case1 = builtin("paper-scole-1");
+  EXPECT_EQ(sc.identification.model, "nonlinear");
+  EXPECT_EQ(sc.identification.estimate, case1.identification.estimate);
+  EXPECT_EQ(sc.identification.initial, case1.identification.initial);
+  EXPECT_EQ(sc.identification.parameterization, case1.identification.parameterization);
+  EXPECT_EQ(sc.sensors.size(), case1.sensors.size());
+  for (std::size_t k = 0; k < sc.sensors.size() && k < case1.sensors.size(); ++k)
+    EXPECT_EQ(sc.sensors[k].name, case1.sensors[k].name);
+  EXPECT_EQ(sc.inputs.size(), slew.inputs.size());
+  EXPECT_EQ(sc.inputs.front().signal.describe(), slew.inputs.front().signal.describe());
   return sc;
 }
 }  // namespace
@@ -494,4 +499,26 @@ TEST(ScoleNonlinearIdentification, OptionsTheNonlinearModelDoesNotOfferAreRefuse
   auto beam = builtin("paper-beam-1");
   beam.identification.model = "nonlinear";
   EXPECT_THROW(scole_nonlinear(beam, 4), scoleid::io::InputError);
+}
+
+TEST(ScoleNonlinearCostate, TaylorRemainderFallsAtSecondOrder) {
+  // R(ε) = |J(c ∘ (1 + ε d)) − J(c) − ε ∇J·(c ∘ d)| for a random direction d over every coefficient.
+  auto g = gradient_case(0.6);
+  VectorXd gc;
+  const double J0 = g->obj->cost_and_coefficient_gradient(g->c, gc);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> N(0.0, 1.0);
+  VectorXd d(g->c.size());
+  for (int k = 0; k < d.size(); ++k) d[k] = N(rng);
+  d /= d.norm();
+  const VectorXd dc = g->c.cwiseProduct(d);
+  const double slope = gc.dot(dc);
+  std::vector<double> R;
+  for (int k = 0; k < 5; ++k) {
+    const double eps = 0.02 / std::pow(2.0, k);
+    VectorXd unused;
+    R.push_back(std::abs(g->obj->cost_and_coefficient_gradient(g->c + eps * dc, unused) - J0 - eps * slope));
+    std::printf("  eps %.4e remainder %.6e ratio %.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
+  }
+  for (std::size_t k = 1; k < R.size(); ++k) EXPECT_NEAR(R[k - 1] / R[k], 4.0, 0.3);
 }

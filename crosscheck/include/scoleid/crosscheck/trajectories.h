@@ -29,7 +29,8 @@ struct TrajectoryOptions {
   int elements = 0;      // FE mesh; 0 = 4 × identification.elements
   double fe_step = 0.0;  // FE time step; 0 = resolve the first 5 flexible modes with ω h <= 0.03
   // SCOLE: also the nonlinear FE model (fe/scole_nonlinear.h) on `nonlinear_elements` elements
-  // (0 = the linear comparison's), stepped at the linear comparison's step (time/nonlinear_forward.h).
+  // (0 = the linear comparison's), stepped at fe_step, or when that is 0 at the automatic rule's
+  // step on its own mesh (time/nonlinear_forward.h).
   bool nonlinear = false;
   int nonlinear_elements = 0;
   bool progress = false;

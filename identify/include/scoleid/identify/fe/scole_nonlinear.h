@@ -31,15 +31,19 @@
 //              reflector moment, actuator slider forces: the linear model's generalized load
 //              G ᵀb (G maps (X, θ, e) to the linear DOFs); a force at a mast station or the
 //              reflector CM also turns with its arm: Q_Ω = (p + N e) × d f.
-// Sensors      shuttle rotation φ·d (the angle–axis read-out), shuttle displacement X·d, velocity
+// Sensors      shuttle rotation φ·d (the truth's angle–axis read-out while the angle stays below π,
+//              where the truth's wraps), shuttle displacement X·d, velocity
 //              (R V)·d, acceleration (R (V̇ + Ω × V))·d, all in ground; mast and reflector
 //              displacement, rotation, line of sight and velocity: the linear model's rows on e
 //              or ė (relative to S, in S); an acceleration: the point's inertial acceleration in
 //              S along d, a_i · d.
 // At rest (q = 0, u = 0) the linearisation is the linear model in the coordinates (X, θ, e):
 // M(0) = Gᵀ M_lin G, the same K, D, loads and sensor rows.
+#include <memory>
 #include <string>
 #include <vector>
+
+#include <Eigen/SparseCholesky>
 
 #include "scoleid/identify/fe/scole_model.h"
 
@@ -98,7 +102,12 @@ public:
     std::vector<double> mass_;            // per mass point
     std::vector<Eigen::Matrix3d> J_;      // per rotor
     MatrixXd Mconst_;                     // the e-independent part of M
+    std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;  // factor of M_ee (constant)
+    // The rigid rows of M(e): A = M_rr (6 × 6), B = M_re (6 × ne).
+    void rigid_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
+    VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
     MatrixXd K_, D_;                      // elastic blocks
+    std::vector<double> input_scale_;     // γ_i per input (1 without a coefficient)
     double constants_ = 1.0;
   };
   Dynamics at(const VectorXd& c, double constants = 1.0) const;
@@ -107,16 +116,28 @@ public:
   const MatrixXd& linear_map() const { return G_; }
 
 private:
+  // Three rows on e with few nonzero columns (a point's or a section's rows touch one element's
+  // DOFs): the products the equations evaluate at every f cost O(columns), not O(ne).
+  struct Rows3 {
+    std::vector<int> cols;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> v;
+    static Rows3 of(const MatrixXd& dense);
+    Eigen::Vector3d times(const VectorXd& x) const;
+    void add_transposed(const Eigen::Vector3d& w, VectorXd& out) const;          // out += Rowsᵀ w
+    void add_left(const Eigen::Matrix3d& A, MatrixXd& out) const;                // out (3 × ne) += A Rows
+  };
   struct MassPoint {
     Eigen::Vector3d p;
     MatrixXd N;        // 3 × ne
     double weight = 0; // mass = weight · c[coefficient] (or · constants)
     int coefficient = -1;
+    Rows3 n;           // N, compact
   };
   struct Rotor {
     Eigen::Matrix3d J;
     MatrixXd Theta;    // 3 × ne
     int coefficient = -1;
+    Rows3 th;          // Θ, compact
   };
   struct Input {
     VectorXd q0;         // Gᵀ b at e = 0 (speeds())

@@ -4,7 +4,8 @@
 //
 //   cost      J(q) = ½ Σ_k τ_k Σ_j R_j (z_j(y_k, u̇_k) − z̃_kj)²  over the samples t_k ≤ T,
 //             τ_k the trapezoid weights of the sample times (so J ≈ ½ ∫ rᵀ R r dt), R_j =
-//             1 / ((T − t0) · mean_k z̃_kj²) as in objective.h (the relative mean-square misfit).
+//             1 / ((t_K − t0) · mean_k z̃_kj²), t_K the last sample on the horizon, as in
+//             objective.h (the relative mean-square misfit).
 //   forward   per step (ESDIRK, explicit first stage, stiffly accurate, diagonal γ):
 //             Y_0 = y_n, Y_i = y_n + h Σ_{j≤i} a_ij F_j, F_j = f(t_j, Y_j; c), y_{n+1} = Y_{s−1}.
 //   costate   the adjoint of exactly these equations (the linearisation along the computed
@@ -15,11 +16,14 @@
 //             the model's transposed products (derivative_vjp, no matrix formed); each stage
 //             system is solved by defect correction on a frozen factorisation of I − hγ J_ref
 //             (J_ref by difference quotients, refreshed only when the correction stops
-//             contracting below 0.3 per iteration), as the forward's Newton iteration is.
+//             contracting below 0.3 per iteration), as the forward's Newton iteration is; it
+//             stops when the correction is below 1e-12 of the solution.
 //             A sample adds ∂g_k/∂y_k, through u̇_k = f_u(y_k) for accelerometers.
 //   gradient  dJ/dc = h Σ_steps Σ_i Φ_iᵀ ∂f/∂c (t_i, Y_i) (+ the samples' u̇ share), chained to q
-//             by ∂c/∂q: the exact gradient of the discrete J (one forward, one backward pass,
-//             whatever the number of parameters).
+//             by ∂c/∂q: the gradient of the discrete J, exact up to the solvers' tolerances
+//             (forward Newton 1e-10, stage systems 1e-12) and the central-difference φ-gradient
+//             of J_r⁻¹ (~1e-10); one forward and one backward pass, whatever the number of
+//             parameters.
 //   Gauss–Newton matrix H = Σ_k τ_k S_kᵀ R S_k, S_k = ∂z_k/∂q by central differences of the
 //             forward outputs (2 P forward runs, relative step 1e-4): an approximation of the
 //             curvature only; the gradient is always the costate's.

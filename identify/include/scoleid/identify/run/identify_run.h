@@ -96,6 +96,7 @@ struct RunResult {
   double wall_seconds = 0;
   double identifiability_seconds = 0;
   MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
+  double integrator_step = 0.0;  // the nonlinear model's largest step (identify.json integrator.step)
   nlohmann::json to_json(const Problem& p) const;
 };
 

@@ -17,9 +17,11 @@
 // that stay zero to rounding from demanding corrections below rounding).
 //
 // Steps: the sample times and the inputs' breakpoints cut the record into intervals, each
-// stepped in equal steps of at most max_step; a step evaluates the inputs inside its own
-// interval (the left limit at its end, the right limit at its start), so a jump never lies
-// inside a step. Outputs at the sample times use f's accelerations there (left limits).
+// stepped in equal steps of at most max_step; a step evaluates the inputs strictly inside its own
+// interval (at the neighbouring representable times of its ends: the right limit at its start,
+// the left limit at its end), so a jump never lies inside a step. Outputs at a sample time t_k use
+// f's accelerations with the inputs at t_k itself, as the truth and the linear model read them
+// (after a jump that falls on a sample).
 //
 // The process never calls SUNDIALS' N_Vector: Simbody's libSimTKmath exports its own older
 // copies of those symbols, and a program linking both (scole-crosscheck) would mix them.
