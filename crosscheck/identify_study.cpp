@@ -90,6 +90,7 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
       st.parameters[i].estimate.push_back(res.estimate[ii]);
       st.parameters[i].std.push_back(res.ident.std.size() > ii ? res.ident.std[ii] : ParameterStudy::nan);
       const bool ok = res.ident.identifiable.size() > i && res.ident.identifiable[i];
+      st.parameters[i].flagged.push_back(res.ident.identifiable.size() > i && !res.ident.identifiable[i]);
       st.parameters[i].half_width.push_back(ok && res.interval.half_width.size() > ii ? res.interval.half_width[ii]
                                                                                       : ParameterStudy::nan);
     }
@@ -139,11 +140,12 @@ Table identify_table(const IdentifyStudy& s) {
     row.push_back(percent(2.0 * p.std.front() / std::abs(p.truth), 3));
     row.push_back(std::isfinite(p.std.front()) ? (p.covered(0) ? "yes" : "no") : "no std");
     row.push_back(percent(p.half_width.front() / std::abs(p.truth), 3));
-    // No interval: a flagged parameter still has its std; without one it was not assessed (--no-std,
-    // or the nonlinear model, which has no Fisher analysis).
+    // No interval: the parameter is flagged, or the run gave a std without an interval (the
+    // nonlinear model), or none at all (--no-std).
     row.push_back(std::isfinite(p.half_width.front()) ? (p.interval_covered(0) ? "yes" : "no")
-                  : std::isfinite(p.std.front())     ? "flagged"
-                                                     : "not assessed");
+                  : !p.flagged.empty() && p.flagged.front() ? "flagged"
+                  : std::isfinite(p.std.front())            ? "no interval"
+                                                            : "not assessed");
     t.rows.push_back(row);
   }
   return t;

@@ -19,12 +19,14 @@ FisherInformation& FisherInformation::operator+=(const FisherInformation& o) {
 }
 
 FisherInformation fisher_information(Objective& obj, const std::vector<io::SensorSpec>& sensors, const VectorXd& q) {
+  return fisher_information(obj.data(), obj.predict(q), obj.output_sensitivities(q), sensors);
+}
+
+FisherInformation fisher_information(const Measurements& data, const MatrixXd& Y, const MatrixXd& G,
+                                     const std::vector<io::SensorSpec>& sensors) {
   FisherInformation id;
-  const Measurements& data = obj.data();
-  const int P = obj.size(), ns = data.sensors();
+  const int P = static_cast<int>(G.cols()), ns = data.sensors();
   const auto N = static_cast<Eigen::Index>(data.t.size());
-  const MatrixXd Y = obj.predict(q);
-  const MatrixXd G = obj.output_sensitivities(q);
   // Noise level per sensor.
   bool from_scenario = true;
   for (int k = 0; k < ns; ++k) {

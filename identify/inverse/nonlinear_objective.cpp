@@ -255,28 +255,32 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
   return J;
 }
 
-double NonlinearObjective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
-  const double J = cost_and_gradient(q, gradient);
-  const int P = size();
-  VectorXd c;
-  MatrixXd dcdq;
-  params_.coefficients(q, c, dcdq);
-  const NonlinearForwardSummary keep = last_forward_;
-  const int K = samples_on_horizon(), ns = model_.sensors();
-  std::vector<MatrixXd> S(static_cast<std::size_t>(P));
+MatrixXd NonlinearObjective::output_sensitivities(const VectorXd& q) {
+  const int P = size(), K = samples_on_horizon(), ns = model_.sensors();
+  MatrixXd G(static_cast<Eigen::Index>(K) * ns, P);
   for (int i = 0; i < P; ++i) {
     const double d = kSensitivityStep * std::max(std::abs(q[i]), 1e-12);
     VectorXd qp = q, qm = q;
     qp[i] += d;
     qm[i] -= d;
-    S[static_cast<std::size_t>(i)] = (predict(qp) - predict(qm)) / (2 * d);
+    const MatrixXd S = (predict(qp) - predict(qm)) / (2 * d);
     counters_.sensitivity_solves += 2;
+    for (int k = 0; k < K; ++k)
+      for (int j = 0; j < ns; ++j) G(static_cast<Eigen::Index>(k) * ns + j, i) = S(k, j);
   }
+  return G;
+}
+
+double NonlinearObjective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  const double J = cost_and_gradient(q, gradient);
+  const int P = size();
+  const NonlinearForwardSummary keep = last_forward_;
+  const int K = samples_on_horizon(), ns = model_.sensors();
+  const MatrixXd G = output_sensitivities(q);
   H = MatrixXd::Zero(P, P);
   for (int k = 0; k < K; ++k)
     for (int j = 0; j < ns; ++j) {
-      VectorXd s(P);
-      for (int i = 0; i < P; ++i) s[i] = S[static_cast<std::size_t>(i)](k, j);
+      const VectorXd s = G.row(static_cast<Eigen::Index>(k) * ns + j).transpose();
       H += tau_[static_cast<std::size_t>(k)] * R_[static_cast<std::size_t>(j)] * s * s.transpose();
     }
   last_forward_ = keep;

@@ -721,10 +721,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                                }()},
                               {"interval_note", interval.note}};
   } else {
-    out["identifiability"] = {
-        {"assessed", false},
-        {"why", model == "nonlinear" ? "the nonlinear model has no Fisher analysis: no standard deviations, no identifiability flags"
-                                     : "run with --no-std: no standard deviations, no identifiability flags"}};
+    out["identifiability"] = {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
   }
   if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0)
     out["data_columns"] = {{"sensors", p.columns.sensors},

@@ -1,9 +1,9 @@
 // identification.model: nonlinear (docs/theory.md §3.8, §6.7): the same run as identify_run.cpp's
 // on the nonlinear SCOLE model — optimiser with horizon continuation, the fit test (its
 // discretisation estimate from the nonlinear model on twice the elements at a quarter of the
-// step), one cautious-continuation restart after a false convergence — without the Fisher
-// analysis, which has no nonlinear counterpart yet: no standard deviation or interval is given,
-// and the parameters are reported as not assessed.
+// step), one cautious-continuation restart after a false convergence, and the Fisher analysis
+// (std, resolution, flags) from differenced output sensitivities; no uncertainty interval (its
+// half-record refit and consider terms are not built for this model).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -161,9 +161,23 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
   r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;
   if (ro.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
   r.estimate = r.summary.q;
-  if (ro.compute_std && ro.verbose)
-    std::printf("identifiability: not assessed (no Fisher analysis for the nonlinear model): no standard deviation or "
-                "interval is given\n");
+  if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) {
+    // Fisher information from differenced output sensitivities (2P forward runs), each sensor's
+    // stated noise or, without one, its residual RMS (identifiability.h); no uncertainty interval.
+    const auto ti = std::chrono::steady_clock::now();
+    std::vector<io::SensorSpec> sensors = p.scenario.sensors;
+    for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
+    obj.set_horizon(obj.data_end());
+    const FisherInformation fi = fisher_information(p.data, r.predicted, obj.output_sensitivities(r.estimate), sensors);
+    r.ident = identifiability_from(fi, r.estimate);
+    if (r.ident.noise_source == "scenario") {
+      std::string origin;
+      for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
+      r.ident.noise_source = origin;
+    }
+    r.interval.note = "no uncertainty interval for the nonlinear model (std and resolution from the Fisher matrix only)";
+    r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
+  }
   r.counters = obj.counters();
   r.integrator_step = fo.max_step;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -522,3 +522,28 @@ TEST(ScoleNonlinearCostate, TaylorRemainderFallsAtSecondOrder) {
   }
   for (std::size_t k = 1; k < R.size(); ++k) EXPECT_NEAR(R[k - 1] / R[k], 4.0, 0.3);
 }
+
+TEST(ScoleNonlinearIdentification, TheFisherStdOfTheNonlinearModelCoversTheErrorOfANoisyFit) {
+  // The same slew with stated noise of about 1 % of each sensor's RMS signal (seeded): the
+  // reported std (Fisher matrix from differenced output sensitivities) must describe the error
+  // of the estimate, |error| < 3 std for each parameter, and the flags must be clear.
+  auto sc = case_one_on_the_slew();
+  const double noise[3] = {1e-2, 1e-3, 3e-5};  // roll tip, pitch tip [ft], reflector twist [rad]
+  for (std::size_t k = 0; k < sc.sensors.size() && k < 3; ++k) sc.sensors[k].noise_std = noise[k];
+  auto p = make_problem(sc, std::nullopt);
+  RunOptions ro;
+  ro.verbose = false;
+  const RunResult r = run_identification(*p, ro);
+  ASSERT_EQ(r.ident.std.size(), 2);
+  EXPECT_TRUE(r.converged()) << r.fit.message;
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    const double err = r.estimate[ii] - r.truth.at(r.names[i]);
+    std::printf("  %s: error %.3e, std %.3e (%.2f std), resolution %.3e\n", r.names[i].c_str(), err, r.ident.std[ii],
+                err / r.ident.std[ii], r.ident.resolution[ii]);
+    EXPECT_TRUE(r.ident.identifiable[i]) << r.ident.reason[i];
+    EXPECT_LT(std::abs(err), 3.0 * r.ident.std[ii]);
+    EXPECT_GT(r.ident.std[ii], 0.0);
+  }
+  EXPECT_EQ(r.ident.noise_source, "scenario");
+}

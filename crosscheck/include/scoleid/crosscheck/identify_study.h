@@ -39,6 +39,7 @@ struct ParameterStudy {
   std::string name;
   double truth = nan;
   std::vector<double> estimate, std, half_width;   // per level
+  std::vector<char> flagged;                       // per level: assessed and not identifiable
   double extrapolated = nan;           // Richardson, p = 2, two finest levels
   double rate = nan;                   // observed order of the estimates (three finest levels)
   double fe_on_fe = nan, fe_on_fe_std = nan;

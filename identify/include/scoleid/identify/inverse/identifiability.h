@@ -57,6 +57,10 @@ struct FisherInformation {
 };
 // `sensors` supplies each sensor's stated noise_std (<= 0: unknown).
 FisherInformation fisher_information(Objective& objective, const std::vector<io::SensorSpec>& sensors, const VectorXd& q);
+// The same from the model's outputs Y (samples × sensors) and their sensitivities G (row
+// sample · sensors + sensor, one column per parameter) at the estimate.
+FisherInformation fisher_information(const Measurements& data, const MatrixXd& Y, const MatrixXd& G,
+                                     const std::vector<io::SensorSpec>& sensors);
 // std, resolution, condition number and the flags from a Fisher information (one experiment's or
 // a sum of several).
 Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q);

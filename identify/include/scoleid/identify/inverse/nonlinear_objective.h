@@ -69,6 +69,9 @@ public:
 
   // The outputs at the samples on the horizon (samples × sensors).
   MatrixXd predict(const VectorXd& q);
+  // ∂y/∂q at the samples on the horizon by central differences (relative step 1e-4), row
+  // sample · sensors + sensor (objective.h's layout): 2P forward runs.
+  MatrixXd output_sensitivities(const VectorXd& q);
   // dJ/dc for coefficients c directly (the gradient before the chain rule).
   double cost_and_coefficient_gradient(const VectorXd& c, VectorXd& gradient);
   const NonlinearForwardSummary& last_forward() const { return last_forward_; }

@@ -102,8 +102,8 @@ struct RunResult {
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
 // identification.model: nonlinear (nonlinear_run.cpp; run_identification hands over to it): the
-// optimiser, the fit test and one cautious restart on the nonlinear SCOLE model; no Fisher
-// analysis (the parameters are reported as not assessed).
+// optimiser, the fit test, one cautious restart and the Fisher analysis on the nonlinear SCOLE
+// model; no uncertainty interval.
 RunResult run_nonlinear_identification(Problem& problem, const RunOptions& options);
 
 // identification.model_error, with the automatic value resolved (io/scenario.h).
