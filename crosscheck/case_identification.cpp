@@ -31,6 +31,7 @@ json identify_row(identify::Problem& p) {
   row["fit_test"] = r.fit.message;
   row["termination"] = identify::to_string(r.summary.termination);
   row["iterations"] = r.summary.iterations_done;
+  row["iterations_all_attempts"] = r.iterations_all_attempts();
   row["seconds"] = r.wall_seconds;
   row["parameters"] = json::array();
   for (std::size_t i = 0; i < r.names.size(); ++i) {

@@ -45,6 +45,7 @@ LevelRun run_one(identify::Problem& p, int segments, identify::RunResult& result
   r.segments = segments;
   r.converged = result.converged();
   r.iterations = result.summary.iterations_done;
+  r.iterations_all_attempts = result.iterations_all_attempts();
   r.termination = identify::to_string(result.summary.termination);
   r.seconds = result.wall_seconds;
   return r;
@@ -159,7 +160,7 @@ nlohmann::json to_json(const IdentifyStudy& s) {
     return a;
   };
   auto run = [](const LevelRun& r) {
-    return nlohmann::json{{"segments", r.segments}, {"converged", r.converged}, {"iterations", r.iterations},
+    return nlohmann::json{{"segments", r.segments}, {"converged", r.converged}, {"iterations", r.iterations}, {"iterations_all_attempts", r.iterations_all_attempts},
                           {"termination", r.termination}, {"seconds", r.seconds}};
   };
   nlohmann::json j;

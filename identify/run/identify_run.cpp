@@ -670,11 +670,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"krylov_iterations", summary.krylov_iterations},
            // Every attempt's iterations with its coarse-to-fine levels (`iterations` is the chosen
            // run's history alone).
-           {"iterations_all_attempts", [&] {
-              int n = 0;
-              for (const auto& a : attempts) n += a.iterations;
-              return n;
-            }()},
+           {"iterations_all_attempts", iterations_all_attempts()},
            {"gradient_evaluations", counters.gradient_evaluations},
            {"forward_solves", counters.forward_solves},
            {"costate_solves", counters.costate_solves},

@@ -55,7 +55,8 @@ struct ParameterStudy {
 struct LevelRun {
   int segments = 0;        // 0 for the FE-on-FE run
   bool converged = false;
-  int iterations = 0;
+  int iterations = 0;                // the chosen attempt's
+  int iterations_all_attempts = 0;   // every attempt's, with coarse-to-fine levels
   std::string termination;
   double seconds = 0.0;
 };

@@ -91,6 +91,13 @@ struct RunResult {
   // The optimiser stopped on a convergence test and the model explains the data (and, with the
   // discrepancy principle, a weight met it).
   bool converged() const { return summary.converged() && fit.explains_data && (smoothness_path.empty() || smoothness_met); }
+  // Every attempt's iterations with its coarse-to-fine levels (summary.iterations_done is the
+  // chosen run's alone).
+  int iterations_all_attempts() const {
+    int n = 0;
+    for (const auto& a : attempts) n += a.iterations;
+    return n;
+  }
   VectorXd half_record_estimate;
   bool half_record_converged = false;
   double wall_seconds = 0;
