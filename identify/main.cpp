@@ -162,8 +162,9 @@ int main(int argc, char** argv) {
     // The output directory is checked (and its staging area made) before any work.
     io::RunDirectory run_dir(out, identify::output_files(), "scole-identify");
     auto problem = identify::make_problem(sc, ro.data_csv);
-    std::fprintf(stderr, "scole-identify: %s, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
-                 problem->structure->elements(), problem->params->size(), problem->data_source.c_str());
+    std::fprintf(stderr, "scole-identify: %s, %s model, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
+                 sc.identification.model.c_str(), problem->structure->elements(), problem->params->size(),
+                 problem->data_source.c_str());
     if (ro.data_csv) {
       auto list = [](const std::vector<std::string>& v) {
         std::string s;

@@ -313,6 +313,39 @@ identification:
   }
 }
 
+TEST(ScoleIdentifyCli, TheNonlinearModelIsUsedAndSaid) {
+  // identification.model: nonlinear on a short slew (2 s, 4 elements): the run says which model it
+  // used on stderr and in identify.json, recovers EI from its own nonlinear data, and gives std
+  // from its Fisher matrix but no interval.
+  TempDir dir;
+  write_file(dir / "slew.yaml", R"(name: short-slew
+structure: scole
+scole: {actuator_stroke: 100}
+inputs:
+  - {name: M_roll, at: shuttle, kind: moment, direction: x, signal: {type: bangbang, amplitude: 100000, t0: 0, width: 2}}
+sensors:
+  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y}
+  - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
+simulation: {duration: 2, sample_interval: 0.02, seed: 1}
+identification:
+  parameterization: physical
+  estimate: [EI]
+  initial: {EI: 3.8e7}
+  elements: 4
+  model: nonlinear
+)");
+  const Result r = run({"--scenario", (dir / "slew.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("nonlinear model"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(read_file(dir / "out" / "identify.json"));
+  EXPECT_EQ(j["model"], "nonlinear");
+  EXPECT_EQ(j["settings"]["identification"]["model"], "nonlinear");
+  const auto& p = j["parameters"][0];
+  EXPECT_LT(std::abs(p["relative_error"].get<double>()), 1e-4) << p.dump();
+  EXPECT_TRUE(p["std"].is_number()) << p.dump();
+  EXPECT_TRUE(p["interval"].is_null()) << p.dump();
+}
+
 TEST(ScoleIdentifyCli, MissingDataFile) {
   TempDir dir;
   const fs::path out = dir / "out";
