@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "best_of.h"
 #include "scoleid/identify/run/identify_run.h"
 
 using namespace scoleid::identify;
@@ -21,15 +22,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double best_of(int reps, const std::function<void()>& f) {
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = Clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
-  }
-  return best;
-}
+using bench::best_of;
 
 scoleid::io::Scenario sections_scenario(int N, int elements) {
   auto sc = scoleid::io::load_scenario("paper-beam-3");

@@ -6,29 +6,16 @@
 //   - the linear gradient in units of the linear forward solve, for comparison.
 // Each figure is the minimum over repetitions (wall clock).
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <functional>
+#include <cstdlib>
 
+#include "best_of.h"
 #include "scoleid/identify/inverse/nonlinear_objective.h"
 #include "scoleid/identify/run/problem.h"
 
 using namespace scoleid::identify;
-using Clock = std::chrono::steady_clock;
 
-namespace {
-
-double best_of(int reps, const std::function<void()>& f) {
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = Clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
-  }
-  return best;
-}
-
-}  // namespace
+using bench::best_of;
 
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
