@@ -333,6 +333,12 @@ Ladder coarse_to_fine(const Problem& p, Objective& obj, const std::vector<std::s
 }
 }  // namespace
 
+bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b) {
+  const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
+  const int rb = (b.optimizer_converged && b.explains_data ? 2 : 0) + (b.explains_data ? 1 : 0);
+  return ra != rb ? ra > rb : a.cost < b.cost;
+}
+
 RunResult run_identification(Problem& p, const RunOptions& ro) {
   if (p.scenario.identification.model == "nonlinear") return run_nonlinear_identification(p, ro);
   const auto t0 = std::chrono::steady_clock::now();
@@ -439,12 +445,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   };
   r.attempts.push_back(attempt_record(first_label, method, r.summary, r.fit, first_iterations + r.summary.iterations_done));
   r.attempts.back().levels = first_levels;
-  // Rank of an attempt: converged and explaining the data, then explaining it, then the cost.
-  auto better = [](const RunResult::Attempt& a, const RunResult::Attempt& b) {
-    const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
-    const int rb = (b.optimizer_converged && b.explains_data ? 2 : 0) + (b.explains_data ? 1 : 0);
-    return ra != rb ? ra > rb : a.cost < b.cost;
-  };
+
   // Further attempts when the model at the estimate does not explain the data.
   // The second of the two starts of a sectional family: coarse to fine after a plain run, the plain
   // run after the ladder (a coarse level can land in a basin the full profile does not leave:
@@ -497,7 +498,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     const FitTest f = test_fit(p, obj, s.q);
     r.attempts.push_back(attempt_record(label, method, s, f, iterations));
     r.attempts.back().levels = levels;
-    if (better(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
+    if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
       r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
       r.summary = s;
       r.fit = f;

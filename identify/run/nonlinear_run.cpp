@@ -147,11 +147,7 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
     oc.continuation_misfit = (id.continuation_misfit > 0 ? id.continuation_misfit : OptimizerOptions{}.continuation_misfit) / 4.0;
     if (ro.verbose) std::printf("fit test: %s\nrestart (cautious continuation)\n", r.fit.message.c_str());
     auto [s, f, pred] = attempt(oc.method + ", horizon continuation at misfit " + io::format_value(oc.continuation_misfit), oc);
-    const auto& a = r.attempts.back();
-    const auto& b = r.attempts.front();
-    const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
-    const int rb = (b.optimizer_converged && b.explains_data ? 2 : 0) + (b.explains_data ? 1 : 0);
-    if (ra > rb || (ra == rb && a.cost < b.cost)) {
+    if (better_attempt(r.attempts.back(), r.attempts.front())) {
       r.chosen_attempt = 1;
       r.summary = s;
       r.fit = f;

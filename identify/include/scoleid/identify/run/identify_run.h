@@ -108,6 +108,8 @@ struct RunResult {
 };
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
+// The rank of two attempts: converged and explaining the data, then explaining it, then the cost.
+bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b);
 // identification.model: nonlinear (nonlinear_run.cpp; run_identification hands over to it): the
 // optimiser, the fit test, one cautious restart and the Fisher analysis on the nonlinear SCOLE
 // model; no uncertainty interval.
