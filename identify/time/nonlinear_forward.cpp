@@ -193,9 +193,12 @@ NonlinearResponse simulate_nonlinear(const ScoleNonlinear::Dynamics& dynamics, c
   grid.erase(std::unique(grid.begin(), grid.end(), [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(a)); }), grid.end());
   std::vector<char> is_break(grid.size(), 0);
   for (const auto& s : signals)
-    for (double b : s.breakpoints())
-      for (std::size_t g = 0; g < grid.size(); ++g)
-        if (std::abs(grid[g] - b) <= 1e-12 * std::max(1.0, std::abs(b))) is_break[g] = 1;
+    for (double b : s.breakpoints()) {
+      // The grid point that stands for b (sorted grid; a table signal has a breakpoint per sample).
+      const double tol = 1e-12 * std::max(1.0, std::abs(b));
+      const auto it = std::lower_bound(grid.begin(), grid.end(), b - tol);
+      if (it != grid.end() && std::abs(*it - b) <= tol) is_break[static_cast<std::size_t>(it - grid.begin())] = 1;
+    }
 
   NonlinearResponse r;
   r.t = times;
