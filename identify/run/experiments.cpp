@@ -155,6 +155,10 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     if (sc.identification.start != "auto")
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           "sets identification.start, which a joint run does not take (it starts plain, without restarts)", r.scenario);
+    if (sc.identification.model != "linear")
+      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+          "sets identification.model: " + sc.identification.model + ", which a joint run does not take (linear model only)",
+          r.scenario);
     ep->runs.push_back(make_problem(sc, r.data));
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
   }

@@ -305,7 +305,24 @@ TEST(Experiments, BadInputIsOneLineNamingFileFieldAndValue) {
 
   const std::string m5 = input_error([&] { load_experiments((s.dir / "missing.yaml").string()); });
   EXPECT_NE(m5.find("missing.yaml"), std::string::npos) << m5;
-  for (const std::string& m : {m1, m2, m3, m4, m5}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+
+  // A run on the nonlinear SCOLE model: joint runs are linear only.
+  s.write("n.yaml", R"(structure: scole
+inputs:
+  - {name: M, at: shuttle, kind: moment, direction: x, signal: {type: bangbang, amplitude: 1000, t0: 0, width: 1}}
+sensors:
+  - {name: tip, at: mast, location: 130, direction: y}
+simulation: {duration: 1, sample_interval: 0.02}
+identification:
+  estimate: [EI]
+  elements: 2
+  model: nonlinear
+)");
+  const std::string f6 = s.write("e6.yaml", "experiments: e6\nruns:\n  - {name: n, scenario: n.yaml}\n");
+  const std::string m6 = input_error([&] { make_experiments(load_experiments(f6)); });
+  EXPECT_NE(m6.find("identification.model"), std::string::npos) << m6;
+  EXPECT_NE(m6.find("e6.yaml"), std::string::npos) << m6;
+  for (const std::string& m : {m1, m2, m3, m4, m5, m6}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
 
 }  // namespace
