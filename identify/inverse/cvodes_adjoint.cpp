@@ -215,3 +215,180 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
 }
 
 }  // namespace scoleid::identify
+
+namespace scoleid::identify {
+
+namespace {
+
+struct NonlinearData {
+  const ScoleNonlinear::Dynamics* dyn = nullptr;
+  const std::vector<io::Signal>* signals = nullptr;
+  int n = 0, ncoef = 0;
+  VectorXd inputs(double t) const {
+    VectorXd f(static_cast<Eigen::Index>(signals->size()));
+    for (std::size_t i = 0; i < signals->size(); ++i) f[static_cast<Eigen::Index>(i)] = (*signals)[i](t);
+    return f;
+  }
+};
+
+int nl_rhs(realtype t, N_Vector yv, N_Vector ydot, void* ud) {
+  const NonlinearData& d = *static_cast<NonlinearData*>(ud);
+  d.dyn->derivative(N_VGetArrayPointer(yv), d.inputs(t), N_VGetArrayPointer(ydot));
+  return 0;
+}
+
+// λ̇ = −f_yᵀ λ
+int nl_rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
+  const NonlinearData& d = *static_cast<NonlinearData*>(ud);
+  const double* y = N_VGetArrayPointer(yv);
+  const VectorXd in = d.inputs(t);
+  VectorXd yd(d.n);
+  d.dyn->derivative(y, in, yd.data());
+  const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
+  Eigen::Map<VectorXd>(N_VGetArrayPointer(yBdot), d.n) = -d.dyn->derivative_vjp(y, in, yd, lam);
+  return 0;
+}
+
+// qB' = λᵀ ∂f/∂c (integrated from T back: qB(t0) = −∫ λᵀ ∂f/∂c dt)
+int nl_rhsQB(realtype t, N_Vector yv, N_Vector yB, N_Vector qBdot, void* ud) {
+  const NonlinearData& d = *static_cast<NonlinearData*>(ud);
+  const double* y = N_VGetArrayPointer(yv);
+  const VectorXd in = d.inputs(t);
+  VectorXd yd(d.n);
+  d.dyn->derivative(y, in, yd.data());
+  const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
+  Eigen::Map<VectorXd>(N_VGetArrayPointer(qBdot), d.ncoef) = d.dyn->coefficient_vjp(y, in, yd, lam);
+  return 0;
+}
+
+}  // namespace
+
+CvodesAdjointResult cvodes_nonlinear_gradient(const ScoleNonlinear& model, const VectorXd& c,
+                                              const std::vector<io::Signal>& signals, const Measurements& data,
+                                              const std::vector<double>& R, double rtol) {
+  const auto dyn = model.at(c);
+  NonlinearData d;
+  d.dyn = &dyn;
+  d.signals = &signals;
+  d.n = model.state_size();
+  d.ncoef = model.coefficients();
+  const int n = d.n, ns = model.sensors(), K = static_cast<int>(data.t.size()), nu = model.speeds();
+  if (static_cast<int>(R.size()) != ns) throw std::invalid_argument("cvodes_nonlinear_gradient: one weight per sensor");
+  std::vector<double> tau(static_cast<std::size_t>(K), 0.0);
+  for (int k = 0; k + 1 < K; ++k) {
+    const double dt = data.t[static_cast<std::size_t>(k + 1)] - data.t[static_cast<std::size_t>(k)];
+    tau[static_cast<std::size_t>(k)] += 0.5 * dt;
+    tau[static_cast<std::size_t>(k + 1)] += 0.5 * dt;
+  }
+  SUNContext ctx = nullptr;
+  check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
+  struct Cleanup {
+    std::vector<N_Vector> vecs;
+    std::vector<SUNMatrix> mats;
+    std::vector<SUNLinearSolver> lss;
+    void* cv = nullptr;
+    SUNContext ctx = nullptr;
+    ~Cleanup() {
+      if (cv) CVodeFree(&cv);
+      for (auto* l : lss) SUNLinSolFree(l);
+      for (auto* a : mats) SUNMatDestroy(a);
+      for (auto* v : vecs) N_VDestroy(v);
+      SUNContext_Free(&ctx);
+    }
+  } cl;
+  cl.ctx = ctx;
+  N_Vector y = N_VNew_Serial(n, ctx), yB = N_VNew_Serial(n, ctx), qB = N_VNew_Serial(d.ncoef, ctx);
+  cl.vecs = {y, yB, qB};
+  N_VConst(0.0, y);
+  N_VConst(0.0, qB);
+  void* cv = CVodeCreate(CV_BDF, ctx);
+  cl.cv = cv;
+  const double atol = rtol * 1e-4;
+  const double t0 = data.t.front();
+  check(CVodeInit(cv, nl_rhs, t0, y), "CVodeInit");
+  check(CVodeSStolerances(cv, rtol, atol), "CVodeSStolerances");
+  check(CVodeSetUserData(cv, &d), "CVodeSetUserData");
+  check(CVodeSetMaxNumSteps(cv, 10000000), "CVodeSetMaxNumSteps");
+  SUNMatrix A = SUNDenseMatrix(n, n, ctx);
+  SUNLinearSolver LS = SUNLinSol_Dense(y, A, ctx);
+  cl.mats.push_back(A);
+  cl.lss.push_back(LS);
+  check(CVodeSetLinearSolver(cv, LS, A), "CVodeSetLinearSolver");
+  check(CVodeAdjInit(cv, 500, CV_HERMITE), "CVodeAdjInit");
+
+  // A sample's cost, ∂g_k/∂y_k and ∂g_k/∂c (through u̇ for accelerometers).
+  CvodesAdjointResult res;
+  res.gradient = VectorXd::Zero(d.ncoef);
+  std::vector<VectorXd> ys(static_cast<std::size_t>(K));
+  auto sample = [&](int k, VectorXd* gy) {
+    const VectorXd& yk = ys[static_cast<std::size_t>(k)];
+    const VectorXd in = d.inputs(data.t[static_cast<std::size_t>(k)]);
+    VectorXd yd(n), udot;
+    dyn.derivative(yk.data(), in, yd.data(), &udot);
+    const VectorXd z = dyn.outputs(yk.data(), udot);
+    VectorXd rho(ns);
+    for (int j = 0; j < ns; ++j) {
+      const double r = z[j] - data.z(k, j);
+      rho[j] = tau[static_cast<std::size_t>(k)] * R[static_cast<std::size_t>(j)] * r;
+      if (!gy) res.cost += 0.5 * rho[j] * r;
+    }
+    if (!gy) return;
+    VectorXd dy, da;
+    dyn.outputs_vjp(yk.data(), udot, rho, dy, da);
+    VectorXd lam = VectorXd::Zero(n);
+    lam.tail(nu) = da;
+    *gy = dy + dyn.derivative_vjp(yk.data(), in, yd, lam);
+    res.gradient += dyn.coefficient_vjp(yk.data(), in, yd, lam);
+  };
+  ys[0] = VectorXd::Zero(n);
+  sample(0, nullptr);
+  double t = t0;
+  int ncheck = 0;
+  for (int k = 1; k < K; ++k) {
+    check(CVodeF(cv, data.t[static_cast<std::size_t>(k)], y, &t, CV_NORMAL, &ncheck), "CVodeF");
+    ys[static_cast<std::size_t>(k)] = Eigen::Map<const VectorXd>(N_VGetArrayPointer(y), n);
+    sample(k, nullptr);
+  }
+  CVodeGetNumSteps(cv, &res.forward_steps);
+
+  VectorXd gy;
+  sample(K - 1, &gy);
+  Eigen::Map<VectorXd>(N_VGetArrayPointer(yB), n) = gy;
+  int which = 0;
+  const double T = data.t.back();
+  check(CVodeCreateB(cv, CV_BDF, &which), "CVodeCreateB");
+  check(CVodeInitB(cv, which, nl_rhsB, T, yB), "CVodeInitB");
+  check(CVodeSStolerancesB(cv, which, rtol, atol), "CVodeSStolerancesB");
+  check(CVodeSetUserDataB(cv, which, &d), "CVodeSetUserDataB");
+  check(CVodeSetMaxNumStepsB(cv, which, 10000000), "CVodeSetMaxNumStepsB");
+  SUNMatrix AB = SUNDenseMatrix(n, n, ctx);
+  SUNLinearSolver LSB = SUNLinSol_Dense(yB, AB, ctx);
+  cl.mats.push_back(AB);
+  cl.lss.push_back(LSB);
+  check(CVodeSetLinearSolverB(cv, which, LSB, AB), "CVodeSetLinearSolverB");
+  check(CVodeQuadInitB(cv, which, nl_rhsQB, qB), "CVodeQuadInitB");
+  check(CVodeQuadSStolerancesB(cv, which, rtol, 1e-30), "CVodeQuadSStolerancesB");
+  check(CVodeSetQuadErrConB(cv, which, SUNTRUE), "CVodeSetQuadErrConB");
+  for (int k = K - 2; k >= 0; --k) {
+    const double tk = data.t[static_cast<std::size_t>(k)];
+    check(CVodeB(cv, tk, CV_NORMAL), "CVodeB");
+    double tret = 0.0;
+    check(CVodeGetB(cv, which, &tret, yB), "CVodeGetB");
+    check(CVodeGetQuadB(cv, which, &tret, qB), "CVodeGetQuadB");
+    if (k == 0) break;
+    sample(k, &gy);  // the jump λ(t_k⁻) = λ(t_k⁺) + ∂g_k/∂y_k, and the sample's ∂g_k/∂c
+    Eigen::Map<VectorXd>(N_VGetArrayPointer(yB), n) += gy;
+    check(CVodeReInitB(cv, which, tk, yB), "CVodeReInitB");
+    check(CVodeQuadReInitB(cv, which, qB), "CVodeQuadReInitB");
+  }
+  {
+    VectorXd unused;
+    sample(0, &unused);  // only its u̇ depends on c
+  }
+  res.gradient -= Eigen::Map<const VectorXd>(N_VGetArrayPointer(qB), d.ncoef);
+  void* cvB = CVodeGetAdjCVodeBmem(cv, which);
+  if (cvB) CVodeGetNumSteps(cvB, &res.backward_steps);
+  return res;
+}
+
+}  // namespace scoleid::identify

@@ -10,6 +10,7 @@
 //   ∂f/∂q_i = [0; M⁻¹ h_i],  ∂g/∂q_i = νᵀ h_i,  h_i = ∂B f − ∂D v − ∂K x − ∂M a.
 // Dense matrices and difference-quotient Jacobians: for verification on small meshes only.
 // It shares nothing with the costate code but the assembled operators.
+#include "scoleid/identify/fe/scole_nonlinear.h"
 #include "scoleid/identify/inverse/objective.h"
 
 namespace scoleid::identify {
@@ -21,5 +22,17 @@ struct CvodesAdjointResult {
 };
 
 CvodesAdjointResult cvodes_adjoint_gradient(Objective& objective, const VectorXd& q, double rtol = 1e-10);
+
+// The nonlinear SCOLE model (fe/scole_nonlinear.h) with the sampled cost of nonlinear_objective.h,
+// J = ½ Σ_k τ_k Σ_j R_j (z_j(y(t_k)) − z̃_kj)² (trapezoid τ_k over data.t, weights R_j given), on
+// the continuous-time ODE ẏ = f(t, y; c) from rest: CVODES BDF forward, and backward the adjoint
+//   λ̇ = −f_yᵀ λ between samples,  λ(t_k⁻) = λ(t_k⁺) + ∂g_k/∂y_k  at each sample (CVodeReInitB),
+//   dJ/dc = ∫ λᵀ ∂f/∂c dt + Σ_k ∂g_k/∂c   (the latter through u̇ for accelerometers).
+// It shares the model's transposed products with the discrete costate (checked against
+// differences on their own), not its time discretisation or its recursion: the two gradients
+// differ by the ESDIRK stepping's error.
+CvodesAdjointResult cvodes_nonlinear_gradient(const ScoleNonlinear& model, const VectorXd& c,
+                                              const std::vector<io::Signal>& signals, const Measurements& data,
+                                              const std::vector<double>& weights, double rtol = 1e-10);
 
 }  // namespace scoleid::identify
