@@ -63,8 +63,8 @@ public:
       VectorXd z = y;
       for (int j = 0; j < i; ++j) z += h * tab_.a(i, j) * F[static_cast<std::size_t>(j)];
       const double ti = std::clamp(t + tab_.c[static_cast<std::size_t>(i)] * h, lo, hi);
-      // Predictor: the previous stage's value.
-      const VectorXd start = Y;
+      // Predictor: the stage equation with the previous stage's derivative, z_i + hγ F_{i−1}.
+      const VectorXd start = z + h * gamma_ * F[static_cast<std::size_t>(i - 1)];
       bool done = false;
       for (int attempt = 0; attempt < 3 && !done; ++attempt) {
         if (!factor_) refresh(ti, start, h);
