@@ -6,7 +6,8 @@
 // ESDIRK3(2)4L[2]SA from ARKODE; explicit first stage, equal diagonal γ, stiffly accurate) at a
 // fixed step. Each implicit stage solves
 //     G(Y_i) = Y_i − h γ f(t_n + c_i h, Y_i) − z_i = 0,   z_i = y_n + h Σ_{j<i} a_ij f(Y_j)
-// by a modified Newton iteration on the matrix I − h γ J, J = ∂f/∂y by difference quotients
+// by a modified Newton iteration from the predictor z_i + hγ F_{i−1} on the matrix I − h γ J,
+// J = ∂f/∂y by difference quotients
 // (dense, one f per column), factorised once and kept across stages and steps. It is refreshed
 // (at the current iterate, and the stage restarted) only when the iteration stops contracting
 // well — an iterate's correction larger than kRefreshContraction (0.3) of the previous one — or
