@@ -65,6 +65,7 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
   const auto t0 = std::chrono::steady_clock::now();
   IdentifyStudy st;
   st.scenario = scenario.name;
+  st.model = scenario.identification.model;
   st.data_kind = opt.with_noise ? "Simbody truth with the scenario's sensor noise" : "Simbody truth, noise-free";
   st.segments = refinement(opt.segments > 0 ? opt.segments : scenario.truth.segments, opt.levels,
                            io::limits::kMaxSegments, "segments");
@@ -122,7 +123,8 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
 
 Table identify_table(const IdentifyStudy& s) {
   Table t;
-  t.title = "Identification, " + s.scenario + " (" + s.data_kind + "): relative errors against the truth's values, %";
+  t.title = "Identification, " + s.scenario + " (" + s.data_kind + ", " + s.model +
+            " model): relative errors against the truth's values, %";
   t.header = {"parameter", "truth"};
   for (int n : s.segments) t.header.push_back("n=" + std::to_string(n));
   t.header.push_back("extrapolated");
@@ -165,6 +167,7 @@ nlohmann::json to_json(const IdentifyStudy& s) {
   };
   nlohmann::json j;
   j["scenario"] = s.scenario;
+  j["model"] = s.model;
   j["data"] = s.data_kind;
   j["segments"] = s.segments;
   j["all_converged"] = s.all_converged();

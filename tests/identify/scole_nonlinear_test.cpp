@@ -601,7 +601,9 @@ identification:
     for (int k = 0; k < gc.size(); ++k)
       std::printf("    %-12s % .8e  % .8e\n", m.fe.model.coefficient_names[static_cast<std::size_t>(k)].c_str(), gc[k],
                   ref.gradient[k]);
-    if (previous > 0) EXPECT_LT(diff, previous / 8.0);  // third order: 64 per factor 4 in h
+    if (previous > 0) {
+      EXPECT_LT(diff, previous / 8.0);  // third order: 64 per factor 4 in h
+    }
     previous = diff;
   }
   EXPECT_LT(previous, 1e-4);

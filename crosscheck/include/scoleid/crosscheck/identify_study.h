@@ -63,6 +63,7 @@ struct LevelRun {
 
 struct IdentifyStudy {
   std::string scenario, data_kind;
+  std::string model = "linear";   // the identifier's (identification.model)
   std::vector<int> segments;
   std::vector<ParameterStudy> parameters;
   std::vector<LevelRun> runs;     // per level
