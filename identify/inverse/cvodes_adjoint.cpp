@@ -16,6 +16,25 @@ void check(int flag, const char* what) {
   if (flag < 0) throw std::runtime_error(std::string(what) + " failed with flag " + std::to_string(flag));
 }
 
+// A SUNContext and everything made in it, freed in reverse order whatever happens.
+struct Sundials {
+  std::vector<N_Vector> vecs;
+  std::vector<SUNMatrix> mats;
+  std::vector<SUNLinearSolver> lss;
+  void* cv = nullptr;
+  SUNContext ctx = nullptr;
+  Sundials() { check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create"); }
+  Sundials(const Sundials&) = delete;
+  Sundials& operator=(const Sundials&) = delete;
+  ~Sundials() {
+    if (cv) CVodeFree(&cv);
+    for (auto* l : lss) SUNLinSolFree(l);
+    for (auto* a : mats) SUNMatDestroy(a);
+    for (auto* v : vecs) N_VDestroy(v);
+    SUNContext_Free(&ctx);
+  }
+};
+
 struct Data {
   int n = 0, P = 0, ns = 0;
   MatrixXd M, D, K, Minv, C0, C1, C2;  // output rows on x, v and a = ẍ (C1, C2 empty without rate sensors)
@@ -142,23 +161,8 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
 
   const double t0 = obj.data().t.front(), T = obj.horizon();
   const int N = 2 * d.n;
-  SUNContext ctx = nullptr;
-  check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
-  struct Cleanup {
-    std::vector<N_Vector> vecs;
-    std::vector<SUNMatrix> mats;
-    std::vector<SUNLinearSolver> lss;
-    void* cv = nullptr;
-    SUNContext ctx = nullptr;
-    ~Cleanup() {
-      if (cv) CVodeFree(&cv);
-      for (auto* l : lss) SUNLinSolFree(l);
-      for (auto* a : mats) SUNMatDestroy(a);
-      for (auto* v : vecs) N_VDestroy(v);
-      SUNContext_Free(&ctx);
-    }
-  } cl;
-  cl.ctx = ctx;
+  Sundials cl;
+  SUNContext ctx = cl.ctx;
   N_Vector y = N_VNew_Serial(N, ctx), yQ = N_VNew_Serial(1, ctx), yB = N_VNew_Serial(N, ctx), qB = N_VNew_Serial(d.P, ctx);
   cl.vecs = {y, yQ, yB, qB};
   N_VConst(0.0, y);
@@ -280,23 +284,8 @@ CvodesAdjointResult cvodes_nonlinear_gradient(const ScoleNonlinear& model, const
     tau[static_cast<std::size_t>(k)] += 0.5 * dt;
     tau[static_cast<std::size_t>(k + 1)] += 0.5 * dt;
   }
-  SUNContext ctx = nullptr;
-  check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
-  struct Cleanup {
-    std::vector<N_Vector> vecs;
-    std::vector<SUNMatrix> mats;
-    std::vector<SUNLinearSolver> lss;
-    void* cv = nullptr;
-    SUNContext ctx = nullptr;
-    ~Cleanup() {
-      if (cv) CVodeFree(&cv);
-      for (auto* l : lss) SUNLinSolFree(l);
-      for (auto* a : mats) SUNMatDestroy(a);
-      for (auto* v : vecs) N_VDestroy(v);
-      SUNContext_Free(&ctx);
-    }
-  } cl;
-  cl.ctx = ctx;
+  Sundials cl;
+  SUNContext ctx = cl.ctx;
   N_Vector y = N_VNew_Serial(n, ctx), yB = N_VNew_Serial(n, ctx), qB = N_VNew_Serial(d.ncoef, ctx);
   cl.vecs = {y, yB, qB};
   N_VConst(0.0, y);
