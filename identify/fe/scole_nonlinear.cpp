@@ -57,6 +57,68 @@ void ScoleNonlinear::Rows3::add_left(const Matrix3d& A, MatrixXd& out) const {
   for (std::size_t k = 0; k < cols.size(); ++k) out.col(cols[k]) += A * v.col(static_cast<Eigen::Index>(k));
 }
 
+VectorXd ScoleNonlinear::Quadratic::gather(const VectorXd& x) const {
+  VectorXd g(static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) g[static_cast<Eigen::Index>(k)] = x[cols[k]];
+  return g;
+}
+
+Eigen::Matrix<double, 3, Eigen::Dynamic> ScoleNonlinear::Quadratic::jacobian(const VectorXd& e) const {
+  const VectorXd g = gather(e);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J = N + skew(A * g) * B - skew(B * g) * A;
+  if (Q.size() != 0) J += t * (Q * g).transpose();
+  return J;
+}
+
+Vector3d ScoleNonlinear::Quadratic::quadratic(const VectorXd& e) const {
+  const VectorXd g = gather(e);
+  Vector3d r = Vector3d(A * g).cross(B * g);
+  if (Q.size() != 0) r += 0.5 * g.dot(Q * g) * t;
+  return r;
+}
+
+Vector3d ScoleNonlinear::Quadratic::bil(const VectorXd& x, const VectorXd& y) const {
+  const VectorXd gx = gather(x), gy = gather(y);
+  Vector3d b = Vector3d(A * gx).cross(B * gy) + Vector3d(A * gy).cross(B * gx);
+  if (Q.size() != 0) b += gx.dot(Q * gy) * t;
+  return b;
+}
+
+void ScoleNonlinear::Quadratic::bil_t(const VectorXd& y, const Vector3d& w, VectorXd& out) const {
+  const VectorXd gy = gather(y);
+  VectorXd g = B.transpose() * w.cross(A * gy) + A.transpose() * Vector3d(B * gy).cross(w);
+  if (Q.size() != 0) g += t.dot(w) * (Q * gy);
+  for (std::size_t k = 0; k < cols.size(); ++k) out[cols[k]] += g[static_cast<Eigen::Index>(k)];
+}
+
+namespace {
+// The columns any of the dense rows (or Q's rows) touch, and the rows restricted to them.
+void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Qfull, std::vector<int>& cols,
+             std::vector<char>& local, std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>*> out, MatrixXd& Q) {
+  const Eigen::Index ne = dense.front()->cols();
+  cols.clear();
+  local.clear();
+  for (Eigen::Index j = 0; j < ne; ++j) {
+    bool rows = false;
+    for (const MatrixXd* d : dense) rows = rows || d->col(j).cwiseAbs().maxCoeff() != 0.0;
+    if (rows || (Qfull.size() != 0 && Qfull.col(j).cwiseAbs().maxCoeff() != 0.0)) {
+      cols.push_back(static_cast<int>(j));
+      local.push_back(rows ? 1 : 0);
+    }
+  }
+  const auto k = static_cast<Eigen::Index>(cols.size());
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    out[i]->resize(3, k);
+    for (Eigen::Index c = 0; c < k; ++c) out[i]->col(c) = dense[i]->col(cols[static_cast<std::size_t>(c)]);
+  }
+  if (Qfull.size() != 0) {
+    Q.resize(k, k);
+    for (Eigen::Index a = 0; a < k; ++a)
+      for (Eigen::Index b = 0; b < k; ++b) Q(a, b) = Qfull(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+  }
+}
+}  // namespace
+
 ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs,
                                const std::vector<io::SensorSpec>& sensors) {
   const StructuralModel& m = fe.model;
@@ -92,7 +154,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
   for (int el = 0; el < fe.elements; ++el) {
     for (int q = 0; q < 4; ++q) {
       const double s = (el + x4[q]) * h;
-      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA, {}});
+      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA, {}, {}});
     }
     for (int q = 0; q < 3; ++q) {
       const double s = (el + x3[q]) * h;
@@ -101,18 +163,42 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     }
   }
   // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
-  points_.push_back({point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0), on_e(fe.reflector_displacement()), 1.0,
-                     ScoleFE::kMReflector, {}});
+  {
+    // The CM turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back towards the
+    // root by the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds (an inextensible mast).
+    const Vector3d r(sc.reflector_rx, sc.reflector_ry, 0.0);
+    MassPoint refl{point(L) + r, on_e(fe.reflector_displacement()), 1.0, ScoleFE::kMReflector, {}, {}};
+    const MatrixXd Th = on_e(fe.mast_rotation(L));
+    const MatrixXd A = 0.5 * Th, B = -skew(r) * Th;
+    MatrixXd Qfull = MatrixXd::Zero(ne_, ne_);
+    for (int el = 0; el < fe.elements; ++el)
+      for (int q = 0; q < 3; ++q) {
+        const MatrixXd R2 = on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
+        Qfull += w3[q] * h * R2.transpose() * R2;
+      }
+    compact({&refl.N, &A, &B}, Qfull, refl.quad.cols, refl.quad.local, {&refl.quad.N, &refl.quad.A, &refl.quad.B},
+            refl.quad.Q);
+    refl.quad.t = Vector3d::UnitZ();
+    points_.push_back(std::move(refl));
+  }
   rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}});
   // Shuttle.
-  points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}});
+  points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}, {}});
   rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}});
   // Proof masses: their own lateral DOFs, axially with the mast.
   for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
     MatrixXd N = MatrixXd::Zero(3, ne_);
     N(0, fe.proof_mass_dof(static_cast<int>(k), 0)) = 1.0;
     N(1, fe.proof_mass_dof(static_cast<int>(k), 1)) = 1.0;
-    points_.push_back({point(sc.actuator_locations[k]), N, sc.actuator_mass, -1, {}});
+    // The slider plane turns with the section at s_k: r = p + N e + Θ(s_k) e × S e, S e the stroke
+    // (ξ − u(s_k), 0) — a coupling of the bending slope and twist with the stroke.
+    const double s = sc.actuator_locations[k];
+    const MatrixXd Th = on_e(fe.mast_rotation(s));
+    MatrixXd S = N - on_e(fe.mast_displacement(s));
+    S.row(2).setZero();
+    MassPoint pm{point(s), N, sc.actuator_mass, -1, {}, {}};
+    compact({&N, &Th, &S}, MatrixXd(), pm.quad.cols, pm.quad.local, {&pm.quad.N, &pm.quad.A, &pm.quad.B}, pm.quad.Q);
+    points_.push_back(std::move(pm));
   }
 
   for (auto& p : points_) p.n = Rows3::of(p.N);
@@ -171,6 +257,10 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     const double mi = p.weight * scale(p.coefficient);
     d.mass_.push_back(mi);
     d.Mconst_.block<3, 3>(0, 0) += mi * Matrix3d::Identity();
+    if (p.quad.active()) {  // its rows on e depend on e (jacobians())
+      d.quadratic_ = true;
+      continue;
+    }
     d.Mconst_.block(0, 6, 3, ne_) += mi * p.N;
     d.Mconst_.block(6, 6, ne_, ne_) += mi * p.N.transpose() * p.N;
   }
@@ -185,11 +275,37 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   d.Mconst_.block(6, 3, ne_, 3) = d.Mconst_.block(3, 6, 3, ne_).transpose();
   for (const auto& in : inputs_) d.input_scale_.push_back(in.coefficient >= 0 ? c[in.coefficient] : 1.0);
   {
-    SparseMatrix C = d.Mconst_.block(6, 6, ne_, ne_).sparseView();
-    C.makeCompressed();
-    d.C_ = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>(C);
-    if (d.C_->info() != Eigen::Success)
+    std::vector<Eigen::Triplet<double>> t;
+    for (Eigen::Index j = 0; j < ne_; ++j)
+      for (Eigen::Index i = 0; i < ne_; ++i)
+        if (d.Mconst_(6 + i, 6 + j) != 0.0) t.emplace_back(i, j, d.Mconst_(6 + i, 6 + j));
+    for (const auto& p : points_)  // the quadratic points' local pattern, explicitly
+      for (std::size_t a = 0; a < p.quad.cols.size(); ++a)
+        for (std::size_t b = 0; b < p.quad.cols.size(); ++b)
+          if (p.quad.local[a] && p.quad.local[b]) t.emplace_back(p.quad.cols[a], p.quad.cols[b], 0.0);
+    d.Cbase_.resize(ne_, ne_);
+    d.Cbase_.setFromTriplets(t.begin(), t.end());
+    d.Cbase_.makeCompressed();
+    auto C = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>();
+    if (d.quadratic_) {
+      // Checked positive definite at e = 0 here; per e, solve_mass factorises and reports failure.
+      SparseMatrix C0 = d.Cbase_;
+      for (std::size_t i = 0; i < points_.size(); ++i) {
+        const auto& q = points_[i].quad;
+        if (!q.active()) continue;
+        const MatrixXd Mi = d.mass_[i] * q.N.transpose() * q.N;  // N(0) = N: local columns only
+        for (std::size_t a = 0; a < q.cols.size(); ++a)
+          for (std::size_t b = 0; b < q.cols.size(); ++b)
+            if (q.local[a] && q.local[b])
+              C0.coeffRef(q.cols[a], q.cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+      }
+      C->compute(C0);
+    } else {
+      C->compute(d.Cbase_);
+    }
+    if (C->info() != Eigen::Success)
       throw std::invalid_argument("ScoleNonlinear::at: the elastic mass block is not positive definite");
+    d.C_ = C;
   }
   d.K_ = MatrixXd::Zero(ne_, ne_);
   d.D_ = MatrixXd::Zero(ne_, ne_);
@@ -198,7 +314,24 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   return d;
 }
 
-void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const {
+std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> ScoleNonlinear::Dynamics::jacobians(const VectorXd& e) const {
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> J(g_->points_.size());
+  if (quadratic_)
+    for (std::size_t i = 0; i < g_->points_.size(); ++i)
+      if (g_->points_[i].quad.active()) J[i] = g_->points_[i].quad.jacobian(e);
+  return J;
+}
+
+namespace {
+// out.col(cols[k]) += A Je.col(k)
+void add_left_compact(const std::vector<int>& cols, const Matrix3d& A, const Eigen::Matrix<double, 3, Eigen::Dynamic>& Je,
+                      MatrixXd& out) {
+  for (std::size_t k = 0; k < cols.size(); ++k) out.col(cols[k]) += A * Je.col(static_cast<Eigen::Index>(k));
+}
+}  // namespace
+
+void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
+                                          Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const {
   const int ne = g_->ne_;
   A = Mconst_.topLeftCorner<6, 6>();
   B = Mconst_.block(0, 6, 6, ne);
@@ -208,6 +341,16 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, Eigen::Matrix<doubl
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
+    if (p.quad.active()) {
+      const Matrix3d Rx = skew(p.p + p.n.times(e) + p.quad.quadratic(e));
+      VO -= mi * Rx;
+      OO += mi * Rx.transpose() * Rx;
+      MatrixXd top = B.topRows<3>();
+      add_left_compact(p.quad.cols, mi * Matrix3d::Identity(), Je[i], top);
+      B.topRows<3>() = top;
+      add_left_compact(p.quad.cols, mi * Rx, Je[i], Oe);
+      continue;
+    }
     const Matrix3d Rx = skew(p.p + p.n.times(e));
     VO -= mi * Rx;
     OO += mi * Rx.transpose() * Rx;
@@ -223,11 +366,20 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
   const int ne = g_->ne_;
   Eigen::Matrix<double, 6, 6> A;
   MatrixXd B;
-  rigid_rows(e, A, B);
+  const auto Je = jacobians(e);
+  rigid_rows(e, Je, A, B);
   MatrixXd M = Mconst_;
   M.topLeftCorner<6, 6>() = A;
   M.block(0, 6, 6, ne) = B;
   M.block(6, 0, ne, 6) = B.transpose();
+  for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+    const auto& cols = g_->points_[i].quad.cols;
+    if (cols.empty()) continue;
+    const MatrixXd Mi = mass_[i] * Je[i].transpose() * Je[i];
+    for (std::size_t a = 0; a < cols.size(); ++a)
+      for (std::size_t b = 0; b < cols.size(); ++b)
+        M(6 + cols[a], 6 + cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  }
   return M;
 }
 
@@ -238,11 +390,73 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
   const int ne = g_->ne_;
   Eigen::Matrix<double, 6, 6> A;
   MatrixXd B;
-  rigid_rows(e, A, B);
-  const MatrixXd Y = C_->solve(MatrixXd(B.transpose()));  // C⁻¹ Bᵀ
+  const auto Je = jacobians(e);
+  rigid_rows(e, Je, A, B);
+  if (quadratic_) {
+    // M_ee(e) = the constant part + Σ m J_lᵀ J_l (J_l = N(e) − t (Q ê)ᵀ, on the point's local
+    // columns: sparse) + for an axial part the rank-2 m [(v + g)(v + g)ᵀ − v vᵀ], g = Q ê,
+    // v = J_lᵀ t, which the Woodbury identity takes.
+    SparseMatrix C = Cbase_;
+    MatrixXd U(ne, 0);
+    std::vector<double> Sd;
+    for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+      const auto& q = g_->points_[i].quad;
+      if (!q.active()) continue;
+      Eigen::Matrix<double, 3, Eigen::Dynamic> Jl = Je[i];
+      VectorXd gq;
+      if (q.Q.size() != 0) {
+        gq = q.Q * q.gather(e);
+        Jl -= q.t * gq.transpose();
+      }
+      const MatrixXd Mi = mass_[i] * Jl.transpose() * Jl;
+      for (std::size_t a = 0; a < q.cols.size(); ++a)
+        for (std::size_t b = 0; b < q.cols.size(); ++b)
+          if (q.local[a] && q.local[b])
+            C.coeffRef(q.cols[a], q.cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+      if (q.Q.size() != 0) {
+        const VectorXd v = Jl.transpose() * q.t;
+        U.conservativeResize(ne, U.cols() + 2);
+        U.rightCols<2>().setZero();
+        for (std::size_t k = 0; k < q.cols.size(); ++k) {
+          const auto kk = static_cast<Eigen::Index>(k);
+          U(q.cols[k], U.cols() - 2) = v[kk] + gq[kk];
+          U(q.cols[k], U.cols() - 1) = v[kk];
+        }
+        Sd.push_back(mass_[i]);
+        Sd.push_back(-mass_[i]);
+      }
+    }
+    // The DOFs are numbered along the mast (banded): no reordering.
+    Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> factor(C);
+    if (factor.info() != Eigen::Success)
+      throw std::runtime_error("ScoleNonlinear: the elastic mass block is not positive definite at this deformation");
+    if (U.cols() == 0) return schur_solve(A, B, [&](const MatrixXd& X) { return MatrixXd(factor.solve(X)); }, r);
+    const MatrixXd Z = factor.solve(U);
+    MatrixXd cap = U.transpose() * Z;
+    for (std::size_t k = 0; k < Sd.size(); ++k) cap(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) += 1.0 / Sd[k];
+    const Eigen::PartialPivLU<MatrixXd> capf(cap);
+    return schur_solve(
+        A, B,
+        [&](const MatrixXd& X) {
+          const MatrixXd Y0 = factor.solve(X);
+          return MatrixXd(Y0 - Z * capf.solve(MatrixXd(U.transpose() * Y0)));
+        },
+        r);
+  }
+  return schur_solve(A, B, [&](const MatrixXd& X) { return MatrixXd(C_->solve(X)); }, r);
+}
+
+template <class SolveC>
+VectorXd ScoleNonlinear::Dynamics::schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
+                                               const VectorXd& r) const {
+  const int ne = g_->ne_;
+  MatrixXd rhs(ne, 7);
+  rhs.leftCols<6>() = B.transpose();
+  rhs.col(6) = r.tail(ne);
+  const MatrixXd sol = solve_C(rhs);
+  const auto Y = sol.leftCols<6>();  // C⁻¹ Bᵀ
   const Eigen::Matrix<double, 6, 6> S = A - B * Y;
-  const VectorXd re = r.tail(ne);
-  const VectorXd Cre = C_->solve(re);
+  const VectorXd Cre = sol.col(6);
   const Eigen::Matrix<double, 6, 1> xr = S.ldlt().solve(Eigen::Matrix<double, 6, 1>(r.head<6>() - B * Cre));
   VectorXd x(6 + ne);
   x.head<6>() = xr;
@@ -259,6 +473,17 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
+    if (p.quad.active()) {
+      const auto& q = p.quad;
+      const auto Je = q.jacobian(e);
+      const Vector3d r = p.p + p.n.times(e) + q.quadratic(e), w = Je * q.gather(ed);
+      const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w) + q.bil(ed, ed));
+      b.head<3>() += f;
+      b.segment<3>(3) += r.cross(f);
+      const VectorXd g = Je.transpose() * f;
+      for (std::size_t k = 0; k < q.cols.size(); ++k) b[6 + q.cols[k]] += g[static_cast<Eigen::Index>(k)];
+      continue;
+    }
     const Vector3d r = p.p + p.n.times(e), w = p.n.times(ed);
     const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w));
     b.head<3>() += f;
@@ -392,6 +617,31 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     const auto& p = g_->points_[i];
     const double m = mass_[i];
     if (m == 0.0 && !(dc && p.coefficient >= 0)) continue;
+    if (p.quad.active()) {
+      // As below with N(e) for N, plus the e-dependence of N(e) (bil_t) and the γ term bil(ė, ė).
+      const auto& q = p.quad;
+      const auto Je = q.jacobian(e);
+      const Vector3d r = p.p + p.n.times(e) + q.quadratic(e), n = Je * q.gather(edot);
+      const Vector3d w = muV + muW.cross(r) + Je * q.gather(mue);
+      const Vector3d acc = aV + aW.cross(r) + Je * q.gather(ae) + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n) +
+                           q.bil(edot, edot);
+      if (dc && p.coefficient >= 0) (*dc)[p.coefficient] += p.weight * w.dot(acc);
+      if (m == 0.0) continue;
+      const Vector3d f = m * acc;
+      const Vector3d ds_dr = f.cross(muW) + m * (w.cross(aW) + W.cross(W.cross(w)));
+      const VectorXd gr = Je.transpose() * ds_dr, ge = Je.transpose() * Vector3d(2.0 * m * w.cross(W));
+      for (std::size_t k = 0; k < q.cols.size(); ++k) {
+        de[q.cols[k]] += gr[static_cast<Eigen::Index>(k)];
+        due[q.cols[k]] += ge[static_cast<Eigen::Index>(k)];
+      }
+      q.bil_t(mue, f, de);
+      q.bil_t(ae, m * w, de);
+      q.bil_t(edot, 2.0 * m * w.cross(W), de);
+      q.bil_t(edot, 2.0 * m * w, due);
+      du.head<3>() += m * w.cross(W);
+      du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
+      continue;
+    }
     const Vector3d r = p.p + p.n.times(e), n = p.n.times(edot);
     const Vector3d w = muV + muW.cross(r) + p.n.times(mue);
     const Vector3d acc = aV + aW.cross(r) + p.n.times(ae) + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n);

@@ -80,9 +80,11 @@ TEST(Trajectories, CantileverConvergesAtSecondOrderInTheLinearRangeOnly) {
 
 TEST(Trajectories, TheNonlinearModelFollowsTheSlewWhereTheLinearOneDeparts) {
   // scole-slew: a 20° roll slew of the whole configuration. The linear FE model misses the
-  // rotating frame's inertial coupling; the nonlinear one (fe/scole_nonlinear.h) carries it, and
-  // what it leaves is the mast's own geometric nonlinearity at tip deflections of 1.7 % of L and
-  // the chain's lumping (docs/theory.md §11.2).
+  // rotating frame's inertial coupling; the nonlinear one (fe/scole_nonlinear.h) carries it, with
+  // the proof masses' slider planes turning with the mast (the free proof masses drift 36 ft) and
+  // the reflector's second-order rotation; what it leaves is the mast's own geometric
+  // nonlinearity at tip deflections of 1.7 % of L and the chain's lumping (docs/theory.md §11.2).
+  // Without the proof-mass term the roll tip was barely closer than with the linear model.
   const fs::path dir = fs::temp_directory_path() / ("scoleid-xc-slew-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const io::Scenario sc = io::load_scenario("scole-slew");
@@ -98,11 +100,14 @@ TEST(Trajectories, TheNonlinearModelFollowsTheSlewWhereTheLinearOneDeparts) {
     ASSERT_EQ(s.nonlinear_relative_rms.size(), 1u);
     const double lin = s.relative_rms[0], non = s.nonlinear_relative_rms[0];
     std::printf("  %-10s linear %.3e  nonlinear %.3e\n", s.name.c_str(), lin, non);
-    if (s.kind == "acceleration") continue;  // the chain's lumped high modes dominate both
-    EXPECT_LT(non, 1.1 * lin) << s.name;
+    if (s.kind == "acceleration") {  // the chain's lumped high modes weigh on both
+      EXPECT_LT(non, lin) << s.name;
+      continue;
+    }
+    // The slew bias: every displacement-type sensor at least 5 times closer to the chain.
+    EXPECT_GT(lin, 5 * non) << s.name;
     worst_linear = std::max(worst_linear, lin);
     worst_nonlinear = std::max(worst_nonlinear, non);
   }
-  // The slew bias: the worst displacement-type sensor at least 5 times closer to the chain.
   EXPECT_GT(worst_linear, 5 * worst_nonlinear);
 }

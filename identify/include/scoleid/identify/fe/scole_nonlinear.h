@@ -15,6 +15,13 @@
 //              γ_i = Ω × V + Ω × (Ω × r_i) + 2 Ω × N_i ė  (transport, centrifugal, Coriolis).
 //              The mast's ρA by four Gauss points per element (exact for the Hermite consistent
 //              mass), the reflector's and proof masses' CMs, the shuttle's CM.
+//              Two points are quadratic in e (struct Quadratic): a proof mass, whose slider plane
+//              turns with the section, r = p + N e + Θ(s_k) e × (stroke), and the reflector's CM,
+//              which turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back by
+//              the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds. For them N_i becomes N_i(e) = ∂r_i/∂e
+//              and γ_i gains the convective term bil(ė, ė) (d²r/dt² = N(e) ë + bil(ė, ė)); M_ee then
+//              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
+//              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
 // Rotors       inertia J_j constant in S, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
 //              linear model's rotation rows); kinetic energy ½ ω_jᵀ J_j ω_j, whose generalized
 //              inertia force (Boltzmann–Hamel) is L_jᵀ J_j L_j u̇ + [0; Ω × J_j ω_j; 0]. The
@@ -102,10 +109,20 @@ public:
     std::vector<double> mass_;            // per mass point
     std::vector<Eigen::Matrix3d> J_;      // per rotor
     MatrixXd Mconst_;                     // the e-independent part of M
-    std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;  // factor of M_ee (constant)
+    // M_ee: constant and factorised once without quadratic points; with them, the constant part
+    // (in a pattern holding theirs) analysed once and factorised per e.
+    std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;
+    SparseMatrix Cbase_;
+    bool quadratic_ = false;
+    // The quadratic points' compact Jacobians N(e), in the order of the points (empty for others).
+    std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> jacobians(const VectorXd& e) const;
     // The rigid rows of M(e): A = M_rr (6 × 6), B = M_re (6 × ne).
-    void rigid_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
+    void rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
+                    Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
     VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
+    template <class SolveC>
+    VectorXd schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
+                         const VectorXd& r) const;
     MatrixXd K_, D_;                      // elastic blocks
     std::vector<double> input_scale_;     // γ_i per input (1 without a coefficient)
     double constants_ = 1.0;
@@ -126,12 +143,36 @@ private:
     void add_transposed(const Eigen::Vector3d& w, VectorXd& out) const;          // out += Rowsᵀ w
     void add_left(const Eigen::Matrix3d& A, MatrixXd& out) const;                // out (3 × ne) += A Rows
   };
+  // A point whose position is quadratic in e: r = p + N e + (A e) × (B e) [+ t ½ eᵀ Q e] (a proof
+  // mass on a slider plane that turns with the section: A the section's rotation rows, B the
+  // stroke's; the reflector's CM turning with the mast's end, A = ½ Θ(L), B e = Θ(L) e × r).
+  // All rows on the union of the columns they touch; with x̂ = x on those columns:
+  //   N(e) = ∂r/∂e = N + [A ê]× B − [B ê]× A,   bil(x, y) = (A x̂) × (B ŷ) + (A ŷ) × (B x̂),
+  //   N(e) x = N x + bil(e, x),  d²r/dt² = N(e) ë + bil(ė, ė),
+  //   ∂/∂x of wᵀ bil(x, y) = Bᵀ (w × A ŷ) + Aᵀ (B ŷ × w)  (bil_t).
+  struct Quadratic {
+    std::vector<int> cols;
+    std::vector<char> local;  // per column: touched by N, A or B (not only by Q)
+    Eigen::Matrix<double, 3, Eigen::Dynamic> N, A, B;
+    // An axial part t ½ êᵀ Q ê (the foreshortening of a point at the mast's end: Q = ∫ Θ_xyᵀ Θ_xy ds
+    // over the mast, t the unit vector back towards the root); empty Q for none. It adds t (Q ê)ᵀ
+    // to N(e), t x̂ᵀ Q ŷ to bil(x, y) and (t·w) Q ŷ to bil_t.
+    MatrixXd Q;
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    bool active() const { return !cols.empty(); }
+    VectorXd gather(const VectorXd& x) const;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> jacobian(const VectorXd& e) const;  // N(e) on cols
+    Eigen::Vector3d quadratic(const VectorXd& e) const;                         // (A e) × (B e)
+    Eigen::Vector3d bil(const VectorXd& x, const VectorXd& y) const;
+    void bil_t(const VectorXd& y, const Eigen::Vector3d& w, VectorXd& out) const;  // out += ∂/∂x (wᵀ bil(x, y))
+  };
   struct MassPoint {
     Eigen::Vector3d p;
     MatrixXd N;        // 3 × ne
     double weight = 0; // mass = weight · c[coefficient] (or · constants)
     int coefficient = -1;
     Rows3 n;           // N, compact
+    Quadratic quad;    // active for a point quadratic in e (N is then its linear part)
   };
   struct Rotor {
     Eigen::Matrix3d J;
