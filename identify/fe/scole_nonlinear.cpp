@@ -178,7 +178,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       }
     compact({&refl.N, &A, &B}, Qfull, refl.quad.cols, refl.quad.local, {&refl.quad.N, &refl.quad.A, &refl.quad.B},
             refl.quad.Q);
-    refl.quad.t = Vector3d::UnitZ();
+    refl.quad.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
     points_.push_back(std::move(refl));
   }
   rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}});
@@ -218,6 +218,10 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     }
     inputs_.push_back(std::move(in));
   }
+  // The reflector's CM is the point after the mast's (points_ is complete: addresses are stable).
+  const Quadratic* reflector_quad = &points_[static_cast<std::size_t>(4 * fe.elements)].quad;
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (inputs_[i].arm && inputs[i].at == "reflector") inputs_[i].quad = reflector_quad;
 
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& spec = sensors[k];
@@ -235,6 +239,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       const bool mast = spec.at == "mast";
       s.p = mast ? point(spec.location) : point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
       s.N = mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
+      if (!mast) s.quad = reflector_quad;
     } else {
       // Relative to S: the linear rows restricted to e (they vanish on rigid motion).
       s.kind = ms.order == 1 ? K::RateRow : K::Row;
@@ -345,9 +350,7 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
       const Matrix3d Rx = skew(p.p + p.n.times(e) + p.quad.quadratic(e));
       VO -= mi * Rx;
       OO += mi * Rx.transpose() * Rx;
-      MatrixXd top = B.topRows<3>();
-      add_left_compact(p.quad.cols, mi * Matrix3d::Identity(), Je[i], top);
-      B.topRows<3>() = top;
+      for (std::size_t k = 0; k < p.quad.cols.size(); ++k) B.col(p.quad.cols[k]).head<3>() += mi * Je[i].col(static_cast<Eigen::Index>(k));
       add_left_compact(p.quad.cols, mi * Rx, Je[i], Oe);
       continue;
     }
@@ -383,8 +386,9 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
   return M;
 }
 
-// M x = r by the Schur complement on the rigid rows: M = [A B; Bᵀ C] with C = M_ee constant
-// (factorised once per coefficient set, sparse: the elements' band and the proof masses):
+// M x = r by the Schur complement on the rigid rows: M = [A B; Bᵀ C] with C = M_ee (sparse: the
+// elements' band and the proof masses; factorised once per coefficient set when constant, per e
+// with quadratic points):
 // S = A − B C⁻¹ Bᵀ (6 × 6), x_r = S⁻¹ (r_r − B C⁻¹ r_e), x_e = C⁻¹ (r_e − Bᵀ x_r).
 VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd& r) const {
   const int ne = g_->ne_;
@@ -401,7 +405,7 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
     std::vector<double> Sd;
     for (std::size_t i = 0; i < g_->points_.size(); ++i) {
       const auto& q = g_->points_[i].quad;
-      if (!q.active()) continue;
+      if (!q.active() || mass_[i] == 0.0) continue;  // (a zero mass would put 1/0 in the capacitance)
       Eigen::Matrix<double, 3, Eigen::Dynamic> Jl = Je[i];
       VectorXd gq;
       if (q.Q.size() != 0) {
@@ -511,6 +515,12 @@ VectorXd ScoleNonlinear::Dynamics::load(const VectorXd& f, const VectorXd& e) co
     const double gi = fi * input_scale_[i];
     Q += gi * in.q0;
     if (in.arm) Q.segment<3>(3) += gi * Vector3d(in.N * e).cross(in.d);
+    if (in.quad) {
+      Q.segment<3>(3) += gi * in.quad->quadratic(e).cross(in.d);
+      VectorXd Qe = Q.tail(g_->ne_);
+      in.quad->bil_t(e, gi * in.d, Qe);  // (N(e) − N)ᵀ d f
+      Q.tail(g_->ne_) = Qe;
+    }
   }
   return Q;
 }
@@ -553,9 +563,17 @@ VectorXd ScoleNonlinear::Dynamics::outputs(const double* y, const VectorXd& udot
       case K::Row: v = se.row.dot(s.e); break;
       case K::RateRow: v = se.row.dot(s.edot); break;
       case K::PointAcceleration: {
-        const Vector3d r = se.p + se.N * s.e;
-        const Vector3d a = Vd + Wd.cross(r) + Vector3d(se.N * edd) + s.Omega.cross(s.V) + s.Omega.cross(s.Omega.cross(r)) +
-                           2.0 * s.Omega.cross(Vector3d(se.N * s.edot));
+        Vector3d r = se.p + se.N * s.e, n = se.N * s.edot, ne2 = se.N * edd;
+        Vector3d conv = Vector3d::Zero();
+        if (se.quad) {  // r(e), N(e) ė, N(e) ë and the convective bil(ė, ė) (§3.8)
+          const VectorXd e = s.e, ed = s.edot;
+          r += se.quad->quadratic(e);
+          n += se.quad->bil(e, ed);
+          ne2 += se.quad->bil(e, edd);
+          conv = se.quad->bil(ed, ed);
+        }
+        const Vector3d a =
+            Vd + Wd.cross(r) + ne2 + conv + s.Omega.cross(s.V) + s.Omega.cross(s.Omega.cross(r)) + 2.0 * s.Omega.cross(n);
         v = a.dot(se.d);
         break;
       }
@@ -678,10 +696,17 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     const auto& in = g_->inputs_[i];
     const double fi = fin[static_cast<Eigen::Index>(i)];
     if (fi == 0.0) continue;
-    if (in.arm) de.noalias() -= fi * input_scale_[i] * (in.N.transpose() * in.d.cross(muW));
+    const double gi = fi * input_scale_[i];
+    if (in.arm) de.noalias() -= gi * (in.N.transpose() * in.d.cross(muW));
+    if (in.quad) {
+      // −f [μ_Ω · (quadratic(e) × d) + d · bil(μ_e, e)]:  ∂/∂e = −f [bil_t(e, d × μ_Ω) + bil_t(μ_e, d)]
+      in.quad->bil_t(e, -gi * in.d.cross(muW), de);
+      in.quad->bil_t(mue, -gi * in.d, de);
+    }
     if (dc && in.coefficient >= 0) {
       double q = mu.dot(in.q0);
       if (in.arm) q += muW.dot(Vector3d(in.N * s.e).cross(in.d));
+      if (in.quad) q += muW.dot(in.quad->quadratic(e).cross(in.d)) + in.d.dot(in.quad->bil(mue, e));
       (*dc)[in.coefficient] -= fi * q;
     }
   }
@@ -773,14 +798,34 @@ void ScoleNonlinear::Dynamics::outputs_vjp(const double* y, const VectorXd& udot
       case K::Row: dy.segment(6, ne) += c * se.row.transpose(); break;
       case K::RateRow: dy.tail(ne) += c * se.row.transpose(); break;
       case K::PointAcceleration: {
-        const Vector3d r = se.p + se.N * s.e, n = se.N * s.edot;
+        Vector3d r = se.p + se.N * s.e, n = se.N * s.edot;
+        const VectorXd e = s.e, ed = s.edot, edd = udot.tail(ne);
+        if (se.quad) {
+          r += se.quad->quadratic(e);
+          n += se.quad->bil(e, ed);
+        }
         da.head<3>() += d;
         da.segment<3>(3) += r.cross(d);
         da.tail(ne) += se.N.transpose() * d;
         dy.segment<3>(6 + ne) += d.cross(W);
         dy.segment<3>(9 + ne) += V.cross(d) + d * W.dot(r) + r * d.dot(W) - 2.0 * d.dot(r) * W + 2.0 * n.cross(d);
         dy.tail(ne) += 2.0 * (se.N.transpose() * d.cross(W));
-        dy.segment(6, ne) += se.N.transpose() * (d.cross(Wd) + W.cross(W.cross(d)));
+        const Vector3d dr = d.cross(Wd) + W.cross(W.cross(d));  // ∂/∂r
+        dy.segment(6, ne) += se.N.transpose() * dr;
+        if (se.quad) {
+          // N(e) for N in ∂ë, ∂ė and ∂r, and the e-derivative of d·(N(e) ë + 2 Ω × N(e) ė);
+          // the convective d·bil(ė, ė) gives 2 bil_t(ė, d) on ė.
+          VectorXd t_a = da.tail(ne), t_e = dy.segment(6, ne), t_d = dy.tail(ne);
+          se.quad->bil_t(e, d, t_a);
+          se.quad->bil_t(e, dr, t_e);
+          se.quad->bil_t(edd, d, t_e);
+          se.quad->bil_t(ed, 2.0 * d.cross(W), t_e);
+          se.quad->bil_t(e, 2.0 * d.cross(W), t_d);
+          se.quad->bil_t(ed, 2.0 * d, t_d);
+          da.tail(ne) = t_a;
+          dy.segment(6, ne) = t_e;
+          dy.tail(ne) = t_d;
+        }
         break;
       }
     }

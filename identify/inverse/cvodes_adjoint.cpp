@@ -235,34 +235,48 @@ struct NonlinearData {
   }
 };
 
+// The model's evaluations may throw (a mass block that is not positive definite); an exception
+// must not cross CVODES's C frames: it becomes the unrecoverable return −1, and the CVODES call
+// that fails reports it (check()).
+template <class F>
+int guarded(F&& f) {
+  try {
+    f();
+    return 0;
+  } catch (...) {
+    return -1;
+  }
+}
+
 int nl_rhs(realtype t, N_Vector yv, N_Vector ydot, void* ud) {
   const NonlinearData& d = *static_cast<NonlinearData*>(ud);
-  d.dyn->derivative(N_VGetArrayPointer(yv), d.inputs(t), N_VGetArrayPointer(ydot));
-  return 0;
+  return guarded([&] { d.dyn->derivative(N_VGetArrayPointer(yv), d.inputs(t), N_VGetArrayPointer(ydot)); });
 }
 
 // λ̇ = −f_yᵀ λ
 int nl_rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
   const NonlinearData& d = *static_cast<NonlinearData*>(ud);
-  const double* y = N_VGetArrayPointer(yv);
-  const VectorXd in = d.inputs(t);
-  VectorXd yd(d.n);
-  d.dyn->derivative(y, in, yd.data());
-  const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(yBdot), d.n) = -d.dyn->derivative_vjp(y, in, yd, lam);
-  return 0;
+  return guarded([&] {
+    const double* y = N_VGetArrayPointer(yv);
+    const VectorXd in = d.inputs(t);
+    VectorXd yd(d.n);
+    d.dyn->derivative(y, in, yd.data());
+    const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
+    Eigen::Map<VectorXd>(N_VGetArrayPointer(yBdot), d.n) = -d.dyn->derivative_vjp(y, in, yd, lam);
+  });
 }
 
 // qB' = λᵀ ∂f/∂c (integrated from T back: qB(t0) = −∫ λᵀ ∂f/∂c dt)
 int nl_rhsQB(realtype t, N_Vector yv, N_Vector yB, N_Vector qBdot, void* ud) {
   const NonlinearData& d = *static_cast<NonlinearData*>(ud);
-  const double* y = N_VGetArrayPointer(yv);
-  const VectorXd in = d.inputs(t);
-  VectorXd yd(d.n);
-  d.dyn->derivative(y, in, yd.data());
-  const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(qBdot), d.ncoef) = d.dyn->coefficient_vjp(y, in, yd, lam);
-  return 0;
+  return guarded([&] {
+    const double* y = N_VGetArrayPointer(yv);
+    const VectorXd in = d.inputs(t);
+    VectorXd yd(d.n);
+    d.dyn->derivative(y, in, yd.data());
+    const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
+    Eigen::Map<VectorXd>(N_VGetArrayPointer(qBdot), d.ncoef) = d.dyn->coefficient_vjp(y, in, yd, lam);
+  });
 }
 
 }  // namespace

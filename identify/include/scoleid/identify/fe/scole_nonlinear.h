@@ -22,6 +22,7 @@
 //              and γ_i gains the convective term bil(ė, ė) (d²r/dt² = N(e) ë + bil(ė, ė)); M_ee then
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
+//              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
 // Rotors       inertia J_j constant in S, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
 //              linear model's rotation rows); kinetic energy ½ ω_jᵀ J_j ω_j, whose generalized
 //              inertia force (Boltzmann–Hamel) is L_jᵀ J_j L_j u̇ + [0; Ω × J_j ω_j; 0]. The
@@ -110,7 +111,7 @@ public:
     std::vector<Eigen::Matrix3d> J_;      // per rotor
     MatrixXd Mconst_;                     // the e-independent part of M
     // M_ee: constant and factorised once without quadratic points; with them, the constant part
-    // (in a pattern holding theirs) analysed once and factorised per e.
+    // in a pattern holding their local rows, factorised per e (solve_mass).
     std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;
     SparseMatrix Cbase_;
     bool quadratic_ = false;
@@ -186,6 +187,9 @@ private:
     MatrixXd N;
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
     int coefficient = -1;
+    // At a quadratic point (the reflector's CM): also Q_Ω += quadratic(e) × d f and
+    // Q_e += (N(e) − N)ᵀ d f, the generalized force L(e)ᵀ d f of the point's own kinematics.
+    const Quadratic* quad = nullptr;
   };
   struct Sensor {
     enum class Kind { ShuttleRotation, ShuttleDisplacement, ShuttleVelocity, ShuttleAcceleration, Row, RateRow,
@@ -195,6 +199,7 @@ private:
     Eigen::RowVectorXd row;  // on e or ė
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     MatrixXd N;
+    const Quadratic* quad = nullptr;  // an accelerometer at a quadratic point (the reflector's CM)
   };
 
   int ne_ = 0, ncoef_ = 0;
