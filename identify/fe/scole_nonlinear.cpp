@@ -272,6 +272,7 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   for (const auto& r : rotors_) {
     const Matrix3d J = r.J * scale(r.coefficient);
     d.J_.push_back(J);
+    if (!r.th.cols.empty()) d.quadratic_ = true;  // its inertia turns with e
     d.Mconst_.block<3, 3>(3, 3) += J;
     d.Mconst_.block(3, 6, 3, ne_) += J * r.Theta;
     d.Mconst_.block(6, 6, ne_, ne_) += r.Theta.transpose() * J * r.Theta;
@@ -284,6 +285,9 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     for (Eigen::Index j = 0; j < ne_; ++j)
       for (Eigen::Index i = 0; i < ne_; ++i)
         if (d.Mconst_(6 + i, 6 + j) != 0.0) t.emplace_back(i, j, d.Mconst_(6 + i, 6 + j));
+    for (const auto& r : rotors_)  // a turned rotor couples all of its columns
+      for (int a : r.th.cols)
+        for (int b : r.th.cols) t.emplace_back(a, b, 0.0);
     for (const auto& p : points_)  // the quadratic points' local pattern, explicitly
       for (std::size_t a = 0; a < p.quad.cols.size(); ++a)
         for (std::size_t b = 0; b < p.quad.cols.size(); ++b)
@@ -328,6 +332,13 @@ std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> ScoleNonlinear::Dynamics::
 }
 
 namespace {
+// The first-order change of a rotor's inertia turned by its elastic rotation θ (J(θ) = R J Rᵀ,
+// R = I + [θ]×): ΔJ = [θ]× J − J [θ]× (symmetric).
+Matrix3d turned(const Matrix3d& J, const Vector3d& theta) {
+  const Matrix3d T = skew(theta);
+  return T * J - J * T;
+}
+
 // out.col(cols[k]) += A Je.col(k)
 void add_left_compact(const std::vector<int>& cols, const Matrix3d& A, const Eigen::Matrix<double, 3, Eigen::Dynamic>& Je,
                       MatrixXd& out) {
@@ -359,6 +370,13 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
     OO += mi * Rx.transpose() * Rx;
     p.n.add_left(mi * Rx, Oe);
   }
+  for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
+    const auto& rt = g_->rotors_[j];
+    if (rt.th.cols.empty()) continue;
+    const Matrix3d dJ = turned(J_[j], rt.th.times(e));
+    OO += dJ;
+    rt.th.add_left(dJ, Oe);
+  }
   A.block<3, 3>(0, 3) += VO;
   A.block<3, 3>(3, 0) += VO.transpose();
   A.block<3, 3>(3, 3) += OO;
@@ -383,7 +401,21 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
       for (std::size_t b = 0; b < cols.size(); ++b)
         M(6 + cols[a], 6 + cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   }
+  for_turned_rotors(e, [&](int a, int b, double v) { M(6 + a, 6 + b) += v; });
   return M;
+}
+
+// Θ_jᵀ ΔJ_j(e) Θ_j on each turned rotor's columns (the e–e part of its turned inertia).
+template <class Add>
+void ScoleNonlinear::Dynamics::for_turned_rotors(const VectorXd& e, Add&& add) const {
+  for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
+    const auto& th = g_->rotors_[j].th;
+    if (th.cols.empty()) continue;
+    const MatrixXd Mj = th.v.transpose() * turned(J_[j], th.times(e)) * th.v;
+    for (std::size_t a = 0; a < th.cols.size(); ++a)
+      for (std::size_t b = 0; b < th.cols.size(); ++b)
+        add(th.cols[a], th.cols[b], Mj(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)));
+  }
 }
 
 // M x = r by the Schur complement on the rigid rows: M = [A B; Bᵀ C] with C = M_ee (sparse: the
@@ -401,6 +433,7 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
     // columns: sparse) + for an axial part the rank-2 m [(v + g)(v + g)ᵀ − v vᵀ], g = Q ê,
     // v = J_lᵀ t, which the Woodbury identity takes.
     SparseMatrix C = Cbase_;
+    for_turned_rotors(e, [&](int a, int b, double v) { C.coeffRef(a, b) += v; });
     MatrixXd U(ne, 0);
     std::vector<double> Sd;
     for (std::size_t i = 0; i < g_->points_.size(); ++i) {
@@ -497,8 +530,21 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     b.tail(ne) = be;
   }
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
-    const Vector3d omega = W + g_->rotors_[j].th.times(ed);
-    b.segment<3>(3) += W.cross(J_[j] * omega);
+    // h = J(θ) ω, ḣ = J(θ) ω̇ + J̇ ω with J̇ ω = θ̇ × J ω − J (θ̇ × ω); Ω row: J̇ ω + Ω × J(θ) ω;
+    // e row: Θᵀ (J̇ ω − ∂T/∂θ), ∂T/∂θ = J ω × ω (T = ½ ωᵀ J(θ) ω).
+    const auto& th = g_->rotors_[j].th;
+    const Matrix3d& J = J_[j];
+    const Vector3d thd = th.times(ed), omega = W + thd;
+    if (th.cols.empty()) {
+      b.segment<3>(3) += W.cross(J * omega);
+      continue;
+    }
+    const Vector3d Jw = J * omega, Jtw = Jw + turned(J, th.times(e)) * omega;
+    const Vector3d Jdw = thd.cross(Jw) - J * thd.cross(omega);
+    b.segment<3>(3) += Jdw + W.cross(Jtw);
+    VectorXd be = b.tail(ne);
+    th.add_transposed(Jdw - Jw.cross(omega), be);
+    b.tail(ne) = be;
   }
   b.tail(ne).noalias() += D_ * ed + K_ * e;
   return b;
@@ -672,16 +718,31 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
     p.n.add_transposed(2.0 * m * w.cross(W), due);
   }
+  // Per rotor, with θ = Θ e, θ̇ = Θ ė, ω = Ω + θ̇, α = a_Ω + Θ a_e, ν = μ_Ω + Θ μ_e, z = Θ μ_e,
+  // y = μ_Ω × Ω and J(θ) x = J x + ΔJ(θ) x (symmetric):
+  //   s_j = ν·J(θ)α + ν·(θ̇ × Jω − J(θ̇ × ω)) + μ_Ω·(Ω × J(θ)ω) − z·(Jω × ω)
+  //   ∂s/∂θ = Jα × ν + Jν × α + Jω × y + Jy × ω,     ∂s/∂θ̇ (explicit) = Jω × ν + Jν × ω,
+  //   ∂s/∂ω = J(ν × θ̇) + θ̇ × Jν + J(θ) y − J(ω × z) − z × Jω,   ∂s/∂Ω (explicit) = J(θ)ω × μ_Ω;
+  //   ∂/∂e = Θᵀ ∂/∂θ, ∂/∂ė = Θᵀ (∂/∂θ̇ + ∂/∂ω), ∂/∂Ω = ∂/∂Ω explicit + ∂/∂ω.
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& rt = g_->rotors_[j];
+    const Vector3d th = rt.th.times(e), thd = rt.th.times(edot), omega = W + thd;
+    const Vector3d z = rt.th.times(mue), nu = muW + z, alpha = aW + rt.th.times(ae), y = muW.cross(W);
+    auto value = [&](const Matrix3d& J) {
+      const Matrix3d Jt = J + turned(J, th);
+      return nu.dot(Jt * alpha) + nu.dot(thd.cross(J * omega) - J * thd.cross(omega)) + muW.dot(W.cross(Jt * omega)) -
+             z.dot(Vector3d(J * omega).cross(omega));
+    };
+    if (dc && rt.coefficient >= 0) (*dc)[rt.coefficient] += value(rt.J);
     const Matrix3d& J = J_[j];
-    const Vector3d omega = W + rt.th.times(edot);
-    if (dc && rt.coefficient >= 0) {
-      const Vector3d lhs = muW + rt.th.times(mue), alpha = aW + rt.th.times(ae);
-      (*dc)[rt.coefficient] += lhs.dot(rt.J * alpha) + muW.dot(W.cross(rt.J * omega));
-    }
-    du.segment<3>(3) += (J * omega).cross(muW) + J * muW.cross(W);
-    rt.th.add_transposed(J * muW.cross(W), due);
+    const Matrix3d Jt = J + turned(J, th);
+    const Vector3d Jw = J * omega, Jnu = J * nu;
+    const Vector3d g_th = Vector3d(J * alpha).cross(nu) + Jnu.cross(alpha) + Jw.cross(y) + Vector3d(J * y).cross(omega);
+    const Vector3d g_thd = Jw.cross(nu) + Jnu.cross(omega);
+    const Vector3d g_w = J * nu.cross(thd) + thd.cross(Jnu) + Jt * y - J * omega.cross(z) - z.cross(Jw);
+    du.segment<3>(3) += Vector3d(Jt * omega).cross(muW) + g_w;
+    rt.th.add_transposed(g_thd + g_w, due);
+    rt.th.add_transposed(g_th, de);
   }
   de.noalias() += K_ * mue;
   due.noalias() += D_ * mue;

@@ -23,15 +23,16 @@
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
 //              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
-// Rotors       inertia J_j constant in S, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
-//              linear model's rotation rows); kinetic energy ½ ω_jᵀ J_j ω_j, whose generalized
-//              inertia force (Boltzmann–Hamel) is L_jᵀ J_j L_j u̇ + [0; Ω × J_j ω_j; 0]. The
-//              shuttle, the reflector about its CM, and the section's ρI_ψ (three Gauss points
-//              per element). The rotor's own elastic rotation is not applied to J_j: an O(|Θ|)
-//              relative change of a term that is itself O(|Ω|²), which keeps the kinetic energy
-//              exact in form, so energy and momentum are conserved exactly by the equations.
+// Rotors       inertia J_j turned by the rotor's elastic rotation θ = Θ_j e to first order,
+//              J(θ) = J_j + [θ]× J_j − J_j [θ]×, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
+//              linear model's rotation rows); kinetic energy T = ½ ω_jᵀ J(θ) ω_j, whose generalized
+//              inertia force (Boltzmann–Hamel) is L_jᵀ (J(θ) ω̇ + J̇ ω) + [0; Ω × J(θ) ω; −Θᵀ ∂T/∂θ],
+//              J̇ ω = θ̇ × J ω − J (θ̇ × ω), ∂T/∂θ = J ω × ω: the gyroscopic coupling of the slew's
+//              rate with an anisotropic rotor's elastic rotation (the reflector's I_zz = 2 I_xx).
+//              The shuttle (no elastic rotation), the reflector about its CM, and the section's
+//              ρI_ψ (three Gauss points per element). Energy and momenta are conserved exactly.
 // Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e] = Q(t, e),
-//              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J_j L_j,   b = Σ m_i L_iᵀ γ_i + Σ [0; Ω × J_j ω_j; 0],
+//              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J(θ_j) L_j,   b = Σ m_i L_iᵀ γ_i + the rotors' terms,
 //              K, D the linear model's elastic blocks (they see only the deformation relative
 //              to S), every term affine in the coefficients c (scole_model.h), so ∂/∂c_k of the
 //              residual is the residual of c = e_k without the constant terms.
@@ -121,6 +122,8 @@ public:
     void rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
                     Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
     VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
+    template <class Add>
+    void for_turned_rotors(const VectorXd& e, Add&& add) const;
     template <class SolveC>
     VectorXd schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
                          const VectorXd& r) const;
