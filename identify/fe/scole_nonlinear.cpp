@@ -295,6 +295,26 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     d.Cbase_.resize(ne_, ne_);
     d.Cbase_.setFromTriplets(t.begin(), t.end());
     d.Cbase_.makeCompressed();
+    auto slot = [&](int i, int j) {
+      const int* first = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j];
+      const int* last = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j + 1];
+      const int* it = std::lower_bound(first, last, i);
+      if (it == last || *it != i) throw std::logic_error("ScoleNonlinear: an entry outside the mass pattern");
+      return static_cast<int>(it - d.Cbase_.innerIndexPtr());
+    };
+    for (const auto& r : rotors_) {
+      std::vector<int> sl;
+      for (int a : r.th.cols)
+        for (int b : r.th.cols) sl.push_back(slot(a, b));
+      d.rotor_slots_.push_back(std::move(sl));
+    }
+    for (const auto& p : points_) {
+      std::vector<int> sl;
+      for (std::size_t a = 0; a < p.quad.cols.size(); ++a)
+        for (std::size_t b = 0; b < p.quad.cols.size(); ++b)
+          sl.push_back(p.quad.local[a] && p.quad.local[b] ? slot(p.quad.cols[a], p.quad.cols[b]) : -1);
+      d.point_slots_.push_back(std::move(sl));
+    }
     auto C = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>();
     if (d.quadratic_) {
       // Checked positive definite at e = 0 here; per e, solve_mass factorises and reports failure.
@@ -433,7 +453,16 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
     // columns: sparse) + for an axial part the rank-2 m [(v + g)(v + g)ᵀ − v vᵀ], g = Q ê,
     // v = J_lᵀ t, which the Woodbury identity takes.
     SparseMatrix C = Cbase_;
-    for_turned_rotors(e, [&](int a, int b, double v) { C.coeffRef(a, b) += v; });
+    double* values = C.valuePtr();
+    for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
+      const auto& th = g_->rotors_[j].th;
+      if (th.cols.empty()) continue;
+      const MatrixXd Mj = th.v.transpose() * turned(J_[j], th.times(e)) * th.v;
+      const auto& sl = rotor_slots_[j];
+      const auto n = static_cast<Eigen::Index>(th.cols.size());
+      for (Eigen::Index a = 0; a < n; ++a)
+        for (Eigen::Index b = 0; b < n; ++b) values[sl[static_cast<std::size_t>(a * n + b)]] += Mj(a, b);
+    }
     MatrixXd U(ne, 0);
     std::vector<double> Sd;
     for (std::size_t i = 0; i < g_->points_.size(); ++i) {
@@ -446,10 +475,13 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
         Jl -= q.t * gq.transpose();
       }
       const MatrixXd Mi = mass_[i] * Jl.transpose() * Jl;
-      for (std::size_t a = 0; a < q.cols.size(); ++a)
-        for (std::size_t b = 0; b < q.cols.size(); ++b)
-          if (q.local[a] && q.local[b])
-            C.coeffRef(q.cols[a], q.cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+      const auto& sl = point_slots_[i];
+      const auto n = static_cast<Eigen::Index>(q.cols.size());
+      for (Eigen::Index a = 0; a < n; ++a)
+        for (Eigen::Index b = 0; b < n; ++b) {
+          const int k = sl[static_cast<std::size_t>(a * n + b)];
+          if (k >= 0) values[k] += Mi(a, b);
+        }
       if (q.Q.size() != 0) {
         const VectorXd v = Jl.transpose() * q.t;
         U.conservativeResize(ne, U.cols() + 2);

@@ -523,13 +523,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     IntervalInputs ii;
     ii.estimate = r.estimate;
     {
-      Measurements first = p.data;
-      const double t_half = first.t.front() + 0.5 * (first.t.back() - first.t.front());
-      std::size_t n = 0;
-      while (n < first.t.size() && first.t[n] <= t_half) ++n;
-      first.t.resize(n);
-      first.z.conservativeResize(static_cast<Eigen::Index>(n), Eigen::NoChange);
-      Objective half(p.model(), *p.params, p.signals, first, p.objective_options);
+      Objective half(p.model(), *p.params, p.signals, first_half(p.data), p.objective_options);
       OptimizerOptions oh = oo;
       oh.continuation = false;
       const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
@@ -547,15 +541,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     }
     ii.consider = consider_terms(p, obj, r.ident, r.estimate);
     r.interval = uncertainty_interval(r.ident, ii);
-    for (std::size_t i = 0; i < r.names.size(); ++i)
-      if (r.ident.identifiable[i] && r.interval.too_wide[i]) {
-        r.ident.identifiable[i] = false;
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "uncertainty interval ±%.3g is %.3g of the estimate: above 0.5",
-                      r.interval.half_width[static_cast<Eigen::Index>(i)],
-                      r.interval.half_width[static_cast<Eigen::Index>(i)] / std::abs(r.estimate[static_cast<Eigen::Index>(i)]));
-        r.ident.reason[i] = buf;
-      }
+    flag_wide_intervals(r);
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();
@@ -764,6 +750,28 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
     case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n"); break;
   }
   io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
+}
+
+Measurements first_half(const Measurements& data) {
+  Measurements first = data;
+  const double t_half = first.t.front() + 0.5 * (first.t.back() - first.t.front());
+  std::size_t n = 0;
+  while (n < first.t.size() && first.t[n] <= t_half) ++n;
+  first.t.resize(n);
+  first.z.conservativeResize(static_cast<Eigen::Index>(n), Eigen::NoChange);
+  return first;
+}
+
+void flag_wide_intervals(RunResult& r) {
+  for (std::size_t i = 0; i < r.names.size() && i < r.interval.too_wide.size(); ++i)
+    if (r.ident.identifiable[i] && r.interval.too_wide[i]) {
+      r.ident.identifiable[i] = false;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "uncertainty interval ±%.3g is %.3g of the estimate: above 0.5",
+                    r.interval.half_width[static_cast<Eigen::Index>(i)],
+                    r.interval.half_width[static_cast<Eigen::Index>(i)] / std::abs(r.estimate[static_cast<Eigen::Index>(i)]));
+      r.ident.reason[i] = buf;
+    }
 }
 
 }  // namespace scoleid::identify

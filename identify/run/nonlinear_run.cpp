@@ -1,9 +1,10 @@
 // identification.model: nonlinear (docs/theory.md §3.8, §6.7): the same run as identify_run.cpp's
 // on the nonlinear SCOLE model — optimiser with horizon continuation, the fit test (its
 // discretisation estimate from the nonlinear model on twice the elements at a quarter of the
-// step), one cautious-continuation restart after a false convergence, and the Fisher analysis
-// (std, resolution, flags) from differenced output sensitivities; no uncertainty interval (its
-// half-record refit and consider terms are not built for this model).
+// step), one cautious-continuation restart after a false convergence, the Fisher analysis (std,
+// resolution, flags) from differenced output sensitivities, and the uncertainty interval of
+// interval.h from those and the half-record refit. Declared uncertainties (consider terms) are not
+// propagated through this model: with any declared, it gives no interval and says so.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -159,7 +160,7 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
   r.estimate = r.summary.q;
   if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) {
     // Fisher information from differenced output sensitivities (2P forward runs), each sensor's
-    // stated noise or, without one, its residual RMS (identifiability.h); no uncertainty interval.
+    // stated noise or, without one, its residual RMS (identifiability.h).
     const auto ti = std::chrono::steady_clock::now();
     std::vector<io::SensorSpec> sensors = p.scenario.sensors;
     for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
@@ -171,7 +172,24 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
       for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
       r.ident.noise_source = origin;
     }
-    r.interval.note = "no uncertainty interval for the nonlinear model (std and resolution from the Fisher matrix only)";
+    if (!p.scenario.identification.uncertain.empty()) {
+      r.interval.note =
+          "no uncertainty interval: declared uncertainties (identification.uncertain) are not propagated through the "
+          "nonlinear model (std and resolution from the Fisher matrix only)";
+    } else {
+      // The half-record refit (interval.h): the same fit on the first half of the record, from q̂.
+      NonlinearObjective half(model, *p.params, p.signals, first_half(p.data), fo);
+      half.set_horizon(half.data_end());
+      OptimizerOptions oh = oo;
+      oh.continuation = false;
+      const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+      IntervalInputs ii;
+      ii.estimate = r.estimate;
+      r.half_record_estimate = ii.half_record_estimate = s.q;
+      r.half_record_converged = ii.half_record_converged = s.converged();
+      r.interval = uncertainty_interval(r.ident, ii);
+      flag_wide_intervals(r);
+    }
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
   r.counters = obj.counters();

@@ -316,7 +316,7 @@ identification:
 TEST(ScoleIdentifyCli, TheNonlinearModelIsUsedAndSaid) {
   // identification.model: nonlinear on a short slew (2 s, 4 elements): the run says which model it
   // used on stderr and in identify.json, recovers EI from its own nonlinear data, and gives std
-  // from its Fisher matrix but no interval.
+  // from its Fisher matrix and an uncertainty interval that holds the error.
   TempDir dir;
   write_file(dir / "slew.yaml", R"(name: short-slew
 structure: scole
@@ -343,7 +343,10 @@ identification:
   const auto& p = j["parameters"][0];
   EXPECT_LT(std::abs(p["relative_error"].get<double>()), 1e-4) << p.dump();
   EXPECT_TRUE(p["std"].is_number()) << p.dump();
-  EXPECT_TRUE(p["interval"].is_null()) << p.dump();
+  ASSERT_TRUE(p["interval"].is_object()) << p.dump();
+  EXPECT_LT(std::abs(p["estimate"].get<double>() - p["truth"].get<double>()), p["interval"]["half_width"].get<double>())
+      << p.dump();
+  EXPECT_EQ(p["interval"]["covers_truth"], true) << p.dump();
 }
 
 TEST(ScoleIdentifyCli, MissingDataFile) {

@@ -527,7 +527,8 @@ TEST(ScoleNonlinearCostate, TaylorRemainderFallsAtSecondOrder) {
 TEST(ScoleNonlinearIdentification, TheFisherStdOfTheNonlinearModelCoversTheErrorOfANoisyFit) {
   // The same slew with stated noise of about 1 % of each sensor's RMS signal (seeded): the
   // reported std (Fisher matrix from differenced output sensitivities) must describe the error
-  // of the estimate, |error| < 3 std for each parameter, and the flags must be clear.
+  // of the estimate, |error| < 3 std for each parameter, the uncertainty interval (with the
+  // half-record refit) must hold it, and the flags must be clear.
   auto sc = case_one_on_the_slew();
   const double noise[3] = {1e-2, 1e-3, 3e-5};  // roll tip, pitch tip [ft], reflector twist [rad]
   for (std::size_t k = 0; k < sc.sensors.size() && k < 3; ++k) sc.sensors[k].noise_std = noise[k];
@@ -545,7 +546,10 @@ TEST(ScoleNonlinearIdentification, TheFisherStdOfTheNonlinearModelCoversTheError
     EXPECT_TRUE(r.ident.identifiable[i]) << r.ident.reason[i];
     EXPECT_LT(std::abs(err), 3.0 * r.ident.std[ii]);
     EXPECT_GT(r.ident.std[ii], 0.0);
+    std::printf("     interval ±%.3e (half-record shift %.3e)\n", r.interval.half_width[ii], r.interval.half_record_shift[ii]);
+    EXPECT_LT(std::abs(err), r.interval.half_width[ii]);
   }
+  EXPECT_TRUE(r.half_record_converged);
   EXPECT_EQ(r.ident.noise_source, "scenario");
 }
 

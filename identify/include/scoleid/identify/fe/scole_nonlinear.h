@@ -116,6 +116,9 @@ public:
     std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;
     SparseMatrix Cbase_;
     bool quadratic_ = false;
+    // Positions in Cbase_'s value array of each turned rotor's (a, b) column pairs and each
+    // quadratic point's local pairs, row-major over the pairs (−1: not local).
+    std::vector<std::vector<int>> rotor_slots_, point_slots_;
     // The quadratic points' compact Jacobians N(e), in the order of the points (empty for others).
     std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> jacobians(const VectorXd& e) const;
     // The rigid rows of M(e): A = M_rr (6 × 6), B = M_re (6 × ne).

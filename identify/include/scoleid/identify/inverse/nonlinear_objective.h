@@ -91,7 +91,7 @@ private:
   const ScoleNonlinear& model_;
   const Parameterization& params_;
   std::vector<io::Signal> signals_;
-  const Measurements& data_;
+  Measurements data_;  // a copy: the caller's may be a temporary (a half-record refit)
   NonlinearForwardOptions fopt_;
   std::vector<double> given_weights_, R_, tau_;
   double T_ = 0.0;

@@ -111,9 +111,13 @@ RunResult run_identification(Problem& problem, const RunOptions& options);
 // The rank of two attempts: converged and explaining the data, then explaining it, then the cost.
 bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b);
 // identification.model: nonlinear (nonlinear_run.cpp; run_identification hands over to it): the
-// optimiser, the fit test, one cautious restart and the Fisher analysis on the nonlinear SCOLE
-// model; no uncertainty interval.
+// optimiser, the fit test, one cautious restart, the Fisher analysis and the uncertainty interval
+// (without declared uncertainties: those it does not propagate, and then gives no interval).
 RunResult run_nonlinear_identification(Problem& problem, const RunOptions& options);
+// The first half of a record (samples up to the middle time): the half-record refit's data.
+Measurements first_half(const Measurements& data);
+// A parameter whose interval is too wide (interval.h) is flagged not identifiable, with the reason.
+void flag_wide_intervals(RunResult& r);
 
 // identification.model_error, with the automatic value resolved (io/scenario.h).
 double model_error(const Problem& problem);
