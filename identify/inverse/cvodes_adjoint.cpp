@@ -253,8 +253,9 @@ int nl_rhs(realtype t, N_Vector yv, N_Vector ydot, void* ud) {
   return guarded([&] { d.dyn->derivative(N_VGetArrayPointer(yv), d.inputs(t), N_VGetArrayPointer(ydot)); });
 }
 
-// λ̇ = −f_yᵀ λ
-int nl_rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
+// A backward right-hand side: product(y, inputs, f(t, y), λ) written to out.
+template <class Product>
+int backward(realtype t, N_Vector yv, N_Vector yB, double* out, int size, void* ud, Product&& product) {
   const NonlinearData& d = *static_cast<NonlinearData*>(ud);
   return guarded([&] {
     const double* y = N_VGetArrayPointer(yv);
@@ -262,21 +263,24 @@ int nl_rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
     VectorXd yd(d.n);
     d.dyn->derivative(y, in, yd.data());
     const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
-    Eigen::Map<VectorXd>(N_VGetArrayPointer(yBdot), d.n) = -d.dyn->derivative_vjp(y, in, yd, lam);
+    Eigen::Map<VectorXd>(out, size) = product(d, y, in, yd, lam);
   });
+}
+
+// λ̇ = −f_yᵀ λ
+int nl_rhsB(realtype t, N_Vector yv, N_Vector yB, N_Vector yBdot, void* ud) {
+  return backward(t, yv, yB, N_VGetArrayPointer(yBdot), static_cast<NonlinearData*>(ud)->n, ud,
+                  [](const NonlinearData& d, const double* y, const VectorXd& in, const VectorXd& yd, const VectorXd& lam) {
+                    return VectorXd(-d.dyn->derivative_vjp(y, in, yd, lam));
+                  });
 }
 
 // qB' = λᵀ ∂f/∂c (integrated from T back: qB(t0) = −∫ λᵀ ∂f/∂c dt)
 int nl_rhsQB(realtype t, N_Vector yv, N_Vector yB, N_Vector qBdot, void* ud) {
-  const NonlinearData& d = *static_cast<NonlinearData*>(ud);
-  return guarded([&] {
-    const double* y = N_VGetArrayPointer(yv);
-    const VectorXd in = d.inputs(t);
-    VectorXd yd(d.n);
-    d.dyn->derivative(y, in, yd.data());
-    const VectorXd lam = Eigen::Map<const VectorXd>(N_VGetArrayPointer(yB), d.n);
-    Eigen::Map<VectorXd>(N_VGetArrayPointer(qBdot), d.ncoef) = d.dyn->coefficient_vjp(y, in, yd, lam);
-  });
+  return backward(t, yv, yB, N_VGetArrayPointer(qBdot), static_cast<NonlinearData*>(ud)->ncoef, ud,
+                  [](const NonlinearData& d, const double* y, const VectorXd& in, const VectorXd& yd, const VectorXd& lam) {
+                    return d.dyn->coefficient_vjp(y, in, yd, lam);
+                  });
 }
 
 }  // namespace
