@@ -692,8 +692,8 @@ namespace scoleid::identify {
 //   ∂s_i/∂r = f × μ_Ω + m (w × a_Ω + Ω × (Ω × w))                      (∂/∂e = Nᵀ ∂/∂r)
 //   ∂s_i/∂V = m w × Ω,   ∂s_i/∂ė = 2 m Nᵀ (w × Ω),
 //   ∂s_i/∂Ω = m (V × w + w (Ω·r) + r (w·Ω) − 2 (w·r) Ω + 2 (N ė) × w).
-// Per rotor, ω = Ω + Θ ė:  s_j = (μ_Ω + Θ μ_e)ᵀ J (a_Ω + Θ a_e) + μ_Ω · (Ω × J ω):
-//   ∂s_j/∂Ω = J ω × μ_Ω + J (μ_Ω × Ω),   ∂s_j/∂ė = Θᵀ J (μ_Ω × Ω).
+// Per rotor: below, at its loop (the inertia turned by θ adds θ- and θ̇-terms). A quadratic point
+// (struct Quadratic): N(e) for N and the e-derivatives of N(e), at its branch.
 // Elastic: ∂/∂ė = D μ_e, ∂/∂e = K μ_e. A force's arm: ∂/∂e of −f μ_Ω · ((N e) × d) = −f Nᵀ (d × μ_Ω).
 void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu,
                                             const VectorXd& fin, VectorXd& de, VectorXd& du, VectorXd* dc) const {

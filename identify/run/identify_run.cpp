@@ -522,8 +522,9 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     // The half-record refit (interval.h): the same fit on the first half of the record, from q̂.
     IntervalInputs ii;
     ii.estimate = r.estimate;
-    {
-      Objective half(p.model(), *p.params, p.signals, first_half(p.data), p.objective_options);
+    // (A record too short to halve into two samples gets none: the interval is then not assessed.)
+    if (const Measurements half_data = first_half(p.data); half_data.t.size() >= 2) {
+      Objective half(p.model(), *p.params, p.signals, half_data, p.objective_options);
       OptimizerOptions oh = oo;
       oh.continuation = false;
       const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
@@ -691,7 +692,8 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                               {"noise_source", ident.noise_source},
                               {"chi2", ident.chi2},
                               {"data_values", ident.data_values},
-                              {"half_record_refit_converged", half_record_converged},
+                              {"half_record_refit_converged",
+                               half_record_estimate.size() != 0 ? json(half_record_converged) : json(nullptr)},
                               {"consider", [&] {
                                  json c = json::array();
                                  for (const auto& t : interval.terms) {

@@ -178,15 +178,18 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
           "nonlinear model (std and resolution from the Fisher matrix only)";
     } else {
       // The half-record refit (interval.h): the same fit on the first half of the record, from q̂.
-      NonlinearObjective half(model, *p.params, p.signals, first_half(p.data), fo);
-      half.set_horizon(half.data_end());
-      OptimizerOptions oh = oo;
-      oh.continuation = false;
-      const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+      // (A record too short to halve into two samples gets none: the interval is then not assessed.)
       IntervalInputs ii;
       ii.estimate = r.estimate;
-      r.half_record_estimate = ii.half_record_estimate = s.q;
-      r.half_record_converged = ii.half_record_converged = s.converged();
+      if (const Measurements half_data = first_half(p.data); half_data.t.size() >= 2) {
+        NonlinearObjective half(model, *p.params, p.signals, half_data, fo);
+        half.set_horizon(half.data_end());
+        OptimizerOptions oh = oo;
+        oh.continuation = false;
+        const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+        r.half_record_estimate = ii.half_record_estimate = s.q;
+        r.half_record_converged = ii.half_record_converged = s.converged();
+      }
       r.interval = uncertainty_interval(r.ident, ii);
       flag_wide_intervals(r);
     }

@@ -373,6 +373,21 @@ TEST(ScoleIdentifyCli, DataTimeNotIncreasing) {
                    {"line 4", "column 't'", "strictly increasing", "0.01"});
 }
 
+TEST(ScoleIdentifyCli, ARecordTooShortToHalveGetsNoIntervalButAResult) {
+  // Two samples: the first half of the record holds one, too few for the half-record refit; the
+  // run must still finish and write its result, the interval not assessed and the refit reported
+  // as not run (null).
+  TempDir dir;
+  write_file(dir / "truth.csv", "t,P,w_mid\n0,10,0\n0.01,10,1e-6\n");
+  const fs::path out = dir / "out";
+  const Result r = run({"--scenario", "paper-beam-1", "--data", (dir / "truth.csv").string(), "--out", out.string(), "-q"}, dir);
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  ASSERT_TRUE(fs::exists(out / "identify.json")) << r.err;
+  const auto j = nlohmann::json::parse(read_file(out / "identify.json"));
+  for (const auto& p : j["parameters"]) EXPECT_TRUE(p["interval"].is_null()) << p.dump();
+  EXPECT_TRUE(j.dump().find("\"half_record_refit_converged\":null") != std::string::npos) << j.dump();
+}
+
 TEST(ScoleIdentifyCli, DataLacksSensorColumn) {
   expect_csv_error("truth.csv", "t,P,other\n0,10,0\n0.01,10,1e-6\n0.02,10,2e-6\n", {"sensor 'w_mid'"});
 }
