@@ -35,6 +35,43 @@ struct Sundials {
   }
 };
 
+// The forward problem in cl.cv: BDF (created by the caller) with a dense solver.
+void forward_problem(Sundials& cl, CVRhsFn rhs, double t0, N_Vector y, int n, double rtol, double atol,
+                     void* user_data) {
+  void* cv = cl.cv;
+  check(CVodeInit(cv, rhs, t0, y), "CVodeInit");
+  check(CVodeSStolerances(cv, rtol, atol), "CVodeSStolerances");
+  check(CVodeSetUserData(cv, user_data), "CVodeSetUserData");
+  check(CVodeSetMaxNumSteps(cv, 10000000), "CVodeSetMaxNumSteps");
+  SUNMatrix A = SUNDenseMatrix(n, n, cl.ctx);
+  SUNLinearSolver LS = SUNLinSol_Dense(y, A, cl.ctx);
+  cl.mats.push_back(A);
+  cl.lss.push_back(LS);
+  check(CVodeSetLinearSolver(cv, LS, A), "CVodeSetLinearSolver");
+}
+
+// The backward (adjoint) problem of the forward run in cl.cv: BDF with a dense solver, the
+// quadrature qB with error control, both at rtol (quadrature atol 1e-30: relative only).
+int backward_problem(Sundials& cl, CVRhsFnB rhsB, CVQuadRhsFnB rhsQB, double T, N_Vector yB, N_Vector qB, int n,
+                     double rtol, double atol, void* user_data) {
+  void* cv = cl.cv;
+  int which = 0;
+  check(CVodeCreateB(cv, CV_BDF, &which), "CVodeCreateB");
+  check(CVodeInitB(cv, which, rhsB, T, yB), "CVodeInitB");
+  check(CVodeSStolerancesB(cv, which, rtol, atol), "CVodeSStolerancesB");
+  check(CVodeSetUserDataB(cv, which, user_data), "CVodeSetUserDataB");
+  check(CVodeSetMaxNumStepsB(cv, which, 10000000), "CVodeSetMaxNumStepsB");
+  SUNMatrix AB = SUNDenseMatrix(n, n, cl.ctx);
+  SUNLinearSolver LSB = SUNLinSol_Dense(yB, AB, cl.ctx);
+  cl.mats.push_back(AB);
+  cl.lss.push_back(LSB);
+  check(CVodeSetLinearSolverB(cv, which, LSB, AB), "CVodeSetLinearSolverB");
+  check(CVodeQuadInitB(cv, which, rhsQB, qB), "CVodeQuadInitB");
+  check(CVodeQuadSStolerancesB(cv, which, rtol, 1e-30), "CVodeQuadSStolerancesB");
+  check(CVodeSetQuadErrConB(cv, which, SUNTRUE), "CVodeSetQuadErrConB");
+  return which;
+}
+
 struct Data {
   int n = 0, P = 0, ns = 0;
   MatrixXd M, D, K, Minv, C0, C1, C2;  // output rows on x, v and a = ẍ (C1, C2 empty without rate sensors)
@@ -172,15 +209,7 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
   void* cv = CVodeCreate(CV_BDF, ctx);
   cl.cv = cv;
   const double atol = rtol * 1e-6;
-  check(CVodeInit(cv, rhs, t0, y), "CVodeInit");
-  check(CVodeSStolerances(cv, rtol, atol), "CVodeSStolerances");
-  check(CVodeSetUserData(cv, &d), "CVodeSetUserData");
-  check(CVodeSetMaxNumSteps(cv, 10000000), "CVodeSetMaxNumSteps");
-  SUNMatrix A = SUNDenseMatrix(N, N, ctx);
-  SUNLinearSolver LS = SUNLinSol_Dense(y, A, ctx);
-  cl.mats.push_back(A);
-  cl.lss.push_back(LS);
-  check(CVodeSetLinearSolver(cv, LS, A), "CVodeSetLinearSolver");
+  forward_problem(cl, rhs, t0, y, N, rtol, atol, &d);
   check(CVodeQuadInit(cv, rhsQ, yQ), "CVodeQuadInit");
   check(CVodeQuadSStolerances(cv, rtol, 1e-30), "CVodeQuadSStolerances");
   check(CVodeSetQuadErrCon(cv, SUNTRUE), "CVodeSetQuadErrCon");
@@ -195,20 +224,7 @@ CvodesAdjointResult cvodes_adjoint_gradient(Objective& obj, const VectorXd& q, d
   res.cost = N_VGetArrayPointer(yQ)[0];
   CVodeGetNumSteps(cv, &res.forward_steps);
 
-  int which = 0;
-  check(CVodeCreateB(cv, CV_BDF, &which), "CVodeCreateB");
-  check(CVodeInitB(cv, which, rhsB, T, yB), "CVodeInitB");
-  check(CVodeSStolerancesB(cv, which, rtol, atol), "CVodeSStolerancesB");
-  check(CVodeSetUserDataB(cv, which, &d), "CVodeSetUserDataB");
-  check(CVodeSetMaxNumStepsB(cv, which, 10000000), "CVodeSetMaxNumStepsB");
-  SUNMatrix AB = SUNDenseMatrix(N, N, ctx);
-  SUNLinearSolver LSB = SUNLinSol_Dense(yB, AB, ctx);
-  cl.mats.push_back(AB);
-  cl.lss.push_back(LSB);
-  check(CVodeSetLinearSolverB(cv, which, LSB, AB), "CVodeSetLinearSolverB");
-  check(CVodeQuadInitB(cv, which, rhsQB, qB), "CVodeQuadInitB");
-  check(CVodeQuadSStolerancesB(cv, which, rtol, 1e-30), "CVodeQuadSStolerancesB");
-  check(CVodeSetQuadErrConB(cv, which, SUNTRUE), "CVodeSetQuadErrConB");
+  const int which = backward_problem(cl, rhsB, rhsQB, T, yB, qB, N, rtol, atol, &d);
   check(CVodeB(cv, t0, CV_NORMAL), "CVodeB");
   double tB = 0.0;
   check(CVodeGetQuadB(cv, which, &tB, qB), "CVodeGetQuadB");
@@ -312,15 +328,7 @@ CvodesAdjointResult cvodes_nonlinear_gradient(const ScoleNonlinear& model, const
   cl.cv = cv;
   const double atol = rtol * 1e-4;
   const double t0 = data.t.front();
-  check(CVodeInit(cv, nl_rhs, t0, y), "CVodeInit");
-  check(CVodeSStolerances(cv, rtol, atol), "CVodeSStolerances");
-  check(CVodeSetUserData(cv, &d), "CVodeSetUserData");
-  check(CVodeSetMaxNumSteps(cv, 10000000), "CVodeSetMaxNumSteps");
-  SUNMatrix A = SUNDenseMatrix(n, n, ctx);
-  SUNLinearSolver LS = SUNLinSol_Dense(y, A, ctx);
-  cl.mats.push_back(A);
-  cl.lss.push_back(LS);
-  check(CVodeSetLinearSolver(cv, LS, A), "CVodeSetLinearSolver");
+  forward_problem(cl, nl_rhs, t0, y, n, rtol, atol, &d);
   check(CVodeAdjInit(cv, 500, CV_HERMITE), "CVodeAdjInit");
 
   // A sample's cost, ∂g_k/∂y_k and ∂g_k/∂c (through u̇ for accelerometers).
@@ -361,21 +369,8 @@ CvodesAdjointResult cvodes_nonlinear_gradient(const ScoleNonlinear& model, const
   VectorXd gy;
   sample(K - 1, &gy);
   Eigen::Map<VectorXd>(N_VGetArrayPointer(yB), n) = gy;
-  int which = 0;
   const double T = data.t.back();
-  check(CVodeCreateB(cv, CV_BDF, &which), "CVodeCreateB");
-  check(CVodeInitB(cv, which, nl_rhsB, T, yB), "CVodeInitB");
-  check(CVodeSStolerancesB(cv, which, rtol, atol), "CVodeSStolerancesB");
-  check(CVodeSetUserDataB(cv, which, &d), "CVodeSetUserDataB");
-  check(CVodeSetMaxNumStepsB(cv, which, 10000000), "CVodeSetMaxNumStepsB");
-  SUNMatrix AB = SUNDenseMatrix(n, n, ctx);
-  SUNLinearSolver LSB = SUNLinSol_Dense(yB, AB, ctx);
-  cl.mats.push_back(AB);
-  cl.lss.push_back(LSB);
-  check(CVodeSetLinearSolverB(cv, which, LSB, AB), "CVodeSetLinearSolverB");
-  check(CVodeQuadInitB(cv, which, nl_rhsQB, qB), "CVodeQuadInitB");
-  check(CVodeQuadSStolerancesB(cv, which, rtol, 1e-30), "CVodeQuadSStolerancesB");
-  check(CVodeSetQuadErrConB(cv, which, SUNTRUE), "CVodeSetQuadErrConB");
+  const int which = backward_problem(cl, nl_rhsB, nl_rhsQB, T, yB, qB, n, rtol, atol, &d);
   for (int k = K - 2; k >= 0; --k) {
     const double tk = data.t[static_cast<std::size_t>(k)];
     check(CVodeB(cv, tk, CV_NORMAL), "CVodeB");
