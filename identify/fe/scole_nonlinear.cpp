@@ -91,6 +91,16 @@ void ScoleNonlinear::Quadratic::bil_t(const VectorXd& y, const Vector3d& w, Vect
   for (std::size_t k = 0; k < cols.size(); ++k) out[cols[k]] += g[static_cast<Eigen::Index>(k)];
 }
 
+Vector3d ScoleNonlinear::Rotor::tilt(const VectorXd& x) const {
+  Vector3d p = th.times(x);
+  p[2] = 0.0;
+  return p;
+}
+
+Eigen::Matrix<double, 3, Eigen::Dynamic> ScoleNonlinear::Rotor::jacobian(const VectorXd& e) const {
+  return th.v + skew(tilt(e)) * half;
+}
+
 namespace {
 // The columns any of the dense rows (or Q's rows) touch, and the rows restricted to them.
 void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Qfull, std::vector<int>& cols,
@@ -159,7 +169,23 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     for (int q = 0; q < 3; ++q) {
       const double s = (el + x3[q]) * h;
       rotors_.push_back({w3[q] * h * Vector3d(bend, bend, 1.0).asDiagonal().toDenseMatrix(), on_e(fe.mast_rotation(s)),
-                         ScoleFE::kRhoIPsi, {}});
+                         ScoleFE::kRhoIPsi, {}, {}});
+    }
+    // The strain energy's higher-order rows at four Gauss points (degree 7: W₄'s density has degree
+    // 6 in s on an element). The rotation rows are polynomials of degree ≤ 2 in s there (Hermite
+    // slopes, linear twist), so a central difference inside the element is their exact derivative.
+    for (int q = 0; q < 4; ++q) {
+      const double s = (el + x4[q]) * h, ds = 0.05 * h;
+      MatrixXd rows(6, ne_);
+      rows.topRows(3) = on_e(fe.mast_rotation(s));
+      rows.bottomRows(3) = (on_e(fe.mast_rotation(s + ds)) - on_e(fe.mast_rotation(s - ds))) / (2.0 * ds);
+      Coupling c;
+      for (Eigen::Index j = 0; j < ne_; ++j)
+        if (rows.col(j).cwiseAbs().maxCoeff() != 0.0) c.cols.push_back(static_cast<int>(j));
+      c.rows.resize(6, static_cast<Eigen::Index>(c.cols.size()));
+      for (std::size_t k = 0; k < c.cols.size(); ++k) c.rows.col(static_cast<Eigen::Index>(k)) = rows.col(c.cols[k]);
+      c.weight = w4[q] * h;
+      coupling_.push_back(std::move(c));
     }
   }
   // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
@@ -176,15 +202,22 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
         const MatrixXd R2 = on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
         Qfull += w3[q] * h * R2.transpose() * R2;
       }
+    // The end section's rotation to second order is R = exp[α] exp[ψ a] (the tilt α the slopes
+    // give, then the twist about the axis a), whose rotation vector is θ + ½ α × ψ a (θ = Θ e).
+    // The second-order part turns the arm r (⊥ a) by ½ (ẑ·θ)(r·θ) ẑ: axial, into Q.
+    {
+      const Eigen::RowVectorXd u = Vector3d::UnitZ().transpose() * Th, v = r.transpose() * Th;
+      Qfull += 0.5 * (u.transpose() * v + v.transpose() * u);
+    }
     compact({&refl.N, &A, &B}, Qfull, refl.quad.cols, refl.quad.local, {&refl.quad.N, &refl.quad.A, &refl.quad.B},
             refl.quad.Q);
     refl.quad.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
     points_.push_back(std::move(refl));
   }
-  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}});
+  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}, {}});
   // Shuttle.
   points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}, {}});
-  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}});
+  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}, {}});
   // Proof masses: their own lateral DOFs, axially with the mast.
   for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
     MatrixXd N = MatrixXd::Zero(3, ne_);
@@ -202,7 +235,11 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
   }
 
   for (auto& p : points_) p.n = Rows3::of(p.N);
-  for (auto& r : rotors_) r.th = Rows3::of(r.Theta);
+  for (auto& r : rotors_) {
+    r.th = Rows3::of(r.Theta);
+    r.half = r.th.v;
+    r.half.topRows<2>() *= 0.5;
+  }
   for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
   for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
 
@@ -340,7 +377,108 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   d.D_ = MatrixXd::Zero(ne_, ne_);
   for (const auto& t : stiffness_) d.K_ += scale(t.coefficient) * MatrixXd(t.matrix);
   for (const auto& t : damping_) d.D_ += scale(t.coefficient) * MatrixXd(t.matrix);
+  d.k_roll_ = scale(ScoleFE::kEIRoll);
+  d.k_pitch_ = scale(ScoleFE::kEIPitch);
+  d.k_twist_ = scale(ScoleFE::kGJ);
   return d;
+}
+
+namespace {
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// The strain energy's density beyond the quadratic, W₃ + W₄ (struct Coupling), at
+// a = (x, y, z, X, Y, Z) = (θ_x, θ_y, θ_z, θ_x', θ_y', θ_z'), with c1 = EI_roll, c2 = EI_pitch, g = GJ,
+// d = x X + y Y, q = x Y − y X:
+//   W₃ = −½ g Z q + (c1 − c2) z X Y
+//   W₄ = ½ [(c1 x X + c2 y Y) d + (c1 − c2) z² (Y² − X²) + ¼ g q²]
+// Value, gradient and Hessian (every term a product of the six values: closed form).
+struct Density {
+  double value = 0;
+  Vector6d grad = Vector6d::Zero();
+  Matrix6d hess = Matrix6d::Zero();
+};
+
+Density strain_density(const Vector6d& a, double c1, double c2, double g, bool hessian) {
+  const double x = a[0], y = a[1], z = a[2], X = a[3], Y = a[4], Z = a[5];
+  const double d = x * X + y * Y, q = x * Y - y * X, b = c1 - c2, w = c1 * x * X + c2 * y * Y;
+  Vector6d gd, gq, gw, gz;
+  gd << X, Y, 0, x, y, 0;
+  gq << Y, -X, 0, -y, x, 0;
+  gw << c1 * X, c2 * Y, 0, c1 * x, c2 * y, 0;
+  const double v = Y * Y - X * X;  // z² v in W₄
+  gz << 0, 0, 2 * z * v, -2 * z * z * X, 2 * z * z * Y, 0;
+  Density D;
+  D.value = -0.5 * g * Z * q + b * z * X * Y + 0.5 * (w * d + b * z * z * v + 0.25 * g * q * q);
+  Vector6d g3;
+  g3 << 0, 0, b * X * Y, b * z * Y, b * z * X, 0;
+  D.grad = -0.5 * g * (Z * gq) + g3 + 0.5 * (gw * d + w * gd + b * gz + 0.5 * g * q * gq);
+  D.grad[5] += -0.5 * g * q;
+  if (!hessian) return D;
+  Matrix6d H = Matrix6d::Zero();
+  auto add = [&](int i, int j, double val) {
+    H(i, j) += val;
+    if (i != j) H(j, i) += val;
+  };
+  // W₃: −½ g Z q (q's Hessian: (0,4) = 1, (1,3) = −1) and b z X Y.
+  for (int k = 0; k < 6; ++k) add(5, k, -0.5 * g * gq[k] * (k == 5 ? 0.5 : 1.0));
+  add(0, 4, -0.5 * g * Z);
+  add(1, 3, 0.5 * g * Z);
+  add(2, 3, b * Y);
+  add(2, 4, b * X);
+  add(3, 4, b * z);
+  // W₄: ½ [gw gdᵀ + gd gwᵀ + d ∇²w + w ∇²d + b ∇²(z² v) + ¼ g (2 gq gqᵀ + 2 q ∇²q)].
+  H += 0.5 * (gw * gd.transpose() + gd * gw.transpose()) + 0.25 * g * gq * gq.transpose();
+  add(0, 3, 0.5 * (d * c1 + w));
+  add(1, 4, 0.5 * (d * c2 + w));
+  add(2, 2, 0.5 * b * 2 * v);
+  add(2, 3, 0.5 * b * (-4 * z * X));
+  add(2, 4, 0.5 * b * (4 * z * Y));
+  add(3, 3, 0.5 * b * (-2 * z * z));
+  add(4, 4, 0.5 * b * (2 * z * z));
+  add(0, 4, 0.25 * g * q);
+  add(1, 3, -0.25 * g * q);
+  D.hess = H;
+  return D;
+}
+
+template <class C>
+Vector6d coupling_values(const C& c, const VectorXd& x) {
+  Vector6d a = Vector6d::Zero();
+  for (std::size_t k = 0; k < c.cols.size(); ++k) a += c.rows.col(static_cast<Eigen::Index>(k)) * x[c.cols[k]];
+  return a;
+}
+template <class C>
+void coupling_add(const C& c, const Vector6d& g, VectorXd& out) {
+  for (std::size_t k = 0; k < c.cols.size(); ++k) out[c.cols[k]] += c.rows.col(static_cast<Eigen::Index>(k)).dot(g);
+}
+}  // namespace
+
+double ScoleNonlinear::Dynamics::coupling_energy(const VectorXd& e) const {
+  double W = 0.0;
+  for (const auto& c : g_->coupling_) W += c.weight * strain_density(coupling_values(c, e), k_roll_, k_pitch_, k_twist_, false).value;
+  return W;
+}
+
+void ScoleNonlinear::Dynamics::add_coupling_force(const VectorXd& e, VectorXd& out) const {
+  for (const auto& c : g_->coupling_)
+    coupling_add(c, c.weight * strain_density(coupling_values(c, e), k_roll_, k_pitch_, k_twist_, false).grad, out);
+}
+
+void ScoleNonlinear::Dynamics::add_coupling_hessian(const VectorXd& e, const VectorXd& x, VectorXd& out) const {
+  for (const auto& c : g_->coupling_)
+    coupling_add(c, c.weight * (strain_density(coupling_values(c, e), k_roll_, k_pitch_, k_twist_, true).hess * coupling_values(c, x)),
+                 out);
+}
+
+void ScoleNonlinear::Dynamics::add_coupling_coefficients(const VectorXd& e, const VectorXd& mu, VectorXd& dc) const {
+  // The density is linear in (EI_roll, EI_pitch, GJ): its gradient at unit coefficients.
+  for (const auto& c : g_->coupling_) {
+    const Vector6d a = coupling_values(c, e), m = coupling_values(c, mu);
+    dc[ScoleFE::kEIRoll] += c.weight * strain_density(a, 1.0, 0.0, 0.0, false).grad.dot(m);
+    dc[ScoleFE::kEIPitch] += c.weight * strain_density(a, 0.0, 1.0, 0.0, false).grad.dot(m);
+    dc[ScoleFE::kGJ] += c.weight * strain_density(a, 0.0, 0.0, 1.0, false).grad.dot(m);
+  }
 }
 
 std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> ScoleNonlinear::Dynamics::jacobians(const VectorXd& e) const {
@@ -358,6 +496,15 @@ Matrix3d turned(const Matrix3d& J, const Vector3d& theta) {
   const Matrix3d T = skew(theta);
   return T * J - J * T;
 }
+
+VectorXd rt_gather(const std::vector<int>& cols, const VectorXd& x) {
+  VectorXd g(static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) g[static_cast<Eigen::Index>(k)] = x[cols[k]];
+  return g;
+}
+
+// P⊥ v: Aᵀ w = Θᵀ P⊥ w (the tilt's rows are Θ's first two).
+Vector3d tilt_of(const Vector3d& v) { return {v[0], v[1], 0.0}; }
 
 // out.col(cols[k]) += A Je.col(k)
 void add_left_compact(const std::vector<int>& cols, const Matrix3d& A, const Eigen::Matrix<double, 3, Eigen::Dynamic>& Je,
@@ -395,7 +542,8 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
     if (rt.th.cols.empty()) continue;
     const Matrix3d dJ = turned(J_[j], rt.th.times(e));
     OO += dJ;
-    rt.th.add_left(dJ, Oe);
+    // J(θ) Θ(e) − J Θ (the constant part is in Mconst_)
+    add_left_compact(rt.th.cols, Matrix3d::Identity(), (J_[j] + dJ) * rt.jacobian(e) - J_[j] * rt.th.v, Oe);
   }
   A.block<3, 3>(0, 3) += VO;
   A.block<3, 3>(3, 0) += VO.transpose();
@@ -425,13 +573,21 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
   return M;
 }
 
-// Θ_jᵀ ΔJ_j(e) Θ_j on each turned rotor's columns (the e–e part of its turned inertia).
+// Θ(e)ᵀ J(θ) Θ(e) − Θᵀ J Θ on a turned rotor's columns: the e-dependent part of its e–e block.
+MatrixXd ScoleNonlinear::Dynamics::rotor_block(std::size_t j, const VectorXd& e) const {
+  const auto& rt = g_->rotors_[j];
+  const Matrix3d& J = J_[j];
+  const auto Te = rt.jacobian(e);
+  return Te.transpose() * (J + turned(J, rt.th.times(e))) * Te - rt.th.v.transpose() * J * rt.th.v;
+}
+
+// rotor_block on each turned rotor's columns (the e–e part of its turned inertia).
 template <class Add>
 void ScoleNonlinear::Dynamics::for_turned_rotors(const VectorXd& e, Add&& add) const {
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& th = g_->rotors_[j].th;
     if (th.cols.empty()) continue;
-    const MatrixXd Mj = th.v.transpose() * turned(J_[j], th.times(e)) * th.v;
+    const MatrixXd Mj = rotor_block(j, e);
     for (std::size_t a = 0; a < th.cols.size(); ++a)
       for (std::size_t b = 0; b < th.cols.size(); ++b)
         add(th.cols[a], th.cols[b], Mj(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)));
@@ -457,7 +613,7 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
     for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
       const auto& th = g_->rotors_[j].th;
       if (th.cols.empty()) continue;
-      const MatrixXd Mj = th.v.transpose() * turned(J_[j], th.times(e)) * th.v;
+      const MatrixXd Mj = rotor_block(j, e);
       const auto& sl = rotor_slots_[j];
       const auto n = static_cast<Eigen::Index>(th.cols.size());
       for (Eigen::Index a = 0; a < n; ++a)
@@ -562,23 +718,32 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     b.tail(ne) = be;
   }
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
-    // h = J(θ) ω, ḣ = J(θ) ω̇ + J̇ ω with J̇ ω = θ̇ × J ω − J (θ̇ × ω); Ω row: J̇ ω + Ω × J(θ) ω;
-    // e row: Θᵀ (J̇ ω − ∂T/∂θ), ∂T/∂θ = J ω × ω (T = ½ ωᵀ J(θ) ω).
-    const auto& th = g_->rotors_[j].th;
+    // ω = Ω + Θ(e) ė, h = J(θ) ω, ḣ = J(θ) ω̇ + J̇ ω with ω̇ = Ω̇ + Θ(e) ë + ṗ × q̇ (ṗ = P⊥ Θ ė,
+    // q̇ = B ė) and J̇ ω = θ̇ × J ω − J (θ̇ × ω). Ω row: the convective part of ḣ, plus Ω × h;
+    // e row (Lagrange, T = ½ ωᵀ J(θ) ω): Θ(e)ᵀ (convective ḣ) + Bᵀ (h × ṗ) − Aᵀ (q̇ × h)
+    // − Θᵀ (J ω × ω), A = P⊥ Θ: the first two from d/dt of Θ(e)ᵀ, the third ∂ω/∂e, the last ∂J/∂θ.
+    const auto& rt = g_->rotors_[j];
+    const auto& th = rt.th;
     const Matrix3d& J = J_[j];
-    const Vector3d thd = th.times(ed), omega = W + thd;
     if (th.cols.empty()) {
-      b.segment<3>(3) += W.cross(J * omega);
+      b.segment<3>(3) += W.cross(J * W);
       continue;
     }
-    const Vector3d Jw = J * omega, Jtw = Jw + turned(J, th.times(e)) * omega;
-    const Vector3d Jdw = thd.cross(Jw) - J * thd.cross(omega);
-    b.segment<3>(3) += Jdw + W.cross(Jtw);
-    VectorXd be = b.tail(ne);
-    th.add_transposed(Jdw - Jw.cross(omega), be);
-    b.tail(ne) = be;
+    const VectorXd edl = rt_gather(th.cols, ed);
+    const Vector3d thd = th.v * edl, pd = Vector3d(thd[0], thd[1], 0.0), qd = rt.half * edl;
+    const Vector3d omega = W + thd + rt.tilt(e).cross(qd);
+    const Matrix3d Jt = J + turned(J, th.times(e));
+    const Vector3d Jw = J * omega, h = Jt * omega;
+    const Vector3d conv = Jt * pd.cross(qd) + thd.cross(Jw) - J * thd.cross(omega);
+    b.segment<3>(3) += conv + W.cross(h);
+    const VectorXd g = rt.jacobian(e).transpose() * conv + rt.half.transpose() * h.cross(pd) -
+                       th.v.transpose() * (tilt_of(qd.cross(h)) + Jw.cross(omega));
+    for (std::size_t k = 0; k < th.cols.size(); ++k) b[6 + th.cols[k]] += g[static_cast<Eigen::Index>(k)];
   }
   b.tail(ne).noalias() += D_ * ed + K_ * e;
+  VectorXd be = b.tail(ne);
+  add_coupling_force(e, be);
+  b.tail(ne) = be;
   return b;
 }
 
@@ -664,7 +829,7 @@ VectorXd ScoleNonlinear::Dynamics::outputs(const double* y, const VectorXd& udot
 double ScoleNonlinear::Dynamics::energy(const double* y) const {
   const StateView s(y, g_->ne_);
   const VectorXd e = s.e, u = s.u;
-  return 0.5 * u.dot(mass(e) * u) + 0.5 * e.dot(K_ * e);
+  return 0.5 * u.dot(mass(e) * u) + 0.5 * e.dot(K_ * e) + coupling_energy(e);
 }
 
 Vector3d ScoleNonlinear::Dynamics::momentum(const double* y) const {
@@ -750,36 +915,63 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
     p.n.add_transposed(2.0 * m * w.cross(W), due);
   }
-  // Per rotor, with θ = Θ e, θ̇ = Θ ė, ω = Ω + θ̇, α = a_Ω + Θ a_e, ν = μ_Ω + Θ μ_e, z = Θ μ_e,
-  // y = μ_Ω × Ω and J(θ) x = J x + ΔJ(θ) x (symmetric):
-  //   s_j = ν·J(θ)α + ν·(θ̇ × Jω − J(θ̇ × ω)) + μ_Ω·(Ω × J(θ)ω) − z·(Jω × ω)
-  //   ∂s/∂θ = Jα × ν + Jν × α + Jω × y + Jy × ω,     ∂s/∂θ̇ (explicit) = Jω × ν + Jν × ω,
-  //   ∂s/∂ω = J(ν × θ̇) + θ̇ × Jν + J(θ) y − J(ω × z) − z × Jω,   ∂s/∂Ω (explicit) = J(θ)ω × μ_Ω;
-  //   ∂/∂e = Θᵀ ∂/∂θ, ∂/∂ė = Θᵀ (∂/∂θ̇ + ∂/∂ω), ∂/∂Ω = ∂/∂Ω explicit + ∂/∂ω.
+  // Per rotor (struct Rotor), with θ = Θ e, θ̇ = Θ ė, p = P⊥ θ, ṗ = P⊥ θ̇, q̇ = B ė,
+  // ω = Ω + θ̇ + p × q̇, J(θ) = J + ΔJ(θ) (symmetric), h = J(θ) ω, and from μ: z = Θ μ_e,
+  // m_A = P⊥ z, m_B = B μ_e, ν = μ_Ω + z + p × m_B (= L(e) μ); α = a_Ω + Θ a_e + p × B a_e,
+  // c = ṗ × q̇, x = μ_Ω × Ω + ṗ × m_B − m_A × q̇:
+  //   s_j = ν·J(θ)(α + c) + ν·(θ̇ × J ω − J(θ̇ × ω)) + x·J(θ) ω − z·(J ω × ω).
+  // With ∂/∂θ of a·J(θ) b = J b × a + J a × b, and g_ν, g_ω, … the partial gradients:
+  //   g_θ = J(α + c) × ν + J ν × (α + c) + J ω × x + J x × ω,   g_θ̇ = J ω × ν + J ν × ω,
+  //   g_ω = J(ν × θ̇) + θ̇ × J ν + J(θ) x − J(ω × z) − z × J ω,
+  //   g_ν = J(θ)(α + c) + θ̇ × J ω − J(θ̇ × ω),   g_ṗ = m_B × h + q̇ × J(θ) ν,
+  //   g_q̇ = m_A × h + J(θ) ν × ṗ + g_ω × p,     g_p = m_B × g_ν + B a_e × J(θ) ν + q̇ × g_ω;
+  //   ∂/∂e = Θᵀ (g_θ + P⊥ g_p),  ∂/∂ė = Θᵀ (g_θ̇ + g_ω + P⊥ g_ṗ) + Bᵀ g_q̇,  ∂/∂Ω = h × μ_Ω + g_ω.
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& rt = g_->rotors_[j];
-    const Vector3d th = rt.th.times(e), thd = rt.th.times(edot), omega = W + thd;
-    const Vector3d z = rt.th.times(mue), nu = muW + z, alpha = aW + rt.th.times(ae), y = muW.cross(W);
+    const Vector3d yv = muW.cross(W);
+    if (rt.th.cols.empty()) {  // the shuttle: s = μ_Ω·(J a_Ω + Ω × J Ω)
+      if (dc && rt.coefficient >= 0) (*dc)[rt.coefficient] += muW.dot(rt.J * aW + W.cross(rt.J * W));
+      const Matrix3d& J = J_[j];
+      du.segment<3>(3) += Vector3d(J * W).cross(muW) + J * yv;
+      continue;
+    }
+    const VectorXd el = rt_gather(rt.th.cols, e), edl = rt_gather(rt.th.cols, edot), mul = rt_gather(rt.th.cols, mue),
+                   ael = rt_gather(rt.th.cols, ae);
+    const Vector3d th = rt.th.v * el, thd = rt.th.v * edl, p = tilt_of(th), pd = tilt_of(thd), qd = rt.half * edl;
+    const Vector3d omega = W + thd + p.cross(qd);
+    const Vector3d z = rt.th.v * mul, mA = tilt_of(z), mB = rt.half * mul, nu = muW + z + p.cross(mB);
+    const Vector3d Ba = rt.half * ael, alpha = aW + rt.th.v * ael + p.cross(Ba), ac = alpha + pd.cross(qd);
+    const Vector3d x = yv + pd.cross(mB) - mA.cross(qd);
     auto value = [&](const Matrix3d& J) {
       const Matrix3d Jt = J + turned(J, th);
-      return nu.dot(Jt * alpha) + nu.dot(thd.cross(J * omega) - J * thd.cross(omega)) + muW.dot(W.cross(Jt * omega)) -
+      return nu.dot(Jt * ac) + nu.dot(thd.cross(J * omega) - J * thd.cross(omega)) + x.dot(Jt * omega) -
              z.dot(Vector3d(J * omega).cross(omega));
     };
     if (dc && rt.coefficient >= 0) (*dc)[rt.coefficient] += value(rt.J);
     const Matrix3d& J = J_[j];
     const Matrix3d Jt = J + turned(J, th);
-    const Vector3d Jw = J * omega, Jnu = J * nu;
-    const Vector3d g_th = Vector3d(J * alpha).cross(nu) + Jnu.cross(alpha) + Jw.cross(y) + Vector3d(J * y).cross(omega);
+    const Vector3d Jw = J * omega, Jnu = J * nu, Jtnu = Jt * nu, h = Jt * omega;
+    const Vector3d g_th = Vector3d(J * ac).cross(nu) + Jnu.cross(ac) + Jw.cross(x) + Vector3d(J * x).cross(omega);
     const Vector3d g_thd = Jw.cross(nu) + Jnu.cross(omega);
-    const Vector3d g_w = J * nu.cross(thd) + thd.cross(Jnu) + Jt * y - J * omega.cross(z) - z.cross(Jw);
-    du.segment<3>(3) += Vector3d(Jt * omega).cross(muW) + g_w;
-    rt.th.add_transposed(g_thd + g_w, due);
-    rt.th.add_transposed(g_th, de);
+    const Vector3d g_w = J * nu.cross(thd) + thd.cross(Jnu) + Jt * x - J * omega.cross(z) - z.cross(Jw);
+    const Vector3d g_nu = Jt * ac + thd.cross(Jw) - J * thd.cross(omega);
+    const Vector3d g_pd = mB.cross(h) + qd.cross(Jtnu);
+    const Vector3d g_qd = mA.cross(h) + Jtnu.cross(pd) + g_w.cross(p);
+    const Vector3d g_p = mB.cross(g_nu) + Ba.cross(Jtnu) + qd.cross(g_w);
+    du.segment<3>(3) += h.cross(muW) + g_w;
+    const VectorXd ge = rt.th.v.transpose() * Vector3d(g_th + tilt_of(g_p));
+    const VectorXd gd = rt.th.v.transpose() * Vector3d(g_thd + g_w + tilt_of(g_pd)) + rt.half.transpose() * g_qd;
+    for (std::size_t k = 0; k < rt.th.cols.size(); ++k) {
+      de[rt.th.cols[k]] += ge[static_cast<Eigen::Index>(k)];
+      due[rt.th.cols[k]] += gd[static_cast<Eigen::Index>(k)];
+    }
   }
   de.noalias() += K_ * mue;
+  add_coupling_hessian(e, mue, de);
   due.noalias() += D_ * mue;
   du.tail(ne) += due;
   if (dc) {
+    add_coupling_coefficients(e, mue, *dc);
     for (const auto& t : g_->stiffness_)
       if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.e);
     for (const auto& t : g_->damping_)

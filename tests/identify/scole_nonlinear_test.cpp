@@ -6,6 +6,7 @@
 // rigid-body angle, where the linear model does not follow.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -150,10 +151,169 @@ TEST(ScoleNonlinear, AtRestItsLinearisationIsTheLinearModel) {
   }
 }
 
+namespace {
+// The section's rotation on the FE's own fields, exactly: the tangent t = t⊥ + a √(1 − |t⊥|²) with t⊥ = θ × a (θ the rotation rows: the slopes
+// turned by 90°, a = −ẑ the axis), the section's rotation R = A Z with A the shortest rotation
+// taking a to t and Z the twist θ_z about ẑ.
+Matrix3d section_rotation(const ScoleFE& fe, int ne, const VectorXd& e, double s) {
+  const Vector3d a(0, 0, -1);
+  const Vector3d th = fe.mast_rotation(s).leftCols(ne) * e;
+  const Vector3d tp = Vector3d(th[0], th[1], 0.0).cross(a);
+  const Vector3d t = tp + a * std::sqrt(1.0 - tp.squaredNorm());
+  const Vector3d axt = a.cross(t);
+  Matrix3d A = Matrix3d::Identity();
+  if (axt.norm() > 0.0) {
+    const Vector3d n = axt.normalized();
+    const double phi = std::atan2(axt.norm(), a.dot(t));
+    A += std::sin(phi) * skew(n) + (1.0 - std::cos(phi)) * skew(n) * skew(n);
+  }
+  return A * Eigen::AngleAxisd(th[2], Vector3d::UnitZ()).toRotationMatrix();
+}
+
+// The Kirchhoff rod's exact strain energy ½ ∫ κᵀ C κ ds of the mast's deflection e: κ = axial(Rᵀ R')
+// with R' by a fourth-order difference, integrated by 4 × 5 Gauss points per element.
+double exact_strain_energy(const ScoleFE& fe, int ne, const VectorXd& e) {
+  const auto& sc = fe.spec;
+  const double h = sc.length / fe.elements;
+  auto rotation = [&](double s) { return section_rotation(fe, ne, e, s); };
+  const double xg[5] = {0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640, 0.9061798459386640};
+  const double wg[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891, 0.2369268850561891};
+  const Vector3d C(sc.EI_roll, sc.EI_pitch, sc.GJ);
+  double W = 0.0;
+  for (int el = 0; el < fe.elements; ++el)
+    for (int sub = 0; sub < 4; ++sub)
+      for (int q = 0; q < 5; ++q) {
+        const double hs = h / 4, s = el * h + (sub + 0.5 + 0.5 * xg[q]) * hs, d = 1e-3 * hs;
+        const Matrix3d Rd = (rotation(s - 2 * d) - 8.0 * rotation(s - d) + 8.0 * rotation(s + d) - rotation(s + 2 * d)) / (12 * d);
+        const Matrix3d K = rotation(s).transpose() * Rd;
+        const Vector3d kappa(0.5 * (K(2, 1) - K(1, 2)), 0.5 * (K(0, 2) - K(2, 0)), 0.5 * (K(1, 0) - K(0, 1)));
+        W += 0.5 * wg[q] * hs * 0.5 * kappa.dot(C.cwiseProduct(kappa));
+      }
+  return W;
+}
+}  // namespace
+
+TEST(ScoleNonlinear, TheStrainEnergyIsTheRodsToFourthOrderInTheDeflection) {
+  // The model's strain energy ½ eᵀ K e + W₃ + W₄ against the exact energy of the inextensible,
+  // unshearable rod on the same fields, for a random deflection scaled by ε: their difference is
+  // of fifth order in ε (the quadratic energy alone: third order). Anisotropic stiffnesses, so
+  // that every term of W₃ and W₄ counts.
+  auto sc = builtin("paper-scole-1");
+  sc.scole.EI_pitch = 0.8 * sc.scole.EI_roll;
+  sc.scole.GJ = 0.6 * sc.scole.EI_roll;
+  sc.scole.actuator_stiffness = 0.0;  // the strokes' springs are not the rod's
+  const Model m = make_model(sc, 4);
+  const int ne = m.nl->elastic();
+  const VectorXd c = scole_coefficients(m.fe.spec);
+  const auto dyn = m.nl->at(c);
+  MatrixXd K = MatrixXd::Zero(m.fe.model.ndof, m.fe.model.ndof);
+  for (const auto& t : m.fe.model.stiffness) K += c[t.coefficient] * MatrixXd(t.matrix);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  VectorXd e0(ne);
+  for (int i = 0; i < ne; ++i) e0[i] = N(rng);
+  // Scaled so that the largest slope or twist is 1 (a field's value at a node is the largest on a
+  // cubic only roughly; the scale ε below is about the largest rotation in radians).
+  e0 /= e0.cwiseAbs().maxCoeff();
+  double prev_full = 0, prev_quad = 0;
+  for (double eps : {0.16, 0.08, 0.04}) {
+    const VectorXd e = eps * e0;
+    VectorXd y = VectorXd::Zero(m.nl->state_size());
+    y.segment(6, ne) = e;
+    const double exact = exact_strain_energy(m.fe, ne, e);
+    const double full = std::abs(dyn.energy(y.data()) - exact) / exact;
+    const double quad = std::abs(0.5 * e.dot(K.topLeftCorner(ne, ne) * e) - exact) / exact;
+    std::printf("  eps %.2f  exact %.6e  relative difference: model %.3e, quadratic energy alone %.3e", eps, exact, full, quad);
+    if (prev_full > 0)
+      std::printf("  (orders %.2f, %.2f)", std::log2(prev_full / full) + 2.0, std::log2(prev_quad / quad) + 2.0);
+    std::printf("\n");
+    if (prev_full > 0) {
+      EXPECT_GT(std::log2(prev_full / full) + 2.0, 4.6);  // fifth order (+2: relative to the quadratic energy)
+      EXPECT_LT(std::log2(prev_quad / quad) + 2.0, 3.4);  // the check sees what the higher terms add
+    }
+    prev_full = full;
+    prev_quad = quad;
+  }
+}
+
+TEST(ScoleNonlinear, TheReflectorsKineticEnergyIsTheTurningBodysToThirdOrder) {
+  // The reflector's rotational kinetic energy, ½ ωᵀ J(θ) ω with ω = Θ(e) ė (its angular velocity
+  // relative to the resting shuttle to second order), against ½ ωᵀ R J Rᵀ ω with ω = axial(Ṙ Rᵀ)
+  // of the exact section rotation at the mast's end, for e and ė scaled by ε: the difference is of
+  // fourth order (J(θ) is first order); without the angular velocity's second-order part it would
+  // be of third. Every other mass is made negligible, the stiffnesses zero. A general inertia: for
+  // a flat reflector (I_zz = I_xx + I_yy about a symmetric axis) the angular velocity's
+  // second-order part drops out of this energy at rest (not with the slew's rate).
+  auto sc = builtin("paper-scole-1");
+  sc.scole.actuator_mass = 1e-9;
+  sc.scole.reflector.Iyy = 3500;
+  sc.scole.reflector.Izz = 6500;
+  sc.scole.reflector.Ixy = 300;
+  sc.scole.reflector.Iyz = -200;
+  const Model m = make_model(sc, 4);
+  const int ne = m.nl->elastic();
+  VectorXd c = scole_coefficients(m.fe.spec);
+  for (int k : {ScoleFE::kRhoA, ScoleFE::kRhoIPsi, ScoleFE::kMReflector}) c[k] *= 1e-12;
+  for (int k : {ScoleFE::kEIRoll, ScoleFE::kEIPitch, ScoleFE::kGJ, ScoleFE::kKActuator}) c[k] = 0.0;
+  const auto dyn = m.nl->at(c);
+  const auto& I = sc.scole.reflector;
+  Matrix3d J;
+  J << I.Ixx, I.Ixy, I.Ixz, I.Ixy, I.Iyy, I.Iyz, I.Ixz, I.Iyz, I.Izz;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> N(0.0, 1.0);
+  VectorXd e0(ne), v0(ne);
+  for (int i = 0; i < ne; ++i) {
+    e0[i] = N(rng);
+    v0[i] = N(rng);
+  }
+  e0 /= e0.cwiseAbs().maxCoeff();
+  v0 /= v0.cwiseAbs().maxCoeff();
+  const double L = sc.scole.length;
+  // The model's and the exact energy at (σe, σė), σ = ±1 and the scale ε.
+  auto energies = [&](double eps) {
+    std::array<double, 4> out{};  // model(+), exact(+), model(−), exact(−)
+    for (int k = 0; k < 2; ++k) {
+      const double sgn = k == 0 ? 1.0 : -1.0;
+      const VectorXd e = sgn * eps * e0, ed = sgn * eps * v0;
+      VectorXd y = VectorXd::Zero(m.nl->state_size());
+      y.segment(6, ne) = e;
+      y.tail(ne) = ed;
+      const double d = 1e-4;
+      auto R_at = [&](double t) { return section_rotation(m.fe, ne, VectorXd(e + t * ed), L); };
+      const Matrix3d R = R_at(0.0);
+      const Matrix3d Rdot = (R_at(-2 * d) - 8.0 * R_at(-d) + 8.0 * R_at(d) - R_at(2 * d)) / (12 * d);
+      const Matrix3d W = Rdot * R.transpose();
+      const Vector3d w(0.5 * (W(2, 1) - W(1, 2)), 0.5 * (W(0, 2) - W(2, 0)), 0.5 * (W(1, 0) - W(0, 1)));
+      out[static_cast<std::size_t>(2 * k)] = dyn.energy(y.data());
+      out[static_cast<std::size_t>(2 * k + 1)] = 0.5 * w.dot(R * J * R.transpose() * w);
+    }
+    return out;
+  };
+  // The whole difference (fourth order) and the difference of the parts odd in ε (the cubic terms
+  // and beyond: fifth order when the cubic terms agree, third when they do not).
+  double prev = 0, prev_odd = 0;
+  for (double eps : {0.08, 0.04, 0.02}) {
+    const auto E = energies(eps);
+    const double diff = std::abs(E[0] - E[1]) / E[1];
+    const double odd = std::abs((E[0] - E[2]) - (E[1] - E[3])) / (2 * E[1]);
+    std::printf("  eps %.2f  exact %.6e  relative difference %.3e, of the odd parts %.3e", eps, E[1], diff, odd);
+    if (prev > 0) std::printf("  (orders %.2f, %.2f)", std::log2(prev / diff) + 2.0, std::log2(prev_odd / odd) + 2.0);
+    std::printf("\n");
+    if (prev > 0) {
+      EXPECT_GT(std::log2(prev / diff) + 2.0, 3.6);
+      EXPECT_GT(std::log2(prev_odd / odd) + 2.0, 4.5);
+    }
+    prev = diff;
+    prev_odd = odd;
+  }
+}
+
 TEST(ScoleNonlinear, UndampedFreeMotionConservesEnergyAndMomenta) {
   // Spinning about all three axes (turning through about a radian) while the mast vibrates; no
   // damping, no inputs, free proof masses.
   auto sc = builtin("paper-scole-1");
+  sc.scole.EI_pitch = 0.85 * sc.scole.EI_roll;  // every term of the cubic strain energy
+  sc.scole.GJ = 0.75 * sc.scole.EI_roll;
   sc.scole.zeta = 0.0;
   sc.scole.actuator_damping = 0.0;
   sc.inputs.clear();
@@ -265,10 +425,11 @@ TEST(ScoleNonlinear, SlewReachesTheRigidBodyAngleWhereTheLinearModelDeparts) {
 
 namespace {
 // Every input kind and every sensor kind, on a general configuration (root off the CM, products
-// of inertia, actuator springs and dampers, damping).
+// of inertia, actuator springs and dampers, damping, EI_roll ≠ EI_pitch ≠ GJ: every term of the
+// cubic strain energy).
 const char* const kEveryKind = R"(name: nonlinear-every-kind
 structure: scole
-scole: {mast_root: [1.5, -2.0, 3.0], zeta: 0.01, actuator_stiffness: 30, actuator_damping: 2,
+scole: {mast_root: [1.5, -2.0, 3.0], zeta: 0.01, actuator_stiffness: 30, actuator_damping: 2, EI_pitch: 3.4e7, GJ: 3.0e7,
         shuttle: {Ixy: 1200, Ixz: -3000}, reflector: {Ixy: 150, Iyz: 40}}
 inputs:
   - {name: F_sx, at: shuttle, kind: force, direction: x, signal: {type: haversine, amplitude: 500, t0: 0, width: 0.4}}
@@ -291,7 +452,7 @@ sensors:
 simulation: {duration: 2, sample_interval: 0.01, seed: 1}
 identification:
   parameterization: physical
-  estimate: [EI, rho_A]
+  estimate: [EI_roll, EI_pitch, GJ, rho_A]
   elements: 4
 )";
 

@@ -18,20 +18,26 @@
 //              Two points are quadratic in e (struct Quadratic): a proof mass, whose slider plane
 //              turns with the section, r = p + N e + Θ(s_k) e × (stroke), and the reflector's CM,
 //              which turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back by
-//              the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds. For them N_i becomes N_i(e) = ∂r_i/∂e
+//              the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds.
+//              The end's rotation is exp[α] exp[ψ ẑ] to second order (struct Coupling), so the arm
+//              also moves by ½ (ẑ·θ)(r·θ) ẑ. For them N_i becomes N_i(e) = ∂r_i/∂e
 //              and γ_i gains the convective term bil(ė, ė) (d²r/dt² = N(e) ë + bil(ė, ė)); M_ee then
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
 //              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
 // Rotors       inertia J_j turned by the rotor's elastic rotation θ = Θ_j e to first order,
-//              J(θ) = J_j + [θ]× J_j − J_j [θ]×, ω_j = Ω + Θ_j ė = L_j u, L_j = [0, I, Θ_j] (Θ_j the
-//              linear model's rotation rows); kinetic energy T = ½ ω_jᵀ J(θ) ω_j, whose generalized
-//              inertia force (Boltzmann–Hamel) is L_jᵀ (J(θ) ω̇ + J̇ ω) + [0; Ω × J(θ) ω; −Θᵀ ∂T/∂θ],
+//              J(θ) = J_j + [θ]× J_j − J_j [θ]×, ω_j = Ω + Θ_j(e) ė = L_j(e) u, L_j = [0, I, Θ_j(e)]
+//              (Θ_j the linear model's rotation rows, Θ_j(e) its second-order angular velocity on
+//              the mast, struct Rotor); kinetic energy T = ½ ω_jᵀ J(θ) ω_j, whose generalized
+//              inertia force (Boltzmann–Hamel on Ω, Lagrange on e) is L_jᵀ (J(θ) ω̇ + J̇ ω) +
+//              [0; Ω × J(θ) ω; Θ̇(e)ᵀ h − (∂ω/∂e)ᵀ h − Θᵀ ∂T/∂θ], h = J(θ) ω,
 //              J̇ ω = θ̇ × J ω − J (θ̇ × ω), ∂T/∂θ = J ω × ω: the gyroscopic coupling of the slew's
 //              rate with an anisotropic rotor's elastic rotation (the reflector's I_zz = 2 I_xx).
 //              The shuttle (no elastic rotation), the reflector about its CM, and the section's
 //              ρI_ψ (three Gauss points per element). Energy and momenta are conserved exactly.
-// Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e] = Q(t, e),
+// Strain       the linear model's ½ eᵀ K e and the mast's W₃ + W₄ (struct Coupling): the
+//              Kirchhoff rod's energy to fourth order in the deflection.
+// Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e + ∇W(e)] = Q(t, e),
 //              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J(θ_j) L_j,   b = Σ m_i L_iᵀ γ_i + the rotors' terms,
 //              K, D the linear model's elastic blocks (they see only the deformation relative
 //              to S), every term affine in the coefficients c (scole_model.h), so ∂/∂c_k of the
@@ -125,12 +131,20 @@ public:
     void rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
                     Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
     VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
+    MatrixXd rotor_block(std::size_t j, const VectorXd& e) const;
     template <class Add>
     void for_turned_rotors(const VectorXd& e, Add&& add) const;
     template <class SolveC>
     VectorXd schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
                          const VectorXd& r) const;
     MatrixXd K_, D_;                      // elastic blocks
+    // The strain energy beyond the quadratic (struct Coupling): its coefficients.
+    double k_roll_ = 0.0, k_pitch_ = 0.0, k_twist_ = 0.0;
+    double coupling_energy(const VectorXd& e) const;
+    void add_coupling_force(const VectorXd& e, VectorXd& out) const;                      // out += ∇W(e)
+    void add_coupling_hessian(const VectorXd& e, const VectorXd& x, VectorXd& out) const;  // out += ∇²W(e) x
+    // ∂/∂c of μᵀ ∇W(e), added to dc (W = W₃ + W₄).
+    void add_coupling_coefficients(const VectorXd& e, const VectorXd& mu, VectorXd& dc) const;
     std::vector<double> input_scale_;     // γ_i per input (1 without a coefficient)
     double constants_ = 1.0;
   };
@@ -173,6 +187,25 @@ private:
     Eigen::Vector3d bil(const VectorXd& x, const VectorXd& y) const;
     void bil_t(const VectorXd& y, const Eigen::Vector3d& w, VectorXd& out) const;  // out += ∂/∂x (wᵀ bil(x, y))
   };
+  // The strain energy of the mast beyond the linear model's quadratic (docs/theory.md §3.8). With the
+  // section's rotation R = exp[α] exp[ψ a] (α the tilt the slopes give, ⊥ a; ψ the twist about the
+  // mast's axis a) and θ = Θ e the linear rotation rows (θ_x, θ_y the slopes turned by 90°, exactly;
+  // θ_z = ψ along ẑ), the tilt's rotation vector is α = θ asin|θ|/|θ| and the body-frame curvature
+  // κ = Zᵀ(α' − ½ α × α' + ⅙ α × (α × α')) + ψ' a is, to third order,
+  //   κ⊥ = θ' − ψ a × θ' + ½ θ (θ·θ') − ½ ψ² θ',   κ_a = ψ' − ½ a·(θ × θ'),
+  // so that ½ ∫ κᵀ C κ ds (C = diag(EI_roll, EI_pitch, GJ)) adds to the quadratic energy
+  //   W₃ = ∫ [ −½ GJ θ_z' (θ_x θ_y' − θ_y θ_x') + (EI_roll − EI_pitch) θ_z θ_x' θ_y' ] ds,
+  //   W₄ = ½ ∫ [ (EI_roll θ_x θ_x' + EI_pitch θ_y θ_y')(θ·θ') + (EI_roll − EI_pitch) θ_z² (θ_y'² − θ_x'²)
+  //              + ¼ GJ (θ_x θ_y' − θ_y θ_x')² ] ds
+  // (every term even in the orientation of a): the twist a bend in two planes carries, the bending
+  // stiffness turning with a twisted section, and the curvature's own nonlinearity (for isotropic
+  // bending ½ EI (u'·u'')², from |t'|² = |u''|² + (u'·u'')²/(1 − |u'|²)). Per Gauss point (four per
+  // element: exact for the Hermite fields) the six rows (θ_x, θ_y, θ_z, θ_x', θ_y', θ_z') on the columns they touch.
+  struct Coupling {
+    std::vector<int> cols;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> rows;
+    double weight = 0;
+  };
   struct MassPoint {
     Eigen::Vector3d p;
     MatrixXd N;        // 3 × ne
@@ -181,11 +214,18 @@ private:
     Rows3 n;           // N, compact
     Quadratic quad;    // active for a point quadratic in e (N is then its linear part)
   };
+  // A rotor on the mast (a section or the reflector on its end) turns with the section's rotation
+  // R = exp[α] exp[ψ ẑ] (struct Coupling), whose angular velocity relative to S is, to second order,
+  //   ω_rel = Θ ė + p × (B ė),   p = α = P⊥ Θ e,   B = (½ P⊥ + P_z) Θ
+  // (½ α × α̇ + ψ̇ α × ẑ): ω = Ω + Θ(e) ė with Θ(e) = Θ + [p]× B. The shuttle's rotor has no columns.
   struct Rotor {
     Eigen::Matrix3d J;
     MatrixXd Theta;    // 3 × ne
     int coefficient = -1;
     Rows3 th;          // Θ, compact
+    Eigen::Matrix<double, 3, Eigen::Dynamic> half;  // B on th.cols
+    Eigen::Vector3d tilt(const VectorXd& x) const;  // P⊥ Θ x
+    Eigen::Matrix<double, 3, Eigen::Dynamic> jacobian(const VectorXd& e) const;  // Θ(e) on th.cols
   };
   struct Input {
     VectorXd q0;         // Gᵀ b at e = 0 (speeds())
@@ -211,6 +251,7 @@ private:
   int ne_ = 0, ncoef_ = 0;
   std::vector<MassPoint> points_;
   std::vector<Rotor> rotors_;
+  std::vector<Coupling> coupling_;
   std::vector<OperatorTerm> stiffness_, damping_;  // e-blocks
   std::vector<Input> inputs_;
   std::vector<Sensor> sensors_;
