@@ -542,8 +542,12 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
     if (rt.th.cols.empty()) continue;
     const Matrix3d dJ = turned(J_[j], rt.th.times(e));
     OO += dJ;
-    // J(θ) Θ(e) − J Θ (the constant part is in Mconst_)
-    add_left_compact(rt.th.cols, Matrix3d::Identity(), (J_[j] + dJ) * rt.jacobian(e) - J_[j] * rt.th.v, Oe);
+    // J(θ) Θ(e) − J Θ = ΔJ Θ + J(θ) [p]× B (the constant part is in Mconst_)
+    const Matrix3d X = dJ, Y = (J_[j] + dJ) * skew(rt.tilt(e));
+    for (std::size_t k = 0; k < rt.th.cols.size(); ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      Oe.col(rt.th.cols[k]) += X * rt.th.v.col(kk) + Y * rt.half.col(kk);
+    }
   }
   A.block<3, 3>(0, 3) += VO;
   A.block<3, 3>(3, 0) += VO.transpose();
