@@ -190,12 +190,13 @@ private:
   // The strain energy of the mast beyond the linear model's quadratic (docs/theory.md §3.8). With the
   // section's rotation R = exp[α] exp[ψ a] (α the tilt the slopes give, ⊥ a; ψ the twist about the
   // mast's axis a) and θ = Θ e the linear rotation rows (θ_x, θ_y the slopes turned by 90°, exactly;
-  // θ_z = ψ along ẑ), the tilt's rotation vector is α = θ asin|θ|/|θ| and the body-frame curvature
+  // θ_z = ψ along ẑ; θ⊥ = (θ_x, θ_y, 0)), the tilt's rotation vector is α = θ⊥ asin|θ⊥|/|θ⊥| and the
+  // body-frame curvature
   // κ = Zᵀ(α' − ½ α × α' + ⅙ α × (α × α')) + ψ' a is, to third order,
-  //   κ⊥ = θ' − ψ a × θ' + ½ θ (θ·θ') − ½ ψ² θ',   κ_a = ψ' − ½ a·(θ × θ'),
+  //   κ⊥ = θ⊥' − ψ a × θ⊥' + ½ θ⊥ (θ⊥·θ⊥') − ½ ψ² θ⊥',   κ_a = ψ' − ½ a·(θ⊥ × θ⊥'),
   // so that ½ ∫ κᵀ C κ ds (C = diag(EI_roll, EI_pitch, GJ)) adds to the quadratic energy
   //   W₃ = ∫ [ −½ GJ θ_z' (θ_x θ_y' − θ_y θ_x') + (EI_roll − EI_pitch) θ_z θ_x' θ_y' ] ds,
-  //   W₄ = ½ ∫ [ (EI_roll θ_x θ_x' + EI_pitch θ_y θ_y')(θ·θ') + (EI_roll − EI_pitch) θ_z² (θ_y'² − θ_x'²)
+  //   W₄ = ½ ∫ [ (EI_roll θ_x θ_x' + EI_pitch θ_y θ_y')(θ⊥·θ⊥') + (EI_roll − EI_pitch) θ_z² (θ_y'² − θ_x'²)
   //              + ¼ GJ (θ_x θ_y' − θ_y θ_x')² ] ds
   // (every term even in the orientation of a): the twist a bend in two planes carries, the bending
   // stiffness turning with a twisted section, and the curvature's own nonlinearity (for isotropic
