@@ -175,6 +175,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
                    list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
                    list(c.unused).c_str());
+      for (const auto& st : c.stepped_inputs)
+        std::fprintf(stderr,
+                     "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g): "
+                     "piecewise linear between samples, each jump moves by up to half a sample (%g s)%s\n",
+                     st.name.c_str(), st.jump, st.at, 0.5 * st.sample,
+                     st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
     }
     const identify::RunResult r = identify::run_identification(*problem, ro);
     identify::write_outputs(run_dir, *problem, r);

@@ -113,8 +113,11 @@ truth: {segments: 40, large_motion: true}
 description: "Paper SCOLE Case I on the 20 deg roll slew of scole-slew: the identifier's nonlinear model"
 structure: scole
 scole: {actuator_stroke: 100}
+# The commanded bang-bang moment is known: the model is driven by it, not by the data's sampled
+# column (piecewise linear between samples, each switch would move by half a sample, 5 ms: +0.6 %
+# on q1 and q2 from the ringing's phase; docs/theory.md §11.3).
 inputs:
-  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16817, t0: 0, width: 10}}
+  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: bangbang, amplitude: 16817, t0: 0, width: 10}, signal_from: scenario}
 )") + kCaseOneSensors + kCaseOneIdentification + R"(  # Finite shuttle rotation, the mast deflecting in the shuttle's rotating frame (docs/theory.md §3.8).
   model: nonlinear
 truth: {segments: 40, large_motion: true}

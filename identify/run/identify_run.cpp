@@ -712,7 +712,15 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     out["data_columns"] = {{"sensors", p.columns.sensors},
                            {"inputs_from_data", p.columns.inputs_from_data},
                            {"inputs_from_scenario", p.columns.inputs_from_scenario},
-                           {"unused", p.columns.unused}};
+                           {"unused", p.columns.unused},
+                           {"stepped_inputs", [&] {
+                              nlohmann::json a = nlohmann::json::array();
+                              for (const auto& st : p.columns.stepped_inputs)
+                                a.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at},
+                                             {"switch_shift_up_to", 0.5 * st.sample},
+                                             {"scenario_gives_signal", st.scenario_signal}});
+                              return a;
+                            }()}};
   return out;
 }
 

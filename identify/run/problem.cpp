@@ -412,9 +412,15 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
         throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' (" + field +
                          ".signal_from is data, in " + sc.source + ")");
       if (in.signal_from != "scenario" && col >= 0) {
-        p->signals[i] = io::Signal::table(tab.t, tab.columns[static_cast<std::size_t>(col)]);
+        const auto& f = tab.columns[static_cast<std::size_t>(col)];
+        p->signals[i] = io::Signal::table(tab.t, f);
         used[static_cast<std::size_t>(col)] = true;
         p->columns.inputs_from_data.push_back(in.name);
+        const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
+        ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
+        for (std::size_t k = 1; k < f.size(); ++k)
+          if (std::abs(f[k] - f[k - 1]) > st.jump) st = {in.name, std::abs(f[k] - f[k - 1]), tab.t[k], tab.t[k] - tab.t[k - 1], st.scenario_signal};
+        if (*hi > *lo && st.jump > 0.25 * (*hi - *lo)) p->columns.stepped_inputs.push_back(st);
       } else {
         if (in.signal.terms().empty())
           throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' and " + field +

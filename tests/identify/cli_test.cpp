@@ -698,6 +698,34 @@ TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
   const auto j2 = read_json_file(out2 / "identify.json");
   EXPECT_EQ(j2["data_columns"]["unused"], nlohmann::json::array({"spare"}));
   EXPECT_EQ(j2["data_columns"]["inputs_from_data"], nlohmann::json::array({"P"}));
+  EXPECT_TRUE(j2["data_columns"]["stepped_inputs"].empty());
+  EXPECT_EQ(r2.err.find("jumps by"), std::string::npos) << r2.err;
+  // 1b. An input column with a step inside the record: piecewise linear between samples, the step
+  // is spread over a sample and may move by half of one; the run says so (stderr, identify.json).
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "t,P,w_tip\n";
+    const std::size_t mid = t.size() / 2;
+    for (std::size_t i = 0; i < t.size(); ++i) os << t[i] << "," << (i < mid ? 0 : 10) << "," << w[i] << "\n";
+    fs::create_directories(dir / "stepped");
+    write_file(dir / "stepped" / "m.csv", os.str());
+    const fs::path out = dir / "run-stepped";
+    const Result r = run({"--scenario", (dir / "good.yaml").string(), "--data", (dir / "stepped" / "m.csv").string(), "--out",
+                          out.string(), "-q", "--max-iterations", "0", "--no-std"},
+                         dir);
+    ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+    EXPECT_NE(r.err.find("input 'P' from the data jumps by 10"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("signal_from: scenario"), std::string::npos) << r.err;
+    const auto j = read_json_file(out / "identify.json");
+    ASSERT_EQ(j["data_columns"]["stepped_inputs"].size(), 1u);
+    const auto& st = j["data_columns"]["stepped_inputs"][0];
+    EXPECT_EQ(st["name"], "P");
+    EXPECT_DOUBLE_EQ(st["largest_jump"].get<double>(), 10.0);
+    EXPECT_DOUBLE_EQ(st["at"].get<double>(), t[mid]);
+    EXPECT_NEAR(st["switch_shift_up_to"].get<double>(), 0.5 * (t[mid] - t[mid - 1]), 1e-12);
+    EXPECT_TRUE(st["scenario_gives_signal"].get<bool>());
+  }
   // 2. An input declared to come from the data, absent from it: refused.
   write_file(dir / "from_data.yaml", good_with("location: 10, signal:", "location: 10, signal_from: data, signal:"));
   {

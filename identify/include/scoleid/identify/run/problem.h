@@ -51,6 +51,16 @@ struct ColumnUse {
   std::vector<std::string> inputs_from_data;      // inputs driven by their column
   std::vector<std::string> inputs_from_scenario;  // inputs driven by the scenario's signal
   std::vector<std::string> unused;                // columns that matched nothing
+  // An input driven by its column that jumps by more than a quarter of its range within one sample:
+  // between samples the column is piecewise linear, so each jump (a step, a bang-bang switch) is
+  // spread over a sample and its centre moved by up to half a sample, which a ringing structure's
+  // phase feels (docs/theory.md §11.3).
+  struct SteppedInput {
+    std::string name;
+    double jump = 0, at = 0, sample = 0;  // largest jump, the time after it, the interval there
+    bool scenario_signal = false;         // the scenario also gives the signal (signal_from: scenario)
+  };
+  std::vector<SteppedInput> stepped_inputs;
 };
 
 struct Problem {
