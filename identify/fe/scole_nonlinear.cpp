@@ -57,11 +57,16 @@ void ScoleNonlinear::Rows3::add_left(const Matrix3d& A, MatrixXd& out) const {
   for (std::size_t k = 0; k < cols.size(); ++k) out.col(cols[k]) += A * v.col(static_cast<Eigen::Index>(k));
 }
 
-VectorXd ScoleNonlinear::Quadratic::gather(const VectorXd& x) const {
+namespace {
+// x on the columns cols, in their order.
+VectorXd gather_cols(const std::vector<int>& cols, const VectorXd& x) {
   VectorXd g(static_cast<Eigen::Index>(cols.size()));
   for (std::size_t k = 0; k < cols.size(); ++k) g[static_cast<Eigen::Index>(k)] = x[cols[k]];
   return g;
 }
+}  // namespace
+
+VectorXd ScoleNonlinear::Quadratic::gather(const VectorXd& x) const { return gather_cols(cols, x); }
 
 Eigen::Matrix<double, 3, Eigen::Dynamic> ScoleNonlinear::Quadratic::jacobian(const VectorXd& e) const {
   const VectorXd g = gather(e);
@@ -497,12 +502,6 @@ Matrix3d turned(const Matrix3d& J, const Vector3d& theta) {
   return T * J - J * T;
 }
 
-VectorXd rt_gather(const std::vector<int>& cols, const VectorXd& x) {
-  VectorXd g(static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t k = 0; k < cols.size(); ++k) g[static_cast<Eigen::Index>(k)] = x[cols[k]];
-  return g;
-}
-
 // P⊥ v: Aᵀ w = Θᵀ P⊥ w (the tilt's rows are Θ's first two).
 Vector3d tilt_of(const Vector3d& v) { return {v[0], v[1], 0.0}; }
 
@@ -733,7 +732,7 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
       b.segment<3>(3) += W.cross(J * W);
       continue;
     }
-    const VectorXd edl = rt_gather(th.cols, ed);
+    const VectorXd edl = gather_cols(th.cols, ed);
     const Vector3d thd = th.v * edl, pd = Vector3d(thd[0], thd[1], 0.0), qd = rt.half * edl;
     const Vector3d omega = W + thd + rt.tilt(e).cross(qd);
     const Matrix3d Jt = J + turned(J, th.times(e));
@@ -939,8 +938,8 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
       du.segment<3>(3) += Vector3d(J * W).cross(muW) + J * yv;
       continue;
     }
-    const VectorXd el = rt_gather(rt.th.cols, e), edl = rt_gather(rt.th.cols, edot), mul = rt_gather(rt.th.cols, mue),
-                   ael = rt_gather(rt.th.cols, ae);
+    const VectorXd el = gather_cols(rt.th.cols, e), edl = gather_cols(rt.th.cols, edot), mul = gather_cols(rt.th.cols, mue),
+                   ael = gather_cols(rt.th.cols, ae);
     const Vector3d th = rt.th.v * el, thd = rt.th.v * edl, p = tilt_of(th), pd = tilt_of(thd), qd = rt.half * edl;
     const Vector3d omega = W + thd + p.cross(qd);
     const Vector3d z = rt.th.v * mul, mA = tilt_of(z), mB = rt.half * mul, nu = muW + z + p.cross(mB);

@@ -419,7 +419,11 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
         const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
         ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
         for (std::size_t k = 1; k < f.size(); ++k)
-          if (std::abs(f[k] - f[k - 1]) > st.jump) st = {in.name, std::abs(f[k] - f[k - 1]), tab.t[k], tab.t[k] - tab.t[k - 1], st.scenario_signal};
+          if (std::abs(f[k] - f[k - 1]) > st.jump) {
+            st.jump = std::abs(f[k] - f[k - 1]);
+            st.at = tab.t[k];
+            st.sample = tab.t[k] - tab.t[k - 1];
+          }
         if (*hi > *lo && st.jump > 0.25 * (*hi - *lo)) p->columns.stepped_inputs.push_back(st);
       } else {
         if (in.signal.terms().empty())
