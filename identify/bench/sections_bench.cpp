@@ -65,6 +65,8 @@ double g_smoothness = 0.0;
 long g_checkpoint = -1;
 // Seed of part 1's noise (the scenario's simulation.seed); < 0 = the scenario's own.
 long g_seed = -1;
+// Part 1's identifier step (identification.time_step, s); 0 = the automatic rule (§5.2).
+double g_time_step = 0.0;
 
 void apply_checkpoint(ObjectiveOptions& o, long L) {
   if (L < 0) return;
@@ -106,7 +108,7 @@ scoleid::io::Scenario part1_scenario(int N) {
   sc.identification.initial["EI"] = 30000.0;
   sc.identification.elements = 64;
   sc.identification.data_elements = 128;
-  sc.identification.time_step = 0.0;  // automatic: what is being measured
+  sc.identification.time_step = g_time_step;  // 0: automatic, what is being measured
   for (auto& sensor : sc.sensors) sensor.noise_std = g_noise;
   if (g_seed >= 0) sc.simulation.seed = static_cast<unsigned>(g_seed);
   sc.identification.smoothness = g_smoothness;
@@ -291,7 +293,8 @@ json run_child_args(const std::vector<std::string>& args, double timeout_s) {
 json run_child(int N, const std::string& method, bool compute_std, double timeout_s) {
   std::vector<std::string> args{"--case", std::to_string(N), "--method", method, "--noise", std::to_string(g_noise),
                                 "--smoothness-weight", std::to_string(g_smoothness),
-                                "--checkpoint", std::to_string(g_checkpoint), "--seed", std::to_string(g_seed)};
+                                "--checkpoint", std::to_string(g_checkpoint), "--seed", std::to_string(g_seed),
+                                "--time-step", std::to_string(g_time_step)};
   if (!compute_std) args.push_back("--no-std");
   json row = run_child_args(args, timeout_s);
   row["N"] = N;
@@ -603,7 +606,7 @@ std::vector<std::string> split(const std::string& s) {
 const char* kUsage =
     "usage: scole-sections-bench [--part 1|2|3] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
     "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
-    "                            [--checkpoint L]\n"
+    "                            [--checkpoint L] [--seed K] [--time-step H]\n"
     "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step), each (N, method) in a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
@@ -616,7 +619,9 @@ const char* kUsage =
     "  --json PATH writes the results as JSON (temp file, then renamed).\n"
     "  --noise SD gives every sensor of part 1 a stated noise std SD [m] (noisy synthetic data);\n"
     "  --smoothness discrepancy|BETA sets part 1's smoothness prior (docs/theory.md §7.8).\n"
-    "  --seed K seeds part 1's noise (default: the scenario's simulation.seed).\n";
+    "  --seed K seeds part 1's noise (default: the scenario's simulation.seed).\n"
+    "  --time-step H fixes part 1's identifier step to H seconds at every N (default: the automatic\n"
+    "  rule of docs/theory.md §5.2, which shortens the step as N grows).\n";
 
 }  // namespace
 
@@ -674,6 +679,9 @@ int main(int argc, char** argv) {
         if (g_checkpoint < -2) throw std::invalid_argument("--checkpoint must be >= 0 (or -1: the default; -2: set-up only)");
       } else if (a == "--seed") {
         g_seed = std::stol(value());
+      } else if (a == "--time-step") {
+        g_time_step = std::stod(value());
+        if (!(g_time_step >= 0)) throw std::invalid_argument("--time-step must be >= 0 (0: automatic)");
       } else if (a == "--curve-case") {  // hidden: one part-3 case, JSON line on stdout
         curve_n = std::stoi(value());
       } else if (a == "--method") {  // hidden, with --case

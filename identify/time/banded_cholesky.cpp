@@ -103,38 +103,59 @@ bool BandedCholesky::factorize() {
       }
     }
   }
+  inv_diag_.resize(static_cast<std::size_t>(n_));
+  for (int i = 0; i < n_; ++i) inv_diag_[static_cast<std::size_t>(i)] = 1.0 / L[offset(i, i)];
   return true;
 }
 
-void BandedCholesky::solve_in_place(double* x) const {
+void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
+
+void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld) const {
   // Both sweeps read L by rows, which are contiguous in storage: L y = r by dot products with
-  // row i, Lᵀ x = y by axpys with row i (column-oriented back substitution).
+  // row i, Lᵀ x = y by axpys with row i (column-oriented back substitution). Each row is applied
+  // to every column before the next row: one column is a chain of dependent operations (row i
+  // needs row i − 1), several columns are independent chains the processor overlaps. Every
+  // column sees the same operations in the same order, so a column's result does not depend on
+  // how many are solved together.
   const int w = b_ + 1;
   const double* L = data_.data();
+  const double* inv = inv_diag_.data();
+  auto col = [X, ld](int j) { return X + static_cast<std::ptrdiff_t>(j) * ld; };
   for (int i = 0; i < nb_; ++i) {
     const int k0 = std::max(0, i - b_);
     const double* Li = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
-    double s = x[i];
-    for (int k = k0; k < i; ++k) s -= *Li++ * x[k];
-    x[i] = s / *Li;
+    for (int j = 0; j < columns; ++j) {
+      double* x = col(j);
+      double s = x[i];
+      for (int k = k0; k < i; ++k) s -= Li[k - k0] * x[k];
+      x[i] = s * inv[i];
+    }
   }
   for (int i = nb_; i < n_; ++i) {
     const double* Li = L + offset(i, 0);
-    double s = x[i];
-    for (int k = 0; k < i; ++k) s -= Li[k] * x[k];
-    x[i] = s / Li[i];
+    for (int j = 0; j < columns; ++j) {
+      double* x = col(j);
+      double s = x[i];
+      for (int k = 0; k < i; ++k) s -= Li[k] * x[k];
+      x[i] = s * inv[i];
+    }
   }
   for (int i = n_ - 1; i >= nb_; --i) {
     const double* Li = L + offset(i, 0);
-    const double xi = (x[i] /= Li[i]);
-    for (int k = 0; k < i; ++k) x[k] -= Li[k] * xi;
+    for (int j = 0; j < columns; ++j) {
+      double* x = col(j);
+      const double xi = (x[i] *= inv[i]);
+      for (int k = 0; k < i; ++k) x[k] -= Li[k] * xi;
+    }
   }
   for (int i = nb_ - 1; i >= 0; --i) {
-    const double* Li = L + static_cast<std::size_t>(i) * w;
-    const double xi = (x[i] /= Li[b_]);
     const int k0 = std::max(0, i - b_);
-    const double* Lk = Li + (k0 - i + b_);
-    for (int k = k0; k < i; ++k) x[k] -= *Lk++ * xi;
+    const double* Lk = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
+    for (int j = 0; j < columns; ++j) {
+      double* x = col(j);
+      const double xi = (x[i] *= inv[i]);
+      for (int k = k0; k < i; ++k) x[k] -= Lk[k - k0] * xi;
+    }
   }
 }
 

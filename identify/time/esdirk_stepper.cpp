@@ -127,7 +127,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
       a.rightCols(P) = G.leftCols(P);
       a.rightCols(P).noalias() -= D_ * v.rightCols(P);
       a.rightCols(P).noalias() -= K_ * x.rightCols(P);
-      for (int j = 1; j < m; ++j) mass_.solve_in_place(a.col(j).data());
+      mass_.solve_in_place(a.col(1).data(), P, n);
       cnt.linear_solves += P;
     }
   };
@@ -189,7 +189,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
         r.rightCols(P) = G.leftCols(P);
         r.rightCols(P).noalias() -= D_ * vt.rightCols(P);
         r.rightCols(P).noalias() -= K_ * w.rightCols(P);
-        for (int j = 1; j < m; ++j) S.solve_in_place(r.col(j).data());
+        S.solve_in_place(r.col(1).data(), P, n);
         cnt.linear_solves += P;
         As[si].rightCols(P) = r.rightCols(P);
         Vs[si].rightCols(P) = vt.rightCols(P) + g * r.rightCols(P);

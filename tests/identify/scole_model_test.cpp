@@ -453,6 +453,18 @@ TEST(ScoleModel, NewtonMatrixBandwidthDoesNotGrowWithTheMesh) {
     c.solve_in_place(x.data());
     const VectorXd ref = MatrixXd(S).ldlt().solve(r);
     EXPECT_LT((x - ref).norm(), 1e-9 * ref.norm()) << ne << " elements";
+    // Several right-hand sides in one sweep (the sensitivities' stage solves): each column is bit
+    // for bit its one-column solve, whatever the number of columns.
+    const MatrixXd R = MatrixXd::Random(fe.model.ndof, 5);
+    MatrixXd X = R;
+    c.solve_in_place(X.data(), 5, X.rows());
+    const MatrixXd Xref = MatrixXd(S).ldlt().solve(R);
+    EXPECT_LT((X - Xref).norm(), 1e-9 * Xref.norm()) << ne << " elements, 5 columns";
+    for (int j = 0; j < 5; ++j) {
+      VectorXd xj = R.col(j);
+      c.solve_in_place(xj.data());
+      EXPECT_TRUE(xj == X.col(j)) << ne << " elements, column " << j;
+    }
   }
   EXPECT_EQ(b[0].band, b[1].band);
   EXPECT_EQ(b[1].band, b[2].band);

@@ -7,6 +7,7 @@
 // docs/theory.md §4.3). An arrowhead matrix has no fill outside band + border, so the cost is
 // O(n b² + n b k + n k²) to factor and O(n (b + k)) to solve: linear in the number of elements.
 #include <Eigen/Sparse>
+#include <cstddef>
 #include <vector>
 
 namespace scoleid::identify {
@@ -47,10 +48,14 @@ public:
   bool factorize();
   // Solves A x = r in place (x holds r on entry).
   void solve_in_place(double* x) const;
+  // Solves A X = R in place for `columns` columns stored column-major with leading dimension ld
+  // (X holds R on entry); each column's result is bit for bit that of the one-column solve.
+  void solve_in_place(double* X, int columns, std::ptrdiff_t ld) const;
 
 private:
   int n_ = 0, b_ = 0, nb_ = 0;  // nb_: rows in the band part (n − border)
   std::vector<double> data_;
+  std::vector<double> inv_diag_;  // 1 / L_ii, set by factorize (a product in the sweeps, not a division)
 };
 
 }  // namespace scoleid::identify
