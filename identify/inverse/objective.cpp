@@ -625,18 +625,33 @@ std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSol
 
 SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<Derivative>& d) const {
   const int n = model_.ndof;
+  // The nonzeros of ∂M, ∂D, ∂K as one list per derivative, column by column (the order of a
+  // sparse product): a sectional parameter touches a few elements, so the list is short where
+  // the sparse product would still visit every column.
+  struct Entry {
+    int row, col;
+    double value;
+    int which;  // 0: ∂M (on ü), 1: ∂D (on u̇), 2: ∂K (on u)
+  };
+  auto lists = std::make_shared<std::vector<std::vector<Entry>>>(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const SparseMatrix* mats[3] = {&d[i].dM, &d[i].dD, &d[i].dK};
+    for (int w = 0; w < 3; ++w)
+      for (int k = 0; k < mats[w]->outerSize(); ++k)
+        for (SparseMatrix::InnerIterator it(*mats[w], k); it; ++it)
+          if (it.value() != 0.0)
+            (*lists)[i].push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), it.value(), w});
+  }
   auto f = std::make_shared<std::vector<double>>(inputs_.size());
-  return [this, &d, n, f](double t, const double* x, const double* v, const double* a, double* Gp) {
-    const Eigen::Map<const VectorXd> X(x, n), V(v, n), A(a, n);
+  return [this, &d, n, f, lists](double t, const double* x, const double* v, const double* a, double* Gp) {
+    const double* on[3] = {a, v, x};
     for (std::size_t k = 0; k < inputs_.size(); ++k) (*f)[k] = inputs_[k](t);
     for (std::size_t i = 0; i < d.size(); ++i) {
-      Eigen::Map<VectorXd> Gi(Gp + i * static_cast<std::size_t>(n), n);
-      const Derivative& di = d[i];
-      Gi.noalias() -= di.dM * A;
-      Gi.noalias() -= di.dD * V;
-      Gi.noalias() -= di.dK * X;
+      double* Gi = Gp + i * static_cast<std::size_t>(n);
+      for (const Entry& e : (*lists)[i]) Gi[e.row] -= e.value * on[e.which][e.col];
+      Eigen::Map<VectorXd> Gm(Gi, n);
       for (std::size_t k = 0; k < f->size(); ++k)
-        if ((*f)[k] != 0.0) Gi += (*f)[k] * di.db[k];
+        if ((*f)[k] != 0.0) Gm += (*f)[k] * d[i].db[k];
     }
   };
 }
@@ -748,6 +763,12 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   Trajectory u(n);
   MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
   VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
+  // Without acceleration sensors the outputs are C x + C₁ v of every column, linear in the
+  // recorded points: the Hermite interpolation is done on the outputs of the two points (sensors ×
+  // columns) instead of on the states (DOFs × columns). Yx = C X + C₁ V, Yv = C V + C₁ A per point.
+  const bool output_space = !accelerations_;
+  const bool rate_rows = C1_.size() > 0;
+  MatrixXd Yx0(ns, m), Yv0(ns, m), Yx1(ns, m), Yv1(ns, m), Ys(ns, m);
   double t_prev = 0.0;
   bool have_prev = false;
   std::size_t next_data = 0;  // first data time not below t_prev
@@ -756,6 +777,14 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
     if (profile) u.push(pt.t, pt.x, pt.v, pt.a);
     const int cols = pt.columns;
     const Eigen::Map<const MatrixXd> X1(pt.x, n, cols), V1(pt.v, n, cols), A1(pt.a, n, cols);
+    if (output_space && cols == m) {
+      Yx1.noalias() = C_ * X1;
+      Yv1.noalias() = C_ * V1;
+      if (rate_rows) {
+        Yx1.noalias() += C1_ * V1;
+        Yv1.noalias() += C1_ * A1;
+      }
+    }
     const double a_end = std::max(t_prev, t0), b_end = std::min(pt.t, T_);
     if (have_prev && pt.t > t_prev && b_end > a_end) {
       if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
@@ -771,6 +800,13 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
           const double t = cuts[k] + kGx[gq] * hk, wt = kGw[gq] * hk;
           const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
           const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+          if (output_space) {
+            Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
+            data_.eval(t, z.data());
+            const VectorXd r = Ys.col(0) - z;
+            add_gauss_newton_point(wt, r, Ys.rightCols(P), Rv, J, gradient, H);
+            continue;
+          }
           Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
           Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
           x = Xs.col(0);
@@ -788,7 +824,12 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
       }
       quadrature += since(tq);
     }
-    if (cols == m) {
+    if (output_space) {
+      // This point's outputs are the next interval's left end (beyond the horizon, where the
+      // tangents have stopped, nothing more is integrated).
+      std::swap(Yx0, Yx1);
+      std::swap(Yv0, Yv1);
+    } else if (cols == m) {
       X0 = X1;
       V0 = V1;
       A0 = A1;

@@ -47,7 +47,7 @@ ButcherTable ButcherTable::arkode_dirk(int id) {
 
 EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
                              NewtonMatrix& newton, ButcherTable table)
-    : M_(M), D_(D), K_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
+    : M_(M), D_(D), K_(K), D_rows_(D), K_rows_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
   explicit_first_ = tab_.explicit_first_stage();
   stiffly_accurate_ = tab_.stiffly_accurate();
   for (int i = 0; i < tab_.stages; ++i)
@@ -118,15 +118,15 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
     forcing(tf, F.data());
     ++cnt.stage_forcings;
     a.col(0) = F;
-    a.col(0).noalias() -= D_ * v.col(0);
-    a.col(0).noalias() -= K_ * x.col(0);
+    a.col(0).noalias() -= D_rows_ * v.col(0);
+    a.col(0).noalias() -= K_rows_ * x.col(0);
     mass_.solve_in_place(a.col(0).data());
     ++cnt.linear_solves;
     if (m > 1) {
       tangent_forcing(tf, x.col(0).data(), v.col(0).data(), a.col(0).data());
       a.rightCols(P) = G.leftCols(P);
-      a.rightCols(P).noalias() -= D_ * v.rightCols(P);
-      a.rightCols(P).noalias() -= K_ * x.rightCols(P);
+      a.rightCols(P).noalias() -= D_rows_ * v.rightCols(P);
+      a.rightCols(P).noalias() -= K_rows_ * x.rightCols(P);
       mass_.solve_in_place(a.col(1).data(), P, n);
       cnt.linear_solves += P;
     }
@@ -177,8 +177,8 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
       forcing(ti, F.data());
       ++cnt.stage_forcings;
       r.col(0) = F;
-      r.col(0).noalias() -= D_ * vt.col(0);
-      r.col(0).noalias() -= K_ * w.col(0);
+      r.col(0).noalias() -= D_rows_ * vt.col(0);
+      r.col(0).noalias() -= K_rows_ * w.col(0);
       S.solve_in_place(r.col(0).data());
       ++cnt.linear_solves;
       As[si].col(0) = r.col(0);
@@ -187,8 +187,8 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
         X0 = w.col(0) + (g * g) * r.col(0);
         tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), As[si].col(0).data());
         r.rightCols(P) = G.leftCols(P);
-        r.rightCols(P).noalias() -= D_ * vt.rightCols(P);
-        r.rightCols(P).noalias() -= K_ * w.rightCols(P);
+        r.rightCols(P).noalias() -= D_rows_ * vt.rightCols(P);
+        r.rightCols(P).noalias() -= K_rows_ * w.rightCols(P);
         S.solve_in_place(r.col(1).data(), P, n);
         cnt.linear_solves += P;
         As[si].rightCols(P) = r.rightCols(P);

@@ -243,6 +243,40 @@ void check_rates(const char* yaml, const RateBounds& bound) {
 // beam 1.3e-4; 2.5e-7. The costate is the continuous gradient, so it differs from the discrete one
 //   by the time error, third order in h (RateSensorCostateConvergesWithTheStep); 2× margin.
 //   CVODES: both at rtol 1e-10, the difference is at the tolerance level; 4× margin.
+// Velocity and displacement sensors without accelerometers: the Gauss–Newton pass then
+// interpolates the outputs C x + C₁ v of the recorded points instead of the states (their
+// Hermite interpolants are linear in the points), which must leave g the exact derivative of the
+// discrete cost.
+TEST(Gradient, VelocitySensorsGaussNewtonIsTheGradientOfTheDiscreteCost) {
+  const char* yaml = R"(name: grad-velocity-beam
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
+inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
+sensors: [{name: v_tip, kind: velocity, location: 10}, {name: v_mid, kind: velocity, location: 6}, {name: w, location: 8}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
+)";
+  Case e = make_case(yaml, false);
+  const VectorXd q = e.p->params->initial();
+  VectorXd g_gn;
+  MatrixXd H;
+  e.obj->gauss_newton(q, g_gn, H);
+  VectorXd g_fd(q.size());
+  for (int i = 0; i < q.size(); ++i) {
+    auto D = [&](double eta) {
+      VectorXd qp = q, qm = q;
+      qp[i] *= std::exp(eta);
+      qm[i] *= std::exp(-eta);
+      return (e.obj->cost(qp) - e.obj->cost(qm)) / (2.0 * eta * q[i]);
+    };
+    g_fd[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
+  }
+  std::printf("  velocity sensors: Gauss-Newton vs FD %.2e\n", max_rel(g_gn, g_fd));
+  EXPECT_LT(max_rel(g_gn, g_fd), 1e-5);
+  // H is symmetric positive definite (three parameters the data see).
+  EXPECT_LT((H - H.transpose()).norm(), 1e-12 * H.norm());
+  EXPECT_GT(H.ldlt().vectorD().minCoeff(), 0.0);
+}
+
 TEST(Gradient, VelocityAndAccelerationSensorsBeam) { check_rates(kRatesBeam, {3e-4, 1e-6, true}); }
 // SCOLE 1.6e-3; 1.2e-6. The same time error, also third order (measured 1.6e-3, 1.7e-4, 4.0e-5,
 //   4.4e-6 as the step is halved); 2.5× margin. CVODES: its tolerance-level error, 4× margin.

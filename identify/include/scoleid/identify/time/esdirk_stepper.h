@@ -105,6 +105,9 @@ public:
 
 private:
   const SparseMatrix &M_, &D_, &K_;
+  // D and K by rows: their products with the stage vectors are then sums per row (a chain of
+  // independent multiply-adds) instead of column scatters, whose stores depend on each other.
+  Eigen::SparseMatrix<double, Eigen::RowMajor> D_rows_, K_rows_;
   const BandedCholesky& mass_;
   NewtonMatrix& newton_;
   ButcherTable tab_;
