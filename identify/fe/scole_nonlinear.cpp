@@ -107,6 +107,68 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> ScoleNonlinear::Rotor::jacobian(const V
 }
 
 namespace {
+Matrix3d first_turn0(const Matrix3d& J, const Vector3d& v) {
+  const Matrix3d VJ = skew(v) * J;
+  return VJ + VJ.transpose();
+}
+}  // namespace
+
+// A rotor's inertia turned by the section's rotation, J(θ) = R J Rᵀ to second order in θ = Θ e.
+// The section turns as R = exp[α]× exp[ψ a]× (tilt, then twist about the axis a = ẑ; §3.8), whose
+// rotation vector is φ = θ + ½ α × ψ a + O(θ³) (Baker–Campbell–Hausdorff), α = P⊥ θ, ψ a = P_z θ.
+// With T = [θ]× and J₁(v) = [v]× J − J [v]×:
+//   J(θ) = J + J₁(θ) + ½ (T² J + J T²) − T J T + J₁(½ α × ψ a) + O(θ³)      (symmetric)
+// — quadratic in θ. Its second-order part carries the centrifugal stiffness of a body turned in a
+// spinning frame: ½ Ωᵀ J(θ) Ω changes at second order in θ (a roll slew that turns the reflector
+// about pitch trades I_xx for I_zz), which a first-order J(θ) cannot give.
+// J_k = J₁(e_k); J_kl from the second-order terms (E_k = [e_k]×):
+// J_kl = ½ ((E_k E_l + E_l E_k) J + J (E_k E_l + E_l E_k)) − E_k J E_l − E_l J E_k
+//        + J₁(½ (P⊥ e_k × P_z e_l + P⊥ e_l × P_z e_k)).
+ScoleNonlinear::Turning::Turning(const Matrix3d& J) {
+  for (int k = 0; k < 3; ++k) {
+    const Vector3d ek = Vector3d::Unit(k);
+    first[static_cast<std::size_t>(k)] = first_turn0(J, ek);
+    for (int l = 0; l < 3; ++l) {
+      const Vector3d el = Vector3d::Unit(l);
+      const Matrix3d Ek = skew(ek), El = skew(el), S = Ek * El + El * Ek, EkJEl = Ek * J * El;
+      const Vector3d bch = 0.5 * (Vector3d(ek[0], ek[1], 0.0).cross(Vector3d(0.0, 0.0, el[2])) +
+                                  Vector3d(el[0], el[1], 0.0).cross(Vector3d(0.0, 0.0, ek[2])));
+      second[static_cast<std::size_t>(k)][static_cast<std::size_t>(l)] =
+          0.5 * (S * J + J * S) - EkJEl - EkJEl.transpose() + first_turn0(J, bch);
+    }
+  }
+}
+
+std::array<Matrix3d, 3> ScoleNonlinear::Turning::slopes(const Vector3d& theta) const {
+  std::array<Matrix3d, 3> out;
+  for (std::size_t k = 0; k < 3; ++k) {
+    out[k] = first[k];
+    for (std::size_t l = 0; l < 3; ++l) out[k] += theta[static_cast<Eigen::Index>(l)] * second[k][l];
+  }
+  return out;
+}
+
+Matrix3d ScoleNonlinear::Turning::change(const Vector3d& theta) const {
+  Matrix3d d = Matrix3d::Zero();
+  for (std::size_t k = 0; k < 3; ++k) {
+    Matrix3d row = first[k];
+    for (std::size_t l = 0; l < 3; ++l) row += 0.5 * theta[static_cast<Eigen::Index>(l)] * second[k][l];
+    d += theta[static_cast<Eigen::Index>(k)] * row;
+  }
+  return d;
+}
+
+Vector3d ScoleNonlinear::Turning::curvature(const Vector3d& u, const Vector3d& a, const Vector3d& b) const {
+  Vector3d g;
+  for (std::size_t k = 0; k < 3; ++k) {
+    Matrix3d Ck = Matrix3d::Zero();
+    for (std::size_t l = 0; l < 3; ++l) Ck += u[static_cast<Eigen::Index>(l)] * second[k][l];
+    g[static_cast<Eigen::Index>(k)] = a.dot(Ck * b);
+  }
+  return g;
+}
+
+namespace {
 // The columns any of the dense rows (or Q's rows) touch, and the rows restricted to them.
 void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Qfull, std::vector<int>& cols,
              std::vector<char>& local, std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>*> out, MatrixXd& Q) {
@@ -174,7 +236,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     for (int q = 0; q < 3; ++q) {
       const double s = (el + x3[q]) * h;
       rotors_.push_back({w3[q] * h * Vector3d(bend, bend, 1.0).asDiagonal().toDenseMatrix(), on_e(fe.mast_rotation(s)),
-                         ScoleFE::kRhoIPsi, {}, {}});
+                         ScoleFE::kRhoIPsi, {}, {}, {}});
     }
     // The strain energy's higher-order rows at four Gauss points (degree 7: W₄'s density has degree
     // 6 in s on an element). The rotation rows are polynomials of degree ≤ 2 in s there (Hermite
@@ -219,10 +281,10 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     refl.quad.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
     points_.push_back(std::move(refl));
   }
-  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}, {}});
+  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}, {}, {}});
   // Shuttle.
   points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}, {}});
-  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}, {}});
+  rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}, {}, {}});
   // Proof masses: their own lateral DOFs, axially with the mast.
   for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
     MatrixXd N = MatrixXd::Zero(3, ne_);
@@ -244,6 +306,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     r.th = Rows3::of(r.Theta);
     r.half = r.th.v;
     r.half.topRows<2>() *= 0.5;
+    r.turn = Turning(r.J);
   }
   for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
   for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
@@ -314,6 +377,7 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   for (const auto& r : rotors_) {
     const Matrix3d J = r.J * scale(r.coefficient);
     d.J_.push_back(J);
+    d.rotor_scale_.push_back(scale(r.coefficient));
     if (!r.th.cols.empty()) d.quadratic_ = true;  // its inertia turns with e
     d.Mconst_.block<3, 3>(3, 3) += J;
     d.Mconst_.block(3, 6, 3, ne_) += J * r.Theta;
@@ -495,13 +559,6 @@ std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> ScoleNonlinear::Dynamics::
 }
 
 namespace {
-// The first-order change of a rotor's inertia turned by its elastic rotation θ (J(θ) = R J Rᵀ,
-// R = I + [θ]×): ΔJ = [θ]× J − J [θ]× (symmetric).
-Matrix3d turned(const Matrix3d& J, const Vector3d& theta) {
-  const Matrix3d T = skew(theta);
-  return T * J - J * T;
-}
-
 // P⊥ v: Aᵀ w = Θᵀ P⊥ w (the tilt's rows are Θ's first two).
 Vector3d tilt_of(const Vector3d& v) { return {v[0], v[1], 0.0}; }
 
@@ -539,7 +596,7 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& rt = g_->rotors_[j];
     if (rt.th.cols.empty()) continue;
-    const Matrix3d dJ = turned(J_[j], rt.th.times(e));
+    const Matrix3d dJ = rotor_scale_[j] * rt.turn.change(rt.th.times(e));
     OO += dJ;
     // J(θ) Θ(e) − J Θ = ΔJ Θ + J(θ) [p]× B (the constant part is in Mconst_)
     const Matrix3d X = dJ, Y = (J_[j] + dJ) * skew(rt.tilt(e));
@@ -581,7 +638,7 @@ MatrixXd ScoleNonlinear::Dynamics::rotor_block(std::size_t j, const VectorXd& e)
   const auto& rt = g_->rotors_[j];
   const Matrix3d& J = J_[j];
   const auto Te = rt.jacobian(e);
-  return Te.transpose() * (J + turned(J, rt.th.times(e))) * Te - rt.th.v.transpose() * J * rt.th.v;
+  return Te.transpose() * (J + rotor_scale_[j] * rt.turn.change(rt.th.times(e))) * Te - rt.th.v.transpose() * J * rt.th.v;
 }
 
 // rotor_block on each turned rotor's columns (the e–e part of its turned inertia).
@@ -722,9 +779,9 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
   }
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     // ω = Ω + Θ(e) ė, h = J(θ) ω, ḣ = J(θ) ω̇ + J̇ ω with ω̇ = Ω̇ + Θ(e) ë + ṗ × q̇ (ṗ = P⊥ Θ ė,
-    // q̇ = B ė) and J̇ ω = θ̇ × J ω − J (θ̇ × ω). Ω row: the convective part of ḣ, plus Ω × h;
+    // q̇ = B ė) and J̇ ω = ∂J/∂θ[θ̇] ω. Ω row: the convective part of ḣ, plus Ω × h;
     // e row (Lagrange, T = ½ ωᵀ J(θ) ω): Θ(e)ᵀ (convective ḣ) + Bᵀ (h × ṗ) − Aᵀ (q̇ × h)
-    // − Θᵀ (J ω × ω), A = P⊥ Θ: the first two from d/dt of Θ(e)ᵀ, the third ∂ω/∂e, the last ∂J/∂θ.
+    // − Θᵀ ∂T/∂θ, A = P⊥ Θ: the first two from d/dt of Θ(e)ᵀ, the third ∂ω/∂e, the last ∂J/∂θ.
     const auto& rt = g_->rotors_[j];
     const auto& th = rt.th;
     const Matrix3d& J = J_[j];
@@ -735,12 +792,22 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     const VectorXd edl = gather_cols(th.cols, ed);
     const Vector3d thd = th.v * edl, pd = Vector3d(thd[0], thd[1], 0.0), qd = rt.half * edl;
     const Vector3d omega = W + thd + rt.tilt(e).cross(qd);
-    const Matrix3d Jt = J + turned(J, th.times(e));
-    const Vector3d Jw = J * omega, h = Jt * omega;
-    const Vector3d conv = Jt * pd.cross(qd) + thd.cross(Jw) - J * thd.cross(omega);
+    const Vector3d theta = th.times(e);
+    const double sc = rotor_scale_[j];
+    const Matrix3d Jt = J + sc * rt.turn.change(theta);
+    const auto Jk = rt.turn.slopes(theta);  // ∂J/∂θ_k / sc
+    const Vector3d h = Jt * omega;
+    // J̇ ω = Σ_k θ̇_k ∂J/∂θ_k ω; ∂T/∂θ_k = ½ ω · ∂J/∂θ_k ω.
+    Vector3d Jdw = Vector3d::Zero(), dT;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vector3d Jkw = Jk[k] * omega;
+      Jdw += thd[static_cast<Eigen::Index>(k)] * Jkw;
+      dT[static_cast<Eigen::Index>(k)] = 0.5 * sc * omega.dot(Jkw);
+    }
+    const Vector3d conv = Jt * pd.cross(qd) + sc * Jdw;
     b.segment<3>(3) += conv + W.cross(h);
     const VectorXd g = rt.jacobian(e).transpose() * conv + rt.half.transpose() * h.cross(pd) -
-                       th.v.transpose() * (tilt_of(qd.cross(h)) + Jw.cross(omega));
+                       th.v.transpose() * (tilt_of(qd.cross(h)) + dT);
     for (std::size_t k = 0; k < th.cols.size(); ++k) b[6 + th.cols[k]] += g[static_cast<Eigen::Index>(k)];
   }
   b.tail(ne).noalias() += D_ * ed + K_ * e;
@@ -919,14 +986,16 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     p.n.add_transposed(2.0 * m * w.cross(W), due);
   }
   // Per rotor (struct Rotor), with θ = Θ e, θ̇ = Θ ė, p = P⊥ θ, ṗ = P⊥ θ̇, q̇ = B ė,
-  // ω = Ω + θ̇ + p × q̇, J(θ) = J + ΔJ(θ) (symmetric), h = J(θ) ω, and from μ: z = Θ μ_e,
+  // ω = Ω + θ̇ + p × q̇, J(θ) = J + ΔJ(θ) (symmetric, second order: struct Turning), h = J(θ) ω, and from μ: z = Θ μ_e,
   // m_A = P⊥ z, m_B = B μ_e, ν = μ_Ω + z + p × m_B (= L(e) μ); α = a_Ω + Θ a_e + p × B a_e,
   // c = ṗ × q̇, x = μ_Ω × Ω + ṗ × m_B − m_A × q̇:
-  //   s_j = ν·J(θ)(α + c) + ν·(θ̇ × J ω − J(θ̇ × ω)) + x·J(θ) ω − z·(J ω × ω).
-  // With ∂/∂θ of a·J(θ) b = J b × a + J a × b, and g_ν, g_ω, … the partial gradients:
-  //   g_θ = J(α + c) × ν + J ν × (α + c) + J ω × x + J x × ω,   g_θ̇ = J ω × ν + J ν × ω,
-  //   g_ω = J(ν × θ̇) + θ̇ × J ν + J(θ) x − J(ω × z) − z × J ω,
-  //   g_ν = J(θ)(α + c) + θ̇ × J ω − J(θ̇ × ω),   g_ṗ = m_B × h + q̇ × J(θ) ν,
+  //   s_j = ν·J(θ)(α + c) + θ̇·G(ν, ω) + x·J(θ) ω − ½ z·G(ω, ω),
+  // G(a, b) = ∇_θ (a·J(θ) b) (so θ̇·G(ν, ω) = ν·J̇ ω and ½ G(ω, ω) = ∂T/∂θ), J'[d] = ∂J/∂θ along
+  // d, and C_u(a, b) = ∇_θ (u·G(a, b)) (J(θ) is quadratic in θ: C does not depend on θ). With
+  // g_ν, g_ω, … the partial gradients:
+  //   g_θ = G(ν, α + c) + G(x, ω) + C_θ̇(ν, ω) − ½ C_z(ω, ω),   g_θ̇ = G(ν, ω),
+  //   g_ω = J'[θ̇] ν + J(θ) x − J'[z] ω,
+  //   g_ν = J(θ)(α + c) + J'[θ̇] ω,   g_ṗ = m_B × h + q̇ × J(θ) ν,
   //   g_q̇ = m_A × h + J(θ) ν × ṗ + g_ω × p,     g_p = m_B × g_ν + B a_e × J(θ) ν + q̇ × g_ω;
   //   ∂/∂e = Θᵀ (g_θ + P⊥ g_p),  ∂/∂ė = Θᵀ (g_θ̇ + g_ω + P⊥ g_ṗ) + Bᵀ g_q̇,  ∂/∂Ω = h × μ_Ω + g_ω.
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
@@ -945,19 +1014,30 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     const Vector3d z = rt.th.v * mul, mA = tilt_of(z), mB = rt.half * mul, nu = muW + z + p.cross(mB);
     const Vector3d Ba = rt.half * ael, alpha = aW + rt.th.v * ael + p.cross(Ba), ac = alpha + pd.cross(qd);
     const Vector3d x = yv + pd.cross(mB) - mA.cross(qd);
-    auto value = [&](const Matrix3d& J) {
-      const Matrix3d Jt = J + turned(J, th);
-      return nu.dot(Jt * ac) + nu.dot(thd.cross(J * omega) - J * thd.cross(omega)) + x.dot(Jt * omega) -
-             z.dot(Vector3d(J * omega).cross(omega));
-    };
-    if (dc && rt.coefficient >= 0) (*dc)[rt.coefficient] += value(rt.J);
-    const Matrix3d& J = J_[j];
-    const Matrix3d Jt = J + turned(J, th);
-    const Vector3d Jw = J * omega, Jnu = J * nu, Jtnu = Jt * nu, h = Jt * omega;
-    const Vector3d g_th = Vector3d(J * ac).cross(nu) + Jnu.cross(ac) + Jw.cross(x) + Vector3d(J * x).cross(omega);
-    const Vector3d g_thd = Jw.cross(nu) + Jnu.cross(omega);
-    const Vector3d g_w = J * nu.cross(thd) + thd.cross(Jnu) + Jt * x - J * omega.cross(z) - z.cross(Jw);
-    const Vector3d g_nu = Jt * ac + thd.cross(Jw) - J * thd.cross(omega);
+    // Everything below is linear in J: with Ĵ(θ) = Rotor::J turned (unscaled) the value is s_j / scale.
+    const auto Jk = rt.turn.slopes(th);  // ∂Ĵ/∂θ_k
+    Matrix3d Jd = Matrix3d::Zero(), Jz = Matrix3d::Zero();  // ∂Ĵ/∂θ along θ̇ and along z
+    Vector3d G_nu_ac, G_x_w, G_nu_w, G_w_w;                // ∇_θ (a · Ĵ(θ) b)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      Jd += thd[kk] * Jk[k];
+      Jz += z[kk] * Jk[k];
+      const Vector3d Jkw = Jk[k] * omega, Jknu = Jk[k] * nu;
+      G_nu_ac[kk] = Jknu.dot(ac);
+      G_x_w[kk] = x.dot(Jkw);
+      G_nu_w[kk] = Jknu.dot(omega);
+      G_w_w[kk] = omega.dot(Jkw);
+    }
+    const Matrix3d Jhat = rt.J + rt.turn.change(th);
+    if (dc && rt.coefficient >= 0)
+      (*dc)[rt.coefficient] += nu.dot(Jhat * ac) + nu.dot(Jd * omega) + x.dot(Jhat * omega) - 0.5 * z.dot(G_w_w);
+    const double sc = rotor_scale_[j];
+    const Matrix3d Jt = sc * Jhat;
+    const Vector3d Jtnu = Jt * nu, h = Jt * omega;
+    const Vector3d g_th = sc * (G_nu_ac + G_x_w + rt.turn.curvature(thd, nu, omega) - 0.5 * rt.turn.curvature(z, omega, omega));
+    const Vector3d g_thd = sc * G_nu_w;
+    const Vector3d g_w = sc * (Jd * nu - Jz * omega) + Jt * x;
+    const Vector3d g_nu = Jt * ac + sc * (Jd * omega);
     const Vector3d g_pd = mB.cross(h) + qd.cross(Jtnu);
     const Vector3d g_qd = mA.cross(h) + Jtnu.cross(pd) + g_w.cross(p);
     const Vector3d g_p = mB.cross(g_nu) + Ba.cross(Jtnu) + qd.cross(g_w);

@@ -25,14 +25,17 @@
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
 //              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
-// Rotors       inertia J_j turned by the rotor's elastic rotation θ = Θ_j e to first order,
-//              J(θ) = J_j + [θ]× J_j − J_j [θ]×, ω_j = Ω + Θ_j(e) ė = L_j(e) u, L_j = [0, I, Θ_j(e)]
+// Rotors       inertia J_j turned by the section's rotation R to second order in θ = Θ_j e,
+//              J(θ) = R J_j Rᵀ + O(θ³) (quadratic in θ; its second-order part is the centrifugal
+//              stiffness of a body turned in a spinning frame; docs/theory.md §3.8),
+//              ω_j = Ω + Θ_j(e) ė = L_j(e) u, L_j = [0, I, Θ_j(e)]
 //              (Θ_j the linear model's rotation rows, Θ_j(e) its second-order angular velocity on
 //              the mast, struct Rotor); kinetic energy T = ½ ω_jᵀ J(θ) ω_j, whose generalized
 //              inertia force (Boltzmann–Hamel on Ω, Lagrange on e) is L_jᵀ (J(θ) ω̇ + J̇ ω) +
 //              [0; Ω × J(θ) ω; Θ̇(e)ᵀ h − (∂ω/∂e)ᵀ h − Θᵀ ∂T/∂θ], h = J(θ) ω,
-//              J̇ ω = θ̇ × J ω − J (θ̇ × ω), ∂T/∂θ = J ω × ω: the gyroscopic coupling of the slew's
-//              rate with an anisotropic rotor's elastic rotation (the reflector's I_zz = 2 I_xx).
+//              J̇ ω = ∂J/∂θ[θ̇] ω, ∂T/∂θ = ½ ∇_θ (ωᵀ J(θ) ω) (first order: θ̇ × J ω − J (θ̇ × ω) and
+//              J ω × ω): the gyroscopic coupling of the slew's rate with an anisotropic rotor's
+//              elastic rotation (the reflector's I_zz = 2 I_xx).
 //              The shuttle (no elastic rotation), the reflector about its CM, and the section's
 //              ρI_ψ (three Gauss points per element). Energy and momenta are conserved exactly.
 // Strain       the linear model's ½ eᵀ K e and the mast's W₃ + W₄ (struct Coupling): the
@@ -54,6 +57,7 @@
 //              S along d, a_i · d.
 // At rest (q = 0, u = 0) the linearisation is the linear model in the coordinates (X, θ, e):
 // M(0) = Gᵀ M_lin G, the same K, D, loads and sensor rows.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -116,6 +120,7 @@ public:
     const ScoleNonlinear* g_ = nullptr;
     std::vector<double> mass_;            // per mass point
     std::vector<Eigen::Matrix3d> J_;      // per rotor
+    std::vector<double> rotor_scale_;     // per rotor: J_ = scale · Rotor::J
     MatrixXd Mconst_;                     // the e-independent part of M
     // M_ee: constant and factorised once without quadratic points; with them, the constant part
     // in a pattern holding their local rows, factorised per e (solve_mass).
@@ -219,12 +224,27 @@ private:
   // R = exp[α] exp[ψ ẑ] (struct Coupling), whose angular velocity relative to S is, to second order,
   //   ω_rel = Θ ė + p × (B ė),   p = α = P⊥ Θ e,   B = (½ P⊥ + P_z) Θ
   // (½ α × α̇ + ψ̇ α × ẑ): ω = Ω + Θ(e) ė with Θ(e) = Θ + [p]× B. The shuttle's rotor has no columns.
+  // A rotor's inertia J turned by that rotation to second order, J(θ) = R J Rᵀ + O(θ³), θ = Θ e:
+  // quadratic in θ, so it is held by its derivatives, J(θ) = J + Σ_k θ_k (J_k + ½ Σ_l θ_l J_kl)
+  // (docs/theory.md §3.8). Linear in J.
+  struct Turning {
+    std::array<Eigen::Matrix3d, 3> first;                  // J_k = ∂J/∂θ_k at θ = 0
+    std::array<std::array<Eigen::Matrix3d, 3>, 3> second;  // J_kl = ∂²J/∂θ_k∂θ_l
+    Turning() = default;
+    explicit Turning(const Eigen::Matrix3d& J);
+    Eigen::Matrix3d change(const Eigen::Vector3d& theta) const;  // J(θ) − J
+    // ∂J/∂θ_k at θ, k = 0, 1, 2
+    std::array<Eigen::Matrix3d, 3> slopes(const Eigen::Vector3d& theta) const;
+    // ∇_θ (u · ∇_θ (a · J(θ) b)) (constant in θ)
+    Eigen::Vector3d curvature(const Eigen::Vector3d& u, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  };
   struct Rotor {
     Eigen::Matrix3d J;
     MatrixXd Theta;    // 3 × ne
     int coefficient = -1;
     Rows3 th;          // Θ, compact
     Eigen::Matrix<double, 3, Eigen::Dynamic> half;  // B on th.cols
+    Turning turn;      // of J (unscaled)
     Eigen::Vector3d tilt(const VectorXd& x) const;  // P⊥ Θ x
     Eigen::Matrix<double, 3, Eigen::Dynamic> jacobian(const VectorXd& e) const;  // Θ(e) on th.cols
   };
