@@ -291,10 +291,17 @@ json run_child_args(const std::vector<std::string>& args, double timeout_s) {
 
 // `--case N --method M` in a child process.
 json run_child(int N, const std::string& method, bool compute_std, double timeout_s) {
-  std::vector<std::string> args{"--case", std::to_string(N), "--method", method, "--noise", std::to_string(g_noise),
-                                "--smoothness-weight", std::to_string(g_smoothness),
+  // Values pass to the child exactly (std::to_string keeps six decimals: a step below 5e-7 would
+  // reach it as 0, the automatic step).
+  auto exact = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  std::vector<std::string> args{"--case", std::to_string(N), "--method", method, "--noise", exact(g_noise),
+                                "--smoothness-weight", exact(g_smoothness),
                                 "--checkpoint", std::to_string(g_checkpoint), "--seed", std::to_string(g_seed),
-                                "--time-step", std::to_string(g_time_step)};
+                                "--time-step", exact(g_time_step)};
   if (!compute_std) args.push_back("--no-std");
   json row = run_child_args(args, timeout_s);
   row["N"] = N;
@@ -607,7 +614,7 @@ const char* kUsage =
     "usage: scole-sections-bench [--part 1|2|3] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
     "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
     "                            [--checkpoint L] [--seed K] [--time-step H]\n"
-    "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step), each (N, method) in a\n"
+    "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step unless --time-step), each (N, method) in a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
     "  Part 2: EI_1..EI_4 + rho_A from the analytic modal series, Gauss-Newton from 10 starts.\n"

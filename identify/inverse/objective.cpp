@@ -627,31 +627,39 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
   const int n = model_.ndof;
   // The nonzeros of ∂M, ∂D, ∂K as one list per derivative, column by column (the order of a
   // sparse product): a sectional parameter touches a few elements, so the list is short where
-  // the sparse product would still visit every column.
+  // the sparse product would still visit every column. The ∂b are copied too: the function does
+  // not refer to `d` once made.
   struct Entry {
     int row, col;
     double value;
     int which;  // 0: ∂M (on ü), 1: ∂D (on u̇), 2: ∂K (on u)
   };
-  auto lists = std::make_shared<std::vector<std::vector<Entry>>>(d.size());
+  struct Lists {
+    std::vector<std::vector<Entry>> entries;
+    std::vector<std::vector<VectorXd>> db;
+    std::vector<double> f;
+  };
+  auto L = std::make_shared<Lists>();
+  L->entries.resize(d.size());
+  L->f.resize(inputs_.size());
   for (std::size_t i = 0; i < d.size(); ++i) {
     const SparseMatrix* mats[3] = {&d[i].dM, &d[i].dD, &d[i].dK};
     for (int w = 0; w < 3; ++w)
       for (int k = 0; k < mats[w]->outerSize(); ++k)
         for (SparseMatrix::InnerIterator it(*mats[w], k); it; ++it)
           if (it.value() != 0.0)
-            (*lists)[i].push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), it.value(), w});
+            L->entries[i].push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), it.value(), w});
+    L->db.push_back(d[i].db);
   }
-  auto f = std::make_shared<std::vector<double>>(inputs_.size());
-  return [this, &d, n, f, lists](double t, const double* x, const double* v, const double* a, double* Gp) {
+  return [this, n, L](double t, const double* x, const double* v, const double* a, double* Gp) {
     const double* on[3] = {a, v, x};
-    for (std::size_t k = 0; k < inputs_.size(); ++k) (*f)[k] = inputs_[k](t);
-    for (std::size_t i = 0; i < d.size(); ++i) {
+    for (std::size_t k = 0; k < inputs_.size(); ++k) L->f[k] = inputs_[k](t);
+    for (std::size_t i = 0; i < L->entries.size(); ++i) {
       double* Gi = Gp + i * static_cast<std::size_t>(n);
-      for (const Entry& e : (*lists)[i]) Gi[e.row] -= e.value * on[e.which][e.col];
+      for (const Entry& e : L->entries[i]) Gi[e.row] -= e.value * on[e.which][e.col];
       Eigen::Map<VectorXd> Gm(Gi, n);
-      for (std::size_t k = 0; k < f->size(); ++k)
-        if ((*f)[k] != 0.0) Gm += (*f)[k] * d[i].db[k];
+      for (std::size_t k = 0; k < L->f.size(); ++k)
+        if (L->f[k] != 0.0) Gm += L->f[k] * L->db[i][k];
     }
   };
 }

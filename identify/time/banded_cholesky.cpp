@@ -65,6 +65,7 @@ void BandedCholesky::assign(const Eigen::SparseMatrix<double>& A) {
 }
 
 bool BandedCholesky::factorize() {
+  inv_diag_.clear();  // set again only when the factorisation succeeds
   const int w = b_ + 1;
   double* L = data_.data();
   // Band rows: L_ij for j ∈ [i − b, i] only depends on band rows.
@@ -111,6 +112,8 @@ bool BandedCholesky::factorize() {
 void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
 
 void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld) const {
+  if (columns > 1 && ld < n_) throw std::invalid_argument("BandedCholesky::solve_in_place: leading dimension below n");
+  if (inv_diag_.size() != static_cast<std::size_t>(n_)) throw std::logic_error("BandedCholesky: solve before a successful factorize");
   // Both sweeps read L by rows, which are contiguous in storage: L y = r by dot products with
   // row i, Lᵀ x = y by axpys with row i (column-oriented back substitution). Each row is applied
   // to every column before the next row: one column is a chain of dependent operations (row i

@@ -47,7 +47,7 @@ ButcherTable ButcherTable::arkode_dirk(int id) {
 
 EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
                              NewtonMatrix& newton, ButcherTable table)
-    : M_(M), D_(D), K_(K), D_rows_(D), K_rows_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
+    : M_(M), D_rows_(D), K_rows_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
   explicit_first_ = tab_.explicit_first_stage();
   stiffly_accurate_ = tab_.stiffly_accurate();
   for (int i = 0; i < tab_.stages; ++i)

@@ -259,7 +259,11 @@ identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initia
   const VectorXd q = e.p->params->initial();
   VectorXd g_gn;
   MatrixXd H;
-  e.obj->gauss_newton(q, g_gn, H);
+  const double J_gn = e.obj->gauss_newton(q, g_gn, H);
+  // The cost from the interpolated outputs is the cost from the interpolated states.
+  const double J = e.obj->cost(q);
+  std::printf("  velocity sensors: J %.15e (Gauss-Newton pass) vs %.15e (forward)\n", J_gn, J);
+  EXPECT_NEAR(J_gn, J, 1e-12 * J);
   VectorXd g_fd(q.size());
   for (int i = 0; i < q.size(); ++i) {
     auto D = [&](double eta) {

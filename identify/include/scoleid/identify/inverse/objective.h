@@ -184,7 +184,7 @@ private:
   Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, const Derivative& d,
                          double t_end) const;
   // The tangents' forcing G_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) for the given derivatives
-  // (kept by reference: `d` must outlive the returned function).
+  // (copied: the returned function does not refer to `d`).
   SecondOrderSolver::TangentForcing tangent_forcing(const std::vector<Derivative>& d) const;
   // The state and the tangents of the given derivatives (as solve_with_sensitivities).
   std::vector<Trajectory> solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,

@@ -46,7 +46,8 @@ public:
   void assign(const Eigen::SparseMatrix<double>& A);
   // Factorises in place; false if the matrix is not positive definite.
   bool factorize();
-  // Solves A x = r in place (x holds r on entry).
+  // Solves A x = r in place (x holds r on entry); needs a successful factorize() since the last
+  // change of the entries.
   void solve_in_place(double* x) const;
   // Solves A X = R in place for `columns` columns stored column-major with leading dimension ld
   // (X holds R on entry); each column's result is bit for bit that of the one-column solve.

@@ -104,9 +104,10 @@ public:
                          double until = std::numeric_limits<double>::infinity()) const;
 
 private:
-  const SparseMatrix &M_, &D_, &K_;
-  // D and K by rows: their products with the stage vectors are then sums per row (a chain of
-  // independent multiply-adds) instead of column scatters, whose stores depend on each other.
+  const SparseMatrix& M_;
+  // D and K copied by rows at construction (the Newton factors and `mass` are the caller's and must
+  // stay those of the same M, D, K): their products with the stage vectors are then sums per row
+  // (independent multiply-adds) instead of column scatters, whose stores depend on each other.
   Eigen::SparseMatrix<double, Eigen::RowMajor> D_rows_, K_rows_;
   const BandedCholesky& mass_;
   NewtonMatrix& newton_;
