@@ -453,6 +453,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
                  format_value(id.steepest_weights[i]));
   id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
   id.time_step = r.nonneg("time_step", id.time_step);
+  id.step_rule = r.choice("step_rule", id.step_rule, {"parameters", "data"});
   id.rtol = r.positive("rtol", id.rtol);
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
@@ -727,7 +728,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
-                         {"time_step", id.time_step}, {"rtol", id.rtol},
+                         {"time_step", id.time_step}, {"step_rule", id.step_rule}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
                          {"restarts", id.restarts}, {"start", id.start}, {"model", id.model},
                          {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};

@@ -67,6 +67,8 @@ long g_checkpoint = -1;
 long g_seed = -1;
 // Part 1's identifier step (identification.time_step, s); 0 = the automatic rule (§5.2).
 double g_time_step = 0.0;
+// Part 1's automatic step rule (identification.step_rule): parameters | data.
+std::string g_step_rule = "parameters";
 
 void apply_checkpoint(ObjectiveOptions& o, long L) {
   if (L < 0) return;
@@ -109,6 +111,7 @@ scoleid::io::Scenario part1_scenario(int N) {
   sc.identification.elements = 64;
   sc.identification.data_elements = 128;
   sc.identification.time_step = g_time_step;  // 0: automatic, what is being measured
+  sc.identification.step_rule = g_step_rule;
   for (auto& sensor : sc.sensors) sensor.noise_std = g_noise;
   if (g_seed >= 0) sc.simulation.seed = static_cast<unsigned>(g_seed);
   sc.identification.smoothness = g_smoothness;
@@ -301,7 +304,7 @@ json run_child(int N, const std::string& method, bool compute_std, double timeou
   std::vector<std::string> args{"--case", std::to_string(N), "--method", method, "--noise", exact(g_noise),
                                 "--smoothness-weight", exact(g_smoothness),
                                 "--checkpoint", std::to_string(g_checkpoint), "--seed", std::to_string(g_seed),
-                                "--time-step", exact(g_time_step)};
+                                "--time-step", exact(g_time_step), "--step-rule", g_step_rule};
   if (!compute_std) args.push_back("--no-std");
   json row = run_child_args(args, timeout_s);
   row["N"] = N;
@@ -613,7 +616,7 @@ std::vector<std::string> split(const std::string& s) {
 const char* kUsage =
     "usage: scole-sections-bench [--part 1|2|3] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
     "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
-    "                            [--checkpoint L] [--seed K] [--time-step H]\n"
+    "                            [--checkpoint L] [--seed K] [--time-step H] [--step-rule parameters|data]\n"
     "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step unless --time-step), each (N, method) in a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
@@ -628,7 +631,9 @@ const char* kUsage =
     "  --smoothness discrepancy|BETA sets part 1's smoothness prior (docs/theory.md §7.8).\n"
     "  --seed K seeds part 1's noise (default: the scenario's simulation.seed).\n"
     "  --time-step H fixes part 1's identifier step to H seconds at every N (default: the automatic\n"
-    "  rule of docs/theory.md §5.2, which shortens the step as N grows).\n";
+    "  rule of docs/theory.md §5.2, which shortens the step as N grows).\n"
+    "  --step-rule data gives part 1 the automatic step from the modes the data contain, the same\n"
+    "  for every N (identification.step_rule; default parameters: modes up to min(N + 2, Nyquist)).\n";
 
 }  // namespace
 
@@ -686,6 +691,9 @@ int main(int argc, char** argv) {
         if (g_checkpoint < -2) throw std::invalid_argument("--checkpoint must be >= 0 (or -1: the default; -2: set-up only)");
       } else if (a == "--seed") {
         g_seed = std::stol(value());
+      } else if (a == "--step-rule") {
+        g_step_rule = value();
+        if (g_step_rule != "parameters" && g_step_rule != "data") throw std::invalid_argument("--step-rule: parameters or data");
       } else if (a == "--time-step") {
         g_time_step = std::stod(value());
         if (!(g_time_step >= 0)) throw std::invalid_argument("--time-step must be >= 0 (0: automatic)");

@@ -679,6 +679,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
              {"step", model == "nonlinear" ? integrator_step : p.objective_options.solver.step},
              {"rtol", model == "nonlinear" ? json(nullptr) : json(p.objective_options.solver.rtol)},
              {"steps", counters.solver.steps},
+             {"step_rule", p.scenario.identification.time_step > 0 ? std::string("given") : p.scenario.identification.step_rule},
              {"resolved_modes", p.content.mode},
              {"modes_below_nyquist", p.content.modes_below_nyquist},
              {"visible_content_modes", p.content.content_mode}}},

@@ -48,7 +48,8 @@ std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elem
 }  // namespace
 
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
-                         const std::vector<io::Signal>& signals, double t_end, double sample_interval) {
+                         const std::vector<io::Signal>& signals, double t_end, double sample_interval,
+                         bool from_data) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
@@ -117,6 +118,10 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
       }
   }
   d.content_mode = last + 1;
+  if (from_data && d.content_mode > 0) {  // the step from the visible content, whatever P
+    d.mode = d.content_mode;
+    d.omega = m.omega[flexible[static_cast<std::size_t>(d.mode - 1)]];
+  }
   // The step resolves K = min(P + 2, K_nyq), not K_data: a mode far below the largest in amplitude
   // can still be the one that carries a weakly seen parameter (SCOLE's modes 5 and 6, at < 1e-4 of
   // the first in every sensor, fix ρI_ψ to 4e-5 when resolved and leave it 5e-3 off when not).
@@ -175,7 +180,8 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   if (sc.identification.time_step > 0) return sc.identification.time_step;
   // Resolve (ω h <= 0.3) modes 1 … K, K = min(P + 2, modes below Nyquist) (data_content): an
   // L-stable step damps what it does not resolve, keeping its quasi-static part.
-  const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval);
+  const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
+                                           sc.identification.step_rule == "data");
   const double w = content.omega;
   double h = sc.simulation.sample_interval;
   if (w > 0) h = std::min(h, 0.3 / w);
@@ -211,11 +217,14 @@ void check_step(const io::Scenario& sc, const StructuralModel& model, const Para
   const std::string got = id.time_step > 0 ? io::format_value(id.time_step)
                                            : std::to_string(id.elements) + " (automatic time step " + io::format_value(h) + ")";
   if (id.time_step > 0 && id.integrator != "bdf") {
-    const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval);
+    const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
+                                             id.step_rule == "data");
     const double w = content.omega;
     if (w * h > 1.0)
       fail_field(sc.source, "identification.time_step",
-                 "must resolve flexible mode " + std::to_string(content.mode) + " = min(P + 2, modes below Nyquist) (" +
+                 "must resolve flexible mode " + std::to_string(content.mode) +
+                     (id.step_rule == "data" ? std::string(" = the highest the data visibly contain (")
+                                             : std::string(" = min(P + 2, modes below Nyquist) (")) +
                      io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
                      io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
                      io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
@@ -451,7 +460,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
                  std::to_string(data_elements));
     step = identifier_step(sc, p->model(), *p->params, p->signals);
     check_step(sc, p->model(), *p->params, p->signals, step, true);
-    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval);
+    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
+                              id.step_rule == "data");
     // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
     // 4x finer than the identifier's.
     const io::Scenario truth_sc = io::truth_scenario(sc);
@@ -468,7 +478,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   if (data_csv) {
     step = identifier_step(sc, p->model(), *p->params, p->signals);
     check_step(sc, p->model(), *p->params, p->signals, step, false);
-    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval);
+    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
+                              id.step_rule == "data");
   }
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = step;

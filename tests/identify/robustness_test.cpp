@@ -402,6 +402,54 @@ TEST(TimeStep, StopsShrinkingWithTheNumberOfParametersAtTheSamplingLimit) {
   EXPECT_LT(h_fast, h[64]);
 }
 
+TEST(TimeStep, TheDataRuleGivesOneStepForEveryNumberOfParametersAndFollowsTheInputsBandwidth) {
+  // identification.step_rule: data: K = K_data (the highest mode the inputs visibly excite at the
+  // sensors), whatever the number of parameters; a smoother input excites fewer modes, so the
+  // step is longer.
+  auto step_for = [](int N, bool smooth, DataContent* content) {
+    auto sc = scoleid::io::load_scenario("beam-ei8");
+    sc.identification.elements = 64;
+    sc.identification.data_elements = 128;
+    sc.identification.step_rule = "data";
+    sc.identification.sections = N;
+    sc.identification.estimate.clear();
+    for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
+    sc.identification.initial = {{"EI", 30000.0}};
+    if (smooth) {  // one slow haversine instead of the step and the short pulse
+      sc.inputs.resize(1);
+      scoleid::io::SignalTerm slow;
+      slow.type = scoleid::io::SignalTerm::Type::Haversine;
+      slow.amplitude = 10.0;
+      slow.width = 2.0;
+      sc.inputs[0].signal = scoleid::io::Signal({slow});
+    }
+    const auto st = make_structure(sc, sc.identification.elements);
+    const auto params = st->parameterize(sc);
+    std::vector<scoleid::io::Signal> signals;
+    for (const auto& in : sc.inputs) signals.push_back(in.signal);
+    *content = data_content(st->model(), *params, signals, sc.simulation.duration, sc.simulation.sample_interval, true);
+    return identifier_step(sc, st->model(), *params, signals);
+  };
+  std::map<int, double> h;
+  std::map<int, DataContent> c;
+  for (int N : {2, 16, 64}) {
+    h[N] = step_for(N, false, &c[N]);
+    std::printf("N = %2d: data rule resolves mode %2d (visible content %d, %d below Nyquist); step %.4g s\n", N, c[N].mode,
+                c[N].content_mode, c[N].modes_below_nyquist, h[N]);
+    EXPECT_EQ(c[N].mode, c[N].content_mode);
+    EXPECT_GT(c[N].content_mode, 0);
+    EXPECT_NEAR(h[N], std::min(0.01, 0.3 / c[N].omega), 1e-15);
+  }
+  EXPECT_DOUBLE_EQ(h[2], h[16]);
+  EXPECT_DOUBLE_EQ(h[2], h[64]);
+  EXPECT_GT(c[2].mode, 2 + 2);  // the rule differs from min(P + 2, K_nyq) here: it means something at N = 2
+  DataContent smooth;
+  const double h_smooth = step_for(64, true, &smooth);
+  std::printf("one slow haversine: visible content to mode %d, step %.4g s\n", smooth.content_mode, h_smooth);
+  EXPECT_LT(smooth.content_mode, c[64].content_mode);
+  EXPECT_GT(h_smooth, h[64]);
+}
+
 TEST(SensitivityBlocks, OneParameterPerBlockGivesTheSameGaussNewtonQuantitiesAndFisherRows) {
   // beam-ei8 on 16 elements: 8 parameters in one block (the default) and in 8 blocks of one. The
   // blocks are the path of integrators without a tangent stepper (the ARKODE reference here); the

@@ -190,7 +190,12 @@ struct IdentificationSpec {
   double continuation_misfit = 0.05;
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
-  double time_step = 0.0;             // esdirk step; 0 = automatic (resolves modes up to number P + 2)
+  double time_step = 0.0;             // esdirk step; 0 = automatic (step_rule)
+  // The automatic step's rule (docs/theory.md §5.2): "parameters" resolves flexible modes up to
+  // min(P + 2, modes below Nyquist) (P the estimated parameters; the default), "data" the modes
+  // the inputs visibly excite at the sensors (K_data, below Nyquist) whatever P: a step independent
+  // of the number of parameters, shorter for few parameters on rich data.
+  std::string step_rule = "parameters";
   double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
   std::vector<UncertainSpec> uncertain;  // declared tolerances of fixed quantities (consider terms)
   // The model-form error the data are expected to carry, as a fraction of each sensor's RMS

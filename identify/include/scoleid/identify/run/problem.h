@@ -89,10 +89,13 @@ Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, do
 // The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for a beam or
 // sectional parameters, which it does not have).
 ScoleNonlinear scole_nonlinear(const io::Scenario& scenario, int elements);
+// from_data (identification.step_rule: data): K = K_data instead of min(P + 2, K_nyq).
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
-                         const std::vector<io::Signal>& signals, double t_end, double sample_interval);
+                         const std::vector<io::Signal>& signals, double t_end, double sample_interval,
+                         bool from_data = false);
 // The identifier's fixed time step: identification.time_step if set, else
-// min(sample interval, 0.3 / ω_K), K = min(P + 2, modes below Nyquist) (data_content),
+// min(sample interval, 0.3 / ω_K), K = min(P + 2, modes below Nyquist) or, with
+// identification.step_rule: data, K_data (data_content),
 // shortened when a damping parameter is estimated until the method's numerical damping ratio at
 // ω_K h is at most 1 % of the smallest modal damping ratio of modes 1 … K (docs/theory.md §5.2).
 // make_problem refuses a given step with ω_K h > 1 and any step whose trajectories exceed
