@@ -19,6 +19,21 @@ using test_support::max_rel;
 
 namespace {
 
+// ∂J/∂q by central differences in log q with one Richardson step (error O(η⁴)).
+VectorXd central_gradient(Objective& obj, const VectorXd& q) {
+  VectorXd g(q.size());
+  for (int i = 0; i < q.size(); ++i) {
+    auto D = [&](double eta) {
+      VectorXd qp = q, qm = q;
+      qp[i] *= std::exp(eta);
+      qm[i] *= std::exp(-eta);
+      return (obj.cost(qp) - obj.cost(qm)) / (2.0 * eta * q[i]);
+    };
+    g[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
+  }
+  return g;
+}
+
 // Small meshes and a 2 s horizon keep the dense CVODES reference cheap.
 const char* kPaper = R"(name: grad-paper
 beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
@@ -197,17 +212,7 @@ void check_rates(const char* yaml, const RateBounds& bound) {
   MatrixXd H;
   e.obj->gauss_newton(q, g_gn, H);
   e.obj->cost_and_gradient(q, g_cg);
-  // Central differences in log q with one Richardson step (error O(η⁴)).
-  VectorXd g_fd(q.size());
-  for (int i = 0; i < q.size(); ++i) {
-    auto D = [&](double eta) {
-      VectorXd qp = q, qm = q;
-      qp[i] *= std::exp(eta);
-      qm[i] *= std::exp(-eta);
-      return (e.obj->cost(qp) - e.obj->cost(qm)) / (2.0 * eta * q[i]);
-    };
-    g_fd[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
-  }
+  const VectorXd g_fd = central_gradient(*e.obj, q);
   std::printf("  esdirk: Gauss-Newton vs FD %.2e, costate vs FD %.2e, costate vs Gauss-Newton %.2e\n",
               max_rel(g_gn, g_fd), max_rel(g_cg, g_fd), max_rel(g_cg, g_gn));
   for (int i = 0; i < q.size(); ++i)
@@ -264,16 +269,7 @@ identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initia
   const double J = e.obj->cost(q);
   std::printf("  velocity sensors: J %.15e (Gauss-Newton pass) vs %.15e (forward)\n", J_gn, J);
   EXPECT_NEAR(J_gn, J, 1e-12 * J);
-  VectorXd g_fd(q.size());
-  for (int i = 0; i < q.size(); ++i) {
-    auto D = [&](double eta) {
-      VectorXd qp = q, qm = q;
-      qp[i] *= std::exp(eta);
-      qm[i] *= std::exp(-eta);
-      return (e.obj->cost(qp) - e.obj->cost(qm)) / (2.0 * eta * q[i]);
-    };
-    g_fd[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
-  }
+  const VectorXd g_fd = central_gradient(*e.obj, q);
   std::printf("  velocity sensors: Gauss-Newton vs FD %.2e\n", max_rel(g_gn, g_fd));
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-5);
   // H is symmetric positive definite (three parameters the data see).

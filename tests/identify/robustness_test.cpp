@@ -362,23 +362,37 @@ TEST(Identification, StartCoarseToFineNeedsSections) {
   }
 }
 
+namespace {
+// beam-ei8's loads on a 64-element beam (data on 128) with EI on N equal sections.
+scoleid::io::Scenario sections_scenario(int N) {
+  auto sc = scoleid::io::load_scenario("beam-ei8");
+  sc.identification.elements = 64;
+  sc.identification.data_elements = 128;
+  sc.identification.sections = N;
+  sc.identification.estimate.clear();
+  for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
+  sc.identification.initial = {{"EI", 30000.0}};
+  return sc;
+}
+
+// The identifier's automatic step for a scenario, and the content it resolves (its step_rule).
+double step_and_content(const scoleid::io::Scenario& sc, DataContent* content) {
+  const auto st = make_structure(sc, sc.identification.elements);
+  const auto params = st->parameterize(sc);
+  std::vector<scoleid::io::Signal> signals;
+  for (const auto& in : sc.inputs) signals.push_back(in.signal);
+  *content = data_content(st->model(), *params, signals, sc.simulation.duration, sc.simulation.sample_interval,
+                          sc.identification.step_rule == "data");
+  return identifier_step(sc, st->model(), *params, signals);
+}
+}  // namespace
+
 TEST(TimeStep, StopsShrinkingWithTheNumberOfParametersAtTheSamplingLimit) {
   // EI on N sections of a 64-element beam: K = min(N + 2, modes below Nyquist).
   auto step_for = [](int N, double sample_interval, DataContent* content) {
-    auto sc = scoleid::io::load_scenario("beam-ei8");
-    sc.identification.elements = 64;
-    sc.identification.data_elements = 128;
+    auto sc = sections_scenario(N);
     sc.simulation.sample_interval = sample_interval;
-    sc.identification.sections = N;
-    sc.identification.estimate.clear();
-    for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
-    sc.identification.initial = {{"EI", 30000.0}};
-    const auto st = make_structure(sc, sc.identification.elements);
-    const auto params = st->parameterize(sc);
-    std::vector<scoleid::io::Signal> signals;
-    for (const auto& in : sc.inputs) signals.push_back(in.signal);
-    *content = data_content(st->model(), *params, signals, sc.simulation.duration, sc.simulation.sample_interval);
-    return identifier_step(sc, st->model(), *params, signals);
+    return step_and_content(sc, content);
   };
   std::map<int, double> h;
   std::map<int, DataContent> c;
@@ -407,14 +421,8 @@ TEST(TimeStep, TheDataRuleGivesOneStepForEveryNumberOfParametersAndFollowsTheInp
   // sensors), whatever the number of parameters; a smoother input excites fewer modes, so the
   // step is longer.
   auto step_for = [](int N, bool smooth, DataContent* content) {
-    auto sc = scoleid::io::load_scenario("beam-ei8");
-    sc.identification.elements = 64;
-    sc.identification.data_elements = 128;
+    auto sc = sections_scenario(N);
     sc.identification.step_rule = "data";
-    sc.identification.sections = N;
-    sc.identification.estimate.clear();
-    for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
-    sc.identification.initial = {{"EI", 30000.0}};
     if (smooth) {  // one slow haversine instead of the step and the short pulse
       sc.inputs.resize(1);
       scoleid::io::SignalTerm slow;
@@ -423,12 +431,7 @@ TEST(TimeStep, TheDataRuleGivesOneStepForEveryNumberOfParametersAndFollowsTheInp
       slow.width = 2.0;
       sc.inputs[0].signal = scoleid::io::Signal({slow});
     }
-    const auto st = make_structure(sc, sc.identification.elements);
-    const auto params = st->parameterize(sc);
-    std::vector<scoleid::io::Signal> signals;
-    for (const auto& in : sc.inputs) signals.push_back(in.signal);
-    *content = data_content(st->model(), *params, signals, sc.simulation.duration, sc.simulation.sample_interval, true);
-    return identifier_step(sc, st->model(), *params, signals);
+    return step_and_content(sc, content);
   };
   std::map<int, double> h;
   std::map<int, DataContent> c;

@@ -250,6 +250,34 @@ TEST(ScoleNonlinear, TheStrainEnergyIsTheRodsToFourthOrderInTheDeflection) {
   }
 }
 
+// paper-scole-1 on 4 elements with a general reflector inertia (products of inertia, I_zz not
+// I_xx + I_yy) and every other mass negligible, the stiffnesses zero: the reflector's own kinetic
+// energy, for the tests of its turning inertia and angular velocity.
+struct ReflectorOnly {
+  Model m;
+  ScoleNonlinear::Dynamics dyn;
+  Matrix3d J;
+  ReflectorOnly() : m(make_model(scenario(), 4)), dyn(m.nl->at(coefficients(m))) {
+    const auto& I = m.sc.scole.reflector;
+    J << I.Ixx, I.Ixy, I.Ixz, I.Ixy, I.Iyy, I.Iyz, I.Ixz, I.Iyz, I.Izz;
+  }
+  static scoleid::io::Scenario scenario() {
+    auto sc = builtin("paper-scole-1");
+    sc.scole.actuator_mass = 1e-9;
+    sc.scole.reflector.Iyy = 3500;
+    sc.scole.reflector.Izz = 6500;
+    sc.scole.reflector.Ixy = 300;
+    sc.scole.reflector.Iyz = -200;
+    return sc;
+  }
+  static VectorXd coefficients(const Model& m) {
+    VectorXd c = scole_coefficients(m.fe.spec);
+    for (int k : {ScoleFE::kRhoA, ScoleFE::kRhoIPsi, ScoleFE::kMReflector}) c[k] *= 1e-12;
+    for (int k : {ScoleFE::kEIRoll, ScoleFE::kEIPitch, ScoleFE::kGJ, ScoleFE::kKActuator}) c[k] = 0.0;
+    return c;
+  }
+};
+
 TEST(ScoleNonlinear, TheReflectorsKineticEnergyIsTheTurningBodysToThirdOrder) {
   // The reflector's rotational kinetic energy, ½ ωᵀ J(θ) ω with ω = Θ(e) ė (its angular velocity
   // relative to the resting shuttle to second order), against ½ ωᵀ R J Rᵀ ω with ω = axial(Ṙ Rᵀ)
@@ -258,21 +286,12 @@ TEST(ScoleNonlinear, TheReflectorsKineticEnergyIsTheTurningBodysToThirdOrder) {
   // be of third. Every other mass is made negligible, the stiffnesses zero. A general inertia: for
   // a flat reflector (I_zz = I_xx + I_yy about a symmetric axis) the angular velocity's
   // second-order part drops out of this energy at rest (not with the slew's rate).
-  auto sc = builtin("paper-scole-1");
-  sc.scole.actuator_mass = 1e-9;
-  sc.scole.reflector.Iyy = 3500;
-  sc.scole.reflector.Izz = 6500;
-  sc.scole.reflector.Ixy = 300;
-  sc.scole.reflector.Iyz = -200;
-  const Model m = make_model(sc, 4);
+  const ReflectorOnly r;
+  const Model& m = r.m;
+  const auto& sc = m.sc;
   const int ne = m.nl->elastic();
-  VectorXd c = scole_coefficients(m.fe.spec);
-  for (int k : {ScoleFE::kRhoA, ScoleFE::kRhoIPsi, ScoleFE::kMReflector}) c[k] *= 1e-12;
-  for (int k : {ScoleFE::kEIRoll, ScoleFE::kEIPitch, ScoleFE::kGJ, ScoleFE::kKActuator}) c[k] = 0.0;
-  const auto dyn = m.nl->at(c);
-  const auto& I = sc.scole.reflector;
-  Matrix3d J;
-  J << I.Ixx, I.Ixy, I.Ixz, I.Ixy, I.Iyy, I.Iyz, I.Ixz, I.Iyz, I.Izz;
+  const auto& dyn = r.dyn;
+  const Matrix3d& J = r.J;
   std::mt19937_64 rng(9);
   std::normal_distribution<double> N(0.0, 1.0);
   VectorXd e0(ne), v0(ne);
@@ -329,21 +348,12 @@ TEST(ScoleNonlinear, TheReflectorsInertiaTurnsToSecondOrderInASpinningFrame) {
   // that by O(ε³); a first-order J(θ) leaves O(ε²), the centrifugal stiffness of a body turned in
   // a spinning frame. Every other mass is made negligible (the shuttle's energy, constant, is
   // subtracted at e = 0), the stiffnesses zero.
-  auto sc = builtin("paper-scole-1");
-  sc.scole.actuator_mass = 1e-9;
-  sc.scole.reflector.Iyy = 3500;
-  sc.scole.reflector.Izz = 6500;
-  sc.scole.reflector.Ixy = 300;
-  sc.scole.reflector.Iyz = -200;
-  const Model m = make_model(sc, 4);
+  const ReflectorOnly r;
+  const Model& m = r.m;
+  const auto& sc = m.sc;
   const int ne = m.nl->elastic();
-  VectorXd c = scole_coefficients(m.fe.spec);
-  for (int k : {ScoleFE::kRhoA, ScoleFE::kRhoIPsi, ScoleFE::kMReflector}) c[k] *= 1e-12;
-  for (int k : {ScoleFE::kEIRoll, ScoleFE::kEIPitch, ScoleFE::kGJ, ScoleFE::kKActuator}) c[k] = 0.0;
-  const auto dyn = m.nl->at(c);
-  const auto& I = sc.scole.reflector;
-  Matrix3d J;
-  J << I.Ixx, I.Ixy, I.Ixz, I.Ixy, I.Iyy, I.Iyz, I.Ixz, I.Iyz, I.Izz;
+  const auto& dyn = r.dyn;
+  const Matrix3d& J = r.J;
   std::mt19937_64 rng(11);
   std::normal_distribution<double> N(0.0, 1.0);
   VectorXd e0(ne);
