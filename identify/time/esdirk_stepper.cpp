@@ -99,8 +99,10 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
   stops.push_back(t1);
 
   int m = 1 + P;
-  MatrixXd x = MatrixXd::Zero(n, m), v = MatrixXd::Zero(n, m), a(n, m), xt(n, m), vt(n, m), w(n, m), r(n, m);
+  MatrixXd x = MatrixXd::Zero(n, m), v = MatrixXd::Zero(n, m), a(n, m), xt(n, m), vt(n, m), w(n, m);
   std::vector<MatrixXd> Vs(static_cast<std::size_t>(s), MatrixXd(n, m)), As(static_cast<std::size_t>(s), MatrixXd(n, m));
+  // The nonzero coefficients of a stage's (or the step's) sum: (h a_ij or h b_j, j).
+  std::vector<std::pair<double, std::size_t>> terms(static_cast<std::size_t>(std::max(s, 4)), {0.0, 0});
   MatrixXd G(n, std::max(P, 1));
   VectorXd F(n), X0(n);
 
@@ -146,7 +148,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
   };
   auto drop_tangents = [&]() {
     m = 1;
-    for (MatrixXd* A : {&x, &v, &a, &xt, &vt, &w, &r}) A->conservativeResize(n, 1);
+    for (MatrixXd* A : {&x, &v, &a, &xt, &vt, &w}) A->conservativeResize(n, 1);
     for (auto& A : Vs) A.conservativeResize(n, 1);
     for (auto& A : As) A.conservativeResize(n, 1);
   };
@@ -159,47 +161,87 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
         As[0] = a;
         continue;
       }
-      xt = x;
-      vt = v;
-      for (int j = 0; j < i; ++j) {
-        const double c = hs * tab_.a(i, j);
-        if (c == 0.0) continue;
-        xt.noalias() += c * Vs[static_cast<std::size_t>(j)];
-        vt.noalias() += c * As[static_cast<std::size_t>(j)];
-      }
       const double g = hs * tab_.a(i, i);
       const double ti = tn + tab_.c[si] * hs;
       const BandedCholesky& S = g > 0.0 ? newton_.factor(g) : mass_;
+      // ṽ = v + h Σ_j a_ij A_j and w = x̃ + g ṽ (x̃ = x + h Σ_j a_ij V_j), each in one pass over all
+      // columns (the sums in the order of the terms, as one accumulation would).
+      std::size_t nt = 0;
+      for (int j = 0; j < i; ++j) {
+        const double c = hs * tab_.a(i, j);
+        if (c != 0.0) terms[nt++] = {c, static_cast<std::size_t>(j)};
+      }
+      const auto& [c0, j0] = terms[0];
+      const auto& [c1, j1] = terms[1];
+      const auto& [c2, j2] = terms[2];
+      switch (nt) {
+        case 0:
+          vt = v;
+          w = x + g * vt;
+          break;
+        case 1:
+          vt = v + c0 * As[j0];
+          w = x + c0 * Vs[j0] + g * vt;
+          break;
+        case 2:
+          vt = v + c0 * As[j0] + c1 * As[j1];
+          w = x + c0 * Vs[j0] + c1 * Vs[j1] + g * vt;
+          break;
+        case 3:
+          vt = v + c0 * As[j0] + c1 * As[j1] + c2 * As[j2];
+          w = x + c0 * Vs[j0] + c1 * Vs[j1] + c2 * Vs[j2] + g * vt;
+          break;
+        default: {
+          xt = x;
+          vt = v;
+          for (std::size_t k = 0; k < nt; ++k) {
+            xt.noalias() += terms[k].first * Vs[terms[k].second];
+            vt.noalias() += terms[k].first * As[terms[k].second];
+          }
+          w = xt + g * vt;
+        }
+      }
       // (M + g D + g² K) A_i = F − D ṽ − K (x̃ + g ṽ);  V_i = ṽ + g A_i;  X_i = x̃ + g ṽ + g² A_i.
-      w = xt;
-      w.noalias() += g * vt;
+      // The right-hand side is formed and solved in A_i itself.
+      MatrixXd& Ai = As[si];
       F.setZero();
       forcing(ti, F.data());
       ++cnt.stage_forcings;
-      r.col(0) = F;
-      r.col(0).noalias() -= D_rows_ * vt.col(0);
-      r.col(0).noalias() -= K_rows_ * w.col(0);
-      S.solve_in_place(r.col(0).data());
+      Ai.col(0) = F;
+      Ai.col(0).noalias() -= D_rows_ * vt.col(0);
+      Ai.col(0).noalias() -= K_rows_ * w.col(0);
+      S.solve_in_place(Ai.col(0).data());
       ++cnt.linear_solves;
-      As[si].col(0) = r.col(0);
-      Vs[si].col(0) = vt.col(0) + g * r.col(0);
+      Vs[si].col(0) = vt.col(0) + g * Ai.col(0);
       if (m > 1) {
-        X0 = w.col(0) + (g * g) * r.col(0);
-        tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), As[si].col(0).data());
-        r.rightCols(P) = G.leftCols(P);
-        r.rightCols(P).noalias() -= D_rows_ * vt.rightCols(P);
-        r.rightCols(P).noalias() -= K_rows_ * w.rightCols(P);
-        S.solve_in_place(r.col(1).data(), P, n);
+        X0 = w.col(0) + (g * g) * Ai.col(0);
+        tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), Ai.col(0).data());
+        Ai.rightCols(P) = G.leftCols(P);
+        Ai.rightCols(P).noalias() -= D_rows_ * vt.rightCols(P);
+        Ai.rightCols(P).noalias() -= K_rows_ * w.rightCols(P);
+        S.solve_in_place(Ai.col(1).data(), P, n);
         cnt.linear_solves += P;
-        As[si].rightCols(P) = r.rightCols(P);
-        Vs[si].rightCols(P) = vt.rightCols(P) + g * r.rightCols(P);
+        Vs[si].rightCols(P) = vt.rightCols(P) + g * Ai.rightCols(P);
       }
     }
+    // x += h Σ_j b_j V_j, v += h Σ_j b_j A_j, accumulated term by term in one pass.
+    std::size_t nb = 0;
     for (int j = 0; j < s; ++j) {
       const double c = hs * tab_.b[static_cast<std::size_t>(j)];
-      if (c == 0.0) continue;
-      x.noalias() += c * Vs[static_cast<std::size_t>(j)];
-      v.noalias() += c * As[static_cast<std::size_t>(j)];
+      if (c != 0.0) terms[nb++] = {c, static_cast<std::size_t>(j)};
+    }
+    if (nb == 4) {
+      const auto& [b0, k0] = terms[0];
+      const auto& [b1, k1] = terms[1];
+      const auto& [b2, k2] = terms[2];
+      const auto& [b3, k3] = terms[3];
+      x = x + b0 * Vs[k0] + b1 * Vs[k1] + b2 * Vs[k2] + b3 * Vs[k3];
+      v = v + b0 * As[k0] + b1 * As[k1] + b2 * As[k2] + b3 * As[k3];
+    } else {
+      for (std::size_t k = 0; k < nb; ++k) {
+        x.noalias() += terms[k].first * Vs[terms[k].second];
+        v.noalias() += terms[k].first * As[terms[k].second];
+      }
     }
     if (stiffly_accurate_) a = As[static_cast<std::size_t>(s - 1)];
     else accelerate(tn + hs);
