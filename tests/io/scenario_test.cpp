@@ -377,6 +377,12 @@ identification:
   EXPECT_EQ(ladder.identification.start, "coarse-to-fine");
   EXPECT_EQ(to_json(ladder)["identification"]["start"].get<std::string>(), "coarse-to-fine");
   EXPECT_NE(error_of(head + "  start: random\n").find("identification.start"), std::string::npos);
+  // The automatic step's rule: parameters by default, or data.
+  EXPECT_EQ(automatic.identification.step_rule, "parameters");
+  const Scenario by_data = parse_scenario(head + "  step_rule: data\n", "scenario 'x.yaml'");
+  EXPECT_EQ(by_data.identification.step_rule, "data");
+  EXPECT_EQ(to_json(by_data)["identification"]["step_rule"].get<std::string>(), "data");
+  EXPECT_NE(error_of(head + "  step_rule: sometimes\n").find("identification.step_rule"), std::string::npos);
   // The identifier's model: linear by default; nonlinear is SCOLE's only.
   EXPECT_EQ(automatic.identification.model, "linear");
   EXPECT_EQ(to_json(automatic)["identification"]["model"].get<std::string>(), "linear");
