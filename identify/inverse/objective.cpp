@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <memory>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -200,21 +201,34 @@ std::vector<double> Objective::union_grid(const std::vector<const std::vector<do
   return g;
 }
 
-double Objective::cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const {
-  return misfit_against(s, solver, u, data_);
+void Objective::window_grid(const Trajectory& w, double t_end, std::vector<double>& grid) const {
+  // The window's part of the global grid (its times ∪ the sample times ∪ {t_end}, within
+  // [t0, t_end]): consecutive windows share their boundary, so their grids join into the global one.
+  grid.clear();
+  const double lo = std::max(data_.t.front(), w.t_begin()), hi = std::min(t_end, w.t_end());
+  if (!(hi > lo)) return;
+  for (double t : w.times())
+    if (t >= lo && t <= hi) grid.push_back(t);
+  for (auto it = std::lower_bound(data_.t.begin(), data_.t.end(), lo); it != data_.t.end() && *it <= hi; ++it)
+    grid.push_back(*it);
+  grid.push_back(lo);
+  grid.push_back(hi);
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
 }
 
-double Objective::misfit_against(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u,
-                                 const Measurements& z_of) const {
+double Objective::misfit_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w,
+                                const Measurements& z_of, double t_end) const {
   const int n = model_.ndof, ns = data_.sensors();
-  const auto grid = union_grid({&u.times()}, T_);
+  std::vector<double> grid;
+  window_grid(w, t_end, grid);
   VectorXd x(n), v(n), z(ns);
   double J = 0.0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
     for (int g = 0; g < 3; ++g) {
       const double t = grid[k] + kGx[g] * h;
-      u.eval(t, x.data(), v.data());
+      w.eval(t, x.data(), v.data());
       z_of.eval(t, z.data());
       const VectorXd r = output_at(s, solver, t, x, v) - z;
       double e = 0.0;
@@ -225,66 +239,118 @@ double Objective::misfit_against(const Setup& s, const SecondOrderSolver& solver
   return J;
 }
 
-
-double Objective::interpolation_misfit(const VectorXd& q) {
-  const Setup s = setup(q);
-  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  // The whole record: the interpolant near T uses samples beyond it.
-  const Trajectory u = forward(solver, s, data_.t.back());
-  const int n = model_.ndof, ns = data_.sensors();
-  VectorXd x(n), v(n);
-  Measurements own{data_.names, data_.t, MatrixXd(static_cast<Eigen::Index>(data_.t.size()), ns)};
-  for (std::size_t i = 0; i < data_.t.size(); ++i) {
-    u.eval(data_.t[i], x.data(), v.data());
-    own.z.row(static_cast<Eigen::Index>(i)) = output_at(s, solver, data_.t[i], x, v).transpose();
-  }
-  return misfit_against(s, solver, u, own);
+double Objective::misfit_against(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u,
+                                 const Measurements& z_of) const {
+  return misfit_window(s, solver, u, z_of, T_);
 }
 
-Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,
-                                                  const Trajectory& u) const {
-  const int n = model_.ndof, ns = data_.sensors();
-  const double t_end = data_.t.back();
-  const auto grid = union_grid({&u.times()}, t_end);
-  VectorXd x(n), v(n), z(ns), rr = VectorXd::Zero(ns), zz = VectorXd::Zero(ns);
-  MisfitProfile prof;
-  std::size_t next = 1;  // next sample time to report
-  auto report = [&](double t) {
-    while (next < data_.t.size() && data_.t[next] <= t) {
+void Objective::forward_windows(const SecondOrderSolver& solver, const Setup& s, double t_end,
+                                const WindowedSink::Visit& visit) {
+  const auto t0 = Clock::now();
+  double inside = 0.0;
+  WindowedSink sink(model_.ndof, kStreamWindow, [&](const Trajectory& w) {
+    const auto tv = Clock::now();
+    visit(w);
+    inside += since(tv);
+  });
+  SolverSummary sum;
+  solver.stream(data_.t.front(), t_end, state_forcing(s), breakpoints_, [&](const SecondOrderSolver::Point& pt) { sink(pt); },
+                &sum);
+  sink.finish();
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.forward_seconds += since(t0) - inside;
+  counters_.quadrature_seconds += inside;
+}
+
+// Running per-sensor sums ∫ r² and ∫ z² from t0, reported as their mean ratio at each sample time
+// they pass (MisfitProfile).
+struct Objective::ProfileSums {
+  explicit ProfileSums(const Measurements& d) : data(d), rr(VectorXd::Zero(d.sensors())), zz(VectorXd::Zero(d.sensors())) {}
+  void report(double t) {
+    const auto ns = rr.size();
+    while (next < data.t.size() && data.t[next] <= t) {
       double m = 0.0;
-      for (int k = 0; k < ns; ++k) m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
-      prof.t.push_back(data_.t[next]);
-      prof.misfit.push_back(m / ns);
+      for (Eigen::Index k = 0; k < ns; ++k) m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
+      prof.t.push_back(data.t[next]);
+      prof.misfit.push_back(m / static_cast<double>(ns));
       ++next;
     }
-  };
+  }
+  const Measurements& data;
+  VectorXd rr, zz;
+  std::size_t next = 1;  // next sample time to report
+  MisfitProfile prof;
+};
+
+void Objective::profile_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w,
+                               ProfileSums& sums) const {
+  const int n = model_.ndof, ns = data_.sensors();
+  std::vector<double> grid;
+  window_grid(w, data_.t.back(), grid);
+  VectorXd x(n), v(n), z(ns);
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
     for (int g = 0; g < 3; ++g) {
       const double t = grid[k] + kGx[g] * h;
-      u.eval(t, x.data(), v.data());
+      w.eval(t, x.data(), v.data());
       data_.eval(t, z.data());
       const VectorXd r = output_at(s, solver, t, x, v) - z;
-      rr += kGw[g] * h * r.cwiseAbs2();
-      zz += kGw[g] * h * z.cwiseAbs2();
+      sums.rr += kGw[g] * h * r.cwiseAbs2();
+      sums.zz += kGw[g] * h * z.cwiseAbs2();
     }
-    report(grid[k + 1]);
+    sums.report(grid[k + 1]);
   }
-  return prof;
+}
+
+double Objective::interpolation_misfit(const VectorXd& q) {
+  const Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  // The whole record: the interpolant near T uses samples beyond it. The model's own samples first,
+  // then the misfit against their interpolant: from one stored state when it fits the trajectory
+  // budget, else from two streamed solves.
+  const int n = model_.ndof, ns = data_.sensors();
+  Measurements own{data_.names, data_.t, MatrixXd(static_cast<Eigen::Index>(data_.t.size()), ns)};
+  if (checkpoint_spacing(solver) == 0) {
+    const Trajectory u = forward(solver, s, data_.t.back());
+    VectorXd x(n), v(n);
+    for (std::size_t i = 0; i < data_.t.size(); ++i) {
+      u.eval(data_.t[i], x.data(), v.data());
+      own.z.row(static_cast<Eigen::Index>(i)) = output_at(s, solver, data_.t[i], x, v).transpose();
+    }
+    return misfit_against(s, solver, u, own);
+  }
+  SolverSummary sum;
+  sample_streamed(solver, data_.t.front(), data_.t.back(), state_forcing(s), breakpoints_, data_.t,
+                  [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
+                    own.z.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
+                  },
+                  &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  double J = 0.0;
+  forward_windows(solver, s, data_.t.back(), [&](const Trajectory& w) { J += misfit_window(s, solver, w, own, T_); });
+  return J;
+}
+
+Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,
+                                                  const Trajectory& u) const {
+  ProfileSums sums(data_);
+  profile_window(s, solver, u, sums);
+  return std::move(sums.prof);
 }
 
 double Objective::cost(const VectorXd& q) {
+  // Streamed: the misfit accumulates window by window, so no O(steps) array is kept.
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s, T_);
-  const auto t0 = Clock::now();
-  const double J = cost_of(s, solver, u);
-  counters_.quadrature_seconds += since(t0);
+  double J = 0.0;
+  forward_windows(solver, s, T_, [&](const Trajectory& w) { J += misfit_window(s, solver, w, data_, T_); });
   return J;
 }
 
 std::size_t Objective::checkpoint_spacing(const SecondOrderSolver& solver) const {
-  if (!solver.can_resume() || C1_.size() != 0) return 0;
+  if (!solver.can_resume()) return 0;
   const double t0 = data_.t.front();
   const double h = options_.solver.step > 0 ? options_.solver.step : (T_ - t0) / 2000.0;
   const double points = (T_ - t0) / h + 1.0 + 2.0 * static_cast<double>(breakpoints_.size());
@@ -375,27 +441,191 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   return J;
 }
 
+Objective::RateTerms Objective::rate_terms(const Setup& s, const SecondOrderSolver& solver) const {
+  const int n = model_.ndof, ns = data_.sensors();
+  RateTerms rt;
+  rt.MinvC2t = MatrixXd::Zero(n, ns);
+  if (accelerations_) {
+    const VectorXd zero = VectorXd::Zero(n);
+    for (int k = 0; k < ns; ++k) {
+      const VectorXd c = C2_.row(k).transpose();
+      solver.acceleration(c.data(), zero.data(), zero.data(), rt.MinvC2t.col(k).data());
+    }
+  }
+  rt.A0 = C_ - rt.MinvC2t.transpose() * s.ops.K;
+  rt.A1 = C1_ - rt.MinvC2t.transpose() * s.ops.D;
+  rt.G = MatrixXd::Zero(ns, static_cast<Eigen::Index>(s.ops.loads.size()));
+  for (std::size_t i = 0; i < s.ops.loads.size(); ++i)
+    rt.G.col(static_cast<Eigen::Index>(i)) = rt.MinvC2t.transpose() * s.ops.loads[i];
+  return rt;
+}
+
+struct Objective::RateSources {
+  using ModelPart = std::function<void(double t, VectorXd& y)>;  // y = A₀u(t) + A₁u̇(t)
+  RateSources(const Objective& o, const RateTerms& rt, ModelPart part)
+      : o_(o), rt_(rt), part_(std::move(part)), y_(o.data_.sensors()), z_(o.data_.sensors()) {}
+  // With an acceleration output r jumps where the input does. The stepper asks for the right limit
+  // in τ at τ_b = T − t_b, which is the left limit in t (the signals are right-continuous).
+  double time_of(double tau) const {
+    const double t = o_.T_ - tau;
+    for (double tb : o_.breakpoints_)
+      if (std::abs(t - tb) <= 1e-12 * std::max(1.0, std::abs(tb)))
+        return tau >= o_.T_ - tb ? std::nextafter(tb, -std::numeric_limits<double>::infinity()) : tb;
+    return t;
+  }
+  void at(double tau) {
+    if (tau == tau_) return;
+    tau_ = tau;
+    const double t = time_of(tau);
+    part_(t, y_);
+    o_.data_.eval(t, z_.data());
+    y_ -= z_;
+    for (std::size_t i = 0; i < o_.inputs_.size(); ++i) {
+      const double fi = o_.inputs_[i](t);
+      if (fi != 0.0) y_ += fi * rt_.G.col(static_cast<Eigen::Index>(i));
+    }
+    for (Eigen::Index j = 0; j < y_.size(); ++j) y_[j] *= o_.R_[static_cast<std::size_t>(j)];
+    w0.noalias() = rt_.A0.transpose() * y_;
+    w1.noalias() = rt_.A1.transpose() * y_;
+  }
+  VectorXd w0, w1;
+
+private:
+  const Objective& o_;
+  const RateTerms& rt_;
+  ModelPart part_;
+  VectorXd y_, z_;
+  double tau_ = std::numeric_limits<double>::quiet_NaN();
+};
+
+double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderSolver& solver, const RateTerms& rt,
+                                              const Trajectory& out, std::vector<Checkpoint> ckpts,
+                                              std::size_t spacing, VectorXd& gc) {
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t0 = data_.t.front();
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  const SecondOrderSolver::Forcing force = state_forcing(s);
+  CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
+  std::vector<double> bp_tau;
+  for (double b : breakpoints_)
+    if (b < T_) bp_tau.push_back(T_ - b);
+  std::sort(bp_tau.begin(), bp_tau.end());
+  // The sources from the recorded (A₀u, A₁u̇): the same numbers as A₀, A₁ times the state's interpolant.
+  VectorXd yo(2 * ns), ydo(2 * ns);
+  RateSources src(*this, rt, [&](double t, VectorXd& y) {
+    out.eval(t, yo.data(), ydo.data());
+    y = yo.head(ns) + yo.tail(ns);
+  });
+  SecondOrderSolver::Forcing g0 = [&](double tau, double* F) {
+    src.at(tau);
+    Eigen::Map<VectorXd>(F, n) = -src.w0;
+  };
+  SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*, double* F) {
+    src.at(tau);
+    Eigen::Map<VectorXd>(F, n) = -src.w1;
+  };
+  double J = 0.0;
+  VectorXd x(n), xv(n), a(n), F(n), py(2 * n), pyd(2 * n), p(n), pd(n), z(ns), r(ns);
+  std::vector<double> grid;
+  double quadrature = 0.0, resolve = 0.0;
+  // Each window holds P and Y stacked over [τa, τb], i.e. t in [T − τb, T − τa].
+  WindowedSink windows(n, spacing, [&](const Trajectory& W) {
+    const double ta = std::max(t0, T_ - W.t_end()), tb = std::min(T_, T_ - W.t_begin());
+    if (!(tb > ta)) return;
+    const auto tr = Clock::now();
+    state.cover(ta, tb);
+    const auto tq = Clock::now();
+    resolve += std::chrono::duration<double>(tq - tr).count();
+    grid.clear();
+    for (double tau : W.times()) grid.push_back(T_ - tau);
+    state.times_in(ta, tb, grid);
+    for (double t : data_.t)
+      if (t >= ta && t <= tb) grid.push_back(t);
+    grid.push_back(ta);
+    grid.push_back(tb);
+    std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+    grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
+    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+      const double h = grid[k + 1] - grid[k];
+      for (int gq = 0; gq < 3; ++gq) {
+        const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
+        state.eval(t, x.data(), xv.data());
+        F.setZero();
+        force(t, F.data());
+        solver.acceleration(F.data(), x.data(), xv.data(), a.data());  // ü from the equation of motion
+        data_.eval(t, z.data());
+        r.noalias() = C_ * x;
+        r.noalias() += C1_ * xv;
+        if (accelerations_) r.noalias() += C2_ * a;
+        r -= z;
+        double e = 0.0;
+        for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+        J += 0.5 * wt * e;
+        // Multiplier of §6.1a: p = p₀ − ẏ − μ with ṗ₀(t) = −P'(T − t), ẏ(t) = −Y'(T − t).
+        W.eval(T_ - t, py.data(), pyd.data());
+        p = py.head(n) + pyd.tail(n);
+        pd = -pyd.head(n);
+        if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
+        add_coefficient_gradient(t, wt, p, pd, x, xv, a, true, gc);
+      }
+    }
+    quadrature += since(tq);
+  }, 2);
+  const auto tc = Clock::now();
+  SolverSummary sum;
+  solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau,
+                        [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum);
+  windows.finish();
+  counters_.solver.Accumulate(sum);
+  counters_.solver.Accumulate(state.summary());
+  counters_.costate_solves += 2;
+  ++counters_.checkpointed_passes;
+  counters_.checkpoint_resolves += state.resolves();
+  counters_.costate_seconds += since(tc) - quadrature - resolve;
+  counters_.forward_seconds += resolve;
+  counters_.quadrature_seconds += quadrature;
+  return J;
+}
+
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  const bool rates = C1_.size() != 0;
   if (const std::size_t L = checkpoint_spacing(solver); L > 0) {
     // Checkpointed (docs/theory.md §7.9): the forward run keeps its outputs and every L-th point.
+    // With rate sensors the outputs are A₀u and A₁u̇ (each with its derivative, so that their
+    // interpolants are those of the state's), from which the residual needs only f(t) and z(t).
     const int n = model_.ndof, ns = data_.sensors();
+    RateTerms rt;
+    if (rates) rt = rate_terms(s, solver);
     const auto tf = Clock::now();
     CheckpointRecorder ck(n, L);
-    Trajectory out(ns);
+    Trajectory out(rates ? 2 * ns : ns);
+    VectorXd y(2 * ns), yd(2 * ns);
+    const VectorXd none = VectorXd::Zero(2 * ns);
     SolverSummary sum;
     solver.stream(data_.t.front(), T_, state_forcing(s), breakpoints_,
                   [&](const SecondOrderSolver::Point& pt) {
                     ck(pt);
-                    push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
+                    if (!rates) {
+                      push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
+                      return;
+                    }
+                    const Eigen::Map<const VectorXd> x(pt.x, n), v(pt.v, n), a(pt.a, n);
+                    y.head(ns).noalias() = rt.A0 * x;
+                    y.tail(ns).noalias() = rt.A1 * v;
+                    yd.head(ns).noalias() = rt.A0 * v;
+                    yd.tail(ns).noalias() = rt.A1 * a;
+                    out.push(pt.t, y.data(), yd.data(), none.data());
                   },
                   &sum);
     counters_.solver.Accumulate(sum);
     ++counters_.forward_solves;
     counters_.forward_seconds += since(tf);
     VectorXd gc = VectorXd::Zero(model_.ncoef);
-    const double J = backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
+    const double J = rates ? backward_rates_checkpointed(s, solver, rt, out, std::move(ck.checkpoints()), L, gc)
+                           : backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
     gradient = s.dcdq.transpose() * gc;
     ++counters_.gradient_evaluations;
     return J;
@@ -403,7 +633,6 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const Trajectory u = forward(solver, s, T_);
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
-  const bool rates = C1_.size() != 0;
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   const SecondOrderSolver::Forcing force = state_forcing(s);
 
@@ -412,25 +641,8 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     if (b < T_) bp_tau.push_back(T_ - b);
   std::sort(bp_tau.begin(), bp_tau.end());
 
-  // Rate sensors (docs/theory.md §6.1a): with ü = M⁻¹(f − D u̇ − K u) the residual is
-  //   r = A₀ u + A₁ u̇ + Σ_i f_i G_i − z̃,   A₀ = C₀ − C₂M⁻¹K,  A₁ = C₁ − C₂M⁻¹D,  G_i = C₂M⁻¹b_i,
-  // dense ns × n, and μ = M⁻¹C₂ᵀ R r = (M⁻¹C₂ᵀ) R r (M symmetric): ns mass solves per gradient, none
-  // per forcing evaluation.
-  MatrixXd A0, A1, MinvC2t, G;
-  if (rates) {
-    MinvC2t = MatrixXd::Zero(n, ns);
-    if (accelerations_) {
-      const VectorXd zero = VectorXd::Zero(n);
-      for (int k = 0; k < ns; ++k) {
-        const VectorXd c = C2_.row(k).transpose();
-        solver.acceleration(c.data(), zero.data(), zero.data(), MinvC2t.col(k).data());
-      }
-    }
-    A0 = C_ - MinvC2t.transpose() * s.ops.K;
-    A1 = C1_ - MinvC2t.transpose() * s.ops.D;
-    G = MatrixXd::Zero(ns, static_cast<Eigen::Index>(s.ops.loads.size()));
-    for (std::size_t i = 0; i < s.ops.loads.size(); ++i) G.col(static_cast<Eigen::Index>(i)) = MinvC2t.transpose() * s.ops.loads[i];
-  }
+  RateTerms rt;
+  if (rates) rt = rate_terms(s, solver);
 
   // Backward solves in reversed time τ = T − t (docs/theory.md §6.2):
   //   P(τ) = p₀(T − τ),  M P'' + D P' + K P = −w₀(T − τ)
@@ -453,35 +665,15 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     counters_.solver.Accumulate(sum);
     ++counters_.costate_solves;
   } else {
-    // With an acceleration output r jumps where the input does. The stepper asks for the right
-    // limit in τ at τ_b = T − t_b, which is the left limit in t (the signals are right-continuous).
-    auto backward_time = [&](double tau) {
-      const double t = T_ - tau;
-      for (double tb : breakpoints_)
-        if (std::abs(t - tb) <= 1e-12 * std::max(1.0, std::abs(tb)))
-          return tau >= T_ - tb ? std::nextafter(tb, -std::numeric_limits<double>::infinity()) : tb;
-      return t;
-    };
-    // w₀ = A₀ᵀ R r and w₁ = A₁ᵀ R r at τ, kept for the second forcing evaluated at the same τ.
-    double tau_last = std::numeric_limits<double>::quiet_NaN();
-    VectorXd xb(n), vb(n), zb(ns), rb(ns), w0(n), w1(n);
-    auto weights_at = [&](double tau) {
-      if (tau == tau_last) return;
-      tau_last = tau;
-      const double t = backward_time(tau);
+    VectorXd xb(n), vb(n);
+    RateSources src(*this, rt, [&](double t, VectorXd& y) {
       u.eval(t, xb.data(), vb.data());
-      data_.eval(t, zb.data());
-      rb.noalias() = A0 * xb;
-      rb.noalias() += A1 * vb;
-      rb -= zb;
-      for (std::size_t i = 0; i < inputs_.size(); ++i) {
-        const double fi = inputs_[i](t);
-        if (fi != 0.0) rb += fi * G.col(static_cast<Eigen::Index>(i));
-      }
-      rb = Rv.cwiseProduct(rb);
-      w0.noalias() = A0.transpose() * rb;
-      w1.noalias() = A1.transpose() * rb;
-    };
+      y.noalias() = rt.A0 * xb;
+      y.noalias() += rt.A1 * vb;
+    });
+    auto weights_at = [&](double tau) { src.at(tau); };
+    const VectorXd& w0 = src.w0;
+    const VectorXd& w1 = src.w1;
     SecondOrderSolver::Forcing g0 = [&](double tau, double* F) {
       weights_at(tau);
       Eigen::Map<VectorXd>(F, n) = -w0;
@@ -539,7 +731,7 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
         // Multiplier of §6.1a: p = p₀ − ẏ − μ, ẏ(t) = −Y'(T − t).
         Y.eval(T_ - t, yx.data(), yd.data());
         p += yd;
-        if (accelerations_) p.noalias() -= MinvC2t * Rv.cwiseProduct(r);  // μ
+        if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
       }
       double e = 0.0;
       for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
@@ -768,7 +960,13 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
   double J = 0.0, quadrature = 0.0;
-  Trajectory u(n);
+  // The misfit profile (over the whole record) from the state's column in windows.
+  std::unique_ptr<ProfileSums> sums;
+  std::unique_ptr<WindowedSink> profile_sink;
+  if (profile) {
+    sums = std::make_unique<ProfileSums>(data_);
+    profile_sink = std::make_unique<WindowedSink>(n, kStreamWindow, [&](const Trajectory& w) { profile_window(s, solver, w, *sums); });
+  }
   MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
   VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
   // Without acceleration sensors the outputs are C x + C₁ v of every column, linear in the
@@ -782,7 +980,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   std::size_t next_data = 0;  // first data time not below t_prev
   std::vector<double> cuts;
   auto visit = [&](const SecondOrderSolver::Point& pt) {
-    if (profile) u.push(pt.t, pt.x, pt.v, pt.a);
+    if (profile_sink) (*profile_sink)(pt);
     const int cols = pt.columns;
     const Eigen::Map<const MatrixXd> X1(pt.x, n, cols), V1(pt.v, n, cols), A1(pt.a, n, cols);
     if (output_space && cols == m) {
@@ -856,7 +1054,10 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   counters_.sensitivity_solves += P;
   counters_.sensitivity_seconds += since(ts) - quadrature;
   const auto tq = Clock::now();
-  if (profile) *profile = misfit_profile(s, solver, u);
+  if (profile) {
+    profile_sink->finish();
+    *profile = std::move(sums->prof);
+  }
   counters_.quadrature_seconds += quadrature + since(tq);
   return J;
 }
@@ -864,11 +1065,9 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
 Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const Trajectory u = forward(solver, s, data_.t.back());
-  const auto t0 = Clock::now();
-  MisfitProfile p = misfit_profile(s, solver, u);
-  counters_.quadrature_seconds += since(t0);
-  return p;
+  ProfileSums sums(data_);
+  forward_windows(solver, s, data_.t.back(), [&](const Trajectory& w) { profile_window(s, solver, w, sums); });
+  return std::move(sums.prof);
 }
 
 VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {

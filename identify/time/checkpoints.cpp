@@ -21,10 +21,14 @@ void CheckpointRecorder::operator()(const SecondOrderSolver::Point& pt) {
   ckpts_.push_back(std::move(c));
 }
 
-WindowedSink::WindowedSink(int n, std::size_t points, Visit visit)
-    : n_(n), points_(std::max<std::size_t>(points, 2)), visit_(std::move(visit)), window_(n) {}
+WindowedSink::WindowedSink(int n, std::size_t points, Visit visit, int columns)
+    : n_(n * std::max(columns, 1)), columns_(std::max(columns, 1)), points_(std::max<std::size_t>(points, 2)),
+      visit_(std::move(visit)), window_(n_) {}
 
 void WindowedSink::operator()(const SecondOrderSolver::Point& pt) {
+  // Columns are stored one after another (n × columns, column-major), so the first `columns_` of
+  // them are the first n_ numbers.
+  if (pt.columns < columns_) throw std::logic_error("WindowedSink: a point without the columns the window holds");
   if (window_.size() >= points_ && pt.t > window_.t_end()) {
     visit_(window_);
     Trajectory next(n_);

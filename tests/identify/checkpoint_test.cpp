@@ -2,7 +2,7 @@
 // resumable point reproduces the original points bit for bit (breakpoints included); windows share
 // their boundaries and keep a breakpoint's two limits together; the gradient and the Gauss–Newton
 // product on a checkpointed state equal the ones on the stored state to rounding, for several
-// spacings, with each state segment re-solved once; streamed samples equal the stored solution's
+// spacings, with each state segment re-solved once (with velocity and acceleration sensors too); streamed samples equal the stored solution's
 // interpolant bit for bit (on breakpoints and beyond the run too) whatever the window.
 #include <gtest/gtest.h>
 
@@ -163,6 +163,55 @@ TEST(Checkpoints, GradientAndProductOnACheckpointedStateEqualTheStoredOnes) {
     const double segments = std::ceil(points / static_cast<double>(L));
     EXPECT_LE(resolves, segments + 3);
     EXPECT_GE(resolves, segments - 3);
+  }
+}
+
+TEST(Checkpoints, RateSensorGradientOnACheckpointedStateEqualsTheStoredOne) {
+  // Velocity and acceleration sensors (docs/theory.md §6.1a): two backward equations streamed
+  // together, their sources from the recorded A₀u and A₁u̇; the step load and the haversine's ends
+  // make the acceleration output jump inside the record.
+  auto sc = scoleid::io::load_scenario("beam-ei8");
+  sc.identification.elements = 16;
+  sc.simulation.duration = 2.0;
+  sc.sensors[1].kind = "velocity";
+  sc.sensors[1].unit = "m/s";
+  sc.sensors[4].kind = "acceleration";
+  sc.sensors[4].unit = "m/s^2";
+  const auto p = make_problem(sc, std::nullopt);
+  const VectorXd q = p->params->initial() * 1.05;
+  Objective whole(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  ASSERT_FALSE(whole.has_matrix_free_products()) << "the scenario should have rate sensors";
+  VectorXd g0;
+  const double J0 = whole.cost_and_gradient(q, g0);
+  EXPECT_EQ(whole.counters().checkpointed_passes, 0);
+  // (The stored rate-sensor gradient is checked against differences and CVODES in gradient_test.)
+  ASSERT_GT(g0.norm(), 0.0);
+  // The cost alone is summed window by window over a streamed state (256 points a window, about
+  // six here): the windows' grids join into the whole run's, so it is the Gauss–Newton pass's J,
+  // which integrates the same grid point by point.
+  VectorXd ggn;
+  MatrixXd H;
+  const double Jgn = whole.gauss_newton(q, ggn, H);
+  const double Jc = whole.cost(q);
+  std::printf("rate sensors: streamed cost %.1e from the Gauss-Newton pass's\n", std::abs(Jc / Jgn - 1.0));
+  EXPECT_LT(std::abs(Jc / Jgn - 1.0), 1e-12);
+  const double points = static_cast<double>(p->data.t.back() / p->objective_options.solver.step);
+  for (long L : {1L, 5L, 40L, 300L}) {
+    ObjectiveOptions oo = p->objective_options;
+    oo.checkpoint_points = L;
+    Objective ck(p->model(), *p->params, p->signals, p->data, oo);
+    VectorXd g;
+    const double J = ck.cost_and_gradient(q, g);
+    const double eJ = std::abs(J / J0 - 1.0), eg = (g - g0).norm() / g0.norm();
+    std::printf("rate sensors, L = %4ld: J %.1e, gradient %.1e (relative to the stored state); %ld segments re-solved\n",
+                L, eJ, eg, ck.counters().checkpoint_resolves);
+    EXPECT_EQ(ck.counters().checkpointed_passes, 1);
+    EXPECT_EQ(ck.counters().costate_solves, 2);
+    EXPECT_LT(eJ, 1e-12);
+    EXPECT_LT(eg, 1e-10);
+    const double segments = std::ceil(points / static_cast<double>(L));
+    EXPECT_LE(ck.counters().checkpoint_resolves, segments + 3 + (L == 1 ? segments : 0));
+    EXPECT_GE(ck.counters().checkpoint_resolves, segments - 3);
   }
 }
 

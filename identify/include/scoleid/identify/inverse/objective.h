@@ -158,7 +158,17 @@ private:
   };
   Setup setup(const VectorXd& q) const;
   Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
-  double cost_of(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
+  // The state streamed over [t0, t_end] in windows of kStreamWindow points (checkpoints.h), each
+  // handed to `visit`: memory O(window · DOF) whatever the record's length.
+  static constexpr std::size_t kStreamWindow = 256;
+  void forward_windows(const SecondOrderSolver& solver, const Setup& s, double t_end, const WindowedSink::Visit& visit);
+  // The quadrature grid on a window: its times ∪ the sample times ∪ {t_end}, within [t0, t_end].
+  void window_grid(const Trajectory& w, double t_end, std::vector<double>& grid) const;
+  // ½ Σ_k R_k ∫ (y_k − z̃_k)² over the window's part of [t0, t_end].
+  double misfit_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w, const Measurements& z,
+                       double t_end) const;
+  struct ProfileSums;
+  void profile_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w, ProfileSums& sums) const;
   // ½ Σ_k R_k ∫ (y_k − z̃_k)² over [t0, T] against the interpolant of `z` (the data, or other samples).
   double misfit_against(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u, const Measurements& z) const;
   MisfitProfile misfit_profile(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u) const;
@@ -211,6 +221,23 @@ private:
   // quadrature into gc with the state re-solved from `ckpts`. Returns the cost when `residual`.
   double backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out, bool residual,
                                std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc);
+  // Rate sensors (docs/theory.md §6.1a): with ü = M⁻¹(f − D u̇ − K u) the residual is
+  //   r = A₀ u + A₁ u̇ + Σ_i f_i G_i − z̃,   A₀ = C₀ − C₂M⁻¹K,  A₁ = C₁ − C₂M⁻¹D,  G_i = C₂M⁻¹b_i,
+  // dense ns × n, and μ = M⁻¹C₂ᵀ R r = (M⁻¹C₂ᵀ) R r: ns mass solves per gradient, none per forcing.
+  struct RateTerms {
+    MatrixXd A0, A1, MinvC2t, G;
+  };
+  RateTerms rate_terms(const Setup& s, const SecondOrderSolver& solver) const;
+  // The rate-sensor costate's two sources at τ, w₀ = A₀ᵀ R r and w₁ = A₁ᵀ R r at t = T − τ (the
+  // left limit in t at a breakpoint), with `model_part(t, y)` giving A₀ u(t) + A₁ u̇(t); evaluated
+  // once per τ for both backward equations.
+  struct RateSources;
+  // The rate-sensor backward pass on a checkpointed state: `out` records (A₀u, A₁u̇) with their
+  // derivatives (2 ns columns), P and Y are streamed together in windows, the state re-solved from
+  // `ckpts` for the quadrature. Returns the cost.
+  double backward_rates_checkpointed(const Setup& s, const SecondOrderSolver& solver, const RateTerms& rt,
+                                     const Trajectory& out, std::vector<Checkpoint> ckpts, std::size_t spacing,
+                                     VectorXd& gc);
 
   // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
   // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.

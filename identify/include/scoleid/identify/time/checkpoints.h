@@ -38,18 +38,20 @@ private:
   std::vector<Checkpoint> ckpts_;
 };
 
-// Collects streamed points (column 0) into windows of at most `points` points and hands each
-// window to `visit`; consecutive windows share their boundary point, and a breakpoint's two limits
-// always stay in one window. finish() hands over the last window.
+// Collects streamed points into windows of at most `points` points and hands each window to
+// `visit`; consecutive windows share their boundary point, and a breakpoint's two limits always stay
+// in one window. finish() hands over the last window. A window holds the first `columns` columns of
+// each point stacked (dimension columns · n: the state, then its tangents); a point with fewer
+// columns throws std::logic_error.
 class WindowedSink {
 public:
   using Visit = std::function<void(const Trajectory&)>;
-  WindowedSink(int n, std::size_t points, Visit visit);
+  WindowedSink(int n, std::size_t points, Visit visit, int columns = 1);
   void operator()(const SecondOrderSolver::Point& pt);
   void finish();
 
 private:
-  int n_;
+  int n_, columns_;
   std::size_t points_;
   Visit visit_;
   Trajectory window_;
