@@ -255,6 +255,34 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       coupling_.push_back(std::move(c));
     }
   }
+  // The mast's foreshortening (struct Foreshortening): the slopes' rows at three Gauss points per
+  // element and, per mast mass point, at three on [element start, s_i].
+  {
+    auto node = [&](double s, double weight) {
+      Foreshortening::Node nd;
+      const MatrixXd R = on_e(fe.mast_rotation(s)).topRows(2);
+      for (Eigen::Index j = 0; j < ne_; ++j)
+        if (R.col(j).cwiseAbs().maxCoeff() != 0.0) nd.cols.push_back(static_cast<int>(j));
+      nd.rows.resize(2, static_cast<Eigen::Index>(nd.cols.size()));
+      for (std::size_t k = 0; k < nd.cols.size(); ++k) nd.rows.col(static_cast<Eigen::Index>(k)) = R.col(nd.cols[k]);
+      nd.weight = weight;
+      return nd;
+    };
+    fs_.elements = fe.elements;
+    for (int el = 0; el < fe.elements; ++el)
+      for (int q = 0; q < 3; ++q) fs_.node.push_back(node((el + x3[q]) * h, w3[q] * h));
+    for (int el = 0; el < fe.elements; ++el)
+      for (int q = 0; q < 4; ++q) {
+        const double s0 = el * h, len = x4[q] * h;
+        for (int k = 0; k < 3; ++k) fs_.node.push_back(node(s0 + x3[k] * len, w3[k] * len));
+        fs_.element_of.push_back(el);
+        fs_.point.push_back(static_cast<std::size_t>(4 * el + q));
+      }
+    fs_.t = Vector3d::UnitZ();  // the mast runs along −z from its root
+    for (std::size_t i : fs_.point)  // T_fs leaves M_ee alone only because the rows are lateral
+      if ((fs_.t.transpose() * points_[i].N).cwiseAbs().maxCoeff() != 0.0)
+        throw std::logic_error("ScoleNonlinear: a mast point's rows move it along the mast");
+  }
   // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
   {
     // The CM turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back towards the
@@ -353,6 +381,70 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     sensors_.push_back(std::move(s));
     sensor_names_.push_back(ms.name);
   }
+}
+
+ScoleNonlinear::Foreshortening::Slopes ScoleNonlinear::Foreshortening::slopes(const VectorXd& x) const {
+  Slopes S(2, static_cast<Eigen::Index>(node.size()));
+  for (std::size_t j = 0; j < node.size(); ++j) {
+    const Node& nd = node[j];
+    Eigen::Vector2d a = Eigen::Vector2d::Zero();
+    for (std::size_t k = 0; k < nd.cols.size(); ++k) a += nd.rows.col(static_cast<Eigen::Index>(k)) * x[nd.cols[k]];
+    S.col(static_cast<Eigen::Index>(j)) = a;
+  }
+  return S;
+}
+
+void ScoleNonlinear::Foreshortening::add(std::size_t j, const Eigen::Vector2d& a, VectorXd& out) const {
+  const Node& nd = node[j];
+  for (std::size_t k = 0; k < nd.cols.size(); ++k) out[nd.cols[k]] += nd.rows.col(static_cast<Eigen::Index>(k)).dot(a);
+}
+
+void ScoleNonlinear::Foreshortening::forms(const Slopes& X, const Slopes& Y, std::vector<double>& out) const {
+  auto form = [&](std::size_t j) {
+    const auto jj = static_cast<Eigen::Index>(j);
+    return node[j].weight * X.col(jj).dot(Y.col(jj));
+  };
+  out.assign(size(), 0.0);
+  double below = 0.0;  // over the elements below the current one
+  int el = 0;
+  const std::size_t first_partial = 3 * static_cast<std::size_t>(elements);
+  for (std::size_t i = 0; i < size(); ++i) {
+    for (; el < element_of[i]; ++el)
+      for (std::size_t q = 0; q < 3; ++q) below += form(3 * static_cast<std::size_t>(el) + q);
+    double v = below;
+    for (std::size_t q = 0; q < 3; ++q) v += form(first_partial + 3 * i + q);
+    out[i] = v;
+  }
+}
+
+template <class G, class Visit>
+void ScoleNonlinear::Foreshortening::coefficients(const std::vector<G>& gamma, G zero, Visit&& visit) const {
+  const std::size_t first_partial = 3 * static_cast<std::size_t>(elements);
+  G above = zero;
+  std::size_t i = size();
+  for (int el = elements - 1; el >= 0; --el) {
+    for (std::size_t q = 0; q < 3; ++q) visit(3 * static_cast<std::size_t>(el) + q, above);
+    for (; i > 0 && element_of[i - 1] == el; --i) {
+      for (std::size_t q = 0; q < 3; ++q) visit(first_partial + 3 * (i - 1) + q, gamma[i - 1]);
+      above += gamma[i - 1];
+    }
+  }
+}
+
+void ScoleNonlinear::Foreshortening::apply(const std::vector<double>& gamma, const Slopes& X, VectorXd& out) const {
+  coefficients(gamma, 0.0, [&](std::size_t j, double c) {
+    if (c != 0.0) add(j, Eigen::Vector2d(c * node[j].weight * X.col(static_cast<Eigen::Index>(j))), out);
+  });
+}
+
+void ScoleNonlinear::Foreshortening::apply_rows(const std::vector<Eigen::Matrix<double, 6, 1>>& gamma, const Slopes& X,
+                                                MatrixXd& out) const {
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  coefficients(gamma, Vector6::Zero().eval(), [&](std::size_t j, const Vector6& g) {
+    const Node& nd = node[j];
+    const Eigen::Vector2d a = nd.weight * X.col(static_cast<Eigen::Index>(j));
+    for (std::size_t k = 0; k < nd.cols.size(); ++k) out.col(nd.cols[k]) += g * nd.rows.col(static_cast<Eigen::Index>(k)).dot(a);
+  });
 }
 
 ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants) const {
@@ -609,6 +701,138 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
   A.block<3, 3>(3, 0) += VO.transpose();
   A.block<3, 3>(3, 3) += OO;
   B.bottomRows<3>() += Oe;
+  add_foreshortening_rows(e, A, B);
+}
+
+// T_fs = Σ m k·s, k = V + Ω × r + N ė the point's velocity without its shift (r = p + N e),
+// s = t ẇ + (Ω × t) w the shift's (w = ½ eᵀ Q e, g = Q e). As t·N = 0 (the mast's rows are
+// lateral), T_fs = ½ uᵀ M_fs u with
+//   M_Ve = m t gᵀ,  M_Ωe = m [(r × t) gᵀ + w [t]× N],  M_VΩ = −m w [t]×,
+//   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×),   M_ee untouched (the ½ m ẇ² term is left out).
+void ScoleNonlinear::Dynamics::add_foreshortening_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A,
+                                                       MatrixXd& B) const {
+  const auto& F = g_->fs_;
+  if (F.size() == 0) return;
+  const auto Se = F.slopes(e);
+  std::vector<double> ww;
+  F.forms(Se, Se, ww);
+  std::vector<Eigen::Matrix<double, 6, 1>> gamma(F.size());
+  const Vector3d t = F.t;
+  const Matrix3d Tx = skew(t);
+  Matrix3d VO = Matrix3d::Zero(), OO = Matrix3d::Zero();
+  MatrixXd Oe = MatrixXd::Zero(3, g_->ne_);
+  for (std::size_t i = 0; i < F.size(); ++i) {
+    const auto& pt = g_->points_[F.point[i]];
+    const double m = mass_[F.point[i]], w = 0.5 * ww[i];
+    const Vector3d r = pt.p + pt.n.times(e);
+    gamma[i] << m * t, m * r.cross(t);
+    const Matrix3d Rx = skew(r);
+    VO -= m * w * Tx;
+    OO -= m * w * (Rx * Tx + Tx * Rx);
+    pt.n.add_left(m * w * Tx, Oe);
+  }
+  A.block<3, 3>(0, 3) += VO;
+  A.block<3, 3>(3, 0) += VO.transpose();
+  A.block<3, 3>(3, 3) += OO;
+  B.bottomRows<3>() += Oe;
+  F.apply_rows(gamma, Se, B);
+}
+
+// T_fs's equations (Boltzmann–Hamel on V, Ω; Lagrange on e) per point, with S = ṡ + Ω × s and
+// K = k̇ + Ω × k (the point's inertial acceleration without the shift):
+//   V: m S,   Ω: m (r × S + w t × K),   e: m (Nᵀ S + g t·K),
+//   S = t ẅ + (Ω̇ × t) w + 2 ẇ Ω × t + w Ω × (Ω × t),  ẅ = gᵀ ë + χ,  χ = ėᵀ Q ė,
+//   K = V̇ + Ω̇ × r + N ë + 2 Ω × N ė + Ω × V + Ω × (Ω × r).
+// The acceleration terms are M_fs's; here the rest (S₀, K₀): b gains them.
+void ScoleNonlinear::Dynamics::add_foreshortening_force(const VectorXd& u, const VectorXd& e, VectorXd& b) const {
+  const auto& F = g_->fs_;
+  if (F.size() == 0) return;
+  const int ne = g_->ne_;
+  const Vector3d V = u.head<3>(), W = u.segment<3>(3);
+  const VectorXd ed = u.tail(ne);
+  std::vector<double> ww, wd, chi, gamma(F.size());
+  const auto Se = F.slopes(e), Sd = F.slopes(ed);
+  F.forms(Se, Se, ww);
+  F.forms(Sd, Se, wd);
+  F.forms(Sd, Sd, chi);
+  const Vector3d t = F.t, Wt = W.cross(t);
+  Vector3d bV = Vector3d::Zero(), bW = Vector3d::Zero();
+  VectorXd be = VectorXd::Zero(ne);
+  for (std::size_t i = 0; i < F.size(); ++i) {
+    const auto& pt = g_->points_[F.point[i]];
+    const double m = mass_[F.point[i]], w = 0.5 * ww[i];
+    const Vector3d r = pt.p + pt.n.times(e), nd = pt.n.times(ed);
+    const Vector3d S0 = m * (t * chi[i] + 2.0 * wd[i] * Wt + w * W.cross(Wt));
+    const Vector3d K0 = m * (2.0 * W.cross(nd) + W.cross(V) + W.cross(W.cross(r)));
+    bV += S0;
+    bW += r.cross(S0) + w * t.cross(K0);
+    pt.n.add_transposed(S0, be);
+    gamma[i] = t.dot(K0);
+  }
+  b.head<3>() += bV;
+  b.segment<3>(3) += bW;
+  F.apply(gamma, Se, be);
+  b.tail(ne) += be;
+}
+
+// s_fs = μᵀ R_fs = Σ m σ,  σ = λ·S + κ·K,  λ = μ_V + μ_Ω × r + N μ_e,  κ = η t + w μ_Ω × t,
+// η = μ_eᵀ Q e (S, K as above, at the accelerations a). With ψ = a_eᵀ Q e, Ω_t = Ω × t:
+//   ∂σ/∂w = λ·(a_Ω × t + Ω × Ω_t) + (μ_Ω × t)·K,  ∂σ/∂ẇ = 2 λ·Ω_t,  ∂σ/∂ψ = ∂σ/∂χ = λ·t,  ∂σ/∂η = t·K,
+//   ∂σ/∂r = S × μ_Ω + κ × a_Ω + Ω × (Ω × κ),   ∂σ/∂(N ė) = 2 κ × Ω,   ∂σ/∂V = κ × Ω,
+//   ∂σ/∂Ω = 2 ẇ t × λ + w (λ (Ω·t) + t (λ·Ω) − 2 (λ·t) Ω) + 2 (N ė) × κ + V × κ
+//           + κ (Ω·r) + r (κ·Ω) − 2 (κ·r) Ω;
+// ∂/∂e = Nᵀ ∂σ/∂r + ∂σ/∂w Q e + ∂σ/∂ẇ Q ė + λ·t Q a_e + t·K Q μ_e,
+// ∂/∂ė = Nᵀ ∂σ/∂(N ė) + ∂σ/∂ẇ Q e + 2 λ·t Q ė  (each times m; ∂/∂c = weight σ).
+void ScoleNonlinear::Dynamics::add_foreshortening_vjp(const VectorXd& u, const VectorXd& e, const VectorXd& a,
+                                                      const VectorXd& mu, VectorXd& de, VectorXd& de_dot, VectorXd& du,
+                                                      VectorXd* dc) const {
+  const auto& F = g_->fs_;
+  if (F.size() == 0) return;
+  const int ne = g_->ne_;
+  const Vector3d V = u.head<3>(), W = u.segment<3>(3);
+  const VectorXd ed = u.tail(ne), ae = a.tail(ne), mue = mu.tail(ne);
+  const Vector3d aV = a.head<3>(), aW = a.segment<3>(3), muV = mu.head<3>(), muW = mu.segment<3>(3);
+  std::vector<double> ww, wd, chi, psi, eta;
+  const auto Se = F.slopes(e), Sd = F.slopes(ed), Sa = F.slopes(ae), Sm = F.slopes(mue);
+  F.forms(Se, Se, ww);
+  F.forms(Sd, Se, wd);
+  F.forms(Sd, Sd, chi);
+  F.forms(Sa, Se, psi);
+  F.forms(Sm, Se, eta);
+  const std::size_t n = F.size();
+  std::vector<double> g_w(n), g_wd(n), g_t(n), g_t2(n), g_K(n);
+  const Vector3d t = F.t, Wt = W.cross(t), muWt = muW.cross(t);
+  Vector3d dV = Vector3d::Zero(), dW = Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& pt = g_->points_[F.point[i]];
+    const double m = mass_[F.point[i]], w = 0.5 * ww[i], wdot = wd[i];
+    const Vector3d r = pt.p + pt.n.times(e), nd = pt.n.times(ed);
+    const Vector3d lam = muV + muW.cross(r) + pt.n.times(mue);
+    const Vector3d kap = eta[i] * t + w * muWt;
+    const Vector3d S = t * (psi[i] + chi[i]) + w * aW.cross(t) + 2.0 * wdot * Wt + w * W.cross(Wt);
+    const Vector3d K = aV + aW.cross(r) + pt.n.times(ae) + 2.0 * W.cross(nd) + W.cross(V) + W.cross(W.cross(r));
+    const double lt = lam.dot(t), tK = t.dot(K);
+    if (dc && pt.coefficient >= 0) (*dc)[pt.coefficient] += pt.weight * (lam.dot(S) + kap.dot(K));
+    if (m == 0.0) continue;
+    g_w[i] = m * (lam.dot(aW.cross(t) + W.cross(Wt)) + muWt.dot(K));
+    g_wd[i] = m * 2.0 * lam.dot(Wt);
+    g_t[i] = m * lt;
+    g_t2[i] = 2.0 * m * lt;
+    g_K[i] = m * tK;
+    pt.n.add_transposed(m * (S.cross(muW) + kap.cross(aW) + W.cross(W.cross(kap))), de);
+    pt.n.add_transposed(2.0 * m * kap.cross(W), de_dot);
+    dV += m * kap.cross(W);
+    dW += m * (2.0 * wdot * t.cross(lam) + w * (lam * W.dot(t) + t * lam.dot(W) - 2.0 * lt * W) + 2.0 * nd.cross(kap) +
+               V.cross(kap) + kap * W.dot(r) + r * kap.dot(W) - 2.0 * kap.dot(r) * W);
+  }
+  du.head<3>() += dV;
+  du.segment<3>(3) += dW;
+  F.apply(g_w, Se, de);
+  F.apply(g_wd, Sd, de);
+  F.apply(g_t, Sa, de);
+  F.apply(g_K, Sm, de);
+  F.apply(g_wd, Se, de_dot);
+  F.apply(g_t2, Sd, de_dot);
 }
 
 MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
@@ -810,6 +1034,7 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
                        th.v.transpose() * (tilt_of(qd.cross(h)) + dT);
     for (std::size_t k = 0; k < th.cols.size(); ++k) b[6 + th.cols[k]] += g[static_cast<Eigen::Index>(k)];
   }
+  add_foreshortening_force(u, e, b);
   b.tail(ne).noalias() += D_ * ed + K_ * e;
   VectorXd be = b.tail(ne);
   add_coupling_force(e, be);
@@ -1051,6 +1276,7 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
   }
   de.noalias() += K_ * mue;
   add_coupling_hessian(e, mue, de);
+  add_foreshortening_vjp(s.u, e, a, mu, de, due, du, dc);
   due.noalias() += D_ * mue;
   du.tail(ne) += due;
   if (dc) {

@@ -23,7 +23,10 @@
 //              also moves by ½ (ẑ·θ)(r·θ) ẑ. For them N_i becomes N_i(e) = ∂r_i/∂e
 //              and γ_i gains the convective term bil(ė, ė) (d²r/dt² = N(e) ë + bil(ė, ė)); M_ee then
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
-//              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e.
+//              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e and
+//              carry their foreshortening w = ½ eᵀ Q(s) e through the kinetic energy's cross term
+//              Σ m (V + Ω × r + N ė)·(t ẇ + (Ω × t) w) (struct Foreshortening): rigid rows of M and
+//              b only, M_ee untouched.
 //              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
 // Rotors       inertia J_j turned by the section's rotation R to second order in θ = Θ_j e,
 //              J(θ) = R J_j Rᵀ + O(θ³) (quadratic in θ; its second-order part is the centrifugal
@@ -136,6 +139,13 @@ public:
     void rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
                     Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
     VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
+    // The mast's foreshortening (struct Foreshortening): its parts of the rigid rows A, B of M(e),
+    // of b(u, e), and of residual_vjp (∂s/∂e into de, ∂s/∂ė into de_dot, ∂s/∂V, ∂s/∂Ω into du, and
+    // ∂s/∂c into dc).
+    void add_foreshortening_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
+    void add_foreshortening_force(const VectorXd& u, const VectorXd& e, VectorXd& b) const;
+    void add_foreshortening_vjp(const VectorXd& u, const VectorXd& e, const VectorXd& a, const VectorXd& mu, VectorXd& de,
+                                VectorXd& de_dot, VectorXd& du, VectorXd* dc) const;
     MatrixXd rotor_block(std::size_t j, const VectorXd& e) const;
     template <class Add>
     void for_turned_rotors(const VectorXd& e, Add&& add) const;
@@ -269,7 +279,46 @@ private:
     const Quadratic* quad = nullptr;  // an accelerometer at a quadratic point (the reflector's CM)
   };
 
+  // The mast's foreshortening (docs/theory.md §3.8, "The mast's foreshortening"). An inextensible
+  // mast point at s moves back towards the root by w(s) = ½ eᵀ Q(s) e, Q(s) = ∫₀ˢ Θ⊥ᵀ Θ⊥ ds' (Θ⊥ the
+  // slopes' rows, the tilt's θ_x, θ_y). The mast's mass points carry it through the kinetic energy
+  //   T_fs = Σ_i m_i k_i · (t ẇ_i + (Ω × t) w_i),   k_i = V + Ω × r_i + N_i ė,
+  // (t the unit vector to the root): the cross term of the point's velocity without the shift with
+  // the velocity of the shift; ½ m |t ẇ + Ω × t w|², of fourth order in the deflection, is left
+  // out. As t·N_i = 0, T_fs is a quadratic form in the speeds with a zero e–e block: it adds only to
+  // the rigid rows of M (A, B) and to b; its e-row force includes Σ_i m_i (Q_i e) t·K_i, K_i the
+  // point's inertial acceleration: the P-delta stiffness of the axial inertial load. Held as the slopes' rows at three Gauss points
+  // per element (|Θ⊥ e|² has degree 4 there) and, per mast point, at three on the part of its own
+  // element below it, so that  xᵀ Q_i y = Σ_{elements below} Σ_q ω_q (R_q x)·(R_q y) + the partial
+  // element's sum,  and Σ_i γ_i Q_i x takes suffix sums over the elements: O(ne) for all points.
+  struct Foreshortening {
+    struct Node {
+      std::vector<int> cols;
+      Eigen::Matrix<double, 2, Eigen::Dynamic> rows;  // Θ⊥ on cols
+      double weight = 0.0;
+    };
+    // Θ⊥ x at every node: the elements' (3 per element) first, then the points' partial ones (3 each).
+    using Slopes = Eigen::Matrix<double, 2, Eigen::Dynamic>;
+    std::vector<Node> node;
+    int elements = 0;
+    std::vector<int> element_of;     // per mast point (ascending)
+    std::vector<std::size_t> point;  // per mast point: its index in points_
+    Eigen::Vector3d t = Eigen::Vector3d::UnitZ();
+    std::size_t size() const { return point.size(); }
+    Slopes slopes(const VectorXd& x) const;
+    void forms(const Slopes& X, const Slopes& Y, std::vector<double>& out) const;       // out_i = xᵀ Q_i y
+    void apply(const std::vector<double>& gamma, const Slopes& X, VectorXd& out) const;  // out += Σ γ_i Q_i x
+    // out (6 × ne) += Σ_i γ_i (Q_i x)ᵀ
+    void apply_rows(const std::vector<Eigen::Matrix<double, 6, 1>>& gamma, const Slopes& X, MatrixXd& out) const;
+    void add(std::size_t j, const Eigen::Vector2d& a, VectorXd& out) const;  // out += node j's Rᵀ a
+    // visit(node, c) for every node with its coefficient in Σ_i γ_i Q_i: γ_i for point i's own
+    // nodes, Σ_{points above} γ_i for an element's (suffix sums from the mast's end).
+    template <class G, class Visit>
+    void coefficients(const std::vector<G>& gamma, G zero, Visit&& visit) const;
+  };
+
   int ne_ = 0, ncoef_ = 0;
+  Foreshortening fs_;
   std::vector<MassPoint> points_;
   std::vector<Rotor> rotors_;
   std::vector<Coupling> coupling_;
