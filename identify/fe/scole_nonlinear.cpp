@@ -708,7 +708,7 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
 // s = t ẇ + (Ω × t) w the shift's (w = ½ eᵀ Q e, g = Q e). As t·N = 0 (the mast's rows are
 // lateral), T_fs = ½ uᵀ M_fs u with
 //   M_Ve = m t gᵀ,  M_Ωe = m [(r × t) gᵀ + w [t]× N],  M_VΩ = −m w [t]×,
-//   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×),   M_ee untouched (the ½ m ẇ² term is left out).
+//   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×),   M_ee untouched (½ m |s|² is left out: fourth order).
 void ScoleNonlinear::Dynamics::add_foreshortening_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A,
                                                        MatrixXd& B) const {
   const auto& F = g_->fs_;

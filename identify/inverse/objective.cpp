@@ -311,7 +311,9 @@ double Objective::interpolation_misfit(const VectorXd& q) {
   // budget, else from two streamed solves.
   const int n = model_.ndof, ns = data_.sensors();
   Measurements own{data_.names, data_.t, MatrixXd(static_cast<Eigen::Index>(data_.t.size()), ns)};
-  if (checkpoint_spacing(solver) == 0) {
+  const double points = (data_.t.back() - data_.t.front()) / (options_.solver.step > 0 ? options_.solver.step : 1e-300);
+  if (!solver.can_resume() ||
+      (options_.solver.step > 0 && points * model_.ndof * 3.0 * sizeof(double) <= options_.trajectory_bytes)) {
     const Trajectory u = forward(solver, s, data_.t.back());
     VectorXd x(n), v(n);
     for (std::size_t i = 0; i < data_.t.size(); ++i) {
@@ -320,6 +322,7 @@ double Objective::interpolation_misfit(const VectorXd& q) {
     }
     return misfit_against(s, solver, u, own);
   }
+  const auto tf = Clock::now();
   SolverSummary sum;
   sample_streamed(solver, data_.t.front(), data_.t.back(), state_forcing(s), breakpoints_, data_.t,
                   [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
@@ -328,6 +331,7 @@ double Objective::interpolation_misfit(const VectorXd& q) {
                   &sum);
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
+  counters_.forward_seconds += since(tf);
   double J = 0.0;
   forward_windows(solver, s, data_.t.back(), [&](const Trajectory& w) { J += misfit_window(s, solver, w, own, T_); });
   return J;
@@ -357,6 +361,28 @@ std::size_t Objective::checkpoint_spacing(const SecondOrderSolver& solver) const
   if (options_.checkpoint_points > 0) return static_cast<std::size_t>(options_.checkpoint_points);
   if (points * model_.ndof * 3.0 * sizeof(double) <= options_.trajectory_bytes) return 0;
   return static_cast<std::size_t>(std::max(2.0, std::ceil(std::sqrt(points / 3.0))));
+}
+
+bool Objective::cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
+                             double& resolve_seconds) const {
+  // The costate window [τa, τb] is t in [T − τb, T − τa] (within the data): the state there from
+  // its checkpoints, and the grid of the window's times (in t), the state's and the samples'.
+  const double ta = std::max(data_.t.front(), T_ - W.t_end()), tb = std::min(T_, T_ - W.t_begin());
+  if (!(tb > ta)) return false;
+  const auto tr = Clock::now();
+  state.cover(ta, tb);
+  resolve_seconds += since(tr);
+  grid.clear();
+  for (double tau : W.times()) grid.push_back(T_ - tau);
+  state.times_in(ta, tb, grid);
+  for (double t : data_.t)
+    if (t >= ta && t <= tb) grid.push_back(t);
+  grid.push_back(ta);
+  grid.push_back(tb);
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
+  return true;
 }
 
 double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out,
@@ -390,22 +416,8 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   double quadrature = 0.0, resolve = 0.0;
   // Each costate window [τa, τb] is t in [T − τb, T − τa]: the state there from its checkpoints.
   WindowedSink windows(n, spacing, [&](const Trajectory& P) {
-    const double ta = std::max(t0, T_ - P.t_end()), tb = std::min(T_, T_ - P.t_begin());
-    if (!(tb > ta)) return;
-    const auto tr = Clock::now();
-    state.cover(ta, tb);
+    if (!cover_window(P, state, grid, resolve)) return;
     const auto tq = Clock::now();
-    resolve += std::chrono::duration<double>(tq - tr).count();
-    grid.clear();
-    for (double tau : P.times()) grid.push_back(T_ - tau);
-    state.times_in(ta, tb, grid);
-    for (double t : data_.t)
-      if (t >= ta && t <= tb) grid.push_back(t);
-    grid.push_back(ta);
-    grid.push_back(tb);
-    std::sort(grid.begin(), grid.end());
-    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-    grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
     for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
       const double h = grid[k + 1] - grid[k];
       for (int gq = 0; gq < 3; ++gq) {
@@ -530,22 +542,8 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
   double quadrature = 0.0, resolve = 0.0;
   // Each window holds P and Y stacked over [τa, τb], i.e. t in [T − τb, T − τa].
   WindowedSink windows(n, spacing, [&](const Trajectory& W) {
-    const double ta = std::max(t0, T_ - W.t_end()), tb = std::min(T_, T_ - W.t_begin());
-    if (!(tb > ta)) return;
-    const auto tr = Clock::now();
-    state.cover(ta, tb);
+    if (!cover_window(W, state, grid, resolve)) return;
     const auto tq = Clock::now();
-    resolve += std::chrono::duration<double>(tq - tr).count();
-    grid.clear();
-    for (double tau : W.times()) grid.push_back(T_ - tau);
-    state.times_in(ta, tb, grid);
-    for (double t : data_.t)
-      if (t >= ta && t <= tb) grid.push_back(t);
-    grid.push_back(ta);
-    grid.push_back(tb);
-    std::sort(grid.begin(), grid.end());
-    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-    grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
     for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
       const double h = grid[k + 1] - grid[k];
       for (int gq = 0; gq < 3; ++gq) {
@@ -965,7 +963,11 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   std::unique_ptr<WindowedSink> profile_sink;
   if (profile) {
     sums = std::make_unique<ProfileSums>(data_);
-    profile_sink = std::make_unique<WindowedSink>(n, kStreamWindow, [&](const Trajectory& w) { profile_window(s, solver, w, *sums); });
+    profile_sink = std::make_unique<WindowedSink>(n, kStreamWindow, [&](const Trajectory& w) {
+      const auto tp = Clock::now();
+      profile_window(s, solver, w, *sums);
+      quadrature += since(tp);
+    });
   }
   MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
   VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
@@ -1049,16 +1051,15 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   };
   SolverSummary sum;
   solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum);
+  if (profile) {
+    profile_sink->finish();  // (its windows' time is in `quadrature`)
+    *profile = std::move(sums->prof);
+  }
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.sensitivity_solves += P;
   counters_.sensitivity_seconds += since(ts) - quadrature;
-  const auto tq = Clock::now();
-  if (profile) {
-    profile_sink->finish();
-    *profile = std::move(sums->prof);
-  }
-  counters_.quadrature_seconds += quadrature + since(tq);
+  counters_.quadrature_seconds += quadrature;
   return J;
 }
 

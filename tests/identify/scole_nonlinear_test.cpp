@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "scoleid/identify/fe/rotation_vector.h"
 #include "scoleid/identify/fe/scole_nonlinear.h"
@@ -40,6 +41,18 @@ Model make_model(scoleid::io::Scenario sc, int elements) {
   m.fe = build_scole(m.sc.scole, elements, m.sc.inputs, m.sc.sensors, m.sc.source);
   m.nl = std::make_unique<ScoleNonlinear>(m.fe, m.sc.inputs, m.sc.sensors);
   return m;
+}
+
+// A deflection and a deflection rate with normal random entries, each scaled to a largest entry of 1.
+std::pair<VectorXd, VectorXd> random_deflection(int ne, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> N(0.0, 1.0);
+  VectorXd e0(ne), v0(ne);
+  for (int i = 0; i < ne; ++i) {
+    e0[i] = N(rng);
+    v0[i] = N(rng);
+  }
+  return {e0 / e0.cwiseAbs().maxCoeff(), v0 / v0.cwiseAbs().maxCoeff()};
 }
 
 scoleid::io::Scenario builtin(const std::string& name) {
@@ -292,15 +305,8 @@ TEST(ScoleNonlinear, TheReflectorsKineticEnergyIsTheTurningBodysToThirdOrder) {
   const int ne = m.nl->elastic();
   const auto& dyn = r.dyn;
   const Matrix3d& J = r.J;
-  std::mt19937_64 rng(9);
-  std::normal_distribution<double> N(0.0, 1.0);
-  VectorXd e0(ne), v0(ne);
-  for (int i = 0; i < ne; ++i) {
-    e0[i] = N(rng);
-    v0[i] = N(rng);
-  }
-  e0 /= e0.cwiseAbs().maxCoeff();
-  v0 /= v0.cwiseAbs().maxCoeff();
+  const auto deflection = random_deflection(ne, 9);
+  const VectorXd &e0 = deflection.first, &v0 = deflection.second;
   const double L = sc.scole.length;
   // The model's and the exact energy at (σe, σė), σ = ±1 and the scale ε.
   auto energies = [&](double eps) {
@@ -451,15 +457,8 @@ TEST(ScoleNonlinear, TheMastsKineticEnergyIsTheShiftedPointsToFourthOrder) {
     y.tail(ne) = ed;
     return dyn.energy(y.data());
   };
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> N(0.0, 1.0);
-  VectorXd e0(ne), v0(ne);
-  for (int i = 0; i < ne; ++i) {
-    e0[i] = N(rng);
-    v0[i] = N(rng);
-  }
-  e0 /= e0.cwiseAbs().maxCoeff();
-  v0 /= v0.cwiseAbs().maxCoeff();
+  const auto deflection = random_deflection(ne, 5);
+  const VectorXd &e0 = deflection.first, &v0 = deflection.second;
   const double base = model(VectorXd::Zero(ne), VectorXd::Zero(ne));
   double prev = 0.0;
   for (double eps : {0.08, 0.04, 0.02, 0.01}) {

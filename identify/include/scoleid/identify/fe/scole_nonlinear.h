@@ -44,7 +44,8 @@
 // Strain       the linear model's ½ eᵀ K e and the mast's W₃ + W₄ (struct Coupling): the
 //              Kirchhoff rod's energy to fourth order in the deflection.
 // Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e + ∇W(e)] = Q(t, e),
-//              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J(θ_j) L_j,   b = Σ m_i L_iᵀ γ_i + the rotors' terms,
+//              M = Σ m_i L_iᵀ L_i + Σ L_jᵀ J(θ_j) L_j + M_fs,   b = Σ m_i L_iᵀ γ_i + the rotors' terms
+//              + the foreshortening's (struct Foreshortening),
 //              K, D the linear model's elastic blocks (they see only the deformation relative
 //              to S), every term affine in the coefficients c (scole_model.h), so ∂/∂c_k of the
 //              residual is the residual of c = e_k without the constant terms.

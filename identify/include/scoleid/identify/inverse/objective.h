@@ -52,8 +52,9 @@ namespace scoleid::identify {
 // step the P tangents in blocks that fit in it (the state re-solved with each block), so memory
 // does not grow with steps × DOFs × P.
 inline constexpr double kSensitivityBlockBytes = 128.0 * 1024 * 1024;
-// A recorded state longer than this is checkpointed in the gradient and the Gauss–Newton products
-// (time/checkpoints.h, docs/theory.md §7.9): esdirk and displacement sensors only.
+// A recorded state longer than this is checkpointed in the gradient (every sensor kind) and the
+// Gauss–Newton products (displacement sensors: the only ones they take), and the interpolation
+// misfit streams it (time/checkpoints.h, docs/theory.md §7.9); esdirk only.
 inline constexpr double kTrajectoryBytes = 32.0 * 1024 * 1024;
 
 struct ObjectiveOptions {
@@ -130,7 +131,8 @@ public:
   // ½ Σ_k R_k ∫ (y_k − ỹ_k)² dt over [t0, T] at q: y the model's output, ỹ the cubic interpolant of
   // its own samples (measurements.h). The part of the cost sampling alone leaves whatever the
   // parameters and the noise: data that the model fits exactly still differ from the model between
-  // samples by the interpolant's error (docs/theory.md §7.8). One forward solve.
+  // samples by the interpolant's error (docs/theory.md §7.8). One stored forward solve, or two
+  // streamed ones above the trajectory budget.
   double interpolation_misfit(const VectorXd& q);
   // Output sensitivities ∂(C u(t_i))/∂q at the sample times: (samples·sensors) × P, row-major by
   // sample. For Fisher information.
@@ -221,6 +223,11 @@ private:
   // quadrature into gc with the state re-solved from `ckpts`. Returns the cost when `residual`.
   double backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out, bool residual,
                                std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc);
+  // A costate window W (in τ) as t in [ta, tb]: the state re-solved over it (time added to
+  // resolve_seconds) and its quadrature grid (W's times, the state's and the samples', sorted and
+  // unique). False when the window holds no time of the data.
+  bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
+                    double& resolve_seconds) const;
   // Rate sensors (docs/theory.md §6.1a): with ü = M⁻¹(f − D u̇ − K u) the residual is
   //   r = A₀ u + A₁ u̇ + Σ_i f_i G_i − z̃,   A₀ = C₀ − C₂M⁻¹K,  A₁ = C₁ − C₂M⁻¹D,  G_i = C₂M⁻¹b_i,
   // dense ns × n, and μ = M⁻¹C₂ᵀ R r = (M⁻¹C₂ᵀ) R r: ns mass solves per gradient, none per forcing.
