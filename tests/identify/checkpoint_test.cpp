@@ -130,6 +130,30 @@ TEST(Checkpoints, WindowsShareBoundariesAndKeepBreakpointLimitsTogether) {
   EXPECT_EQ(joined, ts);
 }
 
+TEST(Checkpoints, AWindowOfTwoColumnsStacksThemAndRefusesAPointWithOne) {
+  const int n = 2;
+  std::vector<Trajectory> windows;
+  WindowedSink sink(n, 2, [&](const Trajectory& w) { windows.push_back(w); }, 2);
+  std::vector<double> x(2 * n);
+  for (int k = 0; k < 3; ++k) {
+    for (int i = 0; i < 2 * n; ++i) x[static_cast<std::size_t>(i)] = 10.0 * k + i;  // column 0: 10k, 10k+1; column 1: 10k+2, 10k+3
+    SecondOrderSolver::Point pt;
+    pt.t = k;
+    pt.columns = 2;
+    pt.x = pt.v = pt.a = x.data();
+    sink(pt);
+  }
+  sink.finish();
+  ASSERT_EQ(windows.size(), 2u);
+  ASSERT_EQ(windows[0].dim(), 2 * n);
+  for (int i = 0; i < 2 * n; ++i) EXPECT_EQ(windows[1].x(1)[i], 20.0 + i);  // both columns, stacked
+  SecondOrderSolver::Point one;
+  one.t = 3;
+  one.columns = 1;
+  one.x = one.v = one.a = x.data();
+  EXPECT_THROW(sink(one), std::logic_error);
+}
+
 TEST(Checkpoints, GradientAndProductOnACheckpointedStateEqualTheStoredOnes) {
   const auto p = ei8();
   const VectorXd q = p->params->initial() * 1.05;
