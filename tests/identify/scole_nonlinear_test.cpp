@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <random>
 #include <utility>
@@ -53,6 +54,23 @@ std::pair<VectorXd, VectorXd> random_deflection(int ne, unsigned seed) {
     v0[i] = N(rng);
   }
   return {e0 / e0.cwiseAbs().maxCoeff(), v0 / v0.cwiseAbs().maxCoeff()};
+}
+
+// For ε = 0.08, 0.04, 0.02, 0.01, at(ε) = {an exact change, the model's difference to it}: prints
+// them and the order at which the difference falls, and expects at least min_order.
+void expect_order(double min_order, const std::function<std::pair<double, double>(double)>& at) {
+  double prev = 0.0;
+  for (double eps : {0.08, 0.04, 0.02, 0.01}) {
+    const auto r = at(eps);
+    const double diff = r.second;
+    std::printf("  eps %.2f  exact change %+.6e  difference %.3e", eps, r.first, diff);
+    if (prev > 0) {
+      std::printf("  (order %.2f)", std::log2(prev / diff));
+      EXPECT_GT(std::log2(prev / diff), min_order) << "eps " << eps;
+    }
+    std::printf("\n");
+    prev = diff;
+  }
 }
 
 scoleid::io::Scenario builtin(const std::string& name) {
@@ -373,19 +391,11 @@ TEST(ScoleNonlinear, TheReflectorsInertiaTurnsToSecondOrderInASpinningFrame) {
     return dyn.energy(y.data());
   };
   const double E0 = model_energy(VectorXd::Zero(ne));
-  double prev = 0.0;
-  for (double eps : {0.08, 0.04, 0.02, 0.01}) {
+  expect_order(2.7, [&](double eps) {
     const Matrix3d R = section_rotation(m.fe, ne, VectorXd(eps * e0), sc.scole.length);
     const double exact = 0.5 * W0.dot((R * J * R.transpose() - J) * W0);
-    const double diff = std::abs(model_energy(eps * e0) - E0 - exact);
-    std::printf("  eps %.2f  exact change %+.6e  difference %.3e", eps, exact, diff);
-    if (prev > 0) {
-      std::printf("  (order %.2f)", std::log2(prev / diff));
-      EXPECT_GT(std::log2(prev / diff), 2.7) << "eps " << eps;
-    }
-    std::printf("\n");
-    prev = diff;
-  }
+    return std::make_pair(exact, std::abs(model_energy(eps * e0) - E0 - exact));
+  });
 }
 
 TEST(ScoleNonlinear, TheMastsKineticEnergyIsTheShiftedPointsToFourthOrder) {
@@ -460,18 +470,11 @@ TEST(ScoleNonlinear, TheMastsKineticEnergyIsTheShiftedPointsToFourthOrder) {
   const auto deflection = random_deflection(ne, 5);
   const VectorXd &e0 = deflection.first, &v0 = deflection.second;
   const double base = model(VectorXd::Zero(ne), VectorXd::Zero(ne));
-  double prev = 0.0;
-  for (double eps : {0.08, 0.04, 0.02, 0.01}) {
+  expect_order(3.6, [&](double eps) {
     const VectorXd e = eps * e0, ed = eps * v0;
-    const double Ex = exact(e, ed), diff = std::abs(model(e, ed) - base - Ex);
-    std::printf("  eps %.2f  exact change %+.6e  difference %.3e", eps, Ex, diff);
-    if (prev > 0) {
-      std::printf("  (order %.2f)", std::log2(prev / diff));
-      EXPECT_GT(std::log2(prev / diff), 3.6) << "eps " << eps;
-    }
-    std::printf("\n");
-    prev = diff;
-  }
+    const double Ex = exact(e, ed);
+    return std::make_pair(Ex, std::abs(model(e, ed) - base - Ex));
+  });
 }
 
 TEST(ScoleNonlinear, UndampedFreeMotionConservesEnergyAndMomenta) {
