@@ -1,6 +1,7 @@
 #include "scoleid/identify/fe/scole_nonlinear.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "scoleid/identify/fe/rotation_vector.h"
@@ -66,34 +67,81 @@ VectorXd gather_cols(const std::vector<int>& cols, const VectorXd& x) {
 }
 }  // namespace
 
-VectorXd ScoleNonlinear::Quadratic::gather(const VectorXd& x) const { return gather_cols(cols, x); }
+VectorXd ScoleNonlinear::Kinematics::gather(const VectorXd& x) const { return gather_cols(cols, x); }
 
-Eigen::Matrix<double, 3, Eigen::Dynamic> ScoleNonlinear::Quadratic::jacobian(const VectorXd& e) const {
-  const VectorXd g = gather(e);
-  Eigen::Matrix<double, 3, Eigen::Dynamic> J = N + skew(A * g) * B - skew(B * g) * A;
-  if (Q.size() != 0) J += t * (Q * g).transpose();
-  return J;
+ScoleNonlinear::Kinematics::At ScoleNonlinear::Kinematics::at(const VectorXd& e, const TurnedRotation* turned,
+                                                              bool third) const {
+  At m;
+  m.k = this;
+  m.g = gather(e);
+  const VectorXd& g = m.g;
+  m.offset.setZero();
+  m.J = N;
+  if (A.cols() != 0) {
+    const Vector3d Ag = A * g, Bg = B * g;
+    m.offset += Ag.cross(Bg);
+    m.J += skew(Ag) * B - skew(Bg) * A;
+  }
+  if (axial()) {
+    const VectorXd Pg = P * g;
+    m.Qg = P.transpose() * Pg;
+    m.offset += 0.5 * Pg.squaredNorm() * t;
+    m.J += t * m.Qg.transpose();
+  }
+  if (Theta.cols() != 0) {
+    const Vector3d th = Theta * g;
+    m.turned = (turned ? *turned : turned_rotation(th, third)).arm(arm);
+    m.offset += m.turned.value - arm - th.cross(arm);
+    m.J += (m.turned.d1 + skew(arm)) * Theta;
+  }
+  return m;
 }
 
-Vector3d ScoleNonlinear::Quadratic::quadratic(const VectorXd& e) const {
-  const VectorXd g = gather(e);
-  Vector3d r = Vector3d(A * g).cross(B * g);
-  if (Q.size() != 0) r += 0.5 * g.dot(Q * g) * t;
+Vector3d ScoleNonlinear::Kinematics::At::rows(const VectorXd& y) const {
+  return (J - k->N) * k->gather(y);
+}
+
+void ScoleNonlinear::Kinematics::At::rows_t(const Vector3d& w, VectorXd& out) const {
+  const VectorXd v = (J - k->N).transpose() * w;
+  for (std::size_t c = 0; c < k->cols.size(); ++c) out[k->cols[c]] += v[static_cast<Eigen::Index>(c)];
+}
+
+Vector3d ScoleNonlinear::Kinematics::At::convective(const VectorXd& x) const {
+  const VectorXd gx = k->gather(x);
+  Vector3d r = Vector3d::Zero();
+  if (k->A.cols() != 0) r += 2.0 * Vector3d(k->A * gx).cross(k->B * gx);
+  if (k->axial()) r += (k->P * gx).squaredNorm() * k->t;
+  if (k->Theta.cols() != 0) {
+    const Vector3d a = k->Theta * gx;
+    r += turned.second(a, a);
+  }
   return r;
 }
 
-Vector3d ScoleNonlinear::Quadratic::bil(const VectorXd& x, const VectorXd& y) const {
-  const VectorXd gx = gather(x), gy = gather(y);
-  Vector3d b = Vector3d(A * gx).cross(B * gy) + Vector3d(A * gy).cross(B * gx);
-  if (Q.size() != 0) b += gx.dot(Q * gy) * t;
-  return b;
+void ScoleNonlinear::Kinematics::At::second_t(const VectorXd& y, const Vector3d& w, VectorXd& out, VectorXd* axial) const {
+  const VectorXd gy = k->gather(y);
+  VectorXd v = VectorXd::Zero(gy.size());
+  if (k->A.cols() != 0) v += k->B.transpose() * w.cross(k->A * gy) + k->A.transpose() * Vector3d(k->B * gy).cross(w);
+  if (k->axial()) {
+    if (axial)
+      *axial += k->t.dot(w) * gy;
+    else
+      v += k->t.dot(w) * (k->P.transpose() * (k->P * gy));
+  }
+  if (k->Theta.cols() != 0) v += k->Theta.transpose() * turned.second_t(k->Theta * gy, w);
+  for (std::size_t c = 0; c < k->cols.size(); ++c) out[k->cols[c]] += v[static_cast<Eigen::Index>(c)];
 }
 
-void ScoleNonlinear::Quadratic::bil_t(const VectorXd& y, const Vector3d& w, VectorXd& out) const {
-  const VectorXd gy = gather(y);
-  VectorXd g = B.transpose() * w.cross(A * gy) + A.transpose() * Vector3d(B * gy).cross(w);
-  if (Q.size() != 0) g += t.dot(w) * (Q * gy);
-  for (std::size_t k = 0; k < cols.size(); ++k) out[cols[k]] += g[static_cast<Eigen::Index>(k)];
+void ScoleNonlinear::Kinematics::add_axial(const VectorXd& z, VectorXd& out) const {
+  const VectorXd v = P.transpose() * (P * z);
+  for (std::size_t c = 0; c < cols.size(); ++c) out[cols[c]] += v[static_cast<Eigen::Index>(c)];
+}
+
+void ScoleNonlinear::Kinematics::At::convective_t(const VectorXd& x, const Vector3d& w, VectorXd& out) const {
+  if (k->Theta.cols() == 0) return;
+  if (!turned.has_third) throw std::logic_error("Kinematics::At::convective_t: evaluated without third derivatives");
+  const VectorXd v = k->Theta.transpose() * turned.third_t(k->Theta * k->gather(x), w);
+  for (std::size_t c = 0; c < k->cols.size(); ++c) out[k->cols[c]] += v[static_cast<Eigen::Index>(c)];
 }
 
 Vector3d ScoleNonlinear::Rotor::tilt(const VectorXd& x) const {
@@ -119,8 +167,8 @@ Matrix3d first_turn0(const Matrix3d& J, const Vector3d& v) {
 // With T = [θ]× and J₁(v) = [v]× J − J [v]×:
 //   J(θ) = J + J₁(θ) + ½ (T² J + J T²) − T J T + J₁(½ α × ψ a) + O(θ³)      (symmetric)
 // — quadratic in θ. Its second-order part carries the centrifugal stiffness of a body turned in a
-// spinning frame: ½ Ωᵀ J(θ) Ω changes at second order in θ (a roll slew that turns the reflector
-// about pitch trades I_xx for I_zz), which a first-order J(θ) cannot give.
+// spinning frame: ½ Ωᵀ J(θ) Ω changes at second order in θ (a roll slew that turns an anisotropic
+// body about pitch trades I_xx for I_zz), which a first-order J(θ) cannot give.
 // J_k = J₁(e_k); J_kl from the second-order terms (E_k = [e_k]×):
 // J_kl = ½ ((E_k E_l + E_l E_k) J + J (E_k E_l + E_l E_k)) − E_k J E_l − E_l J E_k
 //        + J₁(½ (P⊥ e_k × P_z e_l + P⊥ e_l × P_z e_k)).
@@ -169,16 +217,16 @@ Vector3d ScoleNonlinear::Turning::curvature(const Vector3d& u, const Vector3d& a
 }
 
 namespace {
-// The columns any of the dense rows (or Q's rows) touch, and the rows restricted to them.
-void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Qfull, std::vector<int>& cols,
-             std::vector<char>& local, std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>*> out, MatrixXd& Q) {
+// The columns any of the dense rows (or P's) touch, and the rows restricted to them.
+void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Pfull, std::vector<int>& cols,
+             std::vector<char>& local, std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>*> out, SparseMatrix& P) {
   const Eigen::Index ne = dense.front()->cols();
   cols.clear();
   local.clear();
   for (Eigen::Index j = 0; j < ne; ++j) {
     bool rows = false;
     for (const MatrixXd* d : dense) rows = rows || d->col(j).cwiseAbs().maxCoeff() != 0.0;
-    if (rows || (Qfull.size() != 0 && Qfull.col(j).cwiseAbs().maxCoeff() != 0.0)) {
+    if (rows || (Pfull.size() != 0 && Pfull.col(j).cwiseAbs().maxCoeff() != 0.0)) {
       cols.push_back(static_cast<int>(j));
       local.push_back(rows ? 1 : 0);
     }
@@ -188,10 +236,10 @@ void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Qfull, s
     out[i]->resize(3, k);
     for (Eigen::Index c = 0; c < k; ++c) out[i]->col(c) = dense[i]->col(cols[static_cast<std::size_t>(c)]);
   }
-  if (Qfull.size() != 0) {
-    Q.resize(k, k);
-    for (Eigen::Index a = 0; a < k; ++a)
-      for (Eigen::Index b = 0; b < k; ++b) Q(a, b) = Qfull(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+  if (Pfull.size() != 0) {
+    MatrixXd Pc(Pfull.rows(), k);
+    for (Eigen::Index c = 0; c < k; ++c) Pc.col(c) = Pfull.col(cols[static_cast<std::size_t>(c)]);
+    P = Pc.sparseView();
   }
 }
 }  // namespace
@@ -283,33 +331,52 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       if ((fs_.t.transpose() * points_[i].N).cwiseAbs().maxCoeff() != 0.0)
         throw std::logic_error("ScoleNonlinear: a mast point's rows move it along the mast");
   }
-  // Reflector: CM translation (its own coefficient) and rotary inertia about the CM.
+  // Reflector: a rigid body on the mast's end, moving exactly with the end section. Every one of
+  // its points is the end's point turned by the section's rotation (turned_arm.h; the linear part
+  // Θ(L) e × a of an arm a is in the point's linear rows) and carried back towards the root by the
+  // end's foreshortening ½ ∫ (u_x'² + u_y'²) ds (an inextensible mast). Its CM carries its mass (its
+  // own coefficient); its inertia about the CM J is carried by pairs of points at ±d on the
+  // principal axes of the second moment S = ½ tr(J) I − J (J = tr(S) I − S), each pair of mass
+  // s_k / d² (s_k an eigenvalue of S: a pair gives s_k u_k u_kᵀ), their mass taken back at the CM
+  // (a constant offset of the CM point's mass).
+  // A rigid body's kinetic energy is fixed by its mass, CM and second moment, so this is the body's
+  // exactly, rotation and all (docs/theory.md §3.8).
   {
-    // The CM turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back towards the
-    // root by the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds (an inextensible mast).
     const Vector3d r(sc.reflector_rx, sc.reflector_ry, 0.0);
-    MassPoint refl{point(L) + r, on_e(fe.reflector_displacement()), 1.0, ScoleFE::kMReflector, {}, {}};
-    const MatrixXd Th = on_e(fe.mast_rotation(L));
-    const MatrixXd A = 0.5 * Th, B = -skew(r) * Th;
-    MatrixXd Qfull = MatrixXd::Zero(ne_, ne_);
+    const MatrixXd Th = on_e(fe.mast_rotation(L)), U = on_e(fe.mast_displacement(L));
+    // Q = ∫ Θ⊥ᵀ Θ⊥ ds = Pᵀ P: three Gauss points per element (exact: degree 4).
+    MatrixXd Pfull(6 * fe.elements, ne_);
     for (int el = 0; el < fe.elements; ++el)
-      for (int q = 0; q < 3; ++q) {
-        const MatrixXd R2 = on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
-        Qfull += w3[q] * h * R2.transpose() * R2;
-      }
-    // The end section's rotation to second order is R = exp[α] exp[ψ a] (the tilt α the slopes
-    // give, then the twist about the axis a), whose rotation vector is θ + ½ α × ψ a (θ = Θ e).
-    // The second-order part turns the arm r (⊥ a) by ½ (ẑ·θ)(r·θ) ẑ: axial, into Q.
-    {
-      const Eigen::RowVectorXd u = Vector3d::UnitZ().transpose() * Th, v = r.transpose() * Th;
-      Qfull += 0.5 * (u.transpose() * v + v.transpose() * u);
+      for (int q = 0; q < 3; ++q)
+        Pfull.middleRows(6 * el + 2 * q, 2) = std::sqrt(w3[q] * h) * on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
+    auto end_point = [&](const Vector3d& arm, double weight, int coefficient) {
+      MassPoint pt{point(L) + arm, MatrixXd(U - skew(arm) * Th), weight, coefficient, {}, {}};
+      compact({&pt.N, &Th}, Pfull, pt.kin.cols, pt.kin.local, {&pt.kin.N, &pt.kin.Theta}, pt.kin.P);
+      pt.kin.arm = arm;
+      pt.kin.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
+      points_.push_back(std::move(pt));
+    };
+    const std::size_t cm = points_.size();
+    end_point(r, 1.0, ScoleFE::kMReflector);
+    const Matrix3d J = inertia_matrix(sc.reflector);
+    const Eigen::SelfAdjointEigenSolver<Matrix3d> S(0.5 * J.trace() * Matrix3d::Identity() - J);
+    // d: the radius of gyration, so that the pairs weigh what the reflector does (any d > 0 is
+    // exact). An inertia whose largest principal moment exceeds the sum of the other two (no rigid
+    // body's: a flat one given products of inertia) has s_k < 0, a pair of negative mass: exact all
+    // the same; M(e) stays positive definite wherever the inertia does (checked at e = 0 below).
+    const double ssum = S.eigenvalues().cwiseAbs().sum();
+    const double d = sc.reflector.mass > 0.0 && ssum > 0.0 ? std::sqrt(ssum / sc.reflector.mass) : 1.0;
+    double taken = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double sk = S.eigenvalues()[k];
+      if (std::abs(sk) <= 1e-12 * J.trace()) continue;  // a flat body has none along its normal
+      const Vector3d dk = d * S.eigenvectors().col(k);
+      end_point(r + dk, 0.5 * sk / (d * d), -1);
+      end_point(r - dk, 0.5 * sk / (d * d), -1);
+      taken += sk / (d * d);
     }
-    compact({&refl.N, &A, &B}, Qfull, refl.quad.cols, refl.quad.local, {&refl.quad.N, &refl.quad.A, &refl.quad.B},
-            refl.quad.Q);
-    refl.quad.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
-    points_.push_back(std::move(refl));
+    points_[cm].offset = -taken;
   }
-  rotors_.push_back({inertia_matrix(sc.reflector), on_e(fe.mast_rotation(L)), -1, {}, {}, {}});
   // Shuttle.
   points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}, {}});
   rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}, {}, {}});
@@ -325,11 +392,25 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     MatrixXd S = N - on_e(fe.mast_displacement(s));
     S.row(2).setZero();
     MassPoint pm{point(s), N, sc.actuator_mass, -1, {}, {}};
-    compact({&N, &Th, &S}, MatrixXd(), pm.quad.cols, pm.quad.local, {&pm.quad.N, &pm.quad.A, &pm.quad.B}, pm.quad.Q);
+    compact({&N, &Th, &S}, MatrixXd(), pm.kin.cols, pm.kin.local, {&pm.kin.N, &pm.kin.A, &pm.kin.B}, pm.kin.P);
     points_.push_back(std::move(pm));
   }
 
   for (auto& p : points_) p.n = Rows3::of(p.N);
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    auto& q = points_[i].kin;
+    for (std::size_t a = 0; a < q.cols.size(); ++a)
+      if (q.local[a]) q.local_index.push_back(static_cast<int>(a));
+    if (!q.axial()) continue;
+    for (std::size_t g = 0; g < axial_rep_.size() && q.axial_group < 0; ++g) {
+      const auto& r = points_[axial_rep_[g]].kin;
+      if (r.cols == q.cols && r.P.rows() == q.P.rows() && (r.P - q.P).norm() == 0.0) q.axial_group = static_cast<int>(g);
+    }
+    if (q.axial_group < 0) {
+      q.axial_group = static_cast<int>(axial_rep_.size());
+      axial_rep_.push_back(i);
+    }
+  }
   for (auto& r : rotors_) {
     r.th = Rows3::of(r.Theta);
     r.half = r.th.v;
@@ -352,9 +433,9 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     inputs_.push_back(std::move(in));
   }
   // The reflector's CM is the point after the mast's (points_ is complete: addresses are stable).
-  const Quadratic* reflector_quad = &points_[static_cast<std::size_t>(4 * fe.elements)].quad;
+  const Kinematics* reflector_kin = &points_[static_cast<std::size_t>(4 * fe.elements)].kin;
   for (std::size_t i = 0; i < inputs.size(); ++i)
-    if (inputs_[i].arm && inputs[i].at == "reflector") inputs_[i].quad = reflector_quad;
+    if (inputs_[i].arm && inputs[i].at == "reflector") inputs_[i].kin = reflector_kin;
 
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& spec = sensors[k];
@@ -372,7 +453,7 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       const bool mast = spec.at == "mast";
       s.p = mast ? point(spec.location) : point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
       s.N = mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
-      if (!mast) s.quad = reflector_quad;
+      if (!mast) s.kin = reflector_kin;
     } else {
       // Relative to S: the linear rows restricted to e (they vanish on rigid motion).
       s.kind = ms.order == 1 ? K::RateRow : K::Row;
@@ -456,11 +537,11 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   const int nu = speeds();
   d.Mconst_ = MatrixXd::Zero(nu, nu);
   for (const auto& p : points_) {
-    const double mi = p.weight * scale(p.coefficient);
+    const double mi = p.weight * scale(p.coefficient) + p.offset * constants;
     d.mass_.push_back(mi);
     d.Mconst_.block<3, 3>(0, 0) += mi * Matrix3d::Identity();
-    if (p.quad.active()) {  // its rows on e depend on e (jacobians())
-      d.quadratic_ = true;
+    if (p.kin.active()) {  // its rows on e depend on e (kinematics())
+      d.e_dependent_ = true;
       continue;
     }
     d.Mconst_.block(0, 6, 3, ne_) += mi * p.N;
@@ -470,7 +551,7 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     const Matrix3d J = r.J * scale(r.coefficient);
     d.J_.push_back(J);
     d.rotor_scale_.push_back(scale(r.coefficient));
-    if (!r.th.cols.empty()) d.quadratic_ = true;  // its inertia turns with e
+    if (!r.th.cols.empty()) d.e_dependent_ = true;  // its inertia turns with e
     d.Mconst_.block<3, 3>(3, 3) += J;
     d.Mconst_.block(3, 6, 3, ne_) += J * r.Theta;
     d.Mconst_.block(6, 6, ne_, ne_) += r.Theta.transpose() * J * r.Theta;
@@ -486,10 +567,10 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     for (const auto& r : rotors_)  // a turned rotor couples all of its columns
       for (int a : r.th.cols)
         for (int b : r.th.cols) t.emplace_back(a, b, 0.0);
-    for (const auto& p : points_)  // the quadratic points' local pattern, explicitly
-      for (std::size_t a = 0; a < p.quad.cols.size(); ++a)
-        for (std::size_t b = 0; b < p.quad.cols.size(); ++b)
-          if (p.quad.local[a] && p.quad.local[b]) t.emplace_back(p.quad.cols[a], p.quad.cols[b], 0.0);
+    for (const auto& p : points_)  // the nonlinear points' local pattern, explicitly
+      for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
+        for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
+          if (p.kin.local[a] && p.kin.local[b]) t.emplace_back(p.kin.cols[a], p.kin.cols[b], 0.0);
     d.Cbase_.resize(ne_, ne_);
     d.Cbase_.setFromTriplets(t.begin(), t.end());
     d.Cbase_.makeCompressed();
@@ -508,17 +589,17 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
     }
     for (const auto& p : points_) {
       std::vector<int> sl;
-      for (std::size_t a = 0; a < p.quad.cols.size(); ++a)
-        for (std::size_t b = 0; b < p.quad.cols.size(); ++b)
-          sl.push_back(p.quad.local[a] && p.quad.local[b] ? slot(p.quad.cols[a], p.quad.cols[b]) : -1);
+      for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
+        for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
+          sl.push_back(p.kin.local[a] && p.kin.local[b] ? slot(p.kin.cols[a], p.kin.cols[b]) : -1);
       d.point_slots_.push_back(std::move(sl));
     }
     auto C = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>();
-    if (d.quadratic_) {
+    if (d.e_dependent_) {
       // Checked positive definite at e = 0 here; per e, solve_mass factorises and reports failure.
       SparseMatrix C0 = d.Cbase_;
       for (std::size_t i = 0; i < points_.size(); ++i) {
-        const auto& q = points_[i].quad;
+        const auto& q = points_[i].kin;
         if (!q.active()) continue;
         const MatrixXd Mi = d.mass_[i] * q.N.transpose() * q.N;  // N(0) = N: local columns only
         for (std::size_t a = 0; a < q.cols.size(); ++a)
@@ -642,12 +723,28 @@ void ScoleNonlinear::Dynamics::add_coupling_coefficients(const VectorXd& e, cons
   }
 }
 
-std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> ScoleNonlinear::Dynamics::jacobians(const VectorXd& e) const {
-  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> J(g_->points_.size());
-  if (quadratic_)
-    for (std::size_t i = 0; i < g_->points_.size(); ++i)
-      if (g_->points_[i].quad.active()) J[i] = g_->points_[i].quad.jacobian(e);
-  return J;
+std::vector<ScoleNonlinear::Kinematics::At> ScoleNonlinear::Dynamics::kinematics(const VectorXd& e, bool third) const {
+  std::vector<Kinematics::At> K(g_->points_.size());
+  if (!e_dependent_) return K;
+  // The reflector's points share the end section's rotation: one R(θ) for consecutive points at
+  // the same θ.
+  TurnedRotation R;
+  Vector3d last = Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < g_->points_.size(); ++i) {
+    const auto& q = g_->points_[i].kin;
+    if (!q.active()) continue;
+    if (q.Theta.cols() == 0) {
+      K[i] = q.at(e);
+      continue;
+    }
+    const Vector3d th = q.Theta * q.gather(e);
+    if (th != last) {
+      R = turned_rotation(th, third);
+      last = th;
+    }
+    K[i] = q.at(e, &R);
+  }
+  return K;
 }
 
 namespace {
@@ -661,7 +758,7 @@ void add_left_compact(const std::vector<int>& cols, const Matrix3d& A, const Eig
 }
 }  // namespace
 
-void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
+void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<Kinematics::At>& kin,
                                           Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const {
   const int ne = g_->ne_;
   A = Mconst_.topLeftCorner<6, 6>();
@@ -672,12 +769,13 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<E
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
-    if (p.quad.active()) {
-      const Matrix3d Rx = skew(p.p + p.n.times(e) + p.quad.quadratic(e));
+    if (p.kin.active()) {
+      const auto& Je = kin[i].J;
+      const Matrix3d Rx = skew(p.p + p.n.times(e) + kin[i].offset);
       VO -= mi * Rx;
       OO += mi * Rx.transpose() * Rx;
-      for (std::size_t k = 0; k < p.quad.cols.size(); ++k) B.col(p.quad.cols[k]).head<3>() += mi * Je[i].col(static_cast<Eigen::Index>(k));
-      add_left_compact(p.quad.cols, mi * Rx, Je[i], Oe);
+      for (std::size_t k = 0; k < p.kin.cols.size(); ++k) B.col(p.kin.cols[k]).head<3>() += mi * Je.col(static_cast<Eigen::Index>(k));
+      add_left_compact(p.kin.cols, mi * Rx, Je, Oe);
       continue;
     }
     const Matrix3d Rx = skew(p.p + p.n.times(e));
@@ -839,16 +937,16 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
   const int ne = g_->ne_;
   Eigen::Matrix<double, 6, 6> A;
   MatrixXd B;
-  const auto Je = jacobians(e);
-  rigid_rows(e, Je, A, B);
+  const auto kin = kinematics(e);
+  rigid_rows(e, kin, A, B);
   MatrixXd M = Mconst_;
   M.topLeftCorner<6, 6>() = A;
   M.block(0, 6, 6, ne) = B;
   M.block(6, 0, ne, 6) = B.transpose();
   for (std::size_t i = 0; i < g_->points_.size(); ++i) {
-    const auto& cols = g_->points_[i].quad.cols;
+    const auto& cols = g_->points_[i].kin.cols;
     if (cols.empty()) continue;
-    const MatrixXd Mi = mass_[i] * Je[i].transpose() * Je[i];
+    const MatrixXd Mi = mass_[i] * kin[i].J.transpose() * kin[i].J;
     for (std::size_t a = 0; a < cols.size(); ++a)
       for (std::size_t b = 0; b < cols.size(); ++b)
         M(6 + cols[a], 6 + cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
@@ -880,15 +978,19 @@ void ScoleNonlinear::Dynamics::for_turned_rotors(const VectorXd& e, Add&& add) c
 
 // M x = r by the Schur complement on the rigid rows: M = [A B; Bᵀ C] with C = M_ee (sparse: the
 // elements' band and the proof masses; factorised once per coefficient set when constant, per e
-// with quadratic points):
+// with nonlinear points):
 // S = A − B C⁻¹ Bᵀ (6 × 6), x_r = S⁻¹ (r_r − B C⁻¹ r_e), x_e = C⁻¹ (r_e − Bᵀ x_r).
 VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd& r) const {
+  return solve_mass(e, r, kinematics(e));
+}
+
+VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd& r,
+                                              const std::vector<Kinematics::At>& kin) const {
   const int ne = g_->ne_;
   Eigen::Matrix<double, 6, 6> A;
   MatrixXd B;
-  const auto Je = jacobians(e);
-  rigid_rows(e, Je, A, B);
-  if (quadratic_) {
+  rigid_rows(e, kin, A, B);
+  if (e_dependent_) {
     // M_ee(e) = the constant part + Σ m J_lᵀ J_l (J_l = N(e) − t (Q ê)ᵀ, on the point's local
     // columns: sparse) + for an axial part the rank-2 m [(v + g)(v + g)ᵀ − v vᵀ], g = Q ê,
     // v = J_lᵀ t, which the Woodbury identity takes.
@@ -903,37 +1005,60 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
       for (Eigen::Index a = 0; a < n; ++a)
         for (Eigen::Index b = 0; b < n; ++b) values[sl[static_cast<std::size_t>(a * n + b)]] += Mj(a, b);
     }
-    MatrixXd U(ne, 0);
-    std::vector<double> Sd;
+    // Points with the same axial part (the reflector's: one Q, one g) share one rank-2 term,
+    //   Σ m_i [(v_i + g)(v_i + g)ᵀ − v_i v_iᵀ] = V gᵀ + g Vᵀ + m g gᵀ = [V g] [0 1; 1 m] [V g]ᵀ,
+    // V = Σ m_i v_i, m = Σ m_i (the middle matrix has determinant −1 whatever m).
+    struct Axial {
+      const std::vector<int>* cols;
+      VectorXd g, V;
+      double m = 0.0;
+    };
+    std::vector<Axial> axial;
     for (std::size_t i = 0; i < g_->points_.size(); ++i) {
-      const auto& q = g_->points_[i].quad;
-      if (!q.active() || mass_[i] == 0.0) continue;  // (a zero mass would put 1/0 in the capacitance)
-      Eigen::Matrix<double, 3, Eigen::Dynamic> Jl = Je[i];
+      const auto& q = g_->points_[i].kin;
+      if (!q.active() || mass_[i] == 0.0) continue;
+      Eigen::Matrix<double, 3, Eigen::Dynamic> Jl = kin[i].J;
       VectorXd gq;
-      if (q.Q.size() != 0) {
-        gq = q.Q * q.gather(e);
+      if (q.axial()) {
+        gq = kin[i].Qg;
         Jl -= q.t * gq.transpose();
       }
-      const MatrixXd Mi = mass_[i] * Jl.transpose() * Jl;
+      // m J_lᵀ J_l on the local columns only (J_l vanishes on the others).
+      const auto& loc = q.local_index;
+      const auto nl = static_cast<Eigen::Index>(loc.size());
+      Eigen::Matrix<double, 3, Eigen::Dynamic> Jloc(3, nl);
+      for (Eigen::Index a = 0; a < nl; ++a) Jloc.col(a) = Jl.col(loc[static_cast<std::size_t>(a)]);
+      const MatrixXd Mi = mass_[i] * Jloc.transpose() * Jloc;
       const auto& sl = point_slots_[i];
       const auto n = static_cast<Eigen::Index>(q.cols.size());
-      for (Eigen::Index a = 0; a < n; ++a)
-        for (Eigen::Index b = 0; b < n; ++b) {
-          const int k = sl[static_cast<std::size_t>(a * n + b)];
-          if (k >= 0) values[k] += Mi(a, b);
-        }
-      if (q.Q.size() != 0) {
+      for (Eigen::Index a = 0; a < nl; ++a)
+        for (Eigen::Index b = 0; b < nl; ++b)
+          values[sl[static_cast<std::size_t>(loc[static_cast<std::size_t>(a)] * n + loc[static_cast<std::size_t>(b)])]] +=
+              Mi(a, b);
+      if (q.axial()) {
         const VectorXd v = Jl.transpose() * q.t;
-        U.conservativeResize(ne, U.cols() + 2);
-        U.rightCols<2>().setZero();
-        for (std::size_t k = 0; k < q.cols.size(); ++k) {
-          const auto kk = static_cast<Eigen::Index>(k);
-          U(q.cols[k], U.cols() - 2) = v[kk] + gq[kk];
-          U(q.cols[k], U.cols() - 1) = v[kk];
+        Axial* grp = nullptr;
+        for (auto& x : axial)
+          if (*x.cols == q.cols && x.g == gq) grp = &x;
+        if (!grp) {
+          axial.push_back({&q.cols, gq, VectorXd::Zero(gq.size()), 0.0});
+          grp = &axial.back();
         }
-        Sd.push_back(mass_[i]);
-        Sd.push_back(-mass_[i]);
+        grp->V += mass_[i] * v;
+        grp->m += mass_[i];
       }
+    }
+    MatrixXd U = MatrixXd::Zero(ne, static_cast<Eigen::Index>(2 * axial.size()));
+    MatrixXd Cinv = MatrixXd::Zero(U.cols(), U.cols());  // blocks [0 1; 1 m]⁻¹ = [−m 1; 1 0]
+    for (std::size_t x = 0; x < axial.size(); ++x) {
+      const auto c0 = static_cast<Eigen::Index>(2 * x);
+      const auto& cols = *axial[x].cols;
+      for (std::size_t k = 0; k < cols.size(); ++k) {
+        U(cols[k], c0) = axial[x].V[static_cast<Eigen::Index>(k)];
+        U(cols[k], c0 + 1) = axial[x].g[static_cast<Eigen::Index>(k)];
+      }
+      Cinv(c0, c0) = -axial[x].m;
+      Cinv(c0, c0 + 1) = Cinv(c0 + 1, c0) = 1.0;
     }
     // The DOFs are numbered along the mast (banded): no reordering.
     Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> factor(C);
@@ -941,8 +1066,7 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
       throw std::runtime_error("ScoleNonlinear: the elastic mass block is not positive definite at this deformation");
     if (U.cols() == 0) return schur_solve(A, B, [&](const MatrixXd& X) { return MatrixXd(factor.solve(X)); }, r);
     const MatrixXd Z = factor.solve(U);
-    MatrixXd cap = U.transpose() * Z;
-    for (std::size_t k = 0; k < Sd.size(); ++k) cap(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) += 1.0 / Sd[k];
+    const MatrixXd cap = Cinv + U.transpose() * Z;
     const Eigen::PartialPivLU<MatrixXd> capf(cap);
     return schur_solve(
         A, B,
@@ -974,6 +1098,11 @@ VectorXd ScoleNonlinear::Dynamics::schur_solve(const Eigen::Matrix<double, 6, 6>
 }
 
 VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e) const {
+  return internal(u, e, kinematics(e));
+}
+
+VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e,
+                                            const std::vector<Kinematics::At>& kin) const {
   const int ne = g_->ne_;
   const Vector3d V = u.head<3>(), W = u.segment<3>(3);
   const VectorXd ed = u.tail(ne);
@@ -982,11 +1111,12 @@ VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e
     const auto& p = g_->points_[i];
     const double mi = mass_[i];
     if (mi == 0.0) continue;
-    if (p.quad.active()) {
-      const auto& q = p.quad;
-      const auto Je = q.jacobian(e);
-      const Vector3d r = p.p + p.n.times(e) + q.quadratic(e), w = Je * q.gather(ed);
-      const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w) + q.bil(ed, ed));
+    if (p.kin.active()) {
+      const auto& q = p.kin;
+      const auto& k = kin[i];
+      const auto& Je = k.J;
+      const Vector3d r = p.p + p.n.times(e) + k.offset, w = Je * q.gather(ed);
+      const Vector3d f = mi * (W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(w) + k.convective(ed));
       b.head<3>() += f;
       b.segment<3>(3) += r.cross(f);
       const VectorXd g = Je.transpose() * f;
@@ -1053,10 +1183,11 @@ VectorXd ScoleNonlinear::Dynamics::load(const VectorXd& f, const VectorXd& e) co
     const double gi = fi * input_scale_[i];
     Q += gi * in.q0;
     if (in.arm) Q.segment<3>(3) += gi * Vector3d(in.N * e).cross(in.d);
-    if (in.quad) {
-      Q.segment<3>(3) += gi * in.quad->quadratic(e).cross(in.d);
+    if (in.kin) {
+      const auto k = in.kin->at(e, nullptr, false);
+      Q.segment<3>(3) += gi * k.offset.cross(in.d);
       VectorXd Qe = Q.tail(g_->ne_);
-      in.quad->bil_t(e, gi * in.d, Qe);  // (N(e) − N)ᵀ d f
+      k.rows_t(gi * in.d, Qe);  // (N(e) − N)ᵀ d f
       Q.tail(g_->ne_) = Qe;
     }
   }
@@ -1072,7 +1203,8 @@ void ScoleNonlinear::Dynamics::derivative(const double* y, const VectorXd& f, do
   phidot = right_jacobian_inverse(s.phi) * s.Omega;
   edot = s.edot;
   const VectorXd e = s.e, u = s.u;
-  const VectorXd a = solve_mass(e, load(f, e) - internal(u, e));
+  const auto kin = kinematics(e);
+  const VectorXd a = solve_mass(e, load(f, e) - internal(u, e, kin), kin);
   accel = a;
   if (udot) *udot = a;
 }
@@ -1103,12 +1235,13 @@ VectorXd ScoleNonlinear::Dynamics::outputs(const double* y, const VectorXd& udot
       case K::PointAcceleration: {
         Vector3d r = se.p + se.N * s.e, n = se.N * s.edot, ne2 = se.N * edd;
         Vector3d conv = Vector3d::Zero();
-        if (se.quad) {  // r(e), N(e) ė, N(e) ë and the convective bil(ė, ė) (§3.8)
-          const VectorXd e = s.e, ed = s.edot;
-          r += se.quad->quadratic(e);
-          n += se.quad->bil(e, ed);
-          ne2 += se.quad->bil(e, edd);
-          conv = se.quad->bil(ed, ed);
+        if (se.kin) {  // r(e), N(e) ė, N(e) ë and the convective r''[ė, ė] (§3.8)
+          const VectorXd ed = s.edot;
+          const auto k = se.kin->at(s.e, nullptr, false);
+          r += k.offset;
+          n += k.rows(ed);
+          ne2 += k.rows(edd);
+          conv = k.convective(ed);
         }
         const Vector3d a =
             Vd + Wd.cross(r) + ne2 + conv + s.Omega.cross(s.V) + s.Omega.cross(s.Omega.cross(r)) + 2.0 * s.Omega.cross(n);
@@ -1152,11 +1285,12 @@ namespace scoleid::identify {
 //   ∂s_i/∂r = f × μ_Ω + m (w × a_Ω + Ω × (Ω × w))                      (∂/∂e = Nᵀ ∂/∂r)
 //   ∂s_i/∂V = m w × Ω,   ∂s_i/∂ė = 2 m Nᵀ (w × Ω),
 //   ∂s_i/∂Ω = m (V × w + w (Ω·r) + r (w·Ω) − 2 (w·r) Ω + 2 (N ė) × w).
-// Per rotor: below, at its loop (the inertia turned by θ adds θ- and θ̇-terms). A quadratic point
-// (struct Quadratic): N(e) for N and the e-derivatives of N(e), at its branch.
+// Per rotor: below, at its loop (the inertia turned by θ adds θ- and θ̇-terms). A nonlinear point
+// (struct Kinematics): N(e) for N and the e-derivatives of N(e), at its branch.
 // Elastic: ∂/∂ė = D μ_e, ∂/∂e = K μ_e. A force's arm: ∂/∂e of −f μ_Ω · ((N e) × d) = −f Nᵀ (d × μ_Ω).
 void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu,
-                                            const VectorXd& fin, VectorXd& de, VectorXd& du, VectorXd* dc) const {
+                                            const VectorXd& fin, VectorXd& de, VectorXd& du, VectorXd* dc,
+                                            const std::vector<Kinematics::At>& kin) const {
   const int ne = g_->ne_;
   const StateView s(y, ne);
   const Vector3d V = s.V, W = s.Omega;
@@ -1169,18 +1303,21 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
   du = VectorXd::Zero(6 + ne);
   VectorXd due = VectorXd::Zero(ne);  // ∂s/∂ė, gathered apart and added to du at the end
   if (dc) *dc = VectorXd::Zero(g_->ncoef_);
+  std::vector<VectorXd> axial_e(g_->axial_rep_.size()), axial_edot(g_->axial_rep_.size());
   for (std::size_t i = 0; i < g_->points_.size(); ++i) {
     const auto& p = g_->points_[i];
     const double m = mass_[i];
     if (m == 0.0 && !(dc && p.coefficient >= 0)) continue;
-    if (p.quad.active()) {
-      // As below with N(e) for N, plus the e-dependence of N(e) (bil_t) and the γ term bil(ė, ė).
-      const auto& q = p.quad;
-      const auto Je = q.jacobian(e);
-      const Vector3d r = p.p + p.n.times(e) + q.quadratic(e), n = Je * q.gather(edot);
+    if (p.kin.active()) {
+      // As below with N(e) for N, plus the e-dependence of N(e) (second_t) and the γ term r''[ė, ė]
+      // (its ė-derivative by second_t, its e-derivative at fixed ė by convective_t).
+      const auto& q = p.kin;
+      const auto& k = kin[i];
+      const auto& Je = k.J;
+      const Vector3d r = p.p + p.n.times(e) + k.offset, n = Je * q.gather(edot);
       const Vector3d w = muV + muW.cross(r) + Je * q.gather(mue);
       const Vector3d acc = aV + aW.cross(r) + Je * q.gather(ae) + W.cross(V) + W.cross(W.cross(r)) + 2.0 * W.cross(n) +
-                           q.bil(edot, edot);
+                           k.convective(edot);
       if (dc && p.coefficient >= 0) (*dc)[p.coefficient] += p.weight * w.dot(acc);
       if (m == 0.0) continue;
       const Vector3d f = m * acc;
@@ -1190,10 +1327,18 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
         de[q.cols[k]] += gr[static_cast<Eigen::Index>(k)];
         due[q.cols[k]] += ge[static_cast<Eigen::Index>(k)];
       }
-      q.bil_t(mue, f, de);
-      q.bil_t(ae, m * w, de);
-      q.bil_t(edot, 2.0 * m * w.cross(W), de);
-      q.bil_t(edot, 2.0 * m * w, due);
+      VectorXd *ax = nullptr, *ax_dot = nullptr;  // the axial part's Q products, once per group
+      if (q.axial()) {
+        const auto g = static_cast<std::size_t>(q.axial_group);
+        if (axial_e[g].size() == 0) axial_e[g] = axial_edot[g] = VectorXd::Zero(static_cast<Eigen::Index>(q.cols.size()));
+        ax = &axial_e[g];
+        ax_dot = &axial_edot[g];
+      }
+      k.second_t(mue, f, de, ax);
+      k.second_t(ae, m * w, de, ax);
+      k.second_t(edot, 2.0 * m * w.cross(W), de, ax);
+      k.convective_t(edot, m * w, de);
+      k.second_t(edot, 2.0 * m * w, due, ax_dot);
       du.head<3>() += m * w.cross(W);
       du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
       continue;
@@ -1210,6 +1355,12 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     du.segment<3>(3) += m * (V.cross(w) + w * W.dot(r) + r * w.dot(W) - 2.0 * w.dot(r) * W + 2.0 * n.cross(w));
     p.n.add_transposed(2.0 * m * w.cross(W), due);
   }
+  for (std::size_t g = 0; g < axial_e.size(); ++g)
+    if (axial_e[g].size() != 0) {
+      const auto& q = g_->points_[g_->axial_rep_[g]].kin;
+      q.add_axial(axial_e[g], de);
+      q.add_axial(axial_edot[g], due);
+    }
   // Per rotor (struct Rotor), with θ = Θ e, θ̇ = Θ ė, p = P⊥ θ, ṗ = P⊥ θ̇, q̇ = B ė,
   // ω = Ω + θ̇ + p × q̇, J(θ) = J + ΔJ(θ) (symmetric, second order: struct Turning), h = J(θ) ω, and from μ: z = Θ μ_e,
   // m_A = P⊥ z, m_B = B μ_e, ν = μ_Ω + z + p × m_B (= L(e) μ); α = a_Ω + Θ a_e + p × B a_e,
@@ -1292,15 +1443,19 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     if (fi == 0.0) continue;
     const double gi = fi * input_scale_[i];
     if (in.arm) de.noalias() -= gi * (in.N.transpose() * in.d.cross(muW));
-    if (in.quad) {
-      // −f [μ_Ω · (quadratic(e) × d) + d · bil(μ_e, e)]:  ∂/∂e = −f [bil_t(e, d × μ_Ω) + bil_t(μ_e, d)]
-      in.quad->bil_t(e, -gi * in.d.cross(muW), de);
-      in.quad->bil_t(mue, -gi * in.d, de);
+    if (in.kin) {
+      // −f [μ_Ω · (offset(e) × d) + d · (N(e) − N) μ_e]:  ∂/∂e = −f [(N(e) − N)ᵀ (d × μ_Ω) + r''[·, μ_e]ᵀ d]
+      const auto k = in.kin->at(e, nullptr, false);
+      k.rows_t(-gi * in.d.cross(muW), de);
+      k.second_t(mue, -gi * in.d, de);
     }
     if (dc && in.coefficient >= 0) {
       double q = mu.dot(in.q0);
       if (in.arm) q += muW.dot(Vector3d(in.N * s.e).cross(in.d));
-      if (in.quad) q += muW.dot(in.quad->quadratic(e).cross(in.d)) + in.d.dot(in.quad->bil(mue, e));
+      if (in.kin) {
+        const auto k = in.kin->at(e, nullptr, false);
+        q += muW.dot(k.offset.cross(in.d)) + in.d.dot(k.rows(mue));
+      }
       (*dc)[in.coefficient] -= fi * q;
     }
   }
@@ -1320,9 +1475,10 @@ VectorXd ScoleNonlinear::Dynamics::derivative_vjp(const double* y, const VectorX
   const VectorXd le = lambda.segment(6, ne), lu = lambda.tail(6 + ne);
   const VectorXd e = s.e;
   const VectorXd a = ydot.tail(6 + ne);
-  const VectorXd mu = solve_mass(e, lu);
+  const auto kin = kinematics(e, true);
+  const VectorXd mu = solve_mass(e, lu, kin);
   VectorXd de, du;
-  residual_vjp(y, a, mu, fin, de, du, nullptr);
+  residual_vjp(y, a, mu, fin, de, du, nullptr, kin);
   const Matrix3d R = rotation_matrix(s.phi);
   VectorXd out = VectorXd::Zero(g_->state_size());
   Vector3d gphi = right_jacobian(s.phi).transpose() * (skew(s.V) * (R.transpose() * lX));
@@ -1345,9 +1501,10 @@ VectorXd ScoleNonlinear::Dynamics::coefficient_vjp(const double* y, const Vector
   const int ne = g_->ne_;
   const StateView s(y, ne);
   const VectorXd e = s.e;
-  const VectorXd mu = solve_mass(e, VectorXd(lambda.tail(6 + ne)));
+  const auto kin = kinematics(e, true);
+  const VectorXd mu = solve_mass(e, VectorXd(lambda.tail(6 + ne)), kin);
   VectorXd de, du, dc;
-  residual_vjp(y, ydot.tail(6 + ne), mu, fin, de, du, &dc);
+  residual_vjp(y, ydot.tail(6 + ne), mu, fin, de, du, &dc, kin);
   return -dc;
 }
 
@@ -1393,10 +1550,12 @@ void ScoleNonlinear::Dynamics::outputs_vjp(const double* y, const VectorXd& udot
       case K::RateRow: dy.tail(ne) += c * se.row.transpose(); break;
       case K::PointAcceleration: {
         Vector3d r = se.p + se.N * s.e, n = se.N * s.edot;
-        const VectorXd e = s.e, ed = s.edot, edd = udot.tail(ne);
-        if (se.quad) {
-          r += se.quad->quadratic(e);
-          n += se.quad->bil(e, ed);
+        const VectorXd ed = s.edot, edd = udot.tail(ne);
+        Kinematics::At k;
+        if (se.kin) {
+          k = se.kin->at(s.e);
+          r += k.offset;
+          n += k.rows(ed);
         }
         da.head<3>() += d;
         da.segment<3>(3) += r.cross(d);
@@ -1406,16 +1565,17 @@ void ScoleNonlinear::Dynamics::outputs_vjp(const double* y, const VectorXd& udot
         dy.tail(ne) += 2.0 * (se.N.transpose() * d.cross(W));
         const Vector3d dr = d.cross(Wd) + W.cross(W.cross(d));  // ∂/∂r
         dy.segment(6, ne) += se.N.transpose() * dr;
-        if (se.quad) {
-          // N(e) for N in ∂ë, ∂ė and ∂r, and the e-derivative of d·(N(e) ë + 2 Ω × N(e) ė);
-          // the convective d·bil(ė, ė) gives 2 bil_t(ė, d) on ė.
+        if (se.kin) {
+          // N(e) for N in ∂ë, ∂ė and ∂r, and the e-derivative of d·(N(e) ë + 2 Ω × N(e) ė + r''[ė, ė]);
+          // the convective d·r''[ė, ė] gives 2 r''[·, ė]ᵀ d on ė.
           VectorXd t_a = da.tail(ne), t_e = dy.segment(6, ne), t_d = dy.tail(ne);
-          se.quad->bil_t(e, d, t_a);
-          se.quad->bil_t(e, dr, t_e);
-          se.quad->bil_t(edd, d, t_e);
-          se.quad->bil_t(ed, 2.0 * d.cross(W), t_e);
-          se.quad->bil_t(e, 2.0 * d.cross(W), t_d);
-          se.quad->bil_t(ed, 2.0 * d, t_d);
+          k.rows_t(d, t_a);
+          k.rows_t(dr, t_e);
+          k.second_t(edd, d, t_e);
+          k.second_t(ed, 2.0 * d.cross(W), t_e);
+          k.convective_t(ed, d, t_e);
+          k.rows_t(2.0 * d.cross(W), t_d);
+          k.second_t(ed, 2.0 * d, t_d);
           da.tail(ne) = t_a;
           dy.segment(6, ne) = t_e;
           dy.tail(ne) = t_d;

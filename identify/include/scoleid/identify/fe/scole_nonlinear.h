@@ -14,14 +14,15 @@
 //              L_i = [I, −[r_i]×, N_i];  inertial acceleration in S  a_i = L_i u̇ + γ_i,
 //              γ_i = Ω × V + Ω × (Ω × r_i) + 2 Ω × N_i ė  (transport, centrifugal, Coriolis).
 //              The mast's ρA by four Gauss points per element (exact for the Hermite consistent
-//              mass), the reflector's and proof masses' CMs, the shuttle's CM.
-//              Two points are quadratic in e (struct Quadratic): a proof mass, whose slider plane
-//              turns with the section, r = p + N e + Θ(s_k) e × (stroke), and the reflector's CM,
-//              which turns with the mast's end to second order, ½ Θ × (Θ × r), and comes back by
-//              the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds.
-//              The end's rotation is exp[α] exp[ψ ẑ] to second order (struct Coupling), so the arm
-//              also moves by ½ (ẑ·θ)(r·θ) ẑ. For them N_i becomes N_i(e) = ∂r_i/∂e
-//              and γ_i gains the convective term bil(ė, ė) (d²r/dt² = N(e) ë + bil(ė, ė)); M_ee then
+//              mass), the reflector, the proof masses' CMs, the shuttle's CM.
+//              Some points are nonlinear in e (struct Kinematics): a proof mass, whose slider
+//              plane turns with the section, r = p + N e + Θ(s_k) e × (stroke), and the
+//              reflector's points. The reflector is a rigid body on the mast's end: its CM (its
+//              mass) and pairs of points on the principal axes of its second moment (its inertia),
+//              each at an arm turned exactly with the end section (R = exp[α] exp[ψ ẑ],
+//              turned_arm.h) and carried back by the end's foreshortening ½ ∫ (u_x'² + u_y'²) ds.
+//              For them N_i becomes N_i(e) = ∂r_i/∂e and γ_i gains the convective term r''[ė, ė]
+//              (d²r/dt² = N(e) ë + r''[ė, ė]); M_ee then
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e and
 //              carry their foreshortening w = ½ eᵀ Q(s) e through the kinetic energy's cross term
@@ -38,9 +39,9 @@
 //              [0; Ω × J(θ) ω; Θ̇(e)ᵀ h − (∂ω/∂e)ᵀ h − Θᵀ ∂T/∂θ], h = J(θ) ω,
 //              J̇ ω = ∂J/∂θ[θ̇] ω, ∂T/∂θ = ½ ∇_θ (ωᵀ J(θ) ω) (first order: θ̇ × J ω − J (θ̇ × ω) and
 //              J ω × ω): the gyroscopic coupling of the slew's rate with an anisotropic rotor's
-//              elastic rotation (the reflector's I_zz = 2 I_xx).
-//              The shuttle (no elastic rotation), the reflector about its CM, and the section's
-//              ρI_ψ (three Gauss points per element). Energy and momenta are conserved exactly.
+//              elastic rotation.
+//              The shuttle (no elastic rotation) and the section's ρI_ψ (three Gauss points per
+//              element). Energy and momenta are conserved exactly.
 // Strain       the linear model's ½ eᵀ K e and the mast's W₃ + W₄ (struct Coupling): the
 //              Kirchhoff rod's energy to fourth order in the deflection.
 // Equations    M(e) u̇ + b(u, e) + [0; 0; D ė + K e + ∇W(e)] = Q(t, e),
@@ -69,6 +70,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "scoleid/identify/fe/scole_model.h"
+#include "scoleid/identify/fe/turned_arm.h"
 
 namespace scoleid::identify {
 
@@ -86,6 +88,53 @@ public:
   int sensors() const { return static_cast<int>(sensors_.size()); }
   int coefficients() const { return ncoef_; }
   const std::vector<std::string>& sensor_names() const { return sensor_names_; }
+
+private:
+  // A point whose position is nonlinear in e (the proof masses, the reflector's points), on the union
+  // of the columns its rows touch (x̂ = x on them):
+  //   r(e) = p + N e + (A ê) × (B ê) + t ½ êᵀ Q ê + [ρ(Θ ê) − a − (Θ ê) × a],
+  // a quadratic part — a proof mass on a slider plane that turns with the section: A the section's
+  // rotation rows, B the stroke's; an axial part t ½ êᵀ Q ê, the foreshortening of a point at the
+  // mast's end (Q = ∫ Θ⊥ᵀ Θ⊥ ds over the mast, t the unit vector back towards the root) — and a
+  // turned arm a (Θ the end section's rotation rows, ρ = R(θ) a exactly: turned_arm.h; its linear
+  // part θ × a is in N). Empty A, B, Q or Θ for none. The point's map at one e (struct At):
+  //   N(e) = ∂r/∂e = N + [A ê]× B − [B ê]× A + t (Q ê)ᵀ + (∂ρ + [a]×) Θ,
+  //   d²r/dt² = N(e) ë + r''[ė, ė],   r''[x, y] = (A x̂) × (B ŷ) + (A ŷ) × (B x̂) + t x̂ᵀ Q ŷ + ∂²ρ[Θ x̂, Θ ŷ].
+  struct Kinematics {
+    std::vector<int> cols;
+    std::vector<char> local;  // per column: touched by N, A, B or Θ (not only by Q)
+    std::vector<int> local_index;  // the positions in cols of the local columns
+    Eigen::Matrix<double, 3, Eigen::Dynamic> N, A, B, Theta;
+    SparseMatrix P;  // Q = Pᵀ P (the slopes' rows at Gauss points, times √weight); empty for none
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    Eigen::Vector3d arm = Eigen::Vector3d::Zero();
+    bool active() const { return !cols.empty(); }
+    bool axial() const { return P.rows() != 0; }
+    VectorXd gather(const VectorXd& x) const;
+    struct At {
+      const Kinematics* k = nullptr;
+      VectorXd g;                                  // ê
+      TurnedArm turned;                            // ρ at θ = Θ ê (with an arm)
+      Eigen::Vector3d offset;                      // r(e) − p − N e
+      Eigen::Matrix<double, 3, Eigen::Dynamic> J;  // N(e) on cols
+      VectorXd Qg;                                 // Q ê (with an axial part)
+      Eigen::Vector3d rows(const VectorXd& y) const;                          // (N(e) − N) y
+      void rows_t(const Eigen::Vector3d& w, VectorXd& out) const;             // out += (N(e) − N)ᵀ w
+      Eigen::Vector3d convective(const VectorXd& x) const;                    // r''[x, x]
+      // out += ∇_e (w · N(e) y) = r''[·, y]ᵀ w. With `axial`, the axial part's (t·w) Q ŷ is left
+      // to the caller: (t·w) ŷ is added to *axial (on cols), for one add_axial of the sum.
+      void second_t(const VectorXd& y, const Eigen::Vector3d& w, VectorXd& out, VectorXd* axial = nullptr) const;
+      // out += ∇_e (w · r''[x, x]) at fixed x (zero without an arm: the rest is quadratic)
+      void convective_t(const VectorXd& x, const Eigen::Vector3d& w, VectorXd& out) const;
+    };
+    // With the section's rotation R(Θ ê) when the caller already has it (points sharing Θ).
+    At at(const VectorXd& e, const TurnedRotation* turned = nullptr, bool third = true) const;
+    // out += Q ẑ on cols (z on cols).
+    void add_axial(const VectorXd& z, VectorXd& out) const;
+    int axial_group = -1;  // points with the same cols and P share one (ScoleNonlinear::axial_rep_)
+  };
+
+public:
 
   // The operators at coefficients c. `constants` scales the terms without a coefficient (1 for
   // the model; 0 with c = e_k gives ∂/∂c_k of the residual, the loads excluded).
@@ -119,27 +168,31 @@ public:
     friend class ScoleNonlinear;
     // s = μᵀ R(y, a) (R the residual at accelerations a): ∂s/∂e, ∂s/∂u, and per coefficient
     // ∂s/∂c_k (the loads' coefficient-free part excluded).
+    // kin: kinematics(e, true) at the state's e.
     void residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu, const VectorXd& f, VectorXd& de,
-                      VectorXd& du, VectorXd* dc) const;
+                      VectorXd& du, VectorXd* dc, const std::vector<Kinematics::At>& kin) const;
     const ScoleNonlinear* g_ = nullptr;
     std::vector<double> mass_;            // per mass point
     std::vector<Eigen::Matrix3d> J_;      // per rotor
     std::vector<double> rotor_scale_;     // per rotor: J_ = scale · Rotor::J
     MatrixXd Mconst_;                     // the e-independent part of M
-    // M_ee: constant and factorised once without quadratic points; with them, the constant part
+    // M_ee: constant and factorised once without nonlinear points; with them, the constant part
     // in a pattern holding their local rows, factorised per e (solve_mass).
     std::shared_ptr<const Eigen::SimplicialLLT<SparseMatrix>> C_;
     SparseMatrix Cbase_;
-    bool quadratic_ = false;
+    bool e_dependent_ = false;
     // Positions in Cbase_'s value array of each turned rotor's (a, b) column pairs and each
-    // quadratic point's local pairs, row-major over the pairs (−1: not local).
+    // nonlinear point's local pairs, row-major over the pairs (−1: not local).
     std::vector<std::vector<int>> rotor_slots_, point_slots_;
-    // The quadratic points' compact Jacobians N(e), in the order of the points (empty for others).
-    std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> jacobians(const VectorXd& e) const;
+    // The nonlinear points' maps at e, in the order of the points (empty for the others); with
+    // `third`, with the third derivatives the transposed products' convective_t needs.
+    std::vector<Kinematics::At> kinematics(const VectorXd& e, bool third = false) const;
     // The rigid rows of M(e): A = M_rr (6 × 6), B = M_re (6 × ne).
-    void rigid_rows(const VectorXd& e, const std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>& Je,
-                    Eigen::Matrix<double, 6, 6>& A, MatrixXd& B) const;
+    void rigid_rows(const VectorXd& e, const std::vector<Kinematics::At>& kin, Eigen::Matrix<double, 6, 6>& A,
+                    MatrixXd& B) const;
     VectorXd solve_mass(const VectorXd& e, const VectorXd& r) const;
+    VectorXd solve_mass(const VectorXd& e, const VectorXd& r, const std::vector<Kinematics::At>& kin) const;
+    VectorXd internal(const VectorXd& u, const VectorXd& e, const std::vector<Kinematics::At>& kin) const;
     // The mast's foreshortening (struct Foreshortening): its parts of the rigid rows A, B of M(e),
     // of b(u, e), and of residual_vjp (∂s/∂e into de, ∂s/∂ė into de_dot, ∂s/∂V, ∂s/∂Ω into du, and
     // ∂s/∂c into dc).
@@ -180,29 +233,6 @@ private:
     void add_transposed(const Eigen::Vector3d& w, VectorXd& out) const;          // out += Rowsᵀ w
     void add_left(const Eigen::Matrix3d& A, MatrixXd& out) const;                // out (3 × ne) += A Rows
   };
-  // A point whose position is quadratic in e: r = p + N e + (A e) × (B e) [+ t ½ eᵀ Q e] (a proof
-  // mass on a slider plane that turns with the section: A the section's rotation rows, B the
-  // stroke's; the reflector's CM turning with the mast's end, A = ½ Θ(L), B e = Θ(L) e × r).
-  // All rows on the union of the columns they touch; with x̂ = x on those columns:
-  //   N(e) = ∂r/∂e = N + [A ê]× B − [B ê]× A,   bil(x, y) = (A x̂) × (B ŷ) + (A ŷ) × (B x̂),
-  //   N(e) x = N x + bil(e, x),  d²r/dt² = N(e) ë + bil(ė, ė),
-  //   ∂/∂x of wᵀ bil(x, y) = Bᵀ (w × A ŷ) + Aᵀ (B ŷ × w)  (bil_t).
-  struct Quadratic {
-    std::vector<int> cols;
-    std::vector<char> local;  // per column: touched by N, A or B (not only by Q)
-    Eigen::Matrix<double, 3, Eigen::Dynamic> N, A, B;
-    // An axial part t ½ êᵀ Q ê (the foreshortening of a point at the mast's end: Q = ∫ Θ_xyᵀ Θ_xy ds
-    // over the mast, t the unit vector back towards the root); empty Q for none. It adds t (Q ê)ᵀ
-    // to N(e), t x̂ᵀ Q ŷ to bil(x, y) and (t·w) Q ŷ to bil_t.
-    MatrixXd Q;
-    Eigen::Vector3d t = Eigen::Vector3d::Zero();
-    bool active() const { return !cols.empty(); }
-    VectorXd gather(const VectorXd& x) const;
-    Eigen::Matrix<double, 3, Eigen::Dynamic> jacobian(const VectorXd& e) const;  // N(e) on cols
-    Eigen::Vector3d quadratic(const VectorXd& e) const;                         // (A e) × (B e)
-    Eigen::Vector3d bil(const VectorXd& x, const VectorXd& y) const;
-    void bil_t(const VectorXd& y, const Eigen::Vector3d& w, VectorXd& out) const;  // out += ∂/∂x (wᵀ bil(x, y))
-  };
   // The strain energy of the mast beyond the linear model's quadratic (docs/theory.md §3.8). With the
   // section's rotation R = exp[α] exp[ψ a] (α the tilt the slopes give, ⊥ a; ψ the twist about the
   // mast's axis a) and θ = Θ e the linear rotation rows (θ_x, θ_y the slopes turned by 90°, exactly;
@@ -229,9 +259,10 @@ private:
     double weight = 0; // mass = weight · c[coefficient] (or · constants)
     int coefficient = -1;
     Rows3 n;           // N, compact
-    Quadratic quad;    // active for a point quadratic in e (N is then its linear part)
+    Kinematics kin;    // active for a point nonlinear in e (N is then its linear part)
+    double offset = 0; // a constant added to the mass (· constants)
   };
-  // A rotor on the mast (a section or the reflector on its end) turns with the section's rotation
+  // A rotor on the mast (a section) turns with the section's rotation
   // R = exp[α] exp[ψ ẑ] (struct Coupling), whose angular velocity relative to S is, to second order,
   //   ω_rel = Θ ė + p × (B ė),   p = α = P⊥ Θ e,   B = (½ P⊥ + P_z) Θ
   // (½ α × α̇ + ψ̇ α × ẑ): ω = Ω + Θ(e) ė with Θ(e) = Θ + [p]× B. The shuttle's rotor has no columns.
@@ -265,9 +296,9 @@ private:
     MatrixXd N;
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
     int coefficient = -1;
-    // At a quadratic point (the reflector's CM): also Q_Ω += quadratic(e) × d f and
+    // At a point nonlinear in e (the reflector's CM): also Q_Ω += (r(e) − p − N e) × d f and
     // Q_e += (N(e) − N)ᵀ d f, the generalized force L(e)ᵀ d f of the point's own kinematics.
-    const Quadratic* quad = nullptr;
+    const Kinematics* kin = nullptr;
   };
   struct Sensor {
     enum class Kind { ShuttleRotation, ShuttleDisplacement, ShuttleVelocity, ShuttleAcceleration, Row, RateRow,
@@ -277,7 +308,7 @@ private:
     Eigen::RowVectorXd row;  // on e or ė
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     MatrixXd N;
-    const Quadratic* quad = nullptr;  // an accelerometer at a quadratic point (the reflector's CM)
+    const Kinematics* kin = nullptr;  // an accelerometer at a point nonlinear in e (the reflector's CM)
   };
 
   // The mast's foreshortening (docs/theory.md §3.8, "The mast's foreshortening"). An inextensible
@@ -321,6 +352,7 @@ private:
   int ne_ = 0, ncoef_ = 0;
   Foreshortening fs_;
   std::vector<MassPoint> points_;
+  std::vector<std::size_t> axial_rep_;  // per axial group (Kinematics::axial_group): its first point
   std::vector<Rotor> rotors_;
   std::vector<Coupling> coupling_;
   std::vector<OperatorTerm> stiffness_, damping_;  // e-blocks
