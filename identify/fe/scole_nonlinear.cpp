@@ -806,7 +806,8 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<K
 // s = t ẇ + (Ω × t) w the shift's (w = ½ eᵀ Q e, g = Q e). As t·N = 0 (the mast's rows are
 // lateral), T_fs = ½ uᵀ M_fs u with
 //   M_Ve = m t gᵀ,  M_Ωe = m [(r × t) gᵀ + w [t]× N],  M_VΩ = −m w [t]×,
-//   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×),   M_ee untouched (½ m |s|² is left out: fourth order).
+//   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×);   the axial inertia's m g gᵀ on M_ee is applied in
+// axial_inertia_solve (dense), ½ m w² |Ω × t|² is left out (fourth order).
 void ScoleNonlinear::Dynamics::add_foreshortening_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A,
                                                        MatrixXd& B) const {
   const auto& F = g_->fs_;
@@ -838,10 +839,11 @@ void ScoleNonlinear::Dynamics::add_foreshortening_rows(const VectorXd& e, Eigen:
 
 // T_fs's equations (Boltzmann–Hamel on V, Ω; Lagrange on e) per point, with S = ṡ + Ω × s and
 // K = k̇ + Ω × k (the point's inertial acceleration without the shift):
-//   V: m S,   Ω: m (r × S + w t × K),   e: m (Nᵀ S + g t·K),
+//   V: m S,   Ω: m (r × S + w t × K),   e: m (Nᵀ S + g t·K + g ẅ),
 //   S = t ẅ + (Ω̇ × t) w + 2 ẇ Ω × t + w Ω × (Ω × t),  ẅ = gᵀ ë + χ,  χ = ėᵀ Q ė,
-//   K = V̇ + Ω̇ × r + N ë + 2 Ω × N ė + Ω × V + Ω × (Ω × r).
-// The acceleration terms are M_fs's; here the rest (S₀, K₀): b gains them.
+//   K = V̇ + Ω̇ × r + N ë + 2 Ω × N ė + Ω × V + Ω × (Ω × r)
+// (g ẅ the axial inertia's: d/dt (m ẇ g) − m ẇ Q ė). The acceleration terms are M_fs's; here the
+// rest (S₀, K₀, m g χ): b gains them.
 void ScoleNonlinear::Dynamics::add_foreshortening_force(const VectorXd& u, const VectorXd& e, VectorXd& b) const {
   const auto& F = g_->fs_;
   if (F.size() == 0) return;
@@ -865,7 +867,7 @@ void ScoleNonlinear::Dynamics::add_foreshortening_force(const VectorXd& u, const
     bV += S0;
     bW += r.cross(S0) + w * t.cross(K0);
     pt.n.add_transposed(S0, be);
-    gamma[i] = t.dot(K0);
+    gamma[i] = t.dot(K0) + m * chi[i];  // + the axial inertia's m g χ
   }
   b.head<3>() += bV;
   b.segment<3>(3) += bW;
@@ -873,14 +875,15 @@ void ScoleNonlinear::Dynamics::add_foreshortening_force(const VectorXd& u, const
   b.tail(ne) += be;
 }
 
-// s_fs = μᵀ R_fs = Σ m σ,  σ = λ·S + κ·K,  λ = μ_V + μ_Ω × r + N μ_e,  κ = η t + w μ_Ω × t,
+// s_fs = μᵀ R_fs = Σ m σ,  σ = λ·S + κ·K + η (ψ + χ),  λ = μ_V + μ_Ω × r + N μ_e,  κ = η t + w μ_Ω × t,
 // η = μ_eᵀ Q e (S, K as above, at the accelerations a). With ψ = a_eᵀ Q e, Ω_t = Ω × t:
-//   ∂σ/∂w = λ·(a_Ω × t + Ω × Ω_t) + (μ_Ω × t)·K,  ∂σ/∂ẇ = 2 λ·Ω_t,  ∂σ/∂ψ = ∂σ/∂χ = λ·t,  ∂σ/∂η = t·K,
+//   ∂σ/∂w = λ·(a_Ω × t + Ω × Ω_t) + (μ_Ω × t)·K,  ∂σ/∂ẇ = 2 λ·Ω_t,  ∂σ/∂ψ = ∂σ/∂χ = λ·t + η,
+//   ∂σ/∂η = t·K + ψ + χ,
 //   ∂σ/∂r = S × μ_Ω + κ × a_Ω + Ω × (Ω × κ),   ∂σ/∂(N ė) = 2 κ × Ω,   ∂σ/∂V = κ × Ω,
 //   ∂σ/∂Ω = 2 ẇ t × λ + w (λ (Ω·t) + t (λ·Ω) − 2 (λ·t) Ω) + 2 (N ė) × κ + V × κ
 //           + κ (Ω·r) + r (κ·Ω) − 2 (κ·r) Ω;
-// ∂/∂e = Nᵀ ∂σ/∂r + ∂σ/∂w Q e + ∂σ/∂ẇ Q ė + λ·t Q a_e + t·K Q μ_e,
-// ∂/∂ė = Nᵀ ∂σ/∂(N ė) + ∂σ/∂ẇ Q e + 2 λ·t Q ė  (each times m; ∂/∂c = weight σ).
+// ∂/∂e = Nᵀ ∂σ/∂r + ∂σ/∂w Q e + ∂σ/∂ẇ Q ė + ∂σ/∂ψ Q a_e + ∂σ/∂η Q μ_e,
+// ∂/∂ė = Nᵀ ∂σ/∂(N ė) + ∂σ/∂ẇ Q e + 2 ∂σ/∂χ Q ė  (each times m; ∂/∂c = weight σ).
 void ScoleNonlinear::Dynamics::add_foreshortening_vjp(const VectorXd& u, const VectorXd& e, const VectorXd& a,
                                                       const VectorXd& mu, VectorXd& de, VectorXd& de_dot, VectorXd& du,
                                                       VectorXd* dc) const {
@@ -910,13 +913,13 @@ void ScoleNonlinear::Dynamics::add_foreshortening_vjp(const VectorXd& u, const V
     const Vector3d S = t * (psi[i] + chi[i]) + w * aW.cross(t) + 2.0 * wdot * Wt + w * W.cross(Wt);
     const Vector3d K = aV + aW.cross(r) + pt.n.times(ae) + 2.0 * W.cross(nd) + W.cross(V) + W.cross(W.cross(r));
     const double lt = lam.dot(t), tK = t.dot(K);
-    if (dc && pt.coefficient >= 0) (*dc)[pt.coefficient] += pt.weight * (lam.dot(S) + kap.dot(K));
+    if (dc && pt.coefficient >= 0) (*dc)[pt.coefficient] += pt.weight * (lam.dot(S) + kap.dot(K) + eta[i] * (psi[i] + chi[i]));
     if (m == 0.0) continue;
     g_w[i] = m * (lam.dot(aW.cross(t) + W.cross(Wt)) + muWt.dot(K));
     g_wd[i] = m * 2.0 * lam.dot(Wt);
-    g_t[i] = m * lt;
-    g_t2[i] = 2.0 * m * lt;
-    g_K[i] = m * tK;
+    g_t[i] = m * (lt + eta[i]);
+    g_t2[i] = 2.0 * m * (lt + eta[i]);
+    g_K[i] = m * (tK + psi[i] + chi[i]);
     pt.n.add_transposed(m * (S.cross(muW) + kap.cross(aW) + W.cross(W.cross(kap))), de);
     pt.n.add_transposed(2.0 * m * kap.cross(W), de_dot);
     dV += m * kap.cross(W);
@@ -952,6 +955,19 @@ MatrixXd ScoleNonlinear::Dynamics::mass(const VectorXd& e) const {
         M(6 + cols[a], 6 + cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   }
   for_turned_rotors(e, [&](int a, int b, double v) { M(6 + a, 6 + b) += v; });
+  // The mast's axial inertia Σ m g gᵀ, g = Q e (column by column: ΔM e_k).
+  const auto& F = g_->fs_;
+  if (F.size() > 0) {
+    const auto Se = F.slopes(e);
+    std::vector<double> gk;
+    for (int k = 0; k < ne; ++k) {
+      F.forms(Se, F.slopes(VectorXd(VectorXd::Unit(ne, k))), gk);
+      for (std::size_t i = 0; i < F.size(); ++i) gk[i] *= mass_[F.point[i]];
+      VectorXd col = VectorXd::Zero(ne);
+      F.apply(gk, Se, col);
+      M.block(6, 6 + k, ne, 1) += col;
+    }
+  }
   return M;
 }
 
@@ -1064,37 +1080,90 @@ VectorXd ScoleNonlinear::Dynamics::solve_mass(const VectorXd& e, const VectorXd&
     Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> factor(C);
     if (factor.info() != Eigen::Success)
       throw std::runtime_error("ScoleNonlinear: the elastic mass block is not positive definite at this deformation");
-    if (U.cols() == 0) return schur_solve(A, B, [&](const MatrixXd& X) { return MatrixXd(factor.solve(X)); }, r);
+    if (U.cols() == 0)
+      return axial_inertia_solve(e, r, schur_solver(A, B, [&](const MatrixXd& X) { return MatrixXd(factor.solve(X)); }));
     const MatrixXd Z = factor.solve(U);
     const MatrixXd cap = Cinv + U.transpose() * Z;
     const Eigen::PartialPivLU<MatrixXd> capf(cap);
-    return schur_solve(
-        A, B,
-        [&](const MatrixXd& X) {
-          const MatrixXd Y0 = factor.solve(X);
-          return MatrixXd(Y0 - Z * capf.solve(MatrixXd(U.transpose() * Y0)));
-        },
-        r);
+    return axial_inertia_solve(e, r, schur_solver(A, B, [&](const MatrixXd& X) {
+                                 const MatrixXd Y0 = factor.solve(X);
+                                 return MatrixXd(Y0 - Z * capf.solve(MatrixXd(U.transpose() * Y0)));
+                               }));
   }
-  return schur_solve(A, B, [&](const MatrixXd& X) { return MatrixXd(C_->solve(X)); }, r);
+  return axial_inertia_solve(e, r, schur_solver(A, B, [&](const MatrixXd& X) { return MatrixXd(C_->solve(X)); }));
 }
 
+// M₀ with M₀ = [A B; Bᵀ C] by its Schur complement: C⁻¹ Bᵀ and S = A − B C⁻¹ Bᵀ once, then one
+// C-solve per right-hand side: x_r = S⁻¹ (r_r − B C⁻¹ r_e), x_e = C⁻¹ r_e − C⁻¹ Bᵀ x_r.
 template <class SolveC>
-VectorXd ScoleNonlinear::Dynamics::schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
-                                               const VectorXd& r) const {
+std::function<VectorXd(const VectorXd&)> ScoleNonlinear::Dynamics::schur_solver(const Eigen::Matrix<double, 6, 6>& A,
+                                                                                 const MatrixXd& B,
+                                                                                 const SolveC& solve_C) const {
   const int ne = g_->ne_;
-  MatrixXd rhs(ne, 7);
-  rhs.leftCols<6>() = B.transpose();
-  rhs.col(6) = r.tail(ne);
-  const MatrixXd sol = solve_C(rhs);
-  const auto Y = sol.leftCols<6>();  // C⁻¹ Bᵀ
+  const MatrixXd Y = solve_C(MatrixXd(B.transpose()));  // C⁻¹ Bᵀ
   const Eigen::Matrix<double, 6, 6> S = A - B * Y;
-  const VectorXd Cre = sol.col(6);
-  const Eigen::Matrix<double, 6, 1> xr = S.ldlt().solve(Eigen::Matrix<double, 6, 1>(r.head<6>() - B * Cre));
-  VectorXd x(6 + ne);
-  x.head<6>() = xr;
-  x.tail(ne) = Cre - Y * xr;
-  return x;
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> Sf(S);
+  return [=](const VectorXd& r) {
+    const VectorXd Cre = solve_C(MatrixXd(r.tail(ne))).col(0);
+    const Eigen::Matrix<double, 6, 1> xr = Sf.solve(Eigen::Matrix<double, 6, 1>(r.head<6>() - B * Cre));
+    VectorXd x(6 + ne);
+    x.head<6>() = xr;
+    x.tail(ne) = Cre - Y * xr;
+    return x;
+  };
+}
+
+// M x = r with M = M₀ + ΔM, ΔM = Σ_i m_i g_i g_iᵀ on the e block (g_i = Q_i e: the axial inertia
+// ½ m ẇ² of the mast's foreshortening, dense, of relative size |u'|²). Conjugate gradients on M
+// preconditioned by M₀ (both symmetric positive definite): M₀ p is carried along by the recursion
+// (p_k = z_k + β p_{k−1}, z_k = M₀⁻¹ r_k ⇒ M₀ p_k = r_k + β M₀ p_{k−1}), so only M₀⁻¹ and ΔM
+// (O(ne) by struct Foreshortening) are applied. M₀⁻¹ M has its spectrum in [1, 1 + ρ],
+// ρ = max xᵀ ΔM x / xᵀ M₀ x ~ |u'|², and CG gains about a factor ρ/4 per iteration.
+VectorXd ScoleNonlinear::Dynamics::axial_inertia_solve(const VectorXd& e, const VectorXd& r,
+                                                       const std::function<VectorXd(const VectorXd&)>& solve0) const {
+  const auto& F = g_->fs_;
+  VectorXd x = solve0(r);
+  if (F.size() == 0) return x;
+  const int ne = g_->ne_;
+  const auto Se = F.slopes(e);
+  std::vector<double> gx;
+  auto dM = [&](const VectorXd& v) {  // ΔM v
+    F.forms(Se, F.slopes(VectorXd(v.tail(ne))), gx);
+    for (std::size_t i = 0; i < F.size(); ++i) gx[i] *= mass_[F.point[i]];
+    VectorXd out = VectorXd::Zero(6 + ne);
+    VectorXd oe = VectorXd::Zero(ne);
+    F.apply(gx, Se, oe);
+    out.tail(ne) = oe;
+    return out;
+  };
+  // First step from x = M₀⁻¹ r (p = x, M₀ p = r).
+  VectorXd p = x, M0p = r;
+  const VectorXd dMp = dM(p);
+  if (dMp.isZero(0.0)) return x;  // at e = 0
+  VectorXd Mp = M0p + dMp;
+  double pMp = p.dot(Mp);
+  if (pMp <= 0.0) return x;  // r = 0
+  double rz = r.dot(x);
+  const double rz0 = rz;
+  double alpha = rz / pMp;
+  x *= alpha;
+  VectorXd res = r - alpha * Mp;
+  constexpr double kTol = 1e-26;  // (M₀⁻¹-norm of the residual / of r)²
+  for (int k = 0; k < 100; ++k) {
+    const VectorXd z = solve0(res);
+    const double rz_new = res.dot(z);
+    if (rz_new <= kTol * rz0) return x;
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    M0p = res + beta * M0p;
+    p = z + beta * p;
+    Mp = M0p + dM(p);
+    pMp = p.dot(Mp);
+    alpha = rz / pMp;
+    x += alpha * p;
+    res -= alpha * Mp;
+  }
+  throw std::runtime_error("ScoleNonlinear: the mass solve with the mast's axial inertia did not converge at this deformation");
 }
 
 VectorXd ScoleNonlinear::Dynamics::internal(const VectorXd& u, const VectorXd& e) const {

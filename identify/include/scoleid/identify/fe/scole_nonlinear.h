@@ -25,9 +25,10 @@
 //              (d²r/dt² = N(e) ë + r''[ė, ė]); M_ee then
 //              depends on e (factorised per e on a fixed sparse pattern; the foreshortening's dense
 //              rank-2 part by the Woodbury identity). The mast's own points keep r = p + N e and
-//              carry their foreshortening w = ½ eᵀ Q(s) e through the kinetic energy's cross term
-//              Σ m (V + Ω × r + N ė)·(t ẇ + (Ω × t) w) (struct Foreshortening): rigid rows of M and
-//              b only, M_ee untouched.
+//              carry their foreshortening w = ½ eᵀ Q(s) e through the kinetic energy: the cross
+//              term Σ m (V + Ω × r + N ė)·(t ẇ + (Ω × t) w) (rigid rows of M and b) and the axial
+//              inertia Σ ½ m ẇ² (M_ee += Σ m g gᵀ, g = Q e: dense, by conjugate gradients
+//              preconditioned with the rest of M) (struct Foreshortening).
 //              A force at the reflector's CM and an accelerometer there use its r(e), N(e).
 // Rotors       inertia J_j turned by the section's rotation R to second order in θ = Θ_j e,
 //              J(θ) = R J_j Rᵀ + O(θ³) (quadratic in θ; its second-order part is the centrifugal
@@ -63,6 +64,7 @@
 // At rest (q = 0, u = 0) the linearisation is the linear model in the coordinates (X, θ, e):
 // M(0) = Gᵀ M_lin G, the same K, D, loads and sensor rows.
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -203,9 +205,14 @@ public:
     MatrixXd rotor_block(std::size_t j, const VectorXd& e) const;
     template <class Add>
     void for_turned_rotors(const VectorXd& e, Add&& add) const;
+    // M₀⁻¹ for M₀ = [A B; Bᵀ C] (C⁻¹ by solve_C), factorised once.
     template <class SolveC>
-    VectorXd schur_solve(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B, const SolveC& solve_C,
-                         const VectorXd& r) const;
+    std::function<VectorXd(const VectorXd&)> schur_solver(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B,
+                                                          const SolveC& solve_C) const;
+    // M⁻¹ r for M = M₀ + the mast's axial inertia (ΔM = Σ m g gᵀ, g = Q e), by conjugate gradients
+    // preconditioned with M₀.
+    VectorXd axial_inertia_solve(const VectorXd& e, const VectorXd& r,
+                                 const std::function<VectorXd(const VectorXd&)>& solve0) const;
     MatrixXd K_, D_;                      // elastic blocks
     // The strain energy beyond the quadratic (struct Coupling): its coefficients.
     double k_roll_ = 0.0, k_pitch_ = 0.0, k_twist_ = 0.0;
@@ -314,15 +321,17 @@ private:
   // The mast's foreshortening (docs/theory.md §3.8, "The mast's foreshortening"). An inextensible
   // mast point at s moves back towards the root by w(s) = ½ eᵀ Q(s) e, Q(s) = ∫₀ˢ Θ⊥ᵀ Θ⊥ ds' (Θ⊥ the
   // slopes' rows, the tilt's θ_x, θ_y). The mast's mass points carry it through the kinetic energy
-  //   T_fs = Σ_i m_i k_i · (t ẇ_i + (Ω × t) w_i),   k_i = V + Ω × r_i + N_i ė,
+  //   T_fs = Σ_i m_i [k_i · (t ẇ_i + (Ω × t) w_i) + ½ ẇ_i²],   k_i = V + Ω × r_i + N_i ė,
   // (t the unit vector to the root): the cross term of the point's velocity without the shift with
-  // the velocity of the shift; ½ m |t ẇ + Ω × t w|², of fourth order in the deflection, is left
-  // out. As t·N_i = 0, T_fs is a quadratic form in the speeds with a zero e–e block: it adds only to
+  // the velocity of the shift, and the shift's own axial inertia; ½ m w² |Ω × t|², of fourth order
+  // in the deflection and touching only M_ΩΩ, is left out. As t·N_i = 0 the cross term adds only to
   // the rigid rows of M (A, B) and to b; its e-row force includes Σ_i m_i (Q_i e) t·K_i, K_i the
-  // point's inertial acceleration: the P-delta stiffness of the axial inertial load. Held as the slopes' rows at three Gauss points
-  // per element (|Θ⊥ e|² has degree 4 there) and, per mast point, at three on the part of its own
-  // element below it, so that  xᵀ Q_i y = Σ_{elements below} Σ_q ω_q (R_q x)·(R_q y) + the partial
-  // element's sum,  and Σ_i γ_i Q_i x takes suffix sums over the elements: O(ne) for all points.
+  // point's inertial acceleration: the P-delta stiffness of the axial inertial load. The axial
+  // inertia adds Σ_i m_i g_i g_iᵀ (g_i = Q_i e) to M_ee and Σ_i m_i g_i ėᵀ Q_i ė to b. Held as the
+  // slopes' rows at three Gauss points per element (|Θ⊥ e|² has degree 4 there) and, per mast
+  // point, at three on the part of its own element below it, so that  xᵀ Q_i y = Σ_{elements below}
+  // Σ_q ω_q (R_q x)·(R_q y) + the partial element's sum,  and Σ_i γ_i Q_i x takes suffix sums over
+  // the elements: O(ne) for all points (the dense Σ m g gᵀ x too).
   struct Foreshortening {
     struct Node {
       std::vector<int> cols;
