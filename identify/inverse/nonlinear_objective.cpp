@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "scoleid/io/interrupt.h"
+
 namespace scoleid::identify {
 
 namespace {
@@ -182,7 +184,10 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
   std::vector<VectorXd> Lam(static_cast<std::size_t>(s));
   for (auto it = r.steps.rbegin(); it != r.steps.rend(); ++it) {
     const NonlinearStep& st = *it;
-    if (st.sample >= 0) sample_adjoint(st.sample, ybar);
+    if (st.sample >= 0) {
+      io::check_interrupt();
+      sample_adjoint(st.sample, ybar);
+    }
     const double h = st.h;
     if (!have_ref || std::abs(h / h_ref - 1.0) > 0.05)
       refresh(st.Y[static_cast<std::size_t>(s - 1)], st.inputs[static_cast<std::size_t>(s - 1)], h);

@@ -184,6 +184,8 @@ void gauss_newton(Run& r, VectorXd x) {
   if (continuation) {
     try {
       obj.set_horizon(choose_horizon(obj.misfit_profile(x.array().exp()), t0));
+    } catch (const io::Interrupted&) {
+      throw;
     } catch (const std::exception&) {
       return fail_start();
     }
@@ -241,6 +243,8 @@ void gauss_newton(Run& r, VectorXd x) {
           double Ja = 0.0;
           try {
             Ja = obj.cost((x + a * st.delta).array().exp()) + prior.value(x + a * st.delta);
+          } catch (const io::Interrupted&) {
+            throw;
           } catch (const std::exception&) {
             break;
           }
@@ -322,6 +326,8 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   if (continuation) {
     try {
       obj.set_horizon(choose_horizon(x, t0));
+    } catch (const io::Interrupted&) {
+      throw;
     } catch (const std::exception&) {
       start_ok = false;
     }
@@ -470,6 +476,8 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
   if (continuation) {
     try {
       obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
+    } catch (const io::Interrupted&) {
+      throw;
     } catch (const std::exception&) {
       start_ok = false;
     }

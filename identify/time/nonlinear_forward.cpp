@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "scoleid/identify/time/esdirk_stepper.h"
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::identify {
 
@@ -220,6 +221,7 @@ NonlinearResponse simulate_nonlinear(const ScoleNonlinear::Dynamics& dynamics, c
   VectorXd F;
   bool fresh = true;  // F must be evaluated (start, or after a breakpoint)
   for (std::size_t g = 0; g + 1 < grid.size(); ++g) {
+    io::check_interrupt();  // a signal ends a long solve between samples, not after it
     const double a = grid[g], b = grid[g + 1];
     const int m = std::max(1, static_cast<int>(std::ceil((b - a) / h_max - 1e-9)));
     const double h = (b - a) / m;

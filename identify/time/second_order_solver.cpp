@@ -463,6 +463,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     const double stop = stops[seg];
     set_stop(stop);
     while (t < stop) {
+      io::check_interrupt();  // outside the integrator's callbacks, which turn exceptions into flags
       const int flag = one_step(stop, t);
       if (flag < 0) {
         std::string msg = std::string(bdf ? "CVODES" : "ARKODE") + " failed at t = " + std::to_string(t) +
