@@ -807,7 +807,7 @@ void ScoleNonlinear::Dynamics::rigid_rows(const VectorXd& e, const std::vector<K
 // lateral), T_fs = ½ uᵀ M_fs u with
 //   M_Ve = m t gᵀ,  M_Ωe = m [(r × t) gᵀ + w [t]× N],  M_VΩ = −m w [t]×,
 //   M_ΩΩ = −m w ([r]×[t]× + [t]×[r]×);   the axial inertia's m g gᵀ on M_ee is applied in
-// axial_inertia_solve (dense), ½ m w² |Ω × t|² is left out (fourth order).
+// axial_inertia_solve (dense); ½ m w² |Ω × t|² is left out (struct Foreshortening).
 void ScoleNonlinear::Dynamics::add_foreshortening_rows(const VectorXd& e, Eigen::Matrix<double, 6, 6>& A,
                                                        MatrixXd& B) const {
   const auto& F = g_->fs_;
@@ -1140,11 +1140,12 @@ VectorXd ScoleNonlinear::Dynamics::axial_inertia_solve(const VectorXd& e, const 
   VectorXd p = x, M0p = r;
   const VectorXd dMp = dM(p);
   if (dMp.isZero(0.0)) return x;  // at e = 0
-  VectorXd Mp = M0p + dMp;
-  double pMp = p.dot(Mp);
-  if (pMp <= 0.0) return x;  // r = 0
   double rz = r.dot(x);
   const double rz0 = rz;
+  if (!std::isfinite(rz0)) return x;  // a non-finite right-hand side: the caller sees it in x
+  VectorXd Mp = M0p + dMp;
+  double pMp = p.dot(Mp);
+  if (!(pMp > 0.0)) throw std::runtime_error("ScoleNonlinear: the mass matrix is not positive definite at this deformation");
   double alpha = rz / pMp;
   x *= alpha;
   VectorXd res = r - alpha * Mp;
@@ -1159,6 +1160,7 @@ VectorXd ScoleNonlinear::Dynamics::axial_inertia_solve(const VectorXd& e, const 
     p = z + beta * p;
     Mp = M0p + dM(p);
     pMp = p.dot(Mp);
+    if (!(pMp > 0.0)) throw std::runtime_error("ScoleNonlinear: the mass matrix is not positive definite at this deformation");
     alpha = rz / pMp;
     x += alpha * p;
     res -= alpha * Mp;

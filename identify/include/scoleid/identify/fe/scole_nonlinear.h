@@ -205,7 +205,8 @@ public:
     MatrixXd rotor_block(std::size_t j, const VectorXd& e) const;
     template <class Add>
     void for_turned_rotors(const VectorXd& e, Add&& add) const;
-    // M₀⁻¹ for M₀ = [A B; Bᵀ C] (C⁻¹ by solve_C), factorised once.
+    // M₀⁻¹ for M₀ = [A B; Bᵀ C] (C⁻¹ by solve_C), factorised once. The solver holds a copy of
+    // solve_C, whose own references (the factor of C) must outlive it: use it within the call.
     template <class SolveC>
     std::function<VectorXd(const VectorXd&)> schur_solver(const Eigen::Matrix<double, 6, 6>& A, const MatrixXd& B,
                                                           const SolveC& solve_C) const;
@@ -323,8 +324,10 @@ private:
   // slopes' rows, the tilt's θ_x, θ_y). The mast's mass points carry it through the kinetic energy
   //   T_fs = Σ_i m_i [k_i · (t ẇ_i + (Ω × t) w_i) + ½ ẇ_i²],   k_i = V + Ω × r_i + N_i ė,
   // (t the unit vector to the root): the cross term of the point's velocity without the shift with
-  // the velocity of the shift, and the shift's own axial inertia; ½ m w² |Ω × t|², of fourth order
-  // in the deflection and touching only M_ΩΩ, is left out. As t·N_i = 0 the cross term adds only to
+  // the velocity of the shift, and the shift's own axial inertia; ½ m w² |Ω × t|² is left out: like
+  // ½ m ẇ² of fourth order in the energy, but smaller by (Ω / ω)² (ω the mast's frequencies, Ω
+  // the slew rate); it would add m w² (I − t tᵀ) to M_ΩΩ, a centrifugal −m w |Ω × t|² Q e to the
+  // e row and terms to the Ω row. As t·N_i = 0 the cross term adds only to
   // the rigid rows of M (A, B) and to b; its e-row force includes Σ_i m_i (Q_i e) t·K_i, K_i the
   // point's inertial acceleration: the P-delta stiffness of the axial inertial load. The axial
   // inertia adds Σ_i m_i g_i g_iᵀ (g_i = Q_i e) to M_ee and Σ_i m_i g_i ėᵀ Q_i ė to b. Held as the
