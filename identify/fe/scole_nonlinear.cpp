@@ -1114,11 +1114,11 @@ std::function<VectorXd(const VectorXd&)> ScoleNonlinear::Dynamics::schur_solver(
 }
 
 // M x = r with M = M₀ + ΔM, ΔM = Σ_i m_i g_i g_iᵀ on the e block (g_i = Q_i e: the axial inertia
-// ½ m ẇ² of the mast's foreshortening, dense, of relative size |u'|²). Conjugate gradients on M
+// ½ m ẇ² of the mast's foreshortening, dense, growing as |u'|²). Conjugate gradients on M
 // preconditioned by M₀ (both symmetric positive definite): M₀ p is carried along by the recursion
 // (p_k = z_k + β p_{k−1}, z_k = M₀⁻¹ r_k ⇒ M₀ p_k = r_k + β M₀ p_{k−1}), so only M₀⁻¹ and ΔM
 // (O(ne) by struct Foreshortening) are applied. M₀⁻¹ M has its spectrum in [1, 1 + ρ],
-// ρ = max xᵀ ΔM x / xᵀ M₀ x ~ |u'|², and CG gains about a factor ρ/4 per iteration.
+// ρ = max xᵀ ΔM x / xᵀ M₀ x, and CG gains about a factor ρ/4 per iteration while ρ is small.
 VectorXd ScoleNonlinear::Dynamics::axial_inertia_solve(const VectorXd& e, const VectorXd& r,
                                                        const std::function<VectorXd(const VectorXd&)>& solve0) const {
   const auto& F = g_->fs_;
