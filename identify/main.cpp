@@ -223,6 +223,13 @@ int main(int argc, char** argv) {
                    identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());
       return 1;
     }
+    if (!r.converged()) {  // the discrepancy principle found no weight (docs/theory.md §7.8)
+      std::fprintf(stderr,
+                   "scole-identify: no smoothness weight fits the data within the noise band (discrepancy principle not "
+                   "met down to %g); outputs written with \"converged\": false\n",
+                   r.smoothness_weight);
+      return 1;
+    }
     return 0;
   } catch (const io::InputError& e) {
     std::fprintf(stderr, "scole-identify: %s\n", io::one_line(e.what()).c_str());
