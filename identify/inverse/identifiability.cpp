@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 
 namespace scoleid::identify {
 
@@ -87,6 +88,16 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
           id.identifiable[static_cast<std::size_t>(i)] = false;
           id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
         }
+  // Without a stated noise level σ comes from the residual with ν = N − P degrees of freedom; below
+  // ν = 10 that estimate is not a scale (at ν = 10 the level is within a factor 1.75 at 95 %, at
+  // ν = 1 within a factor 16), and neither is any std drawn from it.
+  if (!fi.stated_noise && static_cast<double>(fi.data_values) - P < 10.0)
+    for (int i = 0; i < P; ++i) {
+      id.identifiable[static_cast<std::size_t>(i)] = false;
+      id.reason[static_cast<std::size_t>(i)] =
+          "no noise level stated and " + std::to_string(fi.data_values) + " data values for " + std::to_string(P) +
+          " parameters: fewer than 10 left to estimate the noise from the residual";
+    }
   std::vector<int> keep;
   for (int i = 0; i < P; ++i)
     if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
@@ -109,6 +120,26 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
         char buf[160];
         std::snprintf(buf, sizeof buf, "relative std %.3g and relative resolution %.3g: above 0.5", rel, rel_res);
         id.reason[static_cast<std::size_t>(i)] = buf;
+        continue;
+      }
+      // The std above holds the flagged parameters fixed. Along an unseen direction the estimate
+      // is wherever the start and the optimiser's path left it — a relative change of order one
+      // (a factor e) is as plausible as none — and a parameter with share s in that direction
+      // moves by s along with it. Where s exceeds its relative std, the std would promise what the
+      // data do not hold: that parameter is flagged too (docs/theory.md §8.1).
+      for (int e = 0; e < P; ++e) {
+        if (es.eigenvalues()[e] > 1e-12 * lmax) continue;
+        const double share = std::abs(es.eigenvectors()(i, e));
+        if (share > rel) {
+          id.identifiable[static_cast<std::size_t>(i)] = false;
+          char buf[200];
+          std::snprintf(buf, sizeof buf,
+                        "shares a direction the data cannot see (share %.3g in a Fisher eigenvector below 1e-12 of the "
+                        "largest, against its relative std %.3g)",
+                        share, rel);
+          id.reason[static_cast<std::size_t>(i)] = buf;
+          break;
+        }
       }
     }
   }

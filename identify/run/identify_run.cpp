@@ -73,12 +73,13 @@ const char* integrator_name(SolverOptions::Integrator i) {
 // the central difference of the model's outputs at q̂ (or the difference to the alternative model
 // form), over the parameters the Fisher test kept. A quantity the outputs do not depend on at q̂
 // (an estimated one: the parameters overwrite it) is refused.
-std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const Identifiability& id, const VectorXd& q) {
+// Y0 and G: the model's outputs and their sensitivities at q (the Fisher step's). `discretisation`:
+// the fit test's estimate d of the identifier's discretisation error at q (empty: none).
+std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability& id, const VectorXd& q, const MatrixXd& Y0,
+                                         const MatrixXd& G, const MatrixXd& discretisation) {
   std::vector<ConsiderTerm> terms;
   const auto& uncertain = p.scenario.identification.uncertain;
-  if (uncertain.empty()) return terms;
-  const MatrixXd G = obj.output_sensitivities(q);
-  const MatrixXd Y0 = obj.predict(q);
+  if (uncertain.empty() && discretisation.size() == 0) return terms;
   const int P = static_cast<int>(q.size()), ns = static_cast<int>(Y0.cols());
   std::vector<int> keep;
   for (int i = 0; i < P; ++i)
@@ -106,6 +107,21 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, Objective& obj, const
     Objective o(st->model(), *params, p.signals, p.data, p.objective_options);
     return flat(o.predict(q));
   };
+  // The identifier's own discretisation (docs/theory.md §8.2): the refined model's outputs differ
+  // from the identifier's by d at q̂, and the least-squares fit absorbs the part of d the
+  // parameters can mimic — a bias the residual does not show. Taken at 2d, as the fit test's
+  // allowance (the refined model's own error and the fit's redistribution of it).
+  if (discretisation.rows() == Y0.rows() && discretisation.cols() == Y0.cols() && discretisation.allFinite() && K > 0) {
+    ConsiderTerm t;
+    t.field = "discretisation";
+    t.value = static_cast<double>(p.structure->elements());
+    t.delta = 0.0;
+    const VectorXd d = 2.0 * flat(discretisation);
+    const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
+    t.shift = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
+    if (t.shift.allFinite()) terms.push_back(t);
+  }
   for (const auto& u : uncertain) {
     ConsiderTerm t;
     t.field = u.field;
@@ -192,8 +208,8 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
         ObjectiveOptions o = p.objective_options;
         if (o.solver.step > 0) o.solver.step /= 4.0;
         Objective fo(fine->model(), *params, p.signals, p.data, o);
-        const MatrixXd d = fo.predict(q) - Y;
-        if (d.allFinite()) in.discretisation = d;
+        MatrixXd d = fo.predict(q) - Y;
+        if (d.allFinite()) in.discretisation = std::move(d);
       }
     } catch (const io::Interrupted&) {
       throw;
@@ -201,7 +217,9 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
       // A model that cannot be refined: no discretisation estimate.
     }
   }
-  return fit_test(in);
+  FitTest f = fit_test(in);
+  f.discretisation = std::move(in.discretisation);
+  return f;
 }
 
 namespace {
@@ -331,6 +349,10 @@ Ladder coarse_to_fine(const Problem& p, Objective& obj, const std::vector<std::s
   out.label += " blocks, then " + std::to_string(N) + " sections";
   return out;
 }
+}  // namespace
+
+namespace {
+void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const MatrixXd& Y);
 }  // namespace
 
 bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b) {
@@ -513,7 +535,11 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     // Each sensor's stated noise level: the scenario's, else truth.json's (make_problem).
     std::vector<io::SensorSpec> sensors = p.scenario.sensors;
     for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
-    r.ident = analyse_identifiability(obj, sensors, r.estimate);
+    // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval.
+    const MatrixXd Y = obj.predict(r.estimate);
+    const MatrixXd G = obj.output_sensitivities(r.estimate);
+    r.ident = identifiability_from(fisher_information(obj.data(), Y, G, sensors), r.estimate);
+    flag_mirror_ambiguity(p, obj, r, Y);
     if (r.ident.noise_source == "scenario") {
       std::string origin;
       for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
@@ -540,7 +566,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
       ii.smoothing_estimate = s.q;
       ii.smoothing_converged = s.converged();
     }
-    ii.consider = consider_terms(p, obj, r.ident, r.estimate);
+    ii.consider = consider_terms(p, r.ident, r.estimate, Y, G, r.fit.discretisation);
     r.interval = uncertainty_interval(r.ident, ii);
     flag_wide_intervals(r);
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
@@ -693,6 +719,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                               {"noise_source", ident.noise_source},
                               {"chi2", ident.chi2},
                               {"data_values", ident.data_values},
+                              {"mirror_chi2_difference", std::isfinite(ident.mirror_chi2_difference) ? json(ident.mirror_chi2_difference) : json(nullptr)},
                               {"half_record_refit_converged",
                                half_record_estimate.size() != 0 ? json(half_record_converged) : json(nullptr)},
                               {"consider", [&] {
@@ -772,6 +799,62 @@ Measurements first_half(const Measurements& data) {
   first.z.conservativeResize(static_cast<Eigen::Index>(n), Eigen::NoChange);
   return first;
 }
+
+namespace {
+// The mirror test (docs/theory.md §8.1): the Fisher matrix sees only the estimate's neighbourhood,
+// so a second profile that explains the data as well is invisible to it. A beam's sections have one
+// such candidate by construction — the profile reversed end for end, which a symmetric support,
+// load and sensor layout cannot tell from the original. Each family of sections X_1 … X_N is
+// reversed (the other parameters kept) and the model's χ² there compared with the estimate's,
+// with the same noise levels as the Fisher step: if the difference is below 4 (the
+// likelihood-ratio bound of one degree of freedom at 95 %, rounded) the data cannot tell the two
+// profiles apart, and every section whose mirrored value lies more than 2 std from its estimate is
+// flagged. One state solve; none when the estimate is its own mirror within 2 std.
+void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const MatrixXd& Y) {
+  const auto families = section_families(r.names);
+  if (families.empty() || r.ident.identifiable.empty()) return;
+  VectorXd qm = r.estimate;
+  for (const auto& f : families)
+    for (std::size_t j = 0; j < f.size(); ++j) qm[f[j]] = r.estimate[f[f.size() - 1 - j]];
+  std::vector<int> differ;
+  for (const auto& f : families)
+    for (int i : f) {
+      const auto u = static_cast<std::size_t>(i);
+      if (!r.ident.identifiable[u]) continue;
+      if (std::abs(qm[i] - r.estimate[i]) > 2.0 * r.ident.std[i]) differ.push_back(i);
+    }
+  if (differ.empty()) return;
+  MatrixXd Ym;
+  try {
+    Ym = obj.predict(qm);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    return;  // the mirrored profile cannot be solved: no second candidate
+  }
+  double c0 = 0.0, c1 = 0.0;
+  for (Eigen::Index i = 0; i < Y.rows(); ++i)
+    for (Eigen::Index k = 0; k < Y.cols(); ++k) {
+      const double sd = static_cast<std::size_t>(k) < r.ident.noise_std.size() ? r.ident.noise_std[static_cast<std::size_t>(k)] : 0.0;
+      if (!(sd > 0.0)) continue;
+      const double w = 1.0 / (sd * sd);
+      c0 += w * std::pow(Y(i, k) - p.data.z(i, k), 2);
+      c1 += w * std::pow(Ym(i, k) - p.data.z(i, k), 2);
+    }
+  r.ident.mirror_chi2_difference = c1 - c0;
+  if (!(c1 - c0 < 4.0)) return;
+  for (int i : differ) {
+    const auto u = static_cast<std::size_t>(i);
+    r.ident.identifiable[u] = false;
+    char buf[220];
+    std::snprintf(buf, sizeof buf,
+                  "the profile reversed end for end (this section %.6g instead of %.6g) fits the data as well (chi-square "
+                  "difference %.3g, below 4): the data cannot tell the two apart",
+                  qm[i], r.estimate[i], c1 - c0);
+    r.ident.reason[u] = buf;
+  }
+}
+}  // namespace
 
 void flag_wide_intervals(RunResult& r) {
   for (std::size_t i = 0; i < r.names.size() && i < r.interval.too_wide.size(); ++i)

@@ -75,6 +75,8 @@ struct FitTest {
   double model_error = 0;
   // One line: which sensor fails by how much, or that every sensor passes.
   std::string message;
+  // The discretisation estimate d (samples × sensors) the test used; empty when none was made.
+  Eigen::MatrixXd discretisation;
 };
 
 FitTest fit_test(const FitTestInputs& in);

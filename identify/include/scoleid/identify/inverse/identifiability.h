@@ -22,6 +22,7 @@
 // Flags: a parameter with a share > 0.1 in an eigenvector of the relative Fisher matrix whose
 // eigenvalue is below 1e-12 of the largest is not identifiable; the others' std come from F
 // restricted to them, and a relative std or a relative resolution above 0.5 is flagged too.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,9 @@ struct Identifiability {
   std::vector<std::string> reason;  // why a parameter is flagged ("" when it is not)
   std::vector<double> noise_std;  // σ_k used per sensor
   std::string noise_source;       // "scenario" | "residual" (identify_run refines "scenario" to where each level came from)
+  // χ² of the sections' profile reversed end for end minus the estimate's (identify_run's mirror
+  // test, docs/theory.md §8.1); NaN when not computed (no sections, or the estimate its own mirror).
+  double mirror_chi2_difference = std::nan("");
 };
 
 // The Fisher information of one experiment at q and what goes with it: F = Gᵀ W G, the χ² of the
