@@ -13,7 +13,7 @@ namespace scoleid::crosscheck {
 
 bool IdentifyStudyOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) { if (why) *why = m; return false; };
-  if (segments < 0 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
+  if (segments < 0 || segments == 1 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
   if (levels < 1 || levels > 4) return fail("levels must be in [1, 4]");
   return true;
 }

@@ -376,13 +376,27 @@ int main(int argc, char** argv) {
     }
     dir.keep_earlier_outputs();
     if (do_report) {
-      const crosscheck::ReportInputs in = crosscheck::read_report_inputs(dir.staging());
-      if (in.modes.is_null() && in.trajectories.is_null() && in.identify.is_null())
-        throw io::InputError("output directory '" + out + "': no modes.json, trajectories.json or identify.json to report on");
-      write_report(dir, in, quiet);
+      crosscheck::ReportInputs in;
+      std::vector<std::string> lines;
+      // The earlier outputs are read from the staging copy; a file that does not hold what this
+      // program writes is named as the user's file in --out.
+      try {
+        in = crosscheck::read_report_inputs(dir.staging());
+        if (in.modes.is_null() && in.trajectories.is_null() && in.identify.is_null())
+          throw io::InputError("output directory '" + out + "': no modes.json, trajectories.json or identify.json to report on");
+        lines = crosscheck::summary_lines(in);
+        write_report(dir, in, quiet);
+      } catch (const nlohmann::json::exception& e) {
+        throw io::InputError("output directory '" + out + "': modes.json, trajectories.json or identify.json is not as " +
+                             "scole-crosscheck writes it (" + io::one_line(e.what()) + ")");
+      } catch (const io::InputError& e) {
+        std::string m = e.what();
+        for (std::size_t at; (at = m.find(dir.staging())) != std::string::npos;) m.replace(at, dir.staging().size(), out);
+        throw io::InputError(m);
+      }
       if (all->parsed() || !quiet) {
         std::printf("Cross-check of %s\n", sc.name.c_str());
-        for (const auto& l : crosscheck::summary_lines(in)) std::printf("  %s\n", l.c_str());
+        for (const auto& l : lines) std::printf("  %s\n", l.c_str());
       }
     }
     dir.commit();

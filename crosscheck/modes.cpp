@@ -191,7 +191,7 @@ std::vector<double> analytic_hz(const io::Scenario& sc, int count, std::string& 
 
 bool ModesOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) { if (why) *why = m; return false; };
-  if (segments < 0 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
+  if (segments < 0 || segments == 1 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
   if (elements < 0 || elements > io::limits::kMaxElements) return fail("elements must be in [1, " + std::to_string(io::limits::kMaxElements) + "] (0 = the scenario's)");
   if (count < 1 || count > 50) return fail("count must be in [1, 50]");
   if (levels < 1 || levels > 4) return fail("levels must be in [1, 4]");

@@ -25,7 +25,7 @@ constexpr double kPhaseStep = 0.03;
 
 bool TrajectoryOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) { if (why) *why = m; return false; };
-  if (segments < 0 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
+  if (segments < 0 || segments == 1 || segments > io::limits::kMaxSegments) return fail("segments must be in [2, " + std::to_string(io::limits::kMaxSegments) + "] (0 = the scenario's)");
   if (elements < 0 || elements > io::limits::kMaxElements) return fail("elements must be in [1, " + std::to_string(io::limits::kMaxElements) + "] (0 = 4 x the identifier's)");
   if (levels < 1 || levels > 4) return fail("levels must be in [1, 4]");
   if (!(fe_step >= 0 && fe_step < 1e6)) return fail("fe_step must be >= 0 (0 = automatic)");
@@ -131,6 +131,11 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
                                       const std::string& truth_root) {
   std::string why;
   if (!opt.IsValid(&why)) throw io::InputError("trajectories: " + why);
+  if (opt.fe_step > 0 && !(scenario.simulation.duration / opt.fe_step <= io::limits::kMaxSteps))
+    throw io::InputError("trajectories: --fe-step " + io::format_value(opt.fe_step) + " gives " +
+                         io::format_value(std::ceil(scenario.simulation.duration / opt.fe_step)) + " steps over the " +
+                         io::format_value(scenario.simulation.duration) + " s record; the limit is " +
+                         io::format_value(io::limits::kMaxSteps));
   const auto t0 = std::chrono::steady_clock::now();
   TrajectoryReport rep;
   rep.scenario = scenario.name;

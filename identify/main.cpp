@@ -1,5 +1,6 @@
 // scole-identify: identify distributed parameters of a beam from measured or synthesised
 // responses with the finite-element costate method. See README.md.
+#include <algorithm>
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -67,8 +68,9 @@ int run_experiments_command(const std::string& file, std::string out, const std:
   std::printf("\n%s; %d thread%s; %.3f s\nwrote %s/identify.json\n", r.summary.BriefReport().c_str(), r.threads,
               r.threads == 1 ? "" : "s", r.wall_seconds, out.c_str());
   if (!r.summary.converged()) {
-    std::fprintf(stderr, "scole-identify: did not converge (%s: %s); outputs written with \"converged\": false\n",
-                 identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());
+    std::fprintf(stderr, "scole-identify: did not converge (%s%s%s); outputs written with \"converged\": false\n",
+                 identify::to_string(r.summary.termination), r.summary.message.empty() ? "" : ": ",
+                 io::one_line(r.summary.message).c_str());
     return 1;
   }
   if (!r.converged()) {
@@ -146,6 +148,10 @@ int main(int argc, char** argv) {
       std::fputs(io::builtin_scenario_listing().c_str(), stdout);
       return 0;
     }
+    // A path option given empty is a typo, not a request for the default.
+    for (const char* name : {"--data", "--out", "--experiments", "--scenario"})
+      if (app.count(name) > 0 && app.get_option(name)->as<std::string>().empty())
+        throw io::InputError(std::string("command line: ") + name + " is empty (give a path, or leave the option out)");
     if (!experiments.empty()) return run_experiments_command(experiments, out, method, threads, max_iterations, !no_std, !quiet);
     io::Scenario sc = io::load_scenario(scenario);
     identify::RunOptions ro;
@@ -211,6 +217,12 @@ int main(int argc, char** argv) {
     std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
                 r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
+    if (!r.ident.identifiable.empty() &&
+        std::none_of(r.ident.identifiable.begin(), r.ident.identifiable.end(), [](bool b) { return b; }))
+      std::fprintf(stderr,
+                   "scole-identify: warning: none of the %zu estimated parameters is identifiable from these data (each "
+                   "row says why); the estimates are not determined by the data\n",
+                   r.ident.identifiable.size());
     if (r.summary.converged() && !r.fit.explains_data) {
       std::fprintf(stderr,
                    "scole-identify: stopped at a point that does not explain the data (%s); %zu attempt%s; outputs written "
@@ -219,8 +231,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (!r.summary.converged()) {
-      std::fprintf(stderr, "scole-identify: did not converge (%s: %s); outputs written with \"converged\": false\n",
-                   identify::to_string(r.summary.termination), io::one_line(r.summary.message).c_str());
+      std::fprintf(stderr, "scole-identify: did not converge (%s%s%s); outputs written with \"converged\": false\n",
+                   identify::to_string(r.summary.termination), r.summary.message.empty() ? "" : ": ",
+                   io::one_line(r.summary.message).c_str());
       return 1;
     }
     if (!r.converged()) {  // the discrepancy principle found no weight (docs/theory.md §7.8)

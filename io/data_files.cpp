@@ -13,6 +13,8 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/validation.h"
 
+#include "scoleid/io/limits.h"
+
 namespace scoleid::io {
 
 std::string format_value(double v) {
@@ -66,6 +68,8 @@ std::vector<std::string> split_csv_line(const std::string& line) {
 }
 
 DataTable read_csv(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError("data file '" + path + "': is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("data file '" + path + "': cannot be opened");
   return read_csv_stream(in, path);
@@ -90,6 +94,12 @@ DataTable read_csv_stream(std::istream& in, const std::string& path) {
   }
   if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos)
     throw InputError("data file '" + path + "': empty, expected a header line starting with 't'");
+  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first name.
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+  // Lines ended by CR alone (classic Mac) arrive as one line: say so rather than misread it.
+  if (const auto cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
+    throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
+                     ": lines end in CR alone; save the file with LF or CR LF line endings");
   check_utf8(line, "data file '" + path + "': line " + std::to_string(lineno));
   const auto header = split_csv_line(line);
   if (header.empty() || header[0] != "t")
@@ -129,6 +139,9 @@ DataTable read_csv_stream(std::istream& in, const std::string& path) {
       if (!std::isfinite(v))
         throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ", column '" + header[j] +
                          "': must be finite, got " + f[j]);
+      if (!(std::abs(v) <= limits::kMaxMagnitude))  // (tiny values are data; huge ones overflow the fit)
+        throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ", column '" + header[j] +
+                         "': magnitude must be at most " + format_value(limits::kMaxMagnitude) + ", got " + format_value(v));
       if (j == 0) {
         if (!tab.t.empty() && !(v > tab.t.back()))
           throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
@@ -189,6 +202,8 @@ void write_json_atomic(const std::string& path, const nlohmann::json& j) {
 }
 
 nlohmann::json read_json(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError("JSON file '" + path + "': is a directory");
   std::ifstream in(path);
   if (!in) throw InputError("JSON file '" + path + "': cannot be opened");
   try {
@@ -236,8 +251,9 @@ TruthMeta truth_meta_from_json(const nlohmann::json& j, const std::string& sourc
         const std::string f = "columns['" + one_line(cm.name) + "']";
         for (const auto& other : m.columns)
           if (other.name == cm.name) fail_field(source, f, "must appear once", "a second column of that name");
-        if (!std::isfinite(cm.noise_std) || cm.noise_std < 0)
-          fail_field(source, f + ".noise_std", "must be a finite number >= 0", format_value(cm.noise_std));
+        if (!std::isfinite(cm.noise_std) || cm.noise_std < 0 || cm.noise_std > limits::kMaxMagnitude)
+          fail_field(source, f + ".noise_std", "must be a number in [0, " + format_value(limits::kMaxMagnitude) + "]",
+                     format_value(cm.noise_std));
         if (!std::isfinite(cm.location)) fail_field(source, f + ".location", "must be finite", format_value(cm.location));
         for (double d : cm.direction)
           if (!std::isfinite(d)) fail_field(source, f + ".direction", "must be finite", format_value(d));

@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <vector>
 #include <sstream>
 
 #include "scoleid/io/error.h"
@@ -189,6 +191,8 @@ private:
 void check_document(const YAML::Node& n, const std::string& source, const std::string& path,
                     std::set<std::size_t>& seen) {
   const std::string at = path.empty() ? "document" : path;
+  // A key written without a value (`key:` or `key: ~`) is a slip, not a request for the default.
+  if (n.IsNull() && !path.empty()) fail_field(source, at, "has no value: give one, or leave the key out", "null");
   if (n.IsScalar()) {
     if (first_invalid_utf8(n.Scalar()) != std::string::npos)
       fail_field(source, at, "must be UTF-8 text", "a value with an invalid byte sequence");
@@ -296,6 +300,23 @@ void parse_rigid(const YAML::Node& n, const std::string& source, const std::stri
   b.Ixy = r.num("Ixy", b.Ixy);
   b.Ixz = r.num("Ixz", b.Ixz);
   b.Iyz = r.num("Iyz", b.Iyz);
+  // A body's inertia tensor I (these entries, about its CM) is one only if S = ½ tr(I)·1 − I, its
+  // second moment ∫ r rᵀ dm, is positive semi-definite: every principal minor of S >= 0. That holds
+  // the principal moments to the triangle inequality and I itself positive definite.
+  const double h = 0.5 * (b.Ixx + b.Iyy + b.Izz);
+  const double S[3][3] = {{h - b.Ixx, -b.Ixy, -b.Ixz}, {-b.Ixy, h - b.Iyy, -b.Iyz}, {-b.Ixz, -b.Iyz, h - b.Izz}};
+  const double tol = 1e-12 * h;
+  const double d1[3] = {S[0][0], S[1][1], S[2][2]};
+  const double d2[3] = {S[0][0] * S[1][1] - S[0][1] * S[0][1], S[0][0] * S[2][2] - S[0][2] * S[0][2],
+                        S[1][1] * S[2][2] - S[1][2] * S[1][2]};
+  const double d3 = S[0][0] * (S[1][1] * S[2][2] - S[1][2] * S[1][2]) - S[0][1] * (S[0][1] * S[2][2] - S[1][2] * S[0][2]) +
+                    S[0][2] * (S[0][1] * S[1][2] - S[1][1] * S[0][2]);
+  bool ok = d3 >= -tol * h * h;
+  for (int i = 0; i < 3; ++i) ok = ok && d1[i] >= -tol && d2[i] >= -tol * h;
+  if (!ok)
+    fail_field(source, path, "is not a rigid body's inertia: the principal moments must satisfy the triangle inequality",
+               "Ixx " + format_value(b.Ixx) + ", Iyy " + format_value(b.Iyy) + ", Izz " + format_value(b.Izz) + ", Ixy " +
+                   format_value(b.Ixy) + ", Ixz " + format_value(b.Ixz) + ", Iyz " + format_value(b.Iyz));
 }
 
 // Reads the fields present onto `b` (the defaults, or the scenario's values for truth.overrides);
@@ -552,7 +573,10 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
   check_utf8(yaml_text, source);
   YAML::Node root;
   try {
-    root = YAML::Load(yaml_text);
+    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
+    if (docs.size() > 1)
+      throw InputError(source + ": holds " + std::to_string(docs.size()) + " YAML documents; a scenario is one");
+    if (!docs.empty()) root = docs.front();
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) +
                      ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
@@ -633,6 +657,8 @@ bool has_truth_overrides(const Scenario& s) { return to_json(s)["truth"].contain
 Scenario load_scenario(const std::string& name_or_file) {
   const std::string builtin = builtin_scenario_yaml(name_or_file);
   if (!builtin.empty()) return parse_scenario(builtin, "built-in scenario '" + name_or_file + "'");
+  std::error_code ec;
+  if (std::filesystem::is_directory(name_or_file, ec)) throw InputError("scenario file '" + name_or_file + "': is a directory");
   std::ifstream in(name_or_file);
   if (!in) {
     const bool looks_like_file = name_or_file.find('/') != std::string::npos ||

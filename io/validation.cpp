@@ -114,7 +114,15 @@ void validate_scenario(const Scenario& sc) {
                  format_value(interval));
   };
   check_record("simulation.sample_interval", sc.simulation.sample_interval);
+  if (const double n = sample_count(sc.simulation.duration, sc.simulation.sample_interval); n < 3)
+    fail_field(src, "simulation.sample_interval",
+               "gives " + format_value(n) + " samples over simulation.duration " + format_value(sc.simulation.duration) +
+                   ": at least 3 are needed",
+               format_value(sc.simulation.sample_interval));
   if (sc.truth.output_interval > 0) check_record("truth.output_interval", sc.truth.output_interval);
+  if (sc.truth.output_interval > sc.simulation.duration)
+    fail_field(src, "truth.output_interval", "must not exceed simulation.duration (" + format_value(sc.simulation.duration) + ")",
+               format_value(sc.truth.output_interval));
   if (sc.truth.segments < 2 || sc.truth.segments > limits::kMaxSegments)
     fail_field(src, "truth.segments", "must be an integer in [2, " + std::to_string(limits::kMaxSegments) + "]",
                std::to_string(sc.truth.segments));
@@ -127,6 +135,7 @@ void validate_scenario(const Scenario& sc) {
   if (id.data_elements < 0 || id.data_elements > limits::kMaxDataElements)
     fail_field(src, "identification.data_elements",
                "must be an integer in [0, " + std::to_string(limits::kMaxDataElements) + "]", std::to_string(id.data_elements));
+  if (!(id.rtol > 0 && id.rtol < 1)) fail_field(src, "identification.rtol", "must be in (0, 1)", format_value(id.rtol));
   if (id.max_iterations < 0)
     fail_field(src, "identification.max_iterations", "must be >= 0", std::to_string(id.max_iterations));
   if (id.time_step > 0) {

@@ -443,6 +443,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     }
     for (std::size_t c = 0; c < tab.names.size(); ++c)
       if (!used[c]) p->columns.unused.push_back(tab.names[c]);
+    if (tab.t.size() < 3)
+      throw InputError("data file '" + *data_csv + "': " + std::to_string(tab.t.size()) + " rows: at least 3 samples are needed");
     if (tab.t.front() < 0.0)
       throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
     p->data_source = *data_csv;
@@ -478,8 +480,22 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   if (data_csv) {
     step = identifier_step(sc, p->model(), *p->params, p->signals);
     check_step(sc, p->model(), *p->params, p->signals, step, false);
+    // The record's own span, not the scenario's duration, sets the number of steps.
+    const double span = p->data.t.back() - p->data.t.front(), steps = step > 0 ? span / step : 0.0;
+    if (!(steps <= io::limits::kMaxSteps))
+      throw InputError("data file '" + *data_csv + "': column t spans " + io::format_value(span) + " s, " +
+                       io::format_value(std::ceil(steps)) + " steps of the identifier's " + io::format_value(step) +
+                       " s; the limit is " + io::format_value(io::limits::kMaxSteps) + " steps");
     p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
                               id.step_rule == "data");
+  }
+  // A record in which no sensor moves holds nothing to identify from (cost zero at any start).
+  if (p->data.z.size() > 0 && (p->data.z.array() == 0.0).all()) {
+    if (data_csv) throw InputError("data file '" + *data_csv + "': every sensor's column is zero: nothing to identify from");
+    fail_field(sc.source, "sensors",
+               "record nothing: every sensor's synthetic record is zero (no input within the record, zero amplitudes, or "
+               "sensors where the structure cannot move)",
+               std::to_string(p->data.sensors()) + " sensor" + (p->data.sensors() == 1 ? "" : "s"));
   }
   p->objective_options.solver.rtol = id.rtol;
   p->objective_options.solver.step = step;

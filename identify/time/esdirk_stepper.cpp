@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "scoleid/io/interrupt.h"
+
 namespace scoleid::identify {
 
 bool ButcherTable::explicit_first_stage() const {
@@ -269,6 +271,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
     // Steps end at origin + k h: a resumed run continues the original run's count.
     long k = std::max(0L, std::lround((t - origin) / h));
     while (t < stop) {
+      io::check_interrupt();  // a SIGINT/SIGTERM ends a long solve at the next step (io/interrupt.h)
       double tnext = origin + static_cast<double>(k + 1) * h;
       if (tnext > stop - snap) tnext = stop;  // land on the stop (no micro-step)
       step(t, tnext - t);

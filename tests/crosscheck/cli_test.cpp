@@ -39,6 +39,30 @@ TEST(CrosscheckCli, BadInputIsOneLineExitTwoNothingWritten) {
   EXPECT_EQ(sh(exe + " report --scenario paper-beam-1 --out " + (d / "out").string() + " 2> /dev/null"), 2);
   EXPECT_FALSE(fs::exists(d / "out"));
   EXPECT_EQ(sh(exe + " frobnicate 2> /dev/null"), 2);
+  // A chain of one segment is no chain (it crashed the modes verb); an FE step that makes a
+  // record of 10^10 steps is refused before any truth is run.
+  for (const std::string verb : {"modes", "trajectories", "identify"}) {
+    EXPECT_EQ(sh(exe + " " + verb + " --scenario paper-beam-1 --segments 1 --out " + (d / "out").string() + " 2> " +
+                 (d / "err").string()),
+              2)
+        << verb;
+    EXPECT_NE(slurp(d / "err").find("segments must be in [2,"), std::string::npos) << slurp(d / "err");
+  }
+  EXPECT_EQ(sh(exe + " trajectories --scenario paper-beam-1 --segments 4 --levels 2 --fe-step 1e-9 --out " +
+               (d / "out").string() + " 2> " + (d / "err").string()),
+            2);
+  EXPECT_NE(slurp(d / "err").find("--fe-step 1e-09 gives"), std::string::npos) << slurp(d / "err");
+  EXPECT_FALSE(fs::exists(d / "out"));
+  // `report` on a modes.json that is not what `modes` writes: exit 2, the user's directory named
+  // (not the staging copy), the file left as it was.
+  fs::create_directories(d / "rep");
+  { std::ofstream(d / "rep" / "modes.json") << "[1, 2, 3]\n"; }
+  EXPECT_EQ(sh(exe + " report --scenario paper-beam-1 --out " + (d / "rep").string() + " 2> " + (d / "err").string()), 2);
+  const std::string rep_err = slurp(d / "err");
+  EXPECT_NE(rep_err.find("output directory '" + (d / "rep").string() + "'"), std::string::npos) << rep_err;
+  EXPECT_EQ(rep_err.find("staging"), std::string::npos) << rep_err;
+  EXPECT_EQ(std::count(rep_err.begin(), rep_err.end(), '\n'), 1) << rep_err;
+  EXPECT_EQ(slurp(d / "rep" / "modes.json"), "[1, 2, 3]\n");
   fs::remove_all(d);
 }
 

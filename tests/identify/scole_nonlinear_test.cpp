@@ -709,7 +709,7 @@ namespace {
 const char* const kEveryKind = R"(name: nonlinear-every-kind
 structure: scole
 scole: {mast_root: [1.5, -2.0, 3.0], zeta: 0.01, actuator_stiffness: 30, actuator_damping: 2, EI_pitch: 3.4e7, GJ: 3.0e7,
-        shuttle: {Ixy: 1200, Ixz: -3000}, reflector: {Ixy: 150, Iyz: 40}}
+        shuttle: {Ixy: 1200, Ixz: -3000}, reflector: {Izz: 9000, Ixy: 150, Iyz: 40}}
 inputs:
   - {name: F_sx, at: shuttle, kind: force, direction: x, signal: {type: haversine, amplitude: 500, t0: 0, width: 0.4}}
   - {name: M_sy, at: shuttle, kind: moment, direction: y, signal: {type: haversine, amplitude: 5000, t0: 0.1, width: 0.4}}
@@ -1080,7 +1080,7 @@ TEST(ScoleNonlinearCostate, TheDiscreteCostateConvergesToTheCvodesAdjointOfTheCo
   auto sc = scoleid::io::parse_scenario(R"(name: nonlinear-smooth
 structure: scole
 scole: {mast_root: [1.5, -2.0, 3.0], zeta: 0.01, actuator_stiffness: 30, actuator_damping: 2,
-        shuttle: {Ixy: 1200, Ixz: -3000}, reflector: {Ixy: 150, Iyz: 40}}
+        shuttle: {Ixy: 1200, Ixz: -3000}, reflector: {Izz: 9000, Ixy: 150, Iyz: 40}}
 inputs:
   - {name: M_sx, at: shuttle, kind: moment, direction: x, signal: {type: haversine, amplitude: 20000, t0: 0, width: 1.0}}
   - {name: F_ry, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, t0: 0, width: 0.8}}
