@@ -140,6 +140,10 @@ int main(int argc, char** argv) {
   }
   io::install_interrupt_handlers();
   try {
+    // A path option given empty is a typo, not a request for the default.
+    for (const char* name : {"--data", "--out", "--experiments", "--scenario", "--print-scenario"})
+      if (app.count(name) > 0 && app.get_option(name)->as<std::string>().empty())
+        throw io::InputError(std::string("command line: ") + name + " is empty (give a value, or leave the option out)");
     if (!print_name.empty()) {
       std::fputs(io::builtin_scenario_text(print_name).c_str(), stdout);
       return 0;
@@ -148,10 +152,6 @@ int main(int argc, char** argv) {
       std::fputs(io::builtin_scenario_listing().c_str(), stdout);
       return 0;
     }
-    // A path option given empty is a typo, not a request for the default.
-    for (const char* name : {"--data", "--out", "--experiments", "--scenario"})
-      if (app.count(name) > 0 && app.get_option(name)->as<std::string>().empty())
-        throw io::InputError(std::string("command line: ") + name + " is empty (give a path, or leave the option out)");
     if (!experiments.empty()) return run_experiments_command(experiments, out, method, threads, max_iterations, !no_std, !quiet);
     io::Scenario sc = io::load_scenario(scenario);
     identify::RunOptions ro;

@@ -88,18 +88,20 @@ DataTable read_csv_stream(std::istream& in, const std::string& path) {
   // Header (skipping '#' comment lines).
   while (std::getline(in, line)) {
     ++lineno;
+    // A UTF-8 byte-order mark (spreadsheets write one) belongs to no line's content.
+    if (lineno == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (!line.empty() && line[0] == '#') continue;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     break;
   }
   if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos)
     throw InputError("data file '" + path + "': empty, expected a header line starting with 't'");
-  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first name.
-  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-  // Lines ended by CR alone (classic Mac) arrive as one line: say so rather than misread it.
-  if (const auto cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
-    throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
-                     ": lines end in CR alone; save the file with LF or CR LF line endings");
+  // Lines ended by CR alone (classic Mac) arrive as one line: say so rather than misread it. A CR
+  // followed by anything but another CR is inside the line (CR CR LF endings are read as before).
+  for (std::size_t i = 0; i + 1 < line.size(); ++i)
+    if (line[i] == '\r' && line[i + 1] != '\r')
+      throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
+                       ": lines end in CR alone; save the file with LF or CR LF line endings");
   check_utf8(line, "data file '" + path + "': line " + std::to_string(lineno));
   const auto header = split_csv_line(line);
   if (header.empty() || header[0] != "t")

@@ -573,7 +573,10 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
   check_utf8(yaml_text, source);
   YAML::Node root;
   try {
-    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
+    // (An empty document, as after a trailing `---`, is no second scenario.)
+    std::vector<YAML::Node> docs;
+    for (const auto& d : YAML::LoadAll(yaml_text))
+      if (d && !d.IsNull()) docs.push_back(d);
     if (docs.size() > 1)
       throw InputError(source + ": holds " + std::to_string(docs.size()) + " YAML documents; a scenario is one");
     if (!docs.empty()) root = docs.front();

@@ -52,19 +52,6 @@ TrustRegionStep trust_region_step(const Eigen::MatrixXd& H, const Eigen::VectorX
   return st;
 }
 
-double gauss_newton_decrease(const Eigen::MatrixXd& H, const Eigen::VectorXd& g) {
-  if (H.rows() != g.size() || H.cols() != g.size()) throw std::invalid_argument("gauss_newton_decrease: sizes differ");
-  if (g.size() == 0) return 0.0;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
-  const Eigen::VectorXd mu = es.eigenvalues();
-  const Eigen::VectorXd gt = es.eigenvectors().transpose() * g;
-  const double floor = 1e-12 * std::max(mu.maxCoeff(), 0.0);
-  double d = 0.0;
-  for (int i = 0; i < mu.size(); ++i)
-    if (mu[i] > floor && mu[i] > 0.0) d += gt[i] * gt[i] / mu[i];
-  return 0.5 * d;
-}
-
 double update_radius(double radius, const TrustRegionStep& step, double rho, double max_radius) {
   const double len = step.delta.norm();
   if (!(rho >= 0.25)) return 0.25 * len;

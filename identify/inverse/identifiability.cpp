@@ -81,13 +81,17 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
   // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
   // with a sizeable share in them is flagged; the others get their bounds from the Fisher matrix
   // restricted to them (i.e. with the flagged parameters held fixed).
+  // A parameter's share in them is the length of its unit vector projected on their span
+  // (√Σ_e v_ie², independent of how a repeated small eigenvalue's vectors are chosen).
+  VectorXd unseen_share = VectorXd::Zero(P);
   for (int e = 0; e < P; ++e)
-    if (!(es.eigenvalues()[e] > 1e-12 * lmax))
-      for (int i = 0; i < P; ++i)
-        if (std::abs(es.eigenvectors()(i, e)) > 0.1) {
-          id.identifiable[static_cast<std::size_t>(i)] = false;
-          id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
-        }
+    if (!(es.eigenvalues()[e] > 1e-12 * lmax)) unseen_share += es.eigenvectors().col(e).cwiseAbs2();
+  unseen_share = unseen_share.cwiseSqrt();
+  for (int i = 0; i < P; ++i)
+    if (unseen_share[i] > 0.1) {
+      id.identifiable[static_cast<std::size_t>(i)] = false;
+      id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
+    }
   // Without a stated noise level σ comes from the residual with ν = N − P degrees of freedom; below
   // ν = 10 that estimate is not a scale (at ν = 10 the level is within a factor 1.75 at 95 %, at
   // ν = 1 within a factor 16), and neither is any std drawn from it.
@@ -109,7 +113,13 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
         Fk(a, b) = Fr(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]);
     const MatrixXd Ck = Fk.inverse();
     for (Eigen::Index a = 0; a < K; ++a) {
-      const double rel = std::sqrt(std::max(0.0, Ck(a, a)));
+      if (!(Ck(a, a) > 0.0) || !std::isfinite(Ck(a, a))) {  // the restricted matrix is singular too
+        const int i = keep[static_cast<std::size_t>(a)];
+        id.identifiable[static_cast<std::size_t>(i)] = false;
+        id.reason[static_cast<std::size_t>(i)] = "the Fisher matrix of the parameters the data see is singular";
+        continue;
+      }
+      const double rel = std::sqrt(Ck(a, a));
       const double rel_res = rel * std::sqrt(systematic);
       const int i = keep[static_cast<std::size_t>(a)];
       id.std[i] = rel * q[i];
@@ -127,19 +137,15 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
       // (a factor e) is as plausible as none — and a parameter with share s in that direction
       // moves by s along with it. Where s exceeds its relative std, the std would promise what the
       // data do not hold: that parameter is flagged too (docs/theory.md §8.1).
-      for (int e = 0; e < P; ++e) {
-        if (es.eigenvalues()[e] > 1e-12 * lmax) continue;
-        const double share = std::abs(es.eigenvectors()(i, e));
-        if (share > rel) {
-          id.identifiable[static_cast<std::size_t>(i)] = false;
-          char buf[200];
-          std::snprintf(buf, sizeof buf,
-                        "shares a direction the data cannot see (share %.3g in a Fisher eigenvector below 1e-12 of the "
-                        "largest, against its relative std %.3g)",
-                        share, rel);
-          id.reason[static_cast<std::size_t>(i)] = buf;
-          break;
-        }
+      // (Shares below 1e-6 are rounding in the eigenvectors, and move a parameter by less than that.)
+      if (const double share = unseen_share[i]; share > std::max(rel, 1e-6)) {
+        id.identifiable[static_cast<std::size_t>(i)] = false;
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "shares a direction the data cannot see (share %.3g in the Fisher eigenvectors below 1e-12 of the "
+                      "largest, against its relative std %.3g)",
+                      share, rel);
+        id.reason[static_cast<std::size_t>(i)] = buf;
       }
     }
   }

@@ -269,9 +269,7 @@ void gauss_newton(Run& r, VectorXd x) {
       }
       x += delta;
       const double step = delta.cwiseAbs().maxCoeff();
-      // A stall needs both a small gain over this step and a small gain left to the model's minimum:
-      // slow progress down a long valley is not a minimum (docs/theory.md §7.4).
-      const bool stalled = J - Jn <= r.gauss_newton_stall() * J && gauss_newton_decrease(Hn, gn) <= r.gauss_newton_stall() * Jn;
+      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
       J = Jn;
       gx = gn;
       Hx = Hn;
@@ -571,10 +569,7 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
         continue;
       }
       const double step = delta.cwiseAbs().maxCoeff();
-      // As for Gauss–Newton: a small gain, and the model solved inside the region (its minimum
-      // reached to the forcing term) with little gain predicted; a step cut at the boundary says
-      // the model's minimum lies further out (docs/theory.md §7.4).
-      const bool stalled = J - Jn <= r.gauss_newton_stall() * J && !boundary && predicted <= r.gauss_newton_stall() * J;
+      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
       x += delta;
       J = Jn;
       Jd = Jdn;

@@ -846,11 +846,17 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
   for (int i : differ) {
     const auto u = static_cast<std::size_t>(i);
     r.ident.identifiable[u] = false;
-    char buf[220];
-    std::snprintf(buf, sizeof buf,
-                  "the profile reversed end for end (this section %.6g instead of %.6g) fits the data as well (chi-square "
-                  "difference %.3g, below 4): the data cannot tell the two apart",
-                  qm[i], r.estimate[i], c1 - c0);
+    char buf[260];
+    if (c1 - c0 > -4.0)
+      std::snprintf(buf, sizeof buf,
+                    "the profile reversed end for end (this section %.6g instead of %.6g) fits the data as well (chi-square "
+                    "difference %.3g, below 4): the data cannot tell the two apart",
+                    qm[i], r.estimate[i], c1 - c0);
+    else  // the mirror is the better fit: the estimate is not the best one
+      std::snprintf(buf, sizeof buf,
+                    "the profile reversed end for end (this section %.6g instead of %.6g) fits the data better (chi-square "
+                    "lower by %.3g): the estimate is not the best fit",
+                    qm[i], r.estimate[i], c0 - c1);
     r.ident.reason[u] = buf;
   }
 }

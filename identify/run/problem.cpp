@@ -489,7 +489,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
                               id.step_rule == "data");
   }
-  // A record in which no sensor moves holds nothing to identify from (cost zero at any start).
+  // A record in which no sensor moves holds nothing to identify from (every parameter fits it the
+  // same until the model moves, and then only worse).
   if (p->data.z.size() > 0 && (p->data.z.array() == 0.0).all()) {
     if (data_csv) throw InputError("data file '" + *data_csv + "': every sensor's column is zero: nothing to identify from");
     fail_field(sc.source, "sensors",

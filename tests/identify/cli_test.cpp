@@ -397,6 +397,9 @@ TEST(ScoleIdentifyCli, ARecordInWhichNoSensorMovesIsRefused) {
 TEST(ScoleIdentifyCli, AKeyWithoutAValueAndASecondDocumentAreRefused) {
   expect_yaml_error(good_with("location: 10}\nsimulation", "location: ~}\nsimulation"), {"sensors[0].location", "has no value"});
   expect_yaml_error(std::string(kGood) + "---\nname: second\n", {"2 YAML documents"});
+  // A trailing `---` opens no second scenario: the file still reaches the run (here refused for
+  // an unrelated field, to stop before any work).
+  expect_yaml_error(good_with("  elements: 10\n", "  elements: 10\n  rtol: 10\n") + "---\n", {"identification.rtol"});
 }
 
 TEST(ScoleIdentifyCli, RelativeToleranceOutsideZeroOneIsRefused) {
@@ -433,6 +436,10 @@ TEST(ScoleIdentifyCli, DataLineEndingsAndAByteOrderMark) {
   // A spreadsheet's byte-order mark is dropped: the header reads 't' and the rows are reached
   // (here to be refused for holding no response).
   expect_csv_error("truth.csv", "\xEF\xBB\xBFt,P,w_mid\n0,10,0\n0.01,10,0\n0.02,10,0\n", {"every sensor's column is zero"});
+  // … also before a comment line; and CR CR LF endings (written by some CSV writers) read as lines.
+  expect_csv_error("truth.csv", "\xEF\xBB\xBF# exported\nt,P,w_mid\n0,10,0\n0.01,10,0\n0.02,10,0\n",
+                   {"every sensor's column is zero"});
+  expect_csv_error("truth.csv", "t,P,w_mid\r\r\n0,10,0\r\r\n0.01,10,0\r\r\n0.02,10,0\r\r\n", {"every sensor's column is zero"});
 }
 
 TEST(ScoleIdentifyCli, DataLacksSensorColumn) {

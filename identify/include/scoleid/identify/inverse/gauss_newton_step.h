@@ -29,12 +29,6 @@ struct TrustRegionStep {
 
 TrustRegionStep trust_region_step(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, double radius, double lambda_min = 0.0);
 
-// The decrease the Gauss–Newton model predicts to its minimum, ½ gᵀ H⁺ g, H⁺ the pseudo-inverse over
-// the eigen-directions above 1e-12 of the largest (the flat directions, which identifiability
-// flags, left out). With H = Sᵀ R S and g = Sᵀ R r it is ½ of the residual's R-norm² projected on
-// the sensitivities' span — zero at a stationary point, bounded by J, in the cost's own units.
-double gauss_newton_decrease(const Eigen::MatrixXd& H, const Eigen::VectorXd& g);
-
 // New radius after a trial step with actual/predicted ratio rho.
 double update_radius(double radius, const TrustRegionStep& step, double rho, double max_radius);
 
