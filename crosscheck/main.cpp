@@ -120,7 +120,7 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
         }
       }
     }
-    fs::create_directories(fs::path(out) / "results");
+    if (!files.empty()) fs::create_directories(fs::path(out) / "results");  // (--collect alone writes none)
     bool ok = true;
     for (const auto& f : files) {
       const auto r = crosscheck::run_suite_file(f, out, so);
@@ -151,8 +151,7 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
     if (!missing.empty()) {
       std::string m;
       for (const auto& f : missing) m += (m.empty() ? "" : ", ") + f;
-      std::fprintf(stderr, "scole-crosscheck suite: no results in %s/results for: %s (run them first)\n", out.c_str(), m.c_str());
-      return 1;
+      throw io::InputError("output directory '" + out + "': no results/<family>.json for: " + m + " (run them first)");
     }
     if (results.empty()) throw io::InputError("output directory '" + out + "': no results/*.json to summarise");
     const auto s = crosscheck::summarise_suite(results);

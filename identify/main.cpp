@@ -168,6 +168,11 @@ int main(int argc, char** argv) {
     // The output directory is checked (and its staging area made) before any work.
     io::RunDirectory run_dir(out, identify::output_files(), "scole-identify");
     auto problem = identify::make_problem(sc, ro.data_csv);
+    // (Checked again by the run; here so that the refusal is the only line on stderr.)
+    if (const auto& w = sc.identification.steepest_weights; !w.empty() && static_cast<int>(w.size()) != problem->params->size())
+      io::fail_field(sc.source, "identification.steepest_weights",
+                     "must hold one weight per estimated parameter (" + std::to_string(problem->params->size()) + ")",
+                     std::to_string(w.size()) + " values");
     std::fprintf(stderr, "scole-identify: %s, %s model, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
                  sc.identification.model.c_str(), problem->structure->elements(), problem->params->size(),
                  problem->data_source.c_str());

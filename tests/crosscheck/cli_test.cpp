@@ -63,6 +63,12 @@ TEST(CrosscheckCli, BadInputIsOneLineExitTwoNothingWritten) {
   EXPECT_EQ(rep_err.find("staging"), std::string::npos) << rep_err;
   EXPECT_EQ(std::count(rep_err.begin(), rep_err.end(), '\n'), 1) << rep_err;
   EXPECT_EQ(slurp(d / "rep" / "modes.json"), "[1, 2, 3]\n");
+  // `suite --collect` before the families have run: exit 2, one line, nothing created.
+  fs::create_directories(d / "empty");
+  EXPECT_EQ(sh(exe + " suite --collect --out " + (d / "empty").string() + " 2> " + (d / "err").string()), 2);
+  const std::string collect_err = slurp(d / "err");
+  EXPECT_EQ(std::count(collect_err.begin(), collect_err.end(), '\n'), 1) << collect_err;
+  EXPECT_FALSE(fs::exists(d / "empty" / "results"));
   fs::remove_all(d);
 }
 
@@ -153,7 +159,7 @@ TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
 
 // A small family on a beam (the paper's Case I, chain of 10 and 20 segments): the family's results
 // and the suite's report; the chain's error in q2 falls at second order and the report states the
-// coverage it measured. --collect without the family's results is an incomplete suite: exit 1.
+// coverage it measured. --collect without the family's results is an incomplete suite: refused (exit 2).
 TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
   const fs::path d = scratch("suite-beam");
   fs::create_directories(d / "families");
@@ -165,7 +171,7 @@ TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
         "expect: {rate: {q2: [1.5, 2.5]}}\n");
   const fs::path out = d / "out";
   const std::string dir = " --suite-dir " + (d / "families").string() + " --out " + out.string();
-  EXPECT_EQ(sh(exe + " suite --collect -q" + dir + " > /dev/null 2>&1"), 1);
+  EXPECT_EQ(sh(exe + " suite --collect -q" + dir + " > /dev/null 2>&1"), 2);
   ASSERT_EQ(sh(exe + " suite --only beam-chain -q" + dir), 0);
   const auto r = nlohmann::json::parse(slurp(out / "results" / "beam-chain.json"));
   ASSERT_EQ(r["cases"].size(), 2u);

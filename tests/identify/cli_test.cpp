@@ -406,6 +406,11 @@ TEST(ScoleIdentifyCli, RelativeToleranceOutsideZeroOneIsRefused) {
   expect_yaml_error(good_with("  elements: 10\n", "  elements: 10\n  rtol: 10\n"), {"identification.rtol", "(0, 1)", "10"});
 }
 
+TEST(ScoleIdentifyCli, SteepestWeightsOfTheWrongCountAreTheOnlyLine) {
+  expect_yaml_error(good_with("  elements: 10\n", "  elements: 10\n  steepest_weights: [1, 1, 1]\n"),
+                    {"identification.steepest_weights", "one weight per estimated parameter (2)", "3 values"});
+}
+
 TEST(ScoleIdentifyCli, AnInertiaNoRigidBodyHasIsRefused) {
   expect_yaml_error(R"(name: bad-shuttle
 structure: scole
