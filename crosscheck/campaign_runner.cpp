@@ -144,7 +144,7 @@ json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, 
     auto p = identify::make_problem(sc, csv);
     if (kc.seed >= 0) add_noise(*p, c.noise_relative, case_noise_seed(c, kc));
     if (die_midway) std::_Exit(137);  // the restart test: killed with the case half done
-    row = identify_row(*p);
+    row = identify_row(std::move(p));
   } catch (const io::Interrupted&) {
     throw;
   } catch (const std::exception& e) {

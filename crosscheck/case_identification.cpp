@@ -5,7 +5,7 @@
 #include <string>
 
 #include "scoleid/crosscheck/table.h"
-#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify.h"
 #include "scoleid/io/error.h"
 
 namespace scoleid::crosscheck {
@@ -17,12 +17,10 @@ json num(double v) { return json_number(v); }
 }  // namespace
 
 // One identification on `p` into the result row of one case (or seed).
-json identify_row(identify::Problem& p) {
-  identify::RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = true;
-  ro.data_csv = p.data_source;
-  const identify::RunResult r = identify::run_identification(p, ro);
+json identify_row(std::shared_ptr<identify::Problem> problem) {
+  const Identification id = scoleid::identify_parameters(problem, IdentifyOptions{});
+  const identify::Problem& p = id.problem();
+  const identify::RunResult& r = id.result();
   json row;
   row["converged"] = r.converged();
   row["optimizer_converged"] = r.summary.converged();

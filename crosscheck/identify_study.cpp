@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "scoleid/crosscheck/richardson.h"
-#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
 
@@ -35,12 +35,8 @@ bool IdentifyStudy::all_converged() const {
 }
 
 namespace {
-LevelRun run_one(identify::Problem& p, int segments, identify::RunResult& result) {
-  identify::RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = true;
-  if (p.data_source.rfind("synthetic", 0) != 0) ro.data_csv = p.data_source;
-  result = identify::run_identification(p, ro);
+LevelRun run_one(std::shared_ptr<identify::Problem> p, int segments, identify::RunResult& result) {
+  result = scoleid::identify_parameters(std::move(p), IdentifyOptions{}).result();
   LevelRun r;
   r.segments = segments;
   r.converged = result.converged();
@@ -65,7 +61,7 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
   const auto t0 = std::chrono::steady_clock::now();
   IdentifyStudy st;
   st.scenario = scenario.name;
-  st.model = scenario.identification.model;
+  st.model = io::to_string(scenario.identification.model);
   st.data_kind = opt.with_noise ? "Simbody truth with the scenario's sensor noise" : "Simbody truth, noise-free";
   st.segments = refinement(opt.segments > 0 ? opt.segments : scenario.truth.segments, opt.levels,
                            io::limits::kMaxSegments, "segments");
@@ -74,9 +70,9 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
   st.truths = same ? reuse : run_truth_levels(scenario, st.segments, truth_root, !opt.with_noise, opt.progress);
   for (std::size_t l = 0; l < st.truths.size(); ++l) {
     if (opt.progress) std::fprintf(stderr, "scole-crosscheck: identifying from the %d-segment truth\n", st.segments[l]);
-    auto p = identify::make_problem(scenario, st.truths[l].csv);
+    std::shared_ptr<identify::Problem> p = identify::make_problem(scenario, st.truths[l].csv);
     identify::RunResult res;
-    st.runs.push_back(run_one(*p, st.segments[l], res));
+    st.runs.push_back(run_one(p, st.segments[l], res));
     if (l == 0)
       for (const auto& name : res.names) {
         ParameterStudy ps;
@@ -108,9 +104,8 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
     io::Scenario sc = scenario;
     if (!opt.with_noise)
       for (auto& s : sc.sensors) s.noise_std = 0.0;
-    auto p = identify::make_problem(sc, std::nullopt);
     identify::RunResult res;
-    st.fe_run = run_one(*p, 0, res);
+    st.fe_run = run_one(identify::make_problem(sc, std::nullopt), 0, res);
     for (std::size_t i = 0; i < st.parameters.size(); ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       st.parameters[i].fe_on_fe = res.estimate[ii];

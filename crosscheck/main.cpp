@@ -211,6 +211,189 @@ int run_campaign(const std::string& file, crosscheck::CampaignRunOptions opt) {
     }
   });
 }
+
+// The command line: the verbs and their options.
+struct Cli {
+  std::string scenario = "paper-scole-1", out;
+  bool quiet = false;
+  crosscheck::ModesOptions mo;
+  crosscheck::TrajectoryOptions to;
+  crosscheck::IdentifyStudyOptions io_;
+  std::vector<std::string> suite_only;
+  std::string suite_dir = SCOLEID_MISMATCH_DIR, suite_out = "run/mismatch-suite";
+  bool suite_collect = false;
+  crosscheck::SuiteOptions so;
+  std::string campaign_file;
+  crosscheck::CampaignRunOptions co;
+  CLI::App *modes = nullptr, *traj = nullptr, *ident = nullptr, *report = nullptr, *all = nullptr, *suite = nullptr,
+           *camp = nullptr;
+};
+
+void add_verbs(CLI::App& app, Cli& c) {
+  auto common = [&](CLI::App* sub) {
+    sub->add_option("-s,--scenario", c.scenario, "built-in scenario name or YAML file")->capture_default_str();
+    sub->add_option("-o,--out", c.out, "output directory (default: run/<scenario>/crosscheck)");
+    sub->add_flag("-q,--quiet", c.quiet, "no tables on stdout, no progress on stderr");
+  };
+  auto* modes = c.modes = app.add_subcommand(
+      "modes", "natural frequencies and mode shapes: the Simbody chain linearised at rest at n, 2n, 4n segments against "
+               "the FE model at N, 2N, 4N elements and the analytic values where they exist; observed rates, Richardson "
+               "extrapolation of the chain, MAC matrix. Writes modes.csv, mac.csv, modes.json, and modal-data.csv (the chain's modes at the scenario's displacement-type sensors, stds from its lumping error: measured modes for scole-identify --experiments)");
+  common(modes);
+  modes->add_option("--segments", c.mo.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  modes->add_option("--elements", c.mo.elements, "first FE resolution N (default: the scenario's identification.elements)");
+  modes->add_option("--count", c.mo.count, "flexible modes compared")->capture_default_str();
+  modes->add_option("--levels", c.mo.levels, "resolutions per side (n, 2n, 4n: 3)")->capture_default_str();
+  auto* traj = c.traj = app.add_subcommand(
+      "trajectories", "the scenario's inputs through both models at the truth's parameters: relative RMS difference "
+                      "per sensor at n, 2n, 4n segments and its rate. Writes trajectories.csv, trajectories.json, "
+                      "overlay.csv, truths/");
+  common(traj);
+  traj->add_option("--segments", c.to.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  traj->add_option("--elements", c.to.elements, "FE elements (default: 4 x identification.elements)");
+  traj->add_option("--fe-step", c.to.fe_step, "FE time step (default: resolve the first 5 flexible modes with omega h <= 0.03)");
+  traj->add_option("--levels", c.to.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
+  traj->add_flag("--nonlinear", c.to.nonlinear,
+                 "SCOLE: also the nonlinear FE model (finite shuttle rotation, the mast in the rotating frame), its "
+                 "difference to the chain beside the linear model's");
+  traj->add_option("--nonlinear-elements", c.to.nonlinear_elements,
+                   "elements of the nonlinear FE model (default: as the linear one)");
+  auto* ident = c.ident = app.add_subcommand(
+      "identify", "the identifier on the Simbody truth at n, 2n, 4n segments, the estimates' errors against the "
+                  "truth's values, their extrapolation in n, and the FE-on-FE result beside them. Writes identify.csv, "
+                  "identify.json, truths/");
+  common(ident);
+  ident->add_option("--segments", c.io_.segments, "first chain resolution n (default: the scenario's truth.segments)");
+  ident->add_option("--levels", c.io_.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
+  ident->add_flag("--with-noise", c.io_.with_noise, "keep the scenario's sensor noise in the truths (default: noise-free)");
+  auto* report = c.report = app.add_subcommand("report", "report.md with every table, a CSV behind each, and PNG plots, from the "
+                                              "JSON the other verbs left in --out");
+  common(report);
+  auto* all = c.all = app.add_subcommand("all", "modes, trajectories, identify and report, then the one-screen summary");
+  common(all);
+  auto* suite = c.suite = app.add_subcommand(
+      "suite", "the mismatch suite: each family file (truth differing from the identifier's model by a stated mismatch) "
+               "runs the truth and the identifier; per family <family>.json under --out/results with each case's errors, "
+               "reported intervals and the file's expectations; then report.md, suite.csv, suite.json and suite.png "
+               "(error and interval against mismatch size) with the coverage (truth inside the interval, target >= 90 %) "
+               "and the sharpness (median interval / median error, target <= 10). Exit 1 when an expectation or a "
+               "target fails (outputs written, marked).");
+  suite->add_option("--only", c.suite_only, "run only these families (file path or family name); no report unless --collect is given too (the report then covers every family of --suite-dir)")
+      ->take_all();
+  suite->add_option("--suite-dir", c.suite_dir, "directory of the family files")->capture_default_str();
+  suite->add_option("-o,--out", c.suite_out, "output directory")->capture_default_str();
+  suite->add_option("--seeds", c.so.seeds, "noise seeds per noise case (default: the file's)");
+  suite->add_flag("--collect", c.suite_collect, "only summarise the results already in --out/results: report, coverage, sharpness");
+  suite->add_flag("-q,--quiet", c.quiet, "no progress on stderr");
+  auto* camp = c.camp = app.add_subcommand(
+      "campaign", "a campaign file: scenarios x a parameter grid x noise seeds, each point's Simbody truth once and "
+                  "its identifications (noise-free and one per seed); per-case results stored atomically under "
+                  "--out/cases (a second run resumes: stored cases are not run again); then report.md (per point: "
+                  "error, seed scatter against the reported std, interval coverage), cases.csv, points.csv, "
+                  "histogram.png, campaign.json, and timing.json. Serial by default; started by `mpirun -n K` (or "
+                  "srun) the cases are shared out dynamically over the K ranks, the report identical. Exit 1 when a "
+                  "case failed.");
+  camp->add_option("file", c.campaign_file, "the campaign file (YAML)")->required();
+  camp->add_option("-o,--out", c.co.out, "output directory (default: run/campaign/<campaign name>)");
+  camp->add_flag("-q,--quiet", c.quiet, "no progress on stderr");
+  camp->add_option("--kill-after", c.co.kill_after, "restart test: exit abruptly during the case after this many")->group("");
+  camp->add_option("--kill-rank", c.co.kill_rank, "restart test: the rank that exits (default the last)")->group("");
+}
+
+// modes: the chain against the FE model and the analytic values (modes.csv, mac.csv, modes.json),
+// and the chain's modes as measured modes for scole-identify --experiments (modal-data.csv; a
+// scenario without a displacement-type sensor has no shapes to write).
+void modes_verb(io::RunDirectory& dir, const io::Scenario& sc, const crosscheck::ModesOptions& mo, bool quiet) {
+  if (!quiet) std::fprintf(stderr, "scole-crosscheck: modes of %s\n", sc.name.c_str());
+  const auto r = crosscheck::compare_modes(sc, mo);
+  const auto t = crosscheck::modes_table(r), m = crosscheck::mac_table(r);
+  print(t, quiet);
+  print(m, quiet);
+  io::write_text_atomic(dir.path("modes.csv"), t.csv());
+  io::write_text_atomic(dir.path("mac.csv"), m.csv());
+  io::write_json_atomic(dir.path("modes.json"), crosscheck::to_json(r));
+  try {
+    io::write_modal_data(dir.path("modal-data.csv"),
+                         crosscheck::chain_modal_data(sc, r.segments.front(), static_cast<int>(r.modes.size())));
+  } catch (const io::InputError& e) {
+    std::fprintf(stderr, "scole-crosscheck: note: no modal-data.csv: %s\n", io::one_line(e.what()).c_str());
+  }
+}
+
+// trajectories: both models through the scenario's inputs; returns the noise-free truths it ran.
+std::vector<crosscheck::TruthLevel> trajectories_verb(io::RunDirectory& dir, const io::Scenario& sc,
+                                                      const crosscheck::TrajectoryOptions& to, bool quiet) {
+  const auto r = crosscheck::compare_trajectories(sc, to, dir.path("truths"));
+  const auto t = crosscheck::trajectories_table(r);
+  print(t, quiet);
+  io::write_text_atomic(dir.path("trajectories.csv"), t.csv());
+  io::write_text_atomic(dir.path("overlay.csv"), crosscheck::overlay_table(r).csv());
+  io::write_json_atomic(dir.path("trajectories.json"), crosscheck::to_json(r));
+  return r.truths;
+}
+
+// identify: the identifier on the truths. The trajectories' noise-free truths serve when the levels
+// match; the study runs its own otherwise (replacing them: truths/ then holds what identify.json
+// used). Returns whether every identification converged.
+bool identify_verb(io::RunDirectory& dir, const io::Scenario& sc, const crosscheck::IdentifyStudyOptions& io_, bool quiet,
+                   const std::vector<crosscheck::TruthLevel>& noise_free_truths) {
+  const auto s = crosscheck::identify_study(sc, io_, dir.path("truths"), noise_free_truths);
+  const auto t = crosscheck::identify_table(s);
+  print(t, quiet);
+  io::write_text_atomic(dir.path("identify.csv"), t.csv());
+  io::write_json_atomic(dir.path("identify.json"), crosscheck::to_json(s));
+  if (!s.all_converged()) std::fprintf(stderr, "scole-crosscheck: not every identification converged (identify.json: runs)\n");
+  return s.all_converged();
+}
+
+// report: from the JSON this and earlier runs left. The earlier outputs are read from the staging
+// copy; a file that does not hold what this program writes is named as the user's file in --out.
+std::vector<std::string> report_verb(io::RunDirectory& dir, const std::string& out, bool quiet) {
+  try {
+    const crosscheck::ReportInputs in = crosscheck::read_report_inputs(dir.staging());
+    if (in.modes.is_null() && in.trajectories.is_null() && in.identify.is_null())
+      throw io::InputError("output directory '" + out + "': no modes.json, trajectories.json or identify.json to report on");
+    std::vector<std::string> lines = crosscheck::summary_lines(in);
+    write_report(dir, in, quiet);
+    return lines;
+  } catch (const nlohmann::json::exception& e) {
+    throw io::InputError("output directory '" + out + "': modes.json, trajectories.json or identify.json is not as " +
+                         "scole-crosscheck writes it (" + io::one_line(e.what()) + ")");
+  } catch (const io::InputError& e) {
+    std::string m = e.what();
+    for (std::size_t at; (at = m.find(dir.staging())) != std::string::npos;) m.replace(at, dir.staging().size(), out);
+    throw io::InputError(m);
+  }
+}
+
+// The scenario verbs (modes, trajectories, identify, report, all) into one output directory.
+int run_scenario_verbs(Cli& c) {
+  const io::Scenario sc = io::load_scenario(c.scenario);
+  io::validate_scenario(sc);
+  if (c.out.empty()) c.out = "run/" + sc.name + "/crosscheck";
+  std::string why;
+  if (!c.mo.IsValid(&why) || !c.to.IsValid(&why) || !c.io_.IsValid(&why)) throw io::InputError("command line: " + why);
+  c.to.progress = c.io_.progress = !c.quiet;
+  io::RunDirectory dir(c.out, kOutputs, "scole-crosscheck");
+  const bool all = c.all->parsed();
+  bool converged = true;
+  if (c.modes->parsed() || all) modes_verb(dir, sc, c.mo, c.quiet);
+  std::vector<crosscheck::TruthLevel> noise_free_truths;
+  if (c.traj->parsed() || all) noise_free_truths = trajectories_verb(dir, sc, c.to, c.quiet);
+  if (c.ident->parsed() || all) converged = identify_verb(dir, sc, c.io_, c.quiet, noise_free_truths);
+  dir.keep_earlier_outputs();
+  if (c.report->parsed() || all) {
+    const std::vector<std::string> lines = report_verb(dir, c.out, c.quiet);
+    if (all || !c.quiet) {
+      std::printf("Cross-check of %s\n", sc.name.c_str());
+      for (const auto& l : lines) std::printf("  %s\n", l.c_str());
+    }
+  }
+  dir.commit();
+  if (!c.quiet) std::fprintf(stderr, "scole-crosscheck: wrote %s\n", c.out.c_str());
+  return converged ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -225,85 +408,8 @@ int main(int argc, char** argv) {
       "Exit codes: 0 success; 1 a run failed or an identification did not converge (outputs written, marked); 2 bad "
       "usage or bad input (nothing written); 130/143 interrupted (nothing written). Each verb replaces only its own "
       "files in the output directory, all at once.");
-  std::string scenario = "paper-scole-1", out;
-  bool quiet = false;
-  crosscheck::ModesOptions mo;
-  crosscheck::TrajectoryOptions to;
-  crosscheck::IdentifyStudyOptions io_;
-  auto common = [&](CLI::App* c) {
-    c->add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
-    c->add_option("-o,--out", out, "output directory (default: run/<scenario>/crosscheck)");
-    c->add_flag("-q,--quiet", quiet, "no tables on stdout, no progress on stderr");
-  };
-  auto* modes = app.add_subcommand(
-      "modes", "natural frequencies and mode shapes: the Simbody chain linearised at rest at n, 2n, 4n segments against "
-               "the FE model at N, 2N, 4N elements and the analytic values where they exist; observed rates, Richardson "
-               "extrapolation of the chain, MAC matrix. Writes modes.csv, mac.csv, modes.json, and modal-data.csv (the chain's modes at the scenario's displacement-type sensors, stds from its lumping error: measured modes for scole-identify --experiments)");
-  common(modes);
-  modes->add_option("--segments", mo.segments, "first chain resolution n (default: the scenario's truth.segments)");
-  modes->add_option("--elements", mo.elements, "first FE resolution N (default: the scenario's identification.elements)");
-  modes->add_option("--count", mo.count, "flexible modes compared")->capture_default_str();
-  modes->add_option("--levels", mo.levels, "resolutions per side (n, 2n, 4n: 3)")->capture_default_str();
-  auto* traj = app.add_subcommand(
-      "trajectories", "the scenario's inputs through both models at the truth's parameters: relative RMS difference "
-                      "per sensor at n, 2n, 4n segments and its rate. Writes trajectories.csv, trajectories.json, "
-                      "overlay.csv, truths/");
-  common(traj);
-  traj->add_option("--segments", to.segments, "first chain resolution n (default: the scenario's truth.segments)");
-  traj->add_option("--elements", to.elements, "FE elements (default: 4 x identification.elements)");
-  traj->add_option("--fe-step", to.fe_step, "FE time step (default: resolve the first 5 flexible modes with omega h <= 0.03)");
-  traj->add_option("--levels", to.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
-  traj->add_flag("--nonlinear", to.nonlinear,
-                 "SCOLE: also the nonlinear FE model (finite shuttle rotation, the mast in the rotating frame), its "
-                 "difference to the chain beside the linear model's");
-  traj->add_option("--nonlinear-elements", to.nonlinear_elements,
-                   "elements of the nonlinear FE model (default: as the linear one)");
-  auto* ident = app.add_subcommand(
-      "identify", "the identifier on the Simbody truth at n, 2n, 4n segments, the estimates' errors against the "
-                  "truth's values, their extrapolation in n, and the FE-on-FE result beside them. Writes identify.csv, "
-                  "identify.json, truths/");
-  common(ident);
-  ident->add_option("--segments", io_.segments, "first chain resolution n (default: the scenario's truth.segments)");
-  ident->add_option("--levels", io_.levels, "chain resolutions (n, 2n, 4n: 3)")->capture_default_str();
-  ident->add_flag("--with-noise", io_.with_noise, "keep the scenario's sensor noise in the truths (default: noise-free)");
-  auto* report = app.add_subcommand("report", "report.md with every table, a CSV behind each, and PNG plots, from the "
-                                              "JSON the other verbs left in --out");
-  common(report);
-  auto* all = app.add_subcommand("all", "modes, trajectories, identify and report, then the one-screen summary");
-  common(all);
-  std::vector<std::string> suite_only;
-  std::string suite_dir = SCOLEID_MISMATCH_DIR, suite_out = "run/mismatch-suite";
-  bool suite_collect = false;
-  crosscheck::SuiteOptions so;
-  auto* suite = app.add_subcommand(
-      "suite", "the mismatch suite: each family file (truth differing from the identifier's model by a stated mismatch) "
-               "runs the truth and the identifier; per family <family>.json under --out/results with each case's errors, "
-               "reported intervals and the file's expectations; then report.md, suite.csv, suite.json and suite.png "
-               "(error and interval against mismatch size) with the coverage (truth inside the interval, target >= 90 %) "
-               "and the sharpness (median interval / median error, target <= 10). Exit 1 when an expectation or a "
-               "target fails (outputs written, marked).");
-  suite->add_option("--only", suite_only, "run only these families (file path or family name); no report unless --collect is given too (the report then covers every family of --suite-dir)")
-      ->take_all();
-  suite->add_option("--suite-dir", suite_dir, "directory of the family files")->capture_default_str();
-  suite->add_option("-o,--out", suite_out, "output directory")->capture_default_str();
-  suite->add_option("--seeds", so.seeds, "noise seeds per noise case (default: the file's)");
-  suite->add_flag("--collect", suite_collect, "only summarise the results already in --out/results: report, coverage, sharpness");
-  suite->add_flag("-q,--quiet", quiet, "no progress on stderr");
-  std::string campaign_file;
-  crosscheck::CampaignRunOptions co;
-  auto* camp = app.add_subcommand(
-      "campaign", "a campaign file: scenarios x a parameter grid x noise seeds, each point's Simbody truth once and "
-                  "its identifications (noise-free and one per seed); per-case results stored atomically under "
-                  "--out/cases (a second run resumes: stored cases are not run again); then report.md (per point: "
-                  "error, seed scatter against the reported std, interval coverage), cases.csv, points.csv, "
-                  "histogram.png, campaign.json, and timing.json. Serial by default; started by `mpirun -n K` (or "
-                  "srun) the cases are shared out dynamically over the K ranks, the report identical. Exit 1 when a "
-                  "case failed.");
-  camp->add_option("file", campaign_file, "the campaign file (YAML)")->required();
-  camp->add_option("-o,--out", co.out, "output directory (default: run/campaign/<campaign name>)");
-  camp->add_flag("-q,--quiet", quiet, "no progress on stderr");
-  camp->add_option("--kill-after", co.kill_after, "restart test: exit abruptly during the case after this many")->group("");
-  camp->add_option("--kill-rank", co.kill_rank, "restart test: the rank that exits (default the last)")->group("");
+  Cli c;
+  add_verbs(app, c);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -314,92 +420,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   io::install_interrupt_handlers();
-  if (camp->parsed()) {
-    co.progress = !quiet;
-    return run_campaign(campaign_file, co);
+  if (c.camp->parsed()) {
+    c.co.progress = !c.quiet;
+    return run_campaign(c.campaign_file, c.co);
   }
-  if (suite->parsed()) return run_suite(suite_only, suite_dir, suite_out, suite_collect, so, quiet);
-  return guarded([&] {
-    const io::Scenario sc = io::load_scenario(scenario);
-    io::validate_scenario(sc);
-    if (out.empty()) out = "run/" + sc.name + "/crosscheck";
-    std::string why;
-    if (!mo.IsValid(&why) || !to.IsValid(&why) || !io_.IsValid(&why)) throw io::InputError("command line: " + why);
-    to.progress = io_.progress = !quiet;
-    io::RunDirectory dir(out, kOutputs, "scole-crosscheck");
-    const bool do_modes = modes->parsed() || all->parsed();
-    const bool do_traj = traj->parsed() || all->parsed();
-    const bool do_ident = ident->parsed() || all->parsed();
-    const bool do_report = report->parsed() || all->parsed();
-    bool converged = true;
-    const std::string truths = dir.path("truths");
-    if (do_modes) {
-      if (!quiet) std::fprintf(stderr, "scole-crosscheck: modes of %s\n", sc.name.c_str());
-      const auto r = crosscheck::compare_modes(sc, mo);
-      const auto t = crosscheck::modes_table(r), m = crosscheck::mac_table(r);
-      print(t, quiet);
-      print(m, quiet);
-      io::write_text_atomic(dir.path("modes.csv"), t.csv());
-      io::write_text_atomic(dir.path("mac.csv"), m.csv());
-      io::write_json_atomic(dir.path("modes.json"), crosscheck::to_json(r));
-      // The chain's modes as measured modes, for scole-identify --experiments (modes: {file}); a
-      // scenario without a displacement-type sensor has no shapes to write.
-      try {
-        io::write_modal_data(dir.path("modal-data.csv"),
-                             crosscheck::chain_modal_data(sc, r.segments.front(), static_cast<int>(r.modes.size())));
-      } catch (const io::InputError& e) {
-        std::fprintf(stderr, "scole-crosscheck: note: no modal-data.csv: %s\n", io::one_line(e.what()).c_str());
-      }
-    }
-    std::vector<crosscheck::TruthLevel> noise_free_truths;
-    if (do_traj) {
-      const auto r = crosscheck::compare_trajectories(sc, to, truths);
-      noise_free_truths = r.truths;
-      const auto t = crosscheck::trajectories_table(r);
-      print(t, quiet);
-      io::write_text_atomic(dir.path("trajectories.csv"), t.csv());
-      io::write_text_atomic(dir.path("overlay.csv"), crosscheck::overlay_table(r).csv());
-      io::write_json_atomic(dir.path("trajectories.json"), crosscheck::to_json(r));
-    }
-    if (do_ident) {
-      // The trajectories' noise-free truths serve the identification when the levels match; the
-      // study runs its own otherwise (replacing them: truths/ then holds what identify.json used).
-      const auto s = crosscheck::identify_study(sc, io_, truths, noise_free_truths);
-      const auto t = crosscheck::identify_table(s);
-      print(t, quiet);
-      io::write_text_atomic(dir.path("identify.csv"), t.csv());
-      io::write_json_atomic(dir.path("identify.json"), crosscheck::to_json(s));
-      converged = s.all_converged();
-      if (!converged)
-        std::fprintf(stderr, "scole-crosscheck: not every identification converged (identify.json: runs)\n");
-    }
-    dir.keep_earlier_outputs();
-    if (do_report) {
-      crosscheck::ReportInputs in;
-      std::vector<std::string> lines;
-      // The earlier outputs are read from the staging copy; a file that does not hold what this
-      // program writes is named as the user's file in --out.
-      try {
-        in = crosscheck::read_report_inputs(dir.staging());
-        if (in.modes.is_null() && in.trajectories.is_null() && in.identify.is_null())
-          throw io::InputError("output directory '" + out + "': no modes.json, trajectories.json or identify.json to report on");
-        lines = crosscheck::summary_lines(in);
-        write_report(dir, in, quiet);
-      } catch (const nlohmann::json::exception& e) {
-        throw io::InputError("output directory '" + out + "': modes.json, trajectories.json or identify.json is not as " +
-                             "scole-crosscheck writes it (" + io::one_line(e.what()) + ")");
-      } catch (const io::InputError& e) {
-        std::string m = e.what();
-        for (std::size_t at; (at = m.find(dir.staging())) != std::string::npos;) m.replace(at, dir.staging().size(), out);
-        throw io::InputError(m);
-      }
-      if (all->parsed() || !quiet) {
-        std::printf("Cross-check of %s\n", sc.name.c_str());
-        for (const auto& l : lines) std::printf("  %s\n", l.c_str());
-      }
-    }
-    dir.commit();
-    if (!quiet) std::fprintf(stderr, "scole-crosscheck: wrote %s\n", out.c_str());
-    return converged ? 0 : 1;
-  });
+  if (c.suite->parsed()) return run_suite(c.suite_only, c.suite_dir, c.suite_out, c.suite_collect, c.so, c.quiet);
+  return guarded([&] { return run_scenario_verbs(c); });
 }

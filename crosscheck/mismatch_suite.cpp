@@ -206,152 +206,163 @@ io::Scenario case_scenario(const SuiteFile& f, std::size_t k) {
   return checked_scenario(yaml, f.path + " (case '" + c.label + "' on '" + f.base + "')");
 }
 
-json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const int seeds = f.seeds > 0 ? (opt.seeds > 0 ? opt.seeds : f.seeds) : 0;
-  json res{{"family", f.family}, {"mismatch", f.mismatch}, {"size_unit", f.size_unit}, {"reason", f.reason},
-           {"scenario", f.base}, {"file", fs::path(f.path).filename().string()}};
-  if (seeds) res["noise"] = {{"relative", f.noise_relative}, {"seeds", seeds}};
-  res["cases"] = json::array();
-  for (std::size_t k = 0; k < f.cases.size(); ++k) {
-    const SuiteCase& c = f.cases[k];
-    const io::Scenario sc = case_scenario(f, k);
-    if (opt.progress) std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: truth (%d segments)\n", f.family.c_str(), c.label.c_str(), sc.truth.segments);
-    const auto truths = run_truth_levels(sc, {sc.truth.segments}, (fs::path(out) / "truths" / f.family / c.label).string(),
-                                         true, false);
-    if (opt.progress) std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: identifying\n", f.family.c_str(), c.label.c_str());
-    // The truth is noise-free: the identifier is told no noise level it does not have.
-    io::Scenario id_sc = sc;
-    for (auto& s : id_sc.sensors) s.noise_std = 0.0;
-    auto p = identify::make_problem(id_sc, truths.front().csv);
-    json row = identify_row(*p);
-    row["label"] = c.label;
-    row["size"] = c.size;
-    row["truth_seconds"] = truths.front().seconds;
-    if (seeds) {
-      // The noise-free row above is the reference; each seed adds noise to the same truth.
-      row["noise_free"] = row["parameters"];
-      json runs = json::array();
-      for (int s = 0; s < seeds; ++s) {
-        auto ps = identify::make_problem(id_sc, truths.front().csv);
-        add_noise(*ps, f.noise_relative, f.noise_seed + 1000003u * static_cast<unsigned>(k) + static_cast<unsigned>(s));
-        runs.push_back(identify_row(*ps));
-        if (opt.progress && (s + 1) % 5 == 0)
-          std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: %d of %d seeds\n", f.family.c_str(), c.label.c_str(), s + 1, seeds);
-      }
-      // The case's row is the first seed's; the seeds' statistics beside it.
-      row["parameters"] = runs.front()["parameters"];
-      int converged = row["converged"].get<bool>() ? 1 : 0;  // the noise-free reference
-      for (const auto& r : runs) converged += r["converged"].get<bool>() ? 1 : 0;
-      row["converged"] = converged == seeds + 1;
-      row["termination"] = std::to_string(converged) + " of " + std::to_string(seeds + 1) + " runs converged (noise-free and every draw)";
-      json stats = json::array();
-      for (std::size_t i = 0; i < row["parameters"].size(); ++i) {
-        std::vector<double> est, crb;
-        int covered = 0, conv = 0;
-        for (const auto& r : runs) {
-          est.push_back(val(r["parameters"][i]["estimate"]));
-          crb.push_back(val(r["parameters"][i]["std"]));
-          covered += r["parameters"][i]["covered"].get<bool>() ? 1 : 0;
-          conv += r["converged"].get<bool>() ? 1 : 0;
-        }
-        double mean = 0, var = 0;
-        for (double e : est) mean += e / static_cast<double>(est.size());
-        for (double e : est) var += (e - mean) * (e - mean) / static_cast<double>(est.size() - 1);
-        double crb_mean = 0;
-        for (double s : crb) crb_mean += s / static_cast<double>(crb.size());
-        const double scatter = std::sqrt(var), ref = val(row["noise_free"][i]["estimate"]);
-        const double truth = val(row["noise_free"][i]["truth"]);
-        const double std_of_mean = scatter / std::sqrt(static_cast<double>(est.size()));
-        stats.push_back({{"name", row["parameters"][i]["name"]},
-                         {"mean", num(mean)},
-                         {"scatter", num(scatter)},
-                         {"crb_std", num(crb_mean)},
-                         {"scatter_over_crb", num(scatter / crb_mean)},
-                         {"noise_free_estimate", num(ref)},
-                         {"bias_from_noise", num(mean - ref)},
-                         {"bias_in_std_of_mean", num(std::abs(mean - ref) / std_of_mean)},
-                         // against the truth's value: the noise-free estimate's own (model) error included
-                         {"mean_minus_truth_in_std_of_mean", num((mean - truth) / std_of_mean)},
-                         {"interval_coverage", static_cast<double>(covered) / static_cast<double>(runs.size())},
-                         {"converged_runs", conv}});
-      }
-      row["seed_statistics"] = stats;
-      row["seeds"] = runs;
+namespace {
+
+// Over a case's noise seeds, per parameter: mean, scatter against the mean Cramér–Rao std, the
+// noise-induced bias from the noise-free estimate (and against the truth) in std of the mean, the
+// interval coverage and the converged runs.
+json seed_statistics(const json& runs, const json& row) {
+  json stats = json::array();
+  for (std::size_t i = 0; i < row["parameters"].size(); ++i) {
+    std::vector<double> est, crb;
+    int covered = 0, conv = 0;
+    for (const auto& r : runs) {
+      est.push_back(val(r["parameters"][i]["estimate"]));
+      crb.push_back(val(r["parameters"][i]["std"]));
+      covered += r["parameters"][i]["covered"].get<bool>() ? 1 : 0;
+      conv += r["converged"].get<bool>() ? 1 : 0;
     }
-    res["cases"].push_back(row);
-    if (opt.progress) {
-      std::string line;
-      for (const auto& q : row["parameters"])
-        line += " " + q["name"].get<std::string>() + " " + fmt("%+.2e", q["relative_error"].is_number() ? q["relative_error"].get<double>() : std::nan("")) +
-                (!q["identifiable"].get<bool>() ? std::string(" NOT IDENTIFIABLE")
-                 : !q["relative_half_width"].is_number()
-                     ? std::string(" (no interval)")
-                     : " ±" + fmt("%.2e", q["relative_half_width"].get<double>()) + (q["covered"].get<bool>() ? " covered" : " NOT covered"));
-      std::fprintf(stderr, "scole-crosscheck suite: %s, case %s:%s\n", f.family.c_str(), c.label.c_str(), line.c_str());
-    }
+    double mean = 0, var = 0;
+    for (double e : est) mean += e / static_cast<double>(est.size());
+    for (double e : est) var += (e - mean) * (e - mean) / static_cast<double>(est.size() - 1);
+    double crb_mean = 0;
+    for (double s : crb) crb_mean += s / static_cast<double>(crb.size());
+    const double scatter = std::sqrt(var), ref = val(row["noise_free"][i]["estimate"]);
+    const double truth = val(row["noise_free"][i]["truth"]);
+    const double std_of_mean = scatter / std::sqrt(static_cast<double>(est.size()));
+    stats.push_back({{"name", row["parameters"][i]["name"]},
+                     {"mean", num(mean)},
+                     {"scatter", num(scatter)},
+                     {"crb_std", num(crb_mean)},
+                     {"scatter_over_crb", num(scatter / crb_mean)},
+                     {"noise_free_estimate", num(ref)},
+                     {"bias_from_noise", num(mean - ref)},
+                     {"bias_in_std_of_mean", num(std::abs(mean - ref) / std_of_mean)},
+                     // against the truth's value: the noise-free estimate's own (model) error included
+                     {"mean_minus_truth_in_std_of_mean", num((mean - truth) / std_of_mean)},
+                     {"interval_coverage", static_cast<double>(covered) / static_cast<double>(runs.size())},
+                     {"converged_runs", conv}});
   }
-  // Expectations.
-  json checks = json::array();
-  for (const auto& c : res["cases"]) {
-    const std::string at = " (case " + c["label"].get<std::string>() + ")";
-    // The optimiser must converge; whether the model then explains the data (the fit test) is what
-    // the family measures, reported beside the errors, not an expectation.
-    checks.push_back(check("the optimiser converged" + at, c["optimizer_converged"].get<bool>(), c["termination"].get<std::string>()));
-    for (const auto& q : c["parameters"]) {
-      const std::string n = q["name"];
-      const bool expect_flag = std::find(f.expect.flagged.begin(), f.expect.flagged.end(), n) != f.expect.flagged.end();
-      const bool flagged = !q["identifiable"].get<bool>();
-      checks.push_back(check(n + (expect_flag ? " is flagged not identifiable" : " is identifiable") + at, flagged == expect_flag,
-                             flagged ? q.value("not_identifiable_because", std::string("flagged")) : "identifiable"));
-      const auto b = f.expect.max_relative_error.find(n);
-      if (b != f.expect.max_relative_error.end() && !flagged) {
-        const double e = std::abs(q["relative_error"].get<double>());
-        checks.push_back(check(n + " relative error <= " + fmt("%.3g", b->second) + at, e <= b->second, fmt("%.3e", e)));
-      }
-      if (f.expect.all_covered && !flagged)
-        checks.push_back(check(n + " interval covers the truth" + at, q["covered"].get<bool>(),
-                               fmt("error %.3e, half-width %.3e", std::abs(q["relative_error"].get<double>()), val(q["relative_half_width"]))));
+  return stats;
+}
+
+// One case of a family: its truth, the noise-free identification and, with seeds, one per draw.
+json suite_case(const SuiteFile& f, std::size_t k, const std::string& out, const SuiteOptions& opt, int seeds) {
+  const SuiteCase& c = f.cases[k];
+  const io::Scenario sc = case_scenario(f, k);
+  if (opt.progress) std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: truth (%d segments)\n", f.family.c_str(), c.label.c_str(), sc.truth.segments);
+  const auto truths = run_truth_levels(sc, {sc.truth.segments}, (fs::path(out) / "truths" / f.family / c.label).string(),
+                                       true, false);
+  if (opt.progress) std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: identifying\n", f.family.c_str(), c.label.c_str());
+  // The truth is noise-free: the identifier is told no noise level it does not have.
+  io::Scenario id_sc = sc;
+  for (auto& s : id_sc.sensors) s.noise_std = 0.0;
+  auto p = identify::make_problem(id_sc, truths.front().csv);
+  json row = identify_row(std::move(p));
+  row["label"] = c.label;
+  row["size"] = c.size;
+  row["truth_seconds"] = truths.front().seconds;
+  if (seeds) {
+    // The noise-free row above is the reference; each seed adds noise to the same truth.
+    row["noise_free"] = row["parameters"];
+    json runs = json::array();
+    for (int s = 0; s < seeds; ++s) {
+      auto ps = identify::make_problem(id_sc, truths.front().csv);
+      add_noise(*ps, f.noise_relative, f.noise_seed + 1000003u * static_cast<unsigned>(k) + static_cast<unsigned>(s));
+      runs.push_back(identify_row(std::move(ps)));
+      if (opt.progress && (s + 1) % 5 == 0)
+        std::fprintf(stderr, "scole-crosscheck suite: %s, case %s: %d of %d seeds\n", f.family.c_str(), c.label.c_str(), s + 1, seeds);
     }
-    if (c.contains("seed_statistics"))
-      for (const auto& s : c["seed_statistics"]) {
-        const std::string n = s["name"];
-        const double r = s["scatter_over_crb"].is_number() ? s["scatter_over_crb"].get<double>() : std::nan("");
-        if (f.expect.scatter_over_crb)
-          checks.push_back(check(n + " seed scatter / Cramér–Rao std in [" + fmt("%.3g", f.expect.scatter_over_crb->first) + ", " +
-                                     fmt("%.3g", f.expect.scatter_over_crb->second) + "]" + at,
-                                 r >= f.expect.scatter_over_crb->first && r <= f.expect.scatter_over_crb->second, fmt("%.3f", r)));
-        const double bs = s["bias_in_std_of_mean"].is_number() ? s["bias_in_std_of_mean"].get<double>() : std::nan("");
-        checks.push_back(check(n + " noise-induced bias within " + fmt("%.3g", f.expect.noise_bias_sigmas) + " std of the mean" + at,
-                               bs <= f.expect.noise_bias_sigmas, fmt("%.2f std", bs)));
-      }
+    // The case's row is the first seed's; the seeds' statistics beside it.
+    row["parameters"] = runs.front()["parameters"];
+    int converged = row["converged"].get<bool>() ? 1 : 0;  // the noise-free reference
+    for (const auto& r : runs) converged += r["converged"].get<bool>() ? 1 : 0;
+    row["converged"] = converged == seeds + 1;
+    row["termination"] = std::to_string(converged) + " of " + std::to_string(seeds + 1) + " runs converged (noise-free and every draw)";
+    row["seed_statistics"] = seed_statistics(runs, row);
+    row["seeds"] = runs;
   }
-  if (!f.expect.rate.empty() && res["cases"].size() >= 2) {
-    const auto& cs = res["cases"];
-    for (std::size_t i = 0; i < cs[0]["parameters"].size(); ++i) {
-      const std::string n = cs[0]["parameters"][i]["name"];
-      auto band = f.expect.rate.find(n);
-      if (band == f.expect.rate.end()) band = f.expect.rate.find("");
-      if (band == f.expect.rate.end()) continue;
-      const std::pair<double, double> range = band->second;
-      json orders = json::array();
-      bool ok = true;
-      std::string measured;
-      for (std::size_t k = 0; k + 1 < cs.size(); ++k) {
-        const double e0 = std::abs(val(cs[k]["parameters"][i]["relative_error"]));
-        const double e1 = std::abs(val(cs[k + 1]["parameters"][i]["relative_error"]));
-        const double order = std::log(e0 / e1) / std::log(cs[k + 1]["size"].get<double>() / cs[k]["size"].get<double>());
-        orders.push_back(num(order));
-        ok = ok && order >= range.first && order <= range.second;  // false for NaN
-        measured += (measured.empty() ? "" : ", ") + fmt("%.2f", order);
-      }
-      res["observed_orders"][n] = orders;
-      checks.push_back(check(n + " error falls at order in [" + fmt("%.3g", range.first) + ", " + fmt("%.3g", range.second) + "]",
-                             ok, measured));
+  return row;
+}
+
+// The progress line of a finished case: each parameter's error and interval.
+void print_case(const SuiteFile& f, const SuiteCase& c, const json& row) {
+  std::string line;
+  for (const auto& q : row["parameters"])
+    line += " " + q["name"].get<std::string>() + " " + fmt("%+.2e", q["relative_error"].is_number() ? q["relative_error"].get<double>() : std::nan("")) +
+            (!q["identifiable"].get<bool>() ? std::string(" NOT IDENTIFIABLE")
+             : !q["relative_half_width"].is_number()
+                 ? std::string(" (no interval)")
+                 : " ±" + fmt("%.2e", q["relative_half_width"].get<double>()) + (q["covered"].get<bool>() ? " covered" : " NOT covered"));
+  std::fprintf(stderr, "scole-crosscheck suite: %s, case %s:%s\n", f.family.c_str(), c.label.c_str(), line.c_str());
+}
+
+// A case's expectations: the optimiser converged, the flags, the error bounds, the coverage, and
+// with seeds the scatter against the Cramér–Rao std and the noise bias.
+void case_checks(const SuiteFile& f, const json& c, json& checks) {
+  const std::string at = " (case " + c["label"].get<std::string>() + ")";
+  // The optimiser must converge; whether the model then explains the data (the fit test) is what
+  // the family measures, reported beside the errors, not an expectation.
+  checks.push_back(check("the optimiser converged" + at, c["optimizer_converged"].get<bool>(), c["termination"].get<std::string>()));
+  for (const auto& q : c["parameters"]) {
+    const std::string n = q["name"];
+    const bool expect_flag = std::find(f.expect.flagged.begin(), f.expect.flagged.end(), n) != f.expect.flagged.end();
+    const bool flagged = !q["identifiable"].get<bool>();
+    checks.push_back(check(n + (expect_flag ? " is flagged not identifiable" : " is identifiable") + at, flagged == expect_flag,
+                           flagged ? q.value("not_identifiable_because", std::string("flagged")) : "identifiable"));
+    const auto b = f.expect.max_relative_error.find(n);
+    if (b != f.expect.max_relative_error.end() && !flagged) {
+      const double e = std::abs(q["relative_error"].get<double>());
+      checks.push_back(check(n + " relative error <= " + fmt("%.3g", b->second) + at, e <= b->second, fmt("%.3e", e)));
     }
+    if (f.expect.all_covered && !flagged)
+      checks.push_back(check(n + " interval covers the truth" + at, q["covered"].get<bool>(),
+                             fmt("error %.3e, half-width %.3e", std::abs(q["relative_error"].get<double>()), val(q["relative_half_width"]))));
   }
-  // Every parameter an expectation names must be one the family estimates (a misspelt name would
-  // otherwise check nothing).
+  if (c.contains("seed_statistics"))
+    for (const auto& s : c["seed_statistics"]) {
+      const std::string n = s["name"];
+      const double r = s["scatter_over_crb"].is_number() ? s["scatter_over_crb"].get<double>() : std::nan("");
+      if (f.expect.scatter_over_crb)
+        checks.push_back(check(n + " seed scatter / Cramér–Rao std in [" + fmt("%.3g", f.expect.scatter_over_crb->first) + ", " +
+                                   fmt("%.3g", f.expect.scatter_over_crb->second) + "]" + at,
+                               r >= f.expect.scatter_over_crb->first && r <= f.expect.scatter_over_crb->second, fmt("%.3f", r)));
+      const double bs = s["bias_in_std_of_mean"].is_number() ? s["bias_in_std_of_mean"].get<double>() : std::nan("");
+      checks.push_back(check(n + " noise-induced bias within " + fmt("%.3g", f.expect.noise_bias_sigmas) + " std of the mean" + at,
+                             bs <= f.expect.noise_bias_sigmas, fmt("%.2f std", bs)));
+    }
+}
+
+// The observed order of each parameter's error between consecutive cases, against the family's band.
+void rate_checks(const SuiteFile& f, json& res, json& checks) {
+  if (f.expect.rate.empty() || res["cases"].size() < 2) return;
+  const auto& cs = res["cases"];
+  for (std::size_t i = 0; i < cs[0]["parameters"].size(); ++i) {
+    const std::string n = cs[0]["parameters"][i]["name"];
+    auto band = f.expect.rate.find(n);
+    if (band == f.expect.rate.end()) band = f.expect.rate.find("");
+    if (band == f.expect.rate.end()) continue;
+    const std::pair<double, double> range = band->second;
+    json orders = json::array();
+    bool ok = true;
+    std::string measured;
+    for (std::size_t k = 0; k + 1 < cs.size(); ++k) {
+      const double e0 = std::abs(val(cs[k]["parameters"][i]["relative_error"]));
+      const double e1 = std::abs(val(cs[k + 1]["parameters"][i]["relative_error"]));
+      const double order = std::log(e0 / e1) / std::log(cs[k + 1]["size"].get<double>() / cs[k]["size"].get<double>());
+      orders.push_back(num(order));
+      ok = ok && order >= range.first && order <= range.second;  // false for NaN
+      measured += (measured.empty() ? "" : ", ") + fmt("%.2f", order);
+    }
+    res["observed_orders"][n] = orders;
+    checks.push_back(check(n + " error falls at order in [" + fmt("%.3g", range.first) + ", " + fmt("%.3g", range.second) + "]",
+                           ok, measured));
+  }
+}
+
+// Every parameter an expectation names must be one the family estimates (a misspelt name would
+// otherwise check nothing).
+void name_checks(const SuiteFile& f, const json& res, json& checks) {
   if (!res["cases"].empty()) {
     std::vector<std::string> names;
     for (const auto& q : res["cases"][0]["parameters"]) names.push_back(q["name"].get<std::string>());
@@ -363,6 +374,25 @@ json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptio
     for (const auto& n : named)
       if (!known(n)) checks.push_back(check("expectation names an estimated parameter", false, "'" + n + "' is not estimated"));
   }
+}
+
+}  // namespace
+
+json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int seeds = f.seeds > 0 ? (opt.seeds > 0 ? opt.seeds : f.seeds) : 0;
+  json res{{"family", f.family}, {"mismatch", f.mismatch}, {"size_unit", f.size_unit}, {"reason", f.reason},
+           {"scenario", f.base}, {"file", fs::path(f.path).filename().string()}};
+  if (seeds) res["noise"] = {{"relative", f.noise_relative}, {"seeds", seeds}};
+  res["cases"] = json::array();
+  for (std::size_t k = 0; k < f.cases.size(); ++k) {
+    res["cases"].push_back(suite_case(f, k, out, opt, seeds));
+    if (opt.progress) print_case(f, f.cases[k], res["cases"].back());
+  }
+  json checks = json::array();
+  for (const auto& c : res["cases"]) case_checks(f, c, checks);
+  rate_checks(f, res, checks);
+  name_checks(f, res, checks);
   bool all = true;
   for (const auto& c : checks) all = all && c["held"].get<bool>();
   res["checks"] = checks;

@@ -38,7 +38,7 @@ io::Scenario shape_scenario(const io::Scenario& truth_sc, int count, std::vector
     sc.sensors.push_back(spec);
     scale.push_back(row_scale);
   };
-  if (sc.structure == "scole") {
+  if (sc.structure == io::Structure::Scole) {
     const double L = sc.scole.length;
     for (int k = 1; k <= m; ++k) {
       const double s = L * k / m;
@@ -152,7 +152,7 @@ SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scal
 // Analytic Euler–Bernoulli frequencies [Hz] of a uniform beam, or empty; `what` describes them.
 std::vector<double> analytic_hz(const io::Scenario& sc, int count, std::string& what) {
   what.clear();
-  if (sc.structure != "beam" || sc.beam.EI.size() != 1) return {};
+  if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1) return {};
   using io::EndCondition;
   namespace an = identify::analytic;
   const auto& b = sc.beam;
@@ -230,7 +230,7 @@ ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& opt)
 
   ModesReport rep;
   rep.scenario = scenario.name;
-  rep.structure = scenario.structure;
+  rep.structure = io::to_string(scenario.structure);
   rep.truth_overrides = io::has_truth_overrides(scenario);
   for (const auto& s : shape_sc.sensors) rep.stations.push_back(s.name);
   std::vector<SideModes> chain, fe;

@@ -91,6 +91,146 @@ std::vector<std::string> summary_lines(const ReportInputs& in) {
   return out;
 }
 
+namespace {
+
+// The natural frequencies' section: the table, and the convergence of the chain against the finest
+// FE model as a plot (modes_convergence.csv, modes.gp).
+std::string modes_section(const nlohmann::json& modes, ReportFiles& rf) {
+  std::string md;
+  const auto& m = modes;
+  Table t;
+  t.header = {"mode", "chain extrap. [Hz]", "FE finest [Hz]", "analytic [Hz]", "extrap./FE-1 %", "rate n", "rate N", "MAC"};
+  Table conv;
+  conv.header = {"n"};
+  const std::size_t plotted = std::min<std::size_t>(5, m["modes"].size());
+  for (std::size_t k = 0; k < plotted; ++k) conv.header.push_back("mode" + std::to_string(k + 1));
+  for (std::size_t l = 0; l < m["segments"].size(); ++l) {
+    std::vector<std::string> row{std::to_string(m["segments"][l].get<int>())};
+    for (std::size_t k = 0; k < plotted; ++k) {
+      const auto& e = m["modes"][k];
+      row.push_back(number(std::abs(num(e["chain_hz"][l]) / num(e["fe_hz"].back()) - 1.0), 6));
+    }
+    conv.rows.push_back(row);
+  }
+  for (const auto& e : m["modes"])
+    t.rows.push_back({std::to_string(e["index"].get<int>()), number(num(e["chain_extrapolated_hz"]), 7),
+                      number(num(e["fe_hz"].back()), 7),
+                      std::isfinite(num(e["analytic_hz"])) ? number(num(e["analytic_hz"]), 7) : "-",
+                      percent(num(e["extrapolated_vs_fe"]), 3), number(num(e["chain_rate"]), 3),
+                      number(num(e["fe_rate"]), 3), number(num(e["mac"]), 6)});
+  rf.files.push_back({"modes_convergence.csv", conv.csv()});
+  std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'modes.png'\nset datafile separator ','\n"
+                   "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'chain segments n'\n"
+                   "set ylabel '|f_chain(n) / f_FE - 1|'\nset title " +
+                   gnuplot_quote("Natural frequencies, " + m["scenario"].get<std::string>() + ": chain against the finest FE") +
+                   "\nplot ";
+  for (std::size_t k = 0; k < plotted; ++k)
+    gp += "'modes_convergence.csv' using 1:" + std::to_string(k + 2) + " with linespoints title 'mode " +
+          std::to_string(k + 1) + "', ";
+  const double y0 = conv.rows.empty() ? 1e-3 : std::max(1e-12, std::atof(conv.rows.front().back().c_str()));
+  gp += number(y0, 6) + "*(" + std::to_string(m["segments"].front().get<int>()) + "/x)**2 dashtype 2 title 'n^-2'\n";
+  rf.files.push_back({"modes.gp", gp});
+  rf.scripts.push_back("modes.gp");
+  md += "\n## Natural frequencies\n\n" + t.markdown() + "\nCSV: `modes.csv`, `mac.csv`, `modes_convergence.csv`.\n\n![modes](modes.png)\n";
+  return md;
+}
+
+// The trajectories' section: relative RMS per sensor and level, and the overlay plot of the finest
+// chain against the FE model when overlay.csv is there.
+std::string trajectories_section(const nlohmann::json& trajectories, bool overlay_csv_present, ReportFiles& rf) {
+  std::string md;
+  const auto& tr = trajectories;
+  Table t;
+  t.header = {"sensor", "kind"};
+  for (const auto& n : tr["segments"]) t.header.push_back("n=" + std::to_string(n.get<int>()) + " %");
+  t.header.push_back("rate");
+  for (const auto& s : tr["sensors"]) {
+    std::vector<std::string> row{s["name"].get<std::string>(), s["kind"].get<std::string>()};
+    for (const auto& d : s["relative_rms"]) row.push_back(percent(num(d), 3));
+    row.push_back(number(num(s["rate"]), 3));
+    t.rows.push_back(row);
+  }
+  md += "\n## Trajectories\n\nRelative RMS difference between the chain and the FE model (N = " +
+        std::to_string(tr["elements"].get<int>()) + ") at the truth's parameters.\n\n" + t.markdown() +
+        "\nCSV: `trajectories.csv`, `overlay.csv` (finest n).\n";
+  if (overlay_csv_present) {
+    const auto& sensors = tr["sensors"];
+    const std::size_t k = std::min<std::size_t>(4, sensors.size());
+    std::string gp = "set terminal pngcairo noenhanced size 1000," + std::to_string(300 * k) +
+                     "\nset output 'overlay.png'\nset datafile separator ','\nset key autotitle columnhead\n"
+                     "set multiplot layout " + std::to_string(k) + ",1\nset grid\nset y2tics\nset ytics nomirror\n";
+    for (std::size_t i = 0; i < k; ++i) {
+      const int c = 2 + 3 * static_cast<int>(i);
+      gp += "set title " + gnuplot_quote(sensors[i]["name"].get<std::string>() + " (" + sensors[i]["kind"].get<std::string>() + ")") +
+            "\nset y2label 'chain - FE'\nplot 'overlay.csv' using 1:" + std::to_string(c) +
+            " with lines title 'chain', '' using 1:" + std::to_string(c + 1) + " with lines dashtype 2 title 'FE', '' using 1:" +
+            std::to_string(c + 2) + " axes x1y2 with lines lc rgb 'gray' title 'residual (right)'\n";
+    }
+    gp += "unset multiplot\n";
+    rf.files.push_back({"overlay.gp", gp});
+    rf.scripts.push_back("overlay.gp");
+    md += "\n![overlay](overlay.png)\n";
+  }
+  return md;
+}
+
+// The identification's section: errors per level, extrapolated, FE-on-FE, std and interval
+// coverage, and the convergence plot (identify_convergence.csv, identify.gp).
+std::string identify_section(const nlohmann::json& identify, ReportFiles& rf) {
+  std::string md;
+  const auto& id = identify;
+  Table t;
+  t.header = {"parameter", "truth"};
+  for (const auto& n : id["segments"]) t.header.push_back("n=" + std::to_string(n.get<int>()) + " %");
+  t.header.insert(t.header.end(), {"extrapolated %", "rate", "FE-on-FE %", "2 std (n) %", "covered", "± interval (n) %", "covered"});
+  Table conv;
+  conv.header = {"n"};
+  for (const auto& p : id["parameters"]) conv.header.push_back(p["name"].get<std::string>());
+  for (std::size_t l = 0; l < id["segments"].size(); ++l) {
+    std::vector<std::string> row{std::to_string(id["segments"][l].get<int>())};
+    for (const auto& p : id["parameters"]) row.push_back(number(std::abs(num(p["relative_error"][l])), 6));
+    conv.rows.push_back(row);
+  }
+  for (const auto& p : id["parameters"]) {
+    std::vector<std::string> row{p["name"].get<std::string>(), number(num(p["truth"]), 7)};
+    for (const auto& e : p["relative_error"]) row.push_back(percent(num(e), 3));
+    row.push_back(percent(num(p["extrapolated_relative_error"]), 3));
+    row.push_back(number(num(p["observed_rate"]), 3));
+    row.push_back(percent(num(p["fe_on_fe_relative_error"]), 3));
+    row.push_back(percent(2.0 * num(p["std"].front()) / std::abs(num(p["truth"])), 3));
+    row.push_back(p["covered_by_2std"].front().get<bool>() ? "yes" : "no");
+    const bool has = p.contains("half_width") && p["half_width"].front().is_number();
+    row.push_back(has ? percent(num(p["half_width"].front()) / std::abs(num(p["truth"])), 3) : "-");
+    row.push_back(has ? (p["covered_by_interval"].front().get<bool>() ? "yes" : "no") : "flagged");
+    t.rows.push_back(row);
+  }
+  rf.files.push_back({"identify_convergence.csv", conv.csv()});
+  std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'identify.png'\nset datafile separator ','\n"
+                   "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'truth chain segments n'\n"
+                   "set ylabel '|estimate / truth - 1|'\nset title " +
+                   gnuplot_quote("Identification on the Simbody truth, " + id["scenario"].get<std::string>()) + "\nplot ";
+  int col = 2;
+  for (const auto& p : id["parameters"]) {
+    const std::string name = p["name"].get<std::string>();
+    gp += "'identify_convergence.csv' using 1:" + std::to_string(col++) + " with linespoints title " + gnuplot_quote(name) + ", ";
+    const double x = std::abs(num(p["extrapolated_relative_error"]));
+    if (std::isfinite(x) && x > 0)
+      gp += number(x, 6) + " dashtype 2 title " + gnuplot_quote(name + " extrapolated") + ", ";
+    const double f = std::abs(num(p["fe_on_fe_relative_error"]));
+    if (std::isfinite(f) && f > 0) gp += number(f, 6) + " dashtype 3 title " + gnuplot_quote(name + " FE-on-FE") + ", ";
+  }
+  gp.resize(gp.size() - 2);
+  gp += "\n";
+  rf.files.push_back({"identify.gp", gp});
+  rf.scripts.push_back("identify.gp");
+  md += "\n## Identification\n\n" + id["data"].get<std::string>() + "; the chain's lumping bias extrapolated as n^-2 "
+        "from the two finest truths; FE-on-FE: the same identification on synthetic FE data.\n\n" + t.markdown() +
+        "\nCSV: `identify.csv`, `identify_convergence.csv`.\n\n![identify](identify.png)\n";
+  return md;
+}
+
+}  // namespace
+
 ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
   ReportFiles rf;
   std::string md = "# Cross-check report";
@@ -101,129 +241,9 @@ ReportFiles make_report(const ReportInputs& in, bool overlay_csv_present) {
   for (const auto& l : summary_lines(in)) md += l + "\n";
   md += "```\n";
 
-  if (!in.modes.is_null()) {
-    const auto& m = in.modes;
-    Table t;
-    t.header = {"mode", "chain extrap. [Hz]", "FE finest [Hz]", "analytic [Hz]", "extrap./FE-1 %", "rate n", "rate N", "MAC"};
-    Table conv;
-    conv.header = {"n"};
-    const std::size_t plotted = std::min<std::size_t>(5, m["modes"].size());
-    for (std::size_t k = 0; k < plotted; ++k) conv.header.push_back("mode" + std::to_string(k + 1));
-    for (std::size_t l = 0; l < m["segments"].size(); ++l) {
-      std::vector<std::string> row{std::to_string(m["segments"][l].get<int>())};
-      for (std::size_t k = 0; k < plotted; ++k) {
-        const auto& e = m["modes"][k];
-        row.push_back(number(std::abs(num(e["chain_hz"][l]) / num(e["fe_hz"].back()) - 1.0), 6));
-      }
-      conv.rows.push_back(row);
-    }
-    for (const auto& e : m["modes"])
-      t.rows.push_back({std::to_string(e["index"].get<int>()), number(num(e["chain_extrapolated_hz"]), 7),
-                        number(num(e["fe_hz"].back()), 7),
-                        std::isfinite(num(e["analytic_hz"])) ? number(num(e["analytic_hz"]), 7) : "-",
-                        percent(num(e["extrapolated_vs_fe"]), 3), number(num(e["chain_rate"]), 3),
-                        number(num(e["fe_rate"]), 3), number(num(e["mac"]), 6)});
-    rf.files.push_back({"modes_convergence.csv", conv.csv()});
-    std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'modes.png'\nset datafile separator ','\n"
-                     "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'chain segments n'\n"
-                     "set ylabel '|f_chain(n) / f_FE - 1|'\nset title " +
-                     gnuplot_quote("Natural frequencies, " + m["scenario"].get<std::string>() + ": chain against the finest FE") +
-                     "\nplot ";
-    for (std::size_t k = 0; k < plotted; ++k)
-      gp += "'modes_convergence.csv' using 1:" + std::to_string(k + 2) + " with linespoints title 'mode " +
-            std::to_string(k + 1) + "', ";
-    const double y0 = conv.rows.empty() ? 1e-3 : std::max(1e-12, std::atof(conv.rows.front().back().c_str()));
-    gp += number(y0, 6) + "*(" + std::to_string(m["segments"].front().get<int>()) + "/x)**2 dashtype 2 title 'n^-2'\n";
-    rf.files.push_back({"modes.gp", gp});
-    rf.scripts.push_back("modes.gp");
-    md += "\n## Natural frequencies\n\n" + t.markdown() + "\nCSV: `modes.csv`, `mac.csv`, `modes_convergence.csv`.\n\n![modes](modes.png)\n";
-  }
-
-  if (!in.trajectories.is_null()) {
-    const auto& tr = in.trajectories;
-    Table t;
-    t.header = {"sensor", "kind"};
-    for (const auto& n : tr["segments"]) t.header.push_back("n=" + std::to_string(n.get<int>()) + " %");
-    t.header.push_back("rate");
-    for (const auto& s : tr["sensors"]) {
-      std::vector<std::string> row{s["name"].get<std::string>(), s["kind"].get<std::string>()};
-      for (const auto& d : s["relative_rms"]) row.push_back(percent(num(d), 3));
-      row.push_back(number(num(s["rate"]), 3));
-      t.rows.push_back(row);
-    }
-    md += "\n## Trajectories\n\nRelative RMS difference between the chain and the FE model (N = " +
-          std::to_string(tr["elements"].get<int>()) + ") at the truth's parameters.\n\n" + t.markdown() +
-          "\nCSV: `trajectories.csv`, `overlay.csv` (finest n).\n";
-    if (overlay_csv_present) {
-      const auto& sensors = tr["sensors"];
-      const std::size_t k = std::min<std::size_t>(4, sensors.size());
-      std::string gp = "set terminal pngcairo noenhanced size 1000," + std::to_string(300 * k) +
-                       "\nset output 'overlay.png'\nset datafile separator ','\nset key autotitle columnhead\n"
-                       "set multiplot layout " + std::to_string(k) + ",1\nset grid\nset y2tics\nset ytics nomirror\n";
-      for (std::size_t i = 0; i < k; ++i) {
-        const int c = 2 + 3 * static_cast<int>(i);
-        gp += "set title " + gnuplot_quote(sensors[i]["name"].get<std::string>() + " (" + sensors[i]["kind"].get<std::string>() + ")") +
-              "\nset y2label 'chain - FE'\nplot 'overlay.csv' using 1:" + std::to_string(c) +
-              " with lines title 'chain', '' using 1:" + std::to_string(c + 1) + " with lines dashtype 2 title 'FE', '' using 1:" +
-              std::to_string(c + 2) + " axes x1y2 with lines lc rgb 'gray' title 'residual (right)'\n";
-      }
-      gp += "unset multiplot\n";
-      rf.files.push_back({"overlay.gp", gp});
-      rf.scripts.push_back("overlay.gp");
-      md += "\n![overlay](overlay.png)\n";
-    }
-  }
-
-  if (!in.identify.is_null()) {
-    const auto& id = in.identify;
-    Table t;
-    t.header = {"parameter", "truth"};
-    for (const auto& n : id["segments"]) t.header.push_back("n=" + std::to_string(n.get<int>()) + " %");
-    t.header.insert(t.header.end(), {"extrapolated %", "rate", "FE-on-FE %", "2 std (n) %", "covered", "± interval (n) %", "covered"});
-    Table conv;
-    conv.header = {"n"};
-    for (const auto& p : id["parameters"]) conv.header.push_back(p["name"].get<std::string>());
-    for (std::size_t l = 0; l < id["segments"].size(); ++l) {
-      std::vector<std::string> row{std::to_string(id["segments"][l].get<int>())};
-      for (const auto& p : id["parameters"]) row.push_back(number(std::abs(num(p["relative_error"][l])), 6));
-      conv.rows.push_back(row);
-    }
-    for (const auto& p : id["parameters"]) {
-      std::vector<std::string> row{p["name"].get<std::string>(), number(num(p["truth"]), 7)};
-      for (const auto& e : p["relative_error"]) row.push_back(percent(num(e), 3));
-      row.push_back(percent(num(p["extrapolated_relative_error"]), 3));
-      row.push_back(number(num(p["observed_rate"]), 3));
-      row.push_back(percent(num(p["fe_on_fe_relative_error"]), 3));
-      row.push_back(percent(2.0 * num(p["std"].front()) / std::abs(num(p["truth"])), 3));
-      row.push_back(p["covered_by_2std"].front().get<bool>() ? "yes" : "no");
-      const bool has = p.contains("half_width") && p["half_width"].front().is_number();
-      row.push_back(has ? percent(num(p["half_width"].front()) / std::abs(num(p["truth"])), 3) : "-");
-      row.push_back(has ? (p["covered_by_interval"].front().get<bool>() ? "yes" : "no") : "flagged");
-      t.rows.push_back(row);
-    }
-    rf.files.push_back({"identify_convergence.csv", conv.csv()});
-    std::string gp = "set terminal pngcairo noenhanced size 900,600\nset output 'identify.png'\nset datafile separator ','\n"
-                     "set logscale xy\nset format y '%.0e'\nset key outside right\nset grid\nset xlabel 'truth chain segments n'\n"
-                     "set ylabel '|estimate / truth - 1|'\nset title " +
-                     gnuplot_quote("Identification on the Simbody truth, " + id["scenario"].get<std::string>()) + "\nplot ";
-    int col = 2;
-    for (const auto& p : id["parameters"]) {
-      const std::string name = p["name"].get<std::string>();
-      gp += "'identify_convergence.csv' using 1:" + std::to_string(col++) + " with linespoints title " + gnuplot_quote(name) + ", ";
-      const double x = std::abs(num(p["extrapolated_relative_error"]));
-      if (std::isfinite(x) && x > 0)
-        gp += number(x, 6) + " dashtype 2 title " + gnuplot_quote(name + " extrapolated") + ", ";
-      const double f = std::abs(num(p["fe_on_fe_relative_error"]));
-      if (std::isfinite(f) && f > 0) gp += number(f, 6) + " dashtype 3 title " + gnuplot_quote(name + " FE-on-FE") + ", ";
-    }
-    gp.resize(gp.size() - 2);
-    gp += "\n";
-    rf.files.push_back({"identify.gp", gp});
-    rf.scripts.push_back("identify.gp");
-    md += "\n## Identification\n\n" + id["data"].get<std::string>() + "; the chain's lumping bias extrapolated as n^-2 "
-          "from the two finest truths; FE-on-FE: the same identification on synthetic FE data.\n\n" + t.markdown() +
-          "\nCSV: `identify.csv`, `identify_convergence.csv`.\n\n![identify](identify.png)\n";
-  }
+  if (!in.modes.is_null()) md += modes_section(in.modes, rf);
+  if (!in.trajectories.is_null()) md += trajectories_section(in.trajectories, overlay_csv_present, rf);
+  if (!in.identify.is_null()) md += identify_section(in.identify, rf);
   rf.files.push_back({"report.md", md});
   return rf;
 }

@@ -66,7 +66,7 @@ AtTruth at_truth(const io::Scenario& scenario, const std::string& csv, int eleme
   AtTruth a;
   a.sc = io::truth_scenario(scenario);
   io::Scenario& sc = a.sc;
-  if (sc.structure == "scole" && sc.scole.actuator_lag > 0)
+  if (sc.structure == io::Structure::Scole && sc.scole.actuator_lag > 0)
     io::fail_field(scenario.source, "truth.overrides.scole.actuator_lag",
                    "is a servo lag of the Simbody truth only: the finite-element model cannot follow it, so the "
                    "trajectories cannot be compared at the truth's physics",
@@ -114,8 +114,8 @@ FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int
 
 FeResponse nonlinear_fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
   const AtTruth a = at_truth(scenario, csv, elements);
-  if (a.sc.structure != "scole")
-    io::fail_field(scenario.source, "structure", "has no nonlinear model (scole only)", "'" + a.sc.structure + "'");
+  if (a.sc.structure != io::Structure::Scole)
+    io::fail_field(scenario.source, "structure", "has no nonlinear model (scole only)", "'" + std::string(io::to_string(a.sc.structure)) + "'");
   identify::VectorXd c;
   identify::MatrixXd dcdq;
   a.p->params->coefficients(a.q, c, dcdq);

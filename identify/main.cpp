@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "scoleid/identify.h"
 #include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
@@ -19,7 +20,7 @@ using Eigen::VectorXd;
 namespace {
 
 // scole-identify --experiments FILE: the joint identification (identify/run/experiments.h).
-int run_experiments_command(const std::string& file, std::string out, const std::string& method, int threads,
+int run_experiments_command(const std::string& file, std::string out, std::optional<io::Method> method, int threads,
                             int max_iterations, bool compute_std, bool verbose) {
   const identify::ExperimentsSpec spec = identify::load_experiments(file);
   if (out.empty()) out = "run/" + spec.name;
@@ -82,6 +83,30 @@ int run_experiments_command(const std::string& file, std::string out, const std:
   return 0;
 }
 
+// The problem on stderr: scenario, model, mesh, parameters, the data and how its columns are used.
+void print_problem(const identify::Problem& problem, bool from_file) {
+  const auto& sc = problem.scenario;
+  std::fprintf(stderr, "scole-identify: %s, %s model, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
+               io::to_string(sc.identification.model), problem.structure->elements(), problem.params->size(),
+               problem.data_source.c_str());
+  if (!from_file) return;
+  auto list = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s.empty() ? std::string("none") : s;
+  };
+  const auto& c = problem.columns;
+  std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
+               list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
+               list(c.unused).c_str());
+  for (const auto& st : c.stepped_inputs)
+    std::fprintf(stderr,
+                 "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g): "
+                 "piecewise linear between samples, each jump moves by up to half a sample (%g s)%s\n",
+                 st.name.c_str(), st.jump, st.at, 0.5 * st.sample,
+                 st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -109,8 +134,8 @@ int main(int argc, char** argv) {
   app.add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
   app.add_option("-d,--data", data, "measured data CSV (header t,<columns>; sensors and inputs matched by name)");
   app.add_option("-o,--out", out, "output directory (default: run/<scenario name>)");
-  app.add_option("-m,--method", method, "optimiser: auto | gauss-newton | gauss-newton-krylov | lbfgs | steepest-descent (default: the scenario's)")
-      ->check(CLI::IsMember({"auto", "gauss-newton", "gauss-newton-krylov", "lbfgs", "steepest-descent"}));
+  app.add_option("-m,--method", method, "optimiser: " + io::names_joined<io::Method>(" | ") + " (default: the scenario's)")
+      ->check(CLI::IsMember(io::names<io::Method>()));
   app.add_option("--max-iterations", max_iterations, "override identification.max_iterations (>= 0)")
       ->check(CLI::Range(0, 100000));
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
@@ -152,103 +177,38 @@ int main(int argc, char** argv) {
       std::fputs(io::builtin_scenario_listing().c_str(), stdout);
       return 0;
     }
-    if (!experiments.empty()) return run_experiments_command(experiments, out, method, threads, max_iterations, !no_std, !quiet);
+    const std::optional<io::Method> method_given = method.empty() ? std::nullopt : io::parse<io::Method>(method);
+    if (!experiments.empty())
+      return run_experiments_command(experiments, out, method_given, threads, max_iterations, !no_std, !quiet);
     io::Scenario sc = io::load_scenario(scenario);
-    identify::RunOptions ro;
-    if (!data.empty()) ro.data_csv = data;
-    ro.method = method;
-    ro.compute_std = !no_std;
-    ro.verbose = !quiet;
+    IdentifyOptions options;
+    options.method = method_given;
+    options.compute_std = !no_std;
+    options.verbose = !quiet;
     if (max_iterations >= 0) {
-      ro.max_iterations = max_iterations;
+      options.max_iterations = max_iterations;
       sc.identification.max_iterations = max_iterations;
     }
     io::validate_scenario(sc);  // the overrides pass the same checks as the file
     if (out.empty()) out = "run/" + sc.name;
     // The output directory is checked (and its staging area made) before any work.
-    io::RunDirectory run_dir(out, identify::output_files(), "scole-identify");
-    auto problem = identify::make_problem(sc, ro.data_csv);
+    io::RunDirectory run_dir(out, Identification::output_files(), "scole-identify");
+    const auto problem = prepare(sc, data.empty() ? DataSource::synthetic() : DataSource::file(data));
     // (Checked again by the run; here so that the refusal is the only line on stderr.)
     if (const auto& w = sc.identification.steepest_weights; !w.empty() && static_cast<int>(w.size()) != problem->params->size())
       io::fail_field(sc.source, "identification.steepest_weights",
                      "must hold one weight per estimated parameter (" + std::to_string(problem->params->size()) + ")",
                      std::to_string(w.size()) + " values");
-    std::fprintf(stderr, "scole-identify: %s, %s model, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
-                 sc.identification.model.c_str(), problem->structure->elements(), problem->params->size(),
-                 problem->data_source.c_str());
-    if (ro.data_csv) {
-      auto list = [](const std::vector<std::string>& v) {
-        std::string s;
-        for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-        return s.empty() ? std::string("none") : s;
-      };
-      const auto& c = problem->columns;
-      std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
-                   list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
-                   list(c.unused).c_str());
-      for (const auto& st : c.stepped_inputs)
-        std::fprintf(stderr,
-                     "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g): "
-                     "piecewise linear between samples, each jump moves by up to half a sample (%g s)%s\n",
-                     st.name.c_str(), st.jump, st.at, 0.5 * st.sample,
-                     st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
-    }
-    const identify::RunResult r = identify::run_identification(*problem, ro);
-    identify::write_outputs(run_dir, *problem, r);
+    print_problem(*problem, !data.empty());
+    const Identification id = identify_parameters(problem, options);
+    id.write(run_dir);
     run_dir.commit();
-    // Summary against the truth where known.
-    std::printf("\n%-10s %14s %14s %14s %12s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth", "rel.error",
-                "std", "resolution", "± interval");
-    for (std::size_t i = 0; i < r.names.size(); ++i) {
-      const auto it = r.truth.find(r.names[i]);
-      const auto e = static_cast<Eigen::Index>(i);
-      const double est = r.estimate[e];
-      auto cell = [&](const VectorXd& v) {
-        char buf[32] = "-";
-        if (v.size() > e && std::isfinite(v[e])) std::snprintf(buf, sizeof buf, "%12.3e", v[e]);
-        return std::string(buf);
-      };
-      const bool flagged = r.ident.identifiable.size() && !r.ident.identifiable[i];
-      const char* flag = flagged ? "  NOT IDENTIFIABLE" : r.ident.identifiable.empty() ? "  (not assessed)" : "";
-      const std::string sd = flagged ? "-" : cell(r.ident.std), res = flagged ? "-" : cell(r.ident.resolution),
-                        hw = flagged ? "-" : cell(r.interval.half_width);
-      if (it != r.truth.end())
-        std::printf("%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est,
-                    it->second, est / it->second - 1.0, sd.c_str(), res.c_str(), hw.c_str(), flag);
-      else
-        std::printf("%-10s %14.7g %14.7g %14s %12s %12s %12s %12s%s\n", r.names[i].c_str(), r.initial[e], est, "-", "-",
-                    sd.c_str(), res.c_str(), hw.c_str(), flag);
-    }
-    std::printf("\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n", r.summary.BriefReport().c_str(),
-                r.counters.forward_solves, r.counters.costate_solves, r.counters.sensitivity_solves, r.wall_seconds);
+    std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
-    if (!r.ident.identifiable.empty() &&
-        std::none_of(r.ident.identifiable.begin(), r.ident.identifiable.end(), [](bool b) { return b; }))
-      std::fprintf(stderr,
-                   "scole-identify: warning: none of the %zu estimated parameters is identifiable from these data (each "
-                   "row says why); the estimates are not determined by the data\n",
-                   r.ident.identifiable.size());
-    if (r.summary.converged() && !r.fit.explains_data) {
-      std::fprintf(stderr,
-                   "scole-identify: stopped at a point that does not explain the data (%s); %zu attempt%s; outputs written "
-                   "with \"converged\": false\n",
-                   io::one_line(r.fit.message).c_str(), r.attempts.size(), r.attempts.size() > 1 ? "s" : "");
-      return 1;
-    }
-    if (!r.summary.converged()) {
-      std::fprintf(stderr, "scole-identify: did not converge (%s%s%s); outputs written with \"converged\": false\n",
-                   identify::to_string(r.summary.termination), r.summary.message.empty() ? "" : ": ",
-                   io::one_line(r.summary.message).c_str());
-      return 1;
-    }
-    if (!r.converged()) {  // the discrepancy principle found no weight (docs/theory.md §7.8)
-      std::fprintf(stderr,
-                   "scole-identify: no smoothness weight fits the data within the noise band (discrepancy principle not "
-                   "met down to %g); outputs written with \"converged\": false\n",
-                   r.smoothness_weight);
-      return 1;
-    }
-    return 0;
+    for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
+    if (!id.converged())
+      std::fprintf(stderr, "scole-identify: %s; outputs written with \"converged\": false\n", id.verdict().c_str());
+    return id.exit_code();
   } catch (const io::InputError& e) {
     std::fprintf(stderr, "scole-identify: %s\n", io::one_line(e.what()).c_str());
     return 2;

@@ -103,6 +103,13 @@ public:
     for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
     fail_field(source_, field(key), "must be one of " + list, "'" + v + "'");
   }
+  // A closed choice (io/types.h): its name in the file, the value inside.
+  template <class E>
+  E choice_of(const std::string& key, E dflt) {
+    const std::string v = str(key, to_string(dflt));
+    if (const auto e = parse<E>(v)) return *e;
+    fail_field(source_, field(key), "must be one of " + names_joined<E>(), "'" + v + "'");
+  }
   std::vector<double> numbers(const std::string& key, const std::vector<double>& dflt) {
     if (!has(key)) return dflt;
     const YAML::Node n = node_[key];
@@ -380,7 +387,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
 }
 
 double structure_length(const Scenario& sc) {
-  return sc.structure == "scole" ? sc.scole.length : sc.beam.length;
+  return sc.structure == Structure::Scole ? sc.scole.length : sc.beam.length;
 }
 
 void check_location(const Scenario& sc, const std::string& field, const std::string& at, double loc,
@@ -402,7 +409,7 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     InputSpec in;
     in.name = r.str("name", "u" + std::to_string(i + 1));
     if (!names.insert(in.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + in.name + "'");
-    in.at = r.choice("at", sc.structure == "scole" ? "reflector" : "beam",
+    in.at = r.choice("at", sc.structure == Structure::Scole ? "reflector" : "beam",
                      {"beam", "mast", "shuttle", "reflector", "actuator1", "actuator2"});
     in.kind = r.choice("kind", "force", {"force", "moment"});
     in.location = r.num("location", 0.0);
@@ -425,14 +432,23 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     SensorSpec s;
     s.name = r.str("name", "y" + std::to_string(i + 1));
     if (!names.insert(s.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + s.name + "'");
-    s.at = r.choice("at", sc.structure == "scole" ? "mast" : "beam", {"beam", "mast", "reflector", "shuttle"});
+    s.at = r.choice("at", sc.structure == Structure::Scole ? "mast" : "beam", {"beam", "mast", "reflector", "shuttle"});
     s.kind = r.choice("kind", "displacement",
-                      {"displacement", "rotation", "velocity", "acceleration", "line_of_sight"});
+                      {"displacement", "rotation", "velocity", "acceleration", "line_of_sight", "strain"});
     s.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), s.at, s.location);
     s.direction = parse_direction(r, "direction");
     s.unit = r.str("unit", "");
     s.noise_std = r.nonneg("noise_std", 0.0);
+    if (s.kind == "strain") {
+      if (sc.structure != Structure::Beam)
+        fail_field(sc.source, r.field("kind"), "is a beam's strain gauge (structure: beam)", "'strain'");
+      if (!r.has("offset")) fail_field(sc.source, r.field("offset"), "is required for a strain gauge (its distance from the neutral axis)", "none");
+      s.offset = r.num("offset", 0.0);
+      if (!(s.offset != 0.0)) fail_field(sc.source, r.field("offset"), "must be nonzero (a gauge on the neutral axis reads nothing)", format_value(s.offset));
+    } else if (r.has("offset")) {
+      fail_field(sc.source, r.field("offset"), "belongs to strain gauges (kind: strain)", "'" + s.kind + "' sensor");
+    }
     // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
     // cannot explain, so they belong to the truth's side of a mismatch study only.
     for (const char* key : {"bias", "drift"})
@@ -462,7 +478,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.elements = r.integer("elements", id.elements, 1, limits::kMaxElements);
   id.sections = r.integer("sections", id.sections, 0, limits::kMaxElements);
   id.data_elements = r.integer("data_elements", id.data_elements, 0, limits::kMaxDataElements);
-  id.method = r.choice("method", id.method, {"auto", "gauss-newton", "gauss-newton-krylov", "lbfgs", "steepest-descent"});
+  id.method = r.choice_of("method", id.method);
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
   id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
   id.step_tolerance = r.positive("step_tolerance", id.step_tolerance);
@@ -474,12 +490,12 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
                  format_value(id.steepest_weights[i]));
   id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
   id.time_step = r.nonneg("time_step", id.time_step);
-  id.step_rule = r.choice("step_rule", id.step_rule, {"parameters", "data"});
+  id.step_rule = r.choice_of("step_rule", id.step_rule);
   id.rtol = r.positive("rtol", id.rtol);
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
-  id.start = r.choice("start", id.start, {"auto", "plain", "coarse-to-fine"});
-  id.model = r.choice("model", id.model, {"linear", "nonlinear"});
+  id.start = r.choice_of("start", id.start);
+  id.model = r.choice_of("model", id.model);
   if (r.has("smoothness")) {
     const YAML::Node m = r.child("smoothness");
     if (m.IsScalar() && m.Scalar() == "discrepancy")
@@ -557,7 +573,7 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
       check_location(t, r.field("location"), se.at, se.location, source);
     }
     if (r.has("direction")) {
-      if (t.structure == "beam")
+      if (t.structure == Structure::Beam)
         fail_field(source, r.field("direction"), "does not apply to a beam sensor (it measures w or w_s)",
                    Reader::kind(r.child("direction")));
       se.direction = parse_direction(r, "direction");
@@ -593,7 +609,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     Reader r(root, source, "");
     sc.name = r.str("name", "unnamed");
     sc.description = r.str("description", "");
-    sc.structure = r.choice("structure", "beam", {"beam", "scole"});
+    sc.structure = r.choice_of("structure", Structure::Beam);
     if (r.has("beam")) parse_beam(r.child("beam"), source, sc.beam);
     if (r.has("scole")) parse_scole(r.child("scole"), source, sc.scole);
     {
@@ -610,7 +626,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     parse_sensors(r.child("sensors"), sc);
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
-    if (sc.identification.model == "nonlinear" && sc.structure != "scole")
+    if (sc.identification.model == Model::Nonlinear && sc.structure != Structure::Scole)
       fail_field(source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'nonlinear'");
     for (const auto& u : sc.identification.uncertain) {
       const std::string field = "identification.uncertain." + u.field;
@@ -640,11 +656,11 @@ Scenario truth_scenario(const Scenario& s) {
   try {
     Reader o(YAML::Load(s.truth.overrides), source, "truth.overrides");
     if (o.has("beam")) {
-      if (s.structure != "beam") fail_field(source, "truth.overrides.beam", "must match the structure", "'" + s.structure + "'");
+      if (s.structure != Structure::Beam) fail_field(source, "truth.overrides.beam", "must match the structure", "'" + std::string(to_string(s.structure)) + "'");
       parse_beam(o.child("beam"), source, t.beam, "truth.overrides.beam");
     }
     if (o.has("scole")) {
-      if (s.structure != "scole") fail_field(source, "truth.overrides.scole", "must match the structure", "'" + s.structure + "'");
+      if (s.structure != Structure::Scole) fail_field(source, "truth.overrides.scole", "must match the structure", "'" + std::string(to_string(s.structure)) + "'");
       parse_scole(o.child("scole"), source, t.scole, "truth.overrides.scole");
     }
     // After the structure: a location is checked against the length the truth simulates.
@@ -700,7 +716,7 @@ nlohmann::json to_json(const Scenario& s) {
   j["name"] = s.name;
   j["description"] = s.description;
   j["source"] = s.source;
-  j["structure"] = s.structure;
+  j["structure"] = to_string(s.structure);
   auto beam = [](const BeamSpec& b) {
     return json{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
                 {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta}, {"c_kv", b.c_kv},
@@ -719,14 +735,14 @@ nlohmann::json to_json(const Scenario& s) {
   // The structure section, and the truth's overrides as the fields whose values differ from it.
   json structure, truth_structure;
   const Scenario ts = truth_scenario(s);
-  if (s.structure == "beam") {
+  if (s.structure == Structure::Beam) {
     structure = beam(s.beam);
     truth_structure = beam(ts.beam);
   } else {
     structure = scole(s.scole);
     truth_structure = scole(ts.scole);
   }
-  j[s.structure] = structure;
+  j[to_string(s.structure)] = structure;
   json overrides = json::object();
   for (const auto& [k, v] : truth_structure.items()) {
     if (v == structure[k]) continue;
@@ -745,21 +761,23 @@ nlohmann::json to_json(const Scenario& s) {
                            {"direction", in.direction}, {"unit", in.unit}, {"signal_from", in.signal_from},
                            {"signal", signal(in.signal)}});
   j["sensors"] = json::array();
-  for (const auto& se : s.sensors)
+  for (const auto& se : s.sensors) {
     j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", se.kind}, {"location", se.location},
                             {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
+    if (se.kind == "strain") j["sensors"].back()["offset"] = se.offset;
+  }
   j["simulation"] = {{"duration", s.simulation.duration}, {"sample_interval", s.simulation.sample_interval},
                      {"seed", s.simulation.seed}};
   const auto& id = s.identification;
   j["identification"] = {{"parameterization", id.parameterization}, {"estimate", id.estimate},
                          {"initial", id.initial}, {"elements", id.elements}, {"sections", id.sections}, {"data_elements", id.data_elements},
-                         {"method", id.method}, {"max_iterations", id.max_iterations},
+                         {"method", to_string(id.method)}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
-                         {"time_step", id.time_step}, {"step_rule", id.step_rule}, {"rtol", id.rtol},
+                         {"time_step", id.time_step}, {"step_rule", to_string(id.step_rule)}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
-                         {"restarts", id.restarts}, {"start", id.start}, {"model", id.model},
+                         {"restarts", id.restarts}, {"start", to_string(id.start)}, {"model", to_string(id.model)},
                          {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};
   if (!id.uncertain.empty()) {
     json u = json::object();
@@ -782,7 +800,7 @@ nlohmann::json to_json(const Scenario& s) {
     if (diff.size() > 1) sensor_overrides.push_back(diff);
   }
   json truth_overrides = json::object();
-  if (!overrides.empty()) truth_overrides[s.structure] = overrides;
+  if (!overrides.empty()) truth_overrides[to_string(s.structure)] = overrides;
   if (!sensor_overrides.empty()) truth_overrides["sensors"] = sensor_overrides;
   if (!truth_overrides.empty()) j["truth"]["overrides"] = truth_overrides;
   return j;

@@ -9,7 +9,7 @@ namespace {
 
 std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
   std::vector<std::pair<std::string, double*>> v;
-  if (sc.structure == "beam") {
+  if (sc.structure == Structure::Beam) {
     auto& b = sc.beam;
     v = {{"beam.length", &b.length}, {"beam.rho_A", &b.rho_A}, {"beam.zeta", &b.zeta}, {"beam.c_kv", &b.c_kv},
          {"beam.tip_mass", &b.tip_mass}, {"beam.tip_inertia", &b.tip_inertia}};
@@ -47,7 +47,7 @@ bool signed_field(const std::string& path) {
 }
 
 bool* bool_field(Scenario& sc, const std::string& path) {
-  if (sc.structure == "scole" && path == "scole.bending_rotary_inertia") return &sc.scole.bending_rotary_inertia;
+  if (sc.structure == Structure::Scole && path == "scole.bending_rotary_inertia") return &sc.scole.bending_rotary_inertia;
   return nullptr;
 }
 
@@ -55,7 +55,7 @@ std::vector<std::string> field_paths(const Scenario& sc) {
   Scenario copy = sc;
   std::vector<std::string> v;
   for (auto& [name, ptr] : numbers(copy)) v.push_back(name);
-  if (sc.structure == "scole") v.push_back("scole.bending_rotary_inertia");
+  if (sc.structure == Structure::Scole) v.push_back("scole.bending_rotary_inertia");
   return v;
 }
 

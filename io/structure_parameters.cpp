@@ -13,7 +13,7 @@ struct Row {
 
 std::vector<Row> rows(const Scenario& sc) {
   std::vector<Row> r;
-  if (sc.structure == "scole") {
+  if (sc.structure == Structure::Scole) {
     r = {{{"rho_A", "mast mass per unit length", "mass/length"}, [](Scenario& s) -> double& { return s.scole.rho_A; }},
          {{"EI_roll", "mast bending stiffness, roll plane (displacement along shuttle y)", "force·length²"},
           [](Scenario& s) -> double& { return s.scole.EI_roll; }},
@@ -65,10 +65,10 @@ std::map<std::string, double> structure_parameters(const Scenario& sc) {
 void set_structure_parameters(Scenario& sc, const std::map<std::string, double>& values) {
   // "EI" for every section / both planes first, so that a sectional or per-plane value wins.
   if (const auto it = values.find("EI"); it != values.end()) {
-    if (sc.structure == "scole") sc.scole.EI_roll = sc.scole.EI_pitch = it->second;
+    if (sc.structure == Structure::Scole) sc.scole.EI_roll = sc.scole.EI_pitch = it->second;
     else sc.beam.EI = {it->second};  // a uniform beam
   }
-  if (sc.structure == "beam") {
+  if (sc.structure == Structure::Beam) {
     // A truth with its own sections: take them all.
     std::vector<double> sections;
     for (int k = 1; values.count("EI_" + std::to_string(k)); ++k) sections.push_back(values.at("EI_" + std::to_string(k)));

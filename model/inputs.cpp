@@ -122,7 +122,7 @@ double LaggedSignal::operator()(double t) const {
 
 std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure& st) {
   std::vector<AppliedInput> out;
-  const bool beam = st.kind() == "beam";
+  const bool beam = st.kind() == io::Structure::Beam;
   for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
     const io::InputSpec& in = sc.inputs[i];
     const std::string field = "inputs[" + std::to_string(i) + "]";
@@ -151,7 +151,7 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
         io::fail_field(sc.source, field + ".direction", "must lie in the actuator plane (x, y)",
                        "[" + io::format_value(d[0]) + ", " + io::format_value(d[1]) + ", " + io::format_value(d[2]) + "]");
       a.d_R = d;
-      if (st.kind() == "scole" && sc.scole.actuator_lag > 0)
+      if (st.kind() == io::Structure::Scole && sc.scole.actuator_lag > 0)
         a.lagged = std::make_shared<const LaggedSignal>(in.signal, sc.scole.actuator_lag, sc.simulation.duration,
                                                         sc.source, field + ".signal");
     } else {

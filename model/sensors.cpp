@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "scoleid/io/error.h"
+#include "scoleid/model/hencky.h"
 
 namespace scoleid::model {
 
@@ -40,11 +41,47 @@ double rotation_about(const SimbodyMatterSubsystem& matter, const State& state, 
   const Vec4 aa = R_RB.convertRotationToAngleAxis();
   return aa[0] * dot(Vec3(aa[1], aa[2], aa[3]), d);
 }
+
+// The strain gauge at s on a beam chain (header): the joints at j h and (j + 1) h around s, with
+// their Hencky springs (hencky.h) of the beam the truth simulates.
+void resolve_strain(const io::BeamSpec& beam, const Structure& st, const io::SensorSpec& se, ResolvedSensor& r) {
+  const int n = st.segments();
+  const double h = st.length() / n;
+  const PiecewiseField EI{beam.length, beam.EI};
+  const HenckyLumping lumping = hencky_lumping(n, EI, PiecewiseField{beam.length, {beam.c_kv}});
+  const auto& seg = st.segment_bodies();
+  auto joint = [&](int j) {
+    ResolvedSensor::Joint jt;
+    if (j == 0) {
+      if (beam.left == io::EndCondition::Clamped) jt = {MobilizedBodyIndex(), seg.front(), lumping.stiffness.front()};
+    } else if (j == n) {
+      if (st.tip_body().isValid()) jt = {seg.back(), st.tip_body(), lumping.stiffness.back()};
+      else if (beam.right == io::EndCondition::Clamped) jt = {seg.back(), MobilizedBodyIndex(), lumping.stiffness.back()};
+    } else {
+      jt = {seg[static_cast<std::size_t>(j - 1)], seg[static_cast<std::size_t>(j)], lumping.stiffness[static_cast<std::size_t>(j)]};
+    }
+    return jt;
+  };
+  const int j = std::clamp(static_cast<int>(std::floor(se.location / h)), 0, n - 1);
+  r.joints[0] = joint(j);
+  r.joints[1] = joint(j + 1);
+  r.weight = std::clamp(se.location / h - j, 0.0, 1.0);
+  r.scale = -se.offset / EI.at(se.location);
+}
+
+double joint_moment(const SimbodyMatterSubsystem& matter, const State& state, const ResolvedSensor::Joint& jt) {
+  if (jt.k == 0.0) return 0.0;
+  const MobilizedBody& G = matter.getGround();
+  const Vec3 z(0, 0, 1);
+  const double a = jt.a.isValid() ? rotation_about(matter, state, jt.a, G, z) : 0.0;
+  const double b = jt.b.isValid() ? rotation_about(matter, state, jt.b, G, z) : 0.0;
+  return jt.k * (b - a);
+}
 }  // namespace
 
 std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Structure& st) {
   std::vector<ResolvedSensor> out;
-  const bool beam = st.kind() == "beam";
+  const bool beam = st.kind() == io::Structure::Beam;
   for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
     const io::SensorSpec& se = sc.sensors[i];
     const std::string field = "sensors[" + std::to_string(i) + "]";
@@ -53,7 +90,8 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     r.kind = se.kind == "rotation" ? K::Rotation
              : se.kind == "velocity" ? K::Velocity
              : se.kind == "acceleration" ? K::Acceleration
-             : se.kind == "line_of_sight" ? K::LineOfSight : K::Displacement;
+             : se.kind == "line_of_sight" ? K::LineOfSight
+             : se.kind == "strain" ? K::Strain : K::Displacement;
     r.reference = st.reference_body();
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
@@ -65,7 +103,10 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
       r.station = st.station_at(se.location);
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
       if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
+      if (r.kind == K::Strain) resolve_strain(sc.beam, st, se, r);
     } else {
+      if (r.kind == K::Strain)
+        io::fail_field(sc.source, field + ".kind", "is a beam's strain gauge (structure: beam)", "'strain'");
       if (se.at == "beam")
         io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
       if (d.norm() == 0)
@@ -106,6 +147,9 @@ double read_sensor(const SimbodyMatterSubsystem& matter, const State& state, con
       const Vec3 u = (p_RP - s.root_R).normalize();
       return dot(cross(u0, u), s.d_R);
     }
+    case K::Strain:
+      return s.scale * ((1.0 - s.weight) * joint_moment(matter, state, s.joints[0]) +
+                        s.weight * joint_moment(matter, state, s.joints[1]));
   }
   return 0.0;
 }

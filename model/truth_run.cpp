@@ -80,12 +80,12 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Syste
 }
 
 std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
-  if (sc.structure == "scole" && !sc.scole.bending_rotary_inertia)
+  if (sc.structure == io::Structure::Scole && !sc.scole.bending_rotary_inertia)
     io::fail_field(sc.source, "scole.bending_rotary_inertia",
                    "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "
                    "inertia (a body with polar inertia J has Ixx + Iyy >= J); drop it on the identifier's side only",
                    "false");
-  if (sc.structure == "scole") return std::make_unique<ScoleSystem>(sc.scole, segments);
+  if (sc.structure == io::Structure::Scole) return std::make_unique<ScoleSystem>(sc.scole, segments);
   return std::make_unique<BeamChain>(sc.beam, segments);
 }
 
@@ -285,7 +285,7 @@ class PlausibilityGuard {
 public:
   PlausibilityGuard(const io::Scenario& scenario, const io::Scenario& truth, const Structure& st)
       : matter_(st.matter()), source_(truth.source) {
-    if (st.kind() == "scole") {
+    if (st.kind() == io::Structure::Scole) {
       stroke_ = truth.scole.actuator_stroke;
       stroke_field_ = truth.scole.actuator_stroke != scenario.scole.actuator_stroke
                           ? "truth.overrides.scole.actuator_stroke" : "scole.actuator_stroke";
@@ -296,7 +296,7 @@ public:
         }
     }
     if (truth.truth.large_motion) return;
-    const bool scole = st.kind() == "scole";
+    const bool scole = st.kind() == io::Structure::Scole;
     const MobilizedBodyIndex ref = st.reference_body();
     const std::string rel = scole ? "relative to the shuttle" : "relative to ground";
     if (ref != GroundIndex) rotations_.push_back({ref, GroundIndex, "shuttle attitude (relative to the inertial frame)"});
@@ -451,7 +451,7 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
 
   io::TruthMeta& m = res.meta;
   m.scenario = sc.name;
-  m.structure = sc.structure;
+  m.structure = io::to_string(sc.structure);
   for (const auto& in : sc.inputs)
     m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
   for (const auto& se : sc.sensors)

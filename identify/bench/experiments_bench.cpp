@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
       }
       JointMisfit joint(parts, JointMisfitOptions{t});
       OptimizerOptions oo;
-      oo.method = "gauss-newton";
+      oo.method = scoleid::io::Method::GaussNewton;
       const auto t0 = Clock::now();
       const OptimizerSummary sum = minimize(joint, problems[0]->params->initial(), oo);
       const double w = std::chrono::duration<double>(Clock::now() - t0).count();

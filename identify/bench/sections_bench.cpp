@@ -111,7 +111,7 @@ scoleid::io::Scenario part1_scenario(int N) {
   sc.identification.elements = 64;
   sc.identification.data_elements = 128;
   sc.identification.time_step = g_time_step;  // 0: automatic, what is being measured
-  sc.identification.step_rule = g_step_rule;
+  sc.identification.step_rule = *scoleid::io::parse<scoleid::io::StepRule>(g_step_rule);
   for (auto& sensor : sc.sensors) sensor.noise_std = g_noise;
   if (g_seed >= 0) sc.simulation.seed = static_cast<unsigned>(g_seed);
   sc.identification.smoothness = g_smoothness;
@@ -150,14 +150,14 @@ int run_case(int N, const std::string& method, bool compute_std) {
     apply_checkpoint(p->objective_options, g_checkpoint);
     out["setup_seconds"] = seconds_since(t0);
     RunOptions ro;
-    ro.method = method;
+    ro.method = scoleid::io::parse<scoleid::io::Method>(method).value();
     ro.compute_std = compute_std;
     ro.verbose = false;
     const auto t1 = Clock::now();
     const RunResult r = run_identification(*p, ro);
     out["wall_seconds"] = seconds_since(t1);
     const auto [rms, mx] = rel_errors(*p, r.estimate);
-    out["method_used"] = r.method;
+    out["method_used"] = scoleid::io::to_string(r.method);
     // Iterations of the whole run: every attempt's, with its coarse-to-fine levels; with the
     // discrepancy principle, of every weight tried (the first attempt counts the chosen weight's).
     int iterations = 0;
@@ -538,7 +538,7 @@ json part2() {
       p->data = data;
       p->data_source = "modal series";
       RunOptions ro;
-      ro.method = "gauss-newton";
+      ro.method = scoleid::io::Method::GaussNewton;
       ro.compute_std = true;
       ro.verbose = false;
       const auto t0 = Clock::now();
@@ -640,8 +640,9 @@ const char* kUsage =
 int main(int argc, char** argv) {
   int part = 0, case_n = -1, curve_n = -1;
   std::vector<int> sections = {2, 8, 32, 64};
-  std::vector<std::string> methods = {"gauss-newton", "lbfgs"};
-  std::string method = "gauss-newton", json_path;
+  using scoleid::io::Method;
+  std::vector<std::string> methods = {scoleid::io::to_string(Method::GaussNewton), scoleid::io::to_string(Method::Lbfgs)};
+  std::string method = scoleid::io::to_string(Method::GaussNewton), json_path;
   double timeout_s = 600.0;
   bool compute_std = true;
   try {
@@ -667,7 +668,7 @@ int main(int argc, char** argv) {
       } else if (a == "--methods") {
         methods = split(value());
         for (const auto& m : methods)
-          if (m != "gauss-newton" && m != "gauss-newton-krylov" && m != "lbfgs" && m != "auto")
+          if (const auto parsed = scoleid::io::parse<Method>(m); !parsed || *parsed == Method::SteepestDescent)
             throw std::invalid_argument("--methods: unknown method " + m);
       } else if (a == "--timeout") {
         timeout_s = std::stod(value());

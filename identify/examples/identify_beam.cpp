@@ -1,4 +1,5 @@
-// Example: identify a beam's EI and ρA from a measurement file, through the public API.
+// Example: identify a beam's EI and ρA from a measurement file, through the public API
+// (scoleid/identify.h: scoleid::prepare, scoleid::identify_parameters).
 //
 // Sample run (build/identify/examples/identify-beam-example /tmp/beam-example):
 //
@@ -19,7 +20,7 @@
 #include <filesystem>
 #include <string>
 
-#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/scenario.h"
 
@@ -57,21 +58,20 @@ int main(int argc, char** argv) {
 
   // Step 3. The identification problem: the FE model on the identifier's mesh, the named
   // parameters, the input signals and the measurements matched to the sensors by column name.
-  auto problem = identify::make_problem(sc, csv);
+  const auto problem = scoleid::prepare(sc, scoleid::DataSource::file(csv));
   std::printf("step 3: problem: %d elements, %d parameters, data %s\n", problem->structure->elements(),
               problem->params->size(), problem->data_source.c_str());
 
   // Step 4. Run: Gauss–Newton on the costate/sensitivity gradient, then the Fisher information at
   // the estimate for the standard deviations and the identifiability flags.
-  identify::RunOptions options;
-  options.verbose = false;
-  const identify::RunResult r = identify::run_identification(*problem, options);
-  std::printf("step 4: %s (%s) after %zu iterations\n", r.converged() ? "converged" : "NOT converged",
+  const scoleid::Identification id = scoleid::identify_parameters(problem, scoleid::IdentifyOptions{});
+  const identify::RunResult& r = id.result();
+  std::printf("step 4: %s (%s) after %zu iterations\n", id.converged() ? "converged" : "NOT converged",
               identify::to_string(r.summary.termination), r.summary.iterations.size() - 1);
 
   // Step 5. The answer, against the values the synthetic data were made with.
   const auto truth = identify::make_problem(sc, std::nullopt)->true_values;
-  bool ok = r.converged();
+  bool ok = id.converged();
   std::printf("step 5:");
   for (std::size_t i = 0; i < r.names.size(); ++i) {
     const auto e = static_cast<Eigen::Index>(i);

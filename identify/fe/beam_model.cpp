@@ -22,12 +22,15 @@ int element_of(double s, double L, int ne, double& xi) {
   return e;
 }
 
-Eigen::RowVectorXd field_row(const BeamFE& fe, double s, bool rotation) {
+// The row of w (derivative 0), w_s (1) or w_ss (2) at s, from the Hermite element containing s.
+Eigen::RowVectorXd field_row(const BeamFE& fe, double s, int derivative) {
   Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(fe.model.ndof);
   double xi = 0.0;
   const double h = fe.length / fe.elements;
   const int e = element_of(s, fe.length, fe.elements, xi);
-  const hermite::Vec4 n = rotation ? hermite::slope(xi, h) : hermite::shape(xi, h);
+  const hermite::Vec4 n = derivative == 2   ? hermite::curvature(xi, h)
+                          : derivative == 1 ? hermite::slope(xi, h)
+                                            : hermite::shape(xi, h);
   for (int a = 0; a < 4; ++a) {
     const int r = fe.full_to_reduced[static_cast<std::size_t>(2 * e + a)];
     if (r >= 0) row[r] += n[a];
@@ -37,8 +40,58 @@ Eigen::RowVectorXd field_row(const BeamFE& fe, double s, bool rotation) {
 
 }  // namespace
 
-Eigen::RowVectorXd BeamFE::displacement_row(double s) const { return field_row(*this, s, false); }
-Eigen::RowVectorXd BeamFE::rotation_row(double s) const { return field_row(*this, s, true); }
+Eigen::RowVectorXd BeamFE::displacement_row(double s) const { return field_row(*this, s, 0); }
+Eigen::RowVectorXd BeamFE::rotation_row(double s) const { return field_row(*this, s, 1); }
+Eigen::RowVectorXd BeamFE::curvature_row(double s) const { return field_row(*this, s, 2); }
+
+namespace {
+
+// The inputs' load vectors: a force on the displacement row, a moment on the rotation row.
+void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::InputSpec>& inputs, const std::string& source) {
+  StructuralModel& m = fe.model;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto& in = inputs[i];
+    const std::string f = "inputs[" + std::to_string(i) + "]";
+    if (in.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + in.at + "'");
+    if (!(in.location >= 0.0 && in.location <= beam.length))
+      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
+                 format_value(in.location));
+    ModelInput mi;
+    mi.name = in.name;
+    mi.vector = (in.kind == "moment" ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
+    m.inputs.push_back(std::move(mi));
+  }
+}
+
+// The sensors' rows: w(s) or w_s(s); velocity and acceleration the displacement row on u̇, ü.
+void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+  StructuralModel& m = fe.model;
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const auto& se = sensors[k];
+    const std::string f = "sensors[" + std::to_string(k) + "]";
+    if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
+    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "velocity" && se.kind != "acceleration" &&
+        se.kind != "strain")
+      fail_field(source, f + ".kind",
+                 "is not supported by the beam identifier (displacement|rotation|velocity|acceleration|strain)",
+                 "'" + se.kind + "'");
+    if (!(se.location >= 0.0 && se.location <= beam.length))
+      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
+                 format_value(se.location));
+    ModelSensor ms;
+    ms.name = se.name;
+    ms.kind = se.kind;
+    // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
+    ms.order = se.kind == "velocity" ? 1 : se.kind == "acceleration" ? 2 : 0;
+    // strain: ε = −offset · w_ss, the Hermite curvature row (linear in each element).
+    ms.row = se.kind == "rotation" ? fe.rotation_row(se.location)
+             : se.kind == "strain" ? Eigen::RowVectorXd(-se.offset * fe.curvature_row(se.location))
+                                   : fe.displacement_row(se.location);
+    m.sensors.push_back(std::move(ms));
+  }
+}
+
+}  // namespace
 
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
                   const std::vector<io::SensorSpec>& sensors, const std::string& source) {
@@ -136,36 +189,8 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     if (!tip.empty()) m.mass.push_back({to_sparse(tip), -1});
   }
 
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const auto& in = inputs[i];
-    const std::string f = "inputs[" + std::to_string(i) + "]";
-    if (in.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + in.at + "'");
-    if (!(in.location >= 0.0 && in.location <= beam.length))
-      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
-                 format_value(in.location));
-    ModelInput mi;
-    mi.name = in.name;
-    mi.vector = (in.kind == "moment" ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
-    m.inputs.push_back(std::move(mi));
-  }
-  for (std::size_t k = 0; k < sensors.size(); ++k) {
-    const auto& se = sensors[k];
-    const std::string f = "sensors[" + std::to_string(k) + "]";
-    if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
-    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "velocity" && se.kind != "acceleration")
-      fail_field(source, f + ".kind", "is not supported by the beam identifier (displacement|rotation|velocity|acceleration)",
-                 "'" + se.kind + "'");
-    if (!(se.location >= 0.0 && se.location <= beam.length))
-      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
-                 format_value(se.location));
-    ModelSensor ms;
-    ms.name = se.name;
-    ms.kind = se.kind;
-    // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
-    ms.order = se.kind == "velocity" ? 1 : se.kind == "acceleration" ? 2 : 0;
-    ms.row = se.kind == "rotation" ? fe.rotation_row(se.location) : fe.displacement_row(se.location);
-    m.sensors.push_back(std::move(ms));
-  }
+  add_beam_inputs(fe, beam, inputs, source);
+  add_beam_sensors(fe, beam, sensors, source);
   return fe;
 }
 

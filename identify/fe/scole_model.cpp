@@ -169,8 +169,15 @@ VectorXd ScoleFE::rigid_motion(const Vector3d& a, const Vector3d& theta) const {
   return u;
 }
 
-ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io::InputSpec>& inputs,
-                    const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+namespace {
+
+// The full-vector operators' triplets, one list per coefficient (docs/theory.md §3.3–3.7).
+struct FullOperators {
+  std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const, mass_refl;
+  std::vector<Trip> damp_roll, damp_pitch, act_spring;
+};
+
+void check_spec(const io::ScoleSpec& sc, int elements, const std::string& source) {
   if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
   if (sc.mast_root.size() != 3)
     fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(sc.mast_root.size()) + " values");
@@ -180,15 +187,15 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
                "must be 0: the finite-element model has no servo lag: set it under truth.overrides.scole to study the "
                "mismatch",
                format_value(sc.actuator_lag));
-  ScoleFE fe;
-  fe.spec = sc;
-  fe.elements = elements;
-  const int ne = elements;
-  const int nact = static_cast<int>(sc.actuator_locations.size());
-  const double L = sc.length, h = L / ne;
-  fe.nfull = 6 + kNodeDofs * (ne + 1) + 2 * nact;
+}
 
-  // Reduced order: nodes 1..n (proof masses after their nearest node) | X, Y, Z, θx, θy, θz.
+// Reduced order: nodes 1..n (proof masses after their nearest node) | X, Y, Z, θx, θy, θz; and T:
+// identity on the kept DOFs, the root node expressed in the shuttle's rigid motion.
+void order_dofs(ScoleFE& fe) {
+  const io::ScoleSpec& sc = fe.spec;
+  const int ne = fe.elements;
+  const int nact = static_cast<int>(sc.actuator_locations.size());
+  const double h = sc.length / ne;
   std::vector<int> order;  // full index of each reduced DOF
   std::vector<std::vector<int>> after(static_cast<std::size_t>(ne + 1));
   for (int k = 0; k < nact; ++k) {
@@ -210,42 +217,31 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   for (int k = 0; k < nact; ++k)
     for (int ax = 0; ax < 2; ++ax) fe.proof_reduced.push_back(reduced_of[static_cast<std::size_t>(full_proof(ne, k, ax))]);
 
-  // T: identity on the kept DOFs; the root node expressed in the shuttle's rigid motion.
-  {
-    std::vector<Trip> t;
-    for (int r = 0; r < n; ++r) t.emplace_back(order[static_cast<std::size_t>(r)], r, 1.0);
-    const Vector3d r0 = vec3(sc.mast_root);
-    auto S = [&](int i) { return fe.shuttle_reduced[static_cast<std::size_t>(i)]; };
-    t.emplace_back(full_node(0, ScoleFE::kUx), S(kX), 1.0);
-    t.emplace_back(full_node(0, ScoleFE::kUx), S(kTy), r0[2]);
-    t.emplace_back(full_node(0, ScoleFE::kUx), S(kTz), -r0[1]);
-    t.emplace_back(full_node(0, ScoleFE::kUxSlope), S(kTy), -1.0);
-    t.emplace_back(full_node(0, ScoleFE::kUy), S(kY), 1.0);
-    t.emplace_back(full_node(0, ScoleFE::kUy), S(kTz), r0[0]);
-    t.emplace_back(full_node(0, ScoleFE::kUy), S(kTx), -r0[2]);
-    t.emplace_back(full_node(0, ScoleFE::kUySlope), S(kTx), 1.0);
-    t.emplace_back(full_node(0, ScoleFE::kPsi), S(kTz), 1.0);
-    fe.T.resize(fe.nfull, n);
-    fe.T.setFromTriplets(t.begin(), t.end());
-    fe.T.makeCompressed();
-  }
+  std::vector<Trip> t;
+  for (int r = 0; r < n; ++r) t.emplace_back(order[static_cast<std::size_t>(r)], r, 1.0);
+  const Vector3d r0 = vec3(sc.mast_root);
+  auto S = [&](int i) { return fe.shuttle_reduced[static_cast<std::size_t>(i)]; };
+  t.emplace_back(full_node(0, ScoleFE::kUx), S(kX), 1.0);
+  t.emplace_back(full_node(0, ScoleFE::kUx), S(kTy), r0[2]);
+  t.emplace_back(full_node(0, ScoleFE::kUx), S(kTz), -r0[1]);
+  t.emplace_back(full_node(0, ScoleFE::kUxSlope), S(kTy), -1.0);
+  t.emplace_back(full_node(0, ScoleFE::kUy), S(kY), 1.0);
+  t.emplace_back(full_node(0, ScoleFE::kUy), S(kTz), r0[0]);
+  t.emplace_back(full_node(0, ScoleFE::kUy), S(kTx), -r0[2]);
+  t.emplace_back(full_node(0, ScoleFE::kUySlope), S(kTx), 1.0);
+  t.emplace_back(full_node(0, ScoleFE::kPsi), S(kTz), 1.0);
+  fe.T.resize(fe.nfull, n);
+  fe.T.setFromTriplets(t.begin(), t.end());
+  fe.T.makeCompressed();
+}
 
-  StructuralModel& m = fe.model;
-  m.ndof = n;
-  m.ncoef = ScoleFE::kCount;
-  m.coefficient_names = {"rho_A",  "EI_roll", "EI_pitch",    "GJ",         "rho_I_psi", "d_roll",
-                         "d_pitch", "c_tors", "m_reflector", "k_actuator", "c_actuator"};
-  m.dof_group.assign(static_cast<std::size_t>(n), 0);  // 0: displacements [ft], 1: rotations [rad]
-  for (int i : {kTx, kTy, kTz}) m.dof_group[static_cast<std::size_t>(fe.shuttle_dof(i))] = 1;
-  for (int nd = 1; nd <= ne; ++nd)
-    for (auto f : {ScoleFE::kUxSlope, ScoleFE::kUySlope, ScoleFE::kPsi})
-      m.dof_group[static_cast<std::size_t>(fe.node_dof(nd, f))] = 1;
-
-  // Element operators on the full vector.
-  std::vector<Trip> mass_bend, mass_tors, stiff_roll, stiff_pitch, stiff_tors, mass_const, mass_refl;
-  std::vector<Trip> damp_roll, damp_pitch, act_spring;
+// The mast's elements: Hermite bending in both planes, linear torsion, and the slope quadratic
+// forms (docs/theory.md §3.3, §4.3): G_roll = ∫ (Θx − θx)², G_pitch = ∫ (Θy − θy)² on the
+// cross-section rotation relative to the shuttle (the damping's dissipation), and ½ ∫ (Θx² + Θy²)
+// on the absolute one (the section's bending rotary inertia ρI_ψ/2 per plane).
+void add_mast_elements(FullOperators& o, const io::ScoleSpec& sc, int ne, const FullRows& fr) {
+  const double h = sc.length / ne;
   const hermite::Mat4 Me = hermite::mass(h, 0.0, h), Ke = hermite::stiffness(h, 0.0, h);
-  const FullRows fr(sc, ne, fe.nfull);
   // Three-point Gauss rule on [0, 1]: exact for the quadratic-times-quadratic slope products.
   const double g = 0.5 * std::sqrt(0.6);
   const double gauss_x[3] = {0.5 - g, 0.5, 0.5 + g}, gauss_w[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
@@ -255,55 +251,64 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
       for (int b = 0; b < 4; ++b) {
         const int ax = full_node(e + a / 2, ScoleFE::kUx + a % 2), bx = full_node(e + b / 2, ScoleFE::kUx + b % 2);
         const int ay = full_node(e + a / 2, ScoleFE::kUy + a % 2), by = full_node(e + b / 2, ScoleFE::kUy + b % 2);
-        mass_bend.emplace_back(ax, bx, Me(a, b));
-        mass_bend.emplace_back(ay, by, Me(a, b));
-        stiff_pitch.emplace_back(ax, bx, Ke(a, b));
-        stiff_roll.emplace_back(ay, by, Ke(a, b));
+        o.mass_bend.emplace_back(ax, bx, Me(a, b));
+        o.mass_bend.emplace_back(ay, by, Me(a, b));
+        o.stiff_pitch.emplace_back(ax, bx, Ke(a, b));
+        o.stiff_roll.emplace_back(ay, by, Ke(a, b));
       }
     // Linear torsion element: ∫ N Nᵀ = h/6 [2 1; 1 2], ∫ N' N'ᵀ = 1/h [1 −1; −1 1].
     for (int a = 0; a < 2; ++a)
       for (int b = 0; b < 2; ++b) {
         const int pa = full_node(e + a, ScoleFE::kPsi), pb = full_node(e + b, ScoleFE::kPsi);
-        mass_tors.emplace_back(pa, pb, h / 6.0 * (a == b ? 2.0 : 1.0));
-        stiff_tors.emplace_back(pa, pb, (a == b ? 1.0 : -1.0) / h);
+        o.mass_tors.emplace_back(pa, pb, h / 6.0 * (a == b ? 2.0 : 1.0));
+        o.stiff_tors.emplace_back(pa, pb, (a == b ? 1.0 : -1.0) / h);
       }
-    // Slope quadratic forms (docs/theory.md §3.3, §4.3): G_roll = ∫ (Θx − θx)², G_pitch =
-    // ∫ (Θy − θy)² on the cross-section rotation relative to the shuttle (the damping's
-    // dissipation), and ½ ∫ (Θx² + Θy²) on the absolute one (the section's bending rotary
-    // inertia ρI_ψ/2 per plane).
     for (int q = 0; q < 3; ++q) {
       const MatrixXd rot = fr.rotation((e + gauss_x[q]) * h);
       const MatrixXd rel = rot - shuttle_rot;
       const double w = gauss_w[q] * h;
-      add_quadratic(damp_roll, rel.row(0), MatrixXd::Constant(1, 1, w));
-      add_quadratic(damp_pitch, rel.row(1), MatrixXd::Constant(1, 1, w));
-      if (sc.bending_rotary_inertia) add_quadratic(mass_tors, rot.topRows(2), 0.5 * w * MatrixXd::Identity(2, 2));
+      add_quadratic(o.damp_roll, rel.row(0), MatrixXd::Constant(1, 1, w));
+      add_quadratic(o.damp_pitch, rel.row(1), MatrixXd::Constant(1, 1, w));
+      if (sc.bending_rotary_inertia) add_quadratic(o.mass_tors, rot.topRows(2), 0.5 * w * MatrixXd::Identity(2, 2));
     }
   }
-  // The mast's rigid axial motion: ρA L w².
-  add_quadratic(mass_bend, fr.axial(), MatrixXd::Constant(1, 1, L));
-  // Shuttle.
-  {
-    MatrixXd tr = fr.zero();
-    for (int i = 0; i < 3; ++i) tr(i, kX + i) = 1.0;
-    add_quadratic(mass_const, tr, sc.shuttle.mass * MatrixXd::Identity(3, 3));
-    add_quadratic(mass_const, fr.shuttle_rotation(), inertia_matrix(sc.shuttle));
-  }
-  // Reflector: translation of its CM and rotation of the tip section.
-  add_quadratic(mass_refl, fr.reflector(), MatrixXd::Identity(3, 3));  // × m_reflector
-  add_quadratic(mass_const, fr.rotation(L), inertia_matrix(sc.reflector));
-  // Proof masses: laterally on their sliders (centering spring and damper on the stroke
-  // ξ − u(s_k), §3.7), axially with the mast.
-  for (int k = 0; k < nact; ++k) {
+}
+
+// The bodies: the mast's rigid axial motion (ρA L w²), the shuttle, the reflector (translation of
+// its CM and rotation of the tip section), the proof masses (laterally on their sliders with the
+// centering spring and damper on the stroke ξ − u(s_k), §3.7; axially with the mast).
+void add_bodies(FullOperators& o, const io::ScoleSpec& sc, int ne, const FullRows& fr) {
+  add_quadratic(o.mass_bend, fr.axial(), MatrixXd::Constant(1, 1, sc.length));
+  MatrixXd tr = fr.zero();
+  for (int i = 0; i < 3; ++i) tr(i, kX + i) = 1.0;
+  add_quadratic(o.mass_const, tr, sc.shuttle.mass * MatrixXd::Identity(3, 3));
+  add_quadratic(o.mass_const, fr.shuttle_rotation(), inertia_matrix(sc.shuttle));
+  add_quadratic(o.mass_refl, fr.reflector(), MatrixXd::Identity(3, 3));  // × m_reflector
+  add_quadratic(o.mass_const, fr.rotation(sc.length), inertia_matrix(sc.reflector));
+  for (int k = 0; k < static_cast<int>(sc.actuator_locations.size()); ++k) {
     MatrixXd p = fr.zero();
     p(0, full_proof(ne, k, 0)) = 1.0;
     p(1, full_proof(ne, k, 1)) = 1.0;
     p.row(2) = fr.axial();
-    add_quadratic(mass_const, p, sc.actuator_mass * MatrixXd::Identity(3, 3));
+    add_quadratic(o.mass_const, p, sc.actuator_mass * MatrixXd::Identity(3, 3));
     MatrixXd stroke = p - fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
-    add_quadratic(act_spring, stroke.topRows(2), MatrixXd::Identity(2, 2));
+    add_quadratic(o.act_spring, stroke.topRows(2), MatrixXd::Identity(2, 2));
   }
+}
 
+// The structural model's operators: the full ones reduced by T, each with its coefficient.
+void assemble_operators(ScoleFE& fe, const FullOperators& o) {
+  StructuralModel& m = fe.model;
+  const int n = static_cast<int>(fe.T.cols());
+  m.ndof = n;
+  m.ncoef = ScoleFE::kCount;
+  m.coefficient_names = {"rho_A",  "EI_roll", "EI_pitch",    "GJ",         "rho_I_psi", "d_roll",
+                         "d_pitch", "c_tors", "m_reflector", "k_actuator", "c_actuator"};
+  m.dof_group.assign(static_cast<std::size_t>(n), 0);  // 0: displacements [ft], 1: rotations [rad]
+  for (int i : {kTx, kTy, kTz}) m.dof_group[static_cast<std::size_t>(fe.shuttle_dof(i))] = 1;
+  for (int nd = 1; nd <= fe.elements; ++nd)
+    for (auto f : {ScoleFE::kUxSlope, ScoleFE::kUySlope, ScoleFE::kPsi})
+      m.dof_group[static_cast<std::size_t>(fe.node_dof(nd, f))] = 1;
   auto reduce = [&](const std::vector<Trip>& t) {
     SparseMatrix F(fe.nfull, fe.nfull);
     F.setFromTriplets(t.begin(), t.end());
@@ -312,124 +317,148 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
     R.makeCompressed();
     return R;
   };
-  const SparseMatrix Kr = reduce(stiff_roll), Kp = reduce(stiff_pitch), Kt = reduce(stiff_tors);
-  const SparseMatrix Ka = reduce(act_spring);
-  m.mass = {{reduce(mass_bend), ScoleFE::kRhoA},
-            {reduce(mass_tors), ScoleFE::kRhoIPsi},
-            {reduce(mass_refl), ScoleFE::kMReflector},
-            {reduce(mass_const), -1}};
+  const SparseMatrix Kr = reduce(o.stiff_roll), Kp = reduce(o.stiff_pitch), Kt = reduce(o.stiff_tors);
+  const SparseMatrix Ka = reduce(o.act_spring);
+  m.mass = {{reduce(o.mass_bend), ScoleFE::kRhoA},
+            {reduce(o.mass_tors), ScoleFE::kRhoIPsi},
+            {reduce(o.mass_refl), ScoleFE::kMReflector},
+            {reduce(o.mass_const), -1}};
   m.stiffness = {{Kr, ScoleFE::kEIRoll}, {Kp, ScoleFE::kEIPitch}, {Kt, ScoleFE::kGJ}};
-  m.damping = {{reduce(damp_roll), ScoleFE::kDRoll}, {reduce(damp_pitch), ScoleFE::kDPitch}, {Kt, ScoleFE::kCTors}};
-  if (nact > 0) {
+  m.damping = {{reduce(o.damp_roll), ScoleFE::kDRoll}, {reduce(o.damp_pitch), ScoleFE::kDPitch}, {Kt, ScoleFE::kCTors}};
+  if (!fe.spec.actuator_locations.empty()) {
     m.stiffness.push_back({Ka, ScoleFE::kKActuator});
     m.damping.push_back({Ka, ScoleFE::kCActuator});
   }
+}
 
-  auto direction = [&](const std::vector<double>& d, const std::string& field) {
-    const Vector3d v = vec3(d);
-    if (!(v.norm() > 0.0)) fail_field(source, field, "must be given (x, y, z or a 3-vector)", "none");
-    return v;
-  };
-  auto check_station = [&](double s, const std::string& field) {
-    if (!(s >= 0.0 && s <= L))
-      fail_field(source, field, "must lie on the mast [0, " + format_value(L) + "]", format_value(s));
-  };
+Vector3d given_direction(const std::vector<double>& d, const std::string& source, const std::string& field) {
+  const Vector3d v = vec3(d);
+  if (!(v.norm() > 0.0)) fail_field(source, field, "must be given (x, y, z or a 3-vector)", "none");
+  return v;
+}
+void check_station(double s, double L, const std::string& source, const std::string& field) {
+  if (!(s >= 0.0 && s <= L)) fail_field(source, field, "must lie on the mast [0, " + format_value(L) + "]", format_value(s));
+}
 
+// The rows (3 × nfull) a point input acts through: its work is fᵀ (rows u) along its direction.
+MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& in, const Vector3d& d, const std::string& f,
+                    const std::string& source) {
+  const io::ScoleSpec& sc = fe.spec;
+  const int nact = static_cast<int>(sc.actuator_locations.size());
+  const double L = sc.length;
+  const bool moment = in.kind == "moment";
+  if (in.at == "shuttle") return moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
+  if (in.at == "reflector") return moment ? fr.rotation(L) : fr.reflector();
+  if (in.at == "mast") {
+    check_station(in.location, L, source, f + ".location");
+    return moment ? fr.rotation(in.location) : fr.displacement(in.location);
+  }
+  if (in.at == "actuator1" || in.at == "actuator2") {
+    const int k = in.at == "actuator1" ? 0 : 1;
+    if (k >= nact) fail_field(source, f + ".at", "names an actuator the configuration does not have", "'" + in.at + "'");
+    if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", "'" + in.kind + "'");
+    if (std::abs(d[2]) > 1e-12)
+      fail_field(source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
+    // Slider force: +f on the proof mass, −f on the mast at s_k.
+    MatrixXd rows = -fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
+    rows.row(2).setZero();
+    rows(0, full_proof(fe.elements, k, 0)) += 1.0;
+    rows(1, full_proof(fe.elements, k, 1)) += 1.0;
+    return rows;
+  }
+  fail_field(source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
+             "'" + in.at + "'");
+}
+
+// A rate sensor's row: velocity, d/dt of the displacement sensor's quantity (relative to the
+// shuttle frame; the shuttle's own CM in ground), a row on u̇; acceleration, the inertial
+// acceleration of the point along d (an accelerometer), the absolute displacement's row on ü.
+Eigen::RowVectorXd rate_sensor_row(const FullRows& fr, const io::SensorSpec& se, const Vector3d& d, int order, double L,
+                                   const std::string& f, const std::string& source) {
+  if (se.at != "shuttle" && se.at != "mast" && se.at != "reflector")
+    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
+  const bool mast = se.at == "mast";
+  if (mast) check_station(se.location, L, source, f + ".location");
+  const MatrixXd absolute = se.at == "shuttle" ? fr.shuttle_rigid(Vector3d::Zero())
+                            : mast           ? fr.displacement(se.location)
+                                             : fr.reflector();
+  const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
+  return d.transpose() * (order == 2 || se.at == "shuttle" ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
+}
+
+// A displacement, rotation or line-of-sight sensor's row on u: the shuttle's against ground, the
+// mast's and the reflector's relative to the shuttle frame.
+Eigen::RowVectorXd position_sensor_row(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const Vector3d& d,
+                                       const std::string& f, const std::string& source) {
+  const double L = fe.spec.length;
+  if (se.at == "shuttle") {
+    if (se.kind == "line_of_sight")
+      fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
+    return d.transpose() * (se.kind == "rotation" ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
+  }
+  if (se.at != "mast" && se.at != "reflector")
+    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
+  const bool mast = se.at == "mast";
+  if (mast) check_station(se.location, L, source, f + ".location");
+  const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
+  if (se.kind == "rotation") return d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
+  const MatrixXd rel = (mast ? fr.displacement(se.location) : fr.reflector()) - fr.shuttle_rigid(p0);
+  if (se.kind == "displacement") return d.transpose() * rel;
+  const Vector3d chord = p0 - vec3(fe.spec.mast_root);
+  const double ell = chord.norm();
+  if (!(ell > 0.0))
+    fail_field(source, f + ".location", "must be > 0 for a line of sight (the line starts at the root)",
+               format_value(se.location));
+  const Vector3d u0 = chord / ell;
+  return d.cross(u0).transpose() * rel / ell;
+}
+
+ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const std::string& f,
+                      const std::string& source) {
+  const Vector3d d = given_direction(se.direction, source, f + ".direction");
+  ModelSensor ms;
+  ms.name = se.name;
+  ms.kind = se.kind;
+  Eigen::RowVectorXd row;
+  if (se.kind == "velocity" || se.kind == "acceleration") {
+    ms.order = se.kind == "velocity" ? 1 : 2;
+    row = rate_sensor_row(fr, se, d, ms.order, fe.spec.length, f, source);
+  } else if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight") {
+    fail_field(source, f + ".kind",
+               "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
+               "'" + se.kind + "'");
+  } else {
+    row = position_sensor_row(fe, fr, se, d, f, source);
+  }
+  ms.row = row * fe.T;
+  return ms;
+}
+
+}  // namespace
+
+ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io::InputSpec>& inputs,
+                    const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+  check_spec(sc, elements, source);
+  ScoleFE fe;
+  fe.spec = sc;
+  fe.elements = elements;
+  fe.nfull = 6 + kNodeDofs * (elements + 1) + 2 * static_cast<int>(sc.actuator_locations.size());
+  order_dofs(fe);
+  const FullRows fr(sc, elements, fe.nfull);
+  FullOperators ops;
+  add_mast_elements(ops, sc, elements, fr);
+  add_bodies(ops, sc, elements, fr);
+  assemble_operators(fe, ops);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const auto& in = inputs[i];
     const std::string f = "inputs[" + std::to_string(i) + "]";
-    const Vector3d d = direction(in.direction, f + ".direction");
-    const bool moment = in.kind == "moment";
-    MatrixXd rows;
-    if (in.at == "shuttle") {
-      rows = moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
-    } else if (in.at == "reflector") {
-      rows = moment ? fr.rotation(L) : fr.reflector();
-    } else if (in.at == "mast") {
-      check_station(in.location, f + ".location");
-      rows = moment ? fr.rotation(in.location) : fr.displacement(in.location);
-    } else if (in.at == "actuator1" || in.at == "actuator2") {
-      const int k = in.at == "actuator1" ? 0 : 1;
-      if (k >= nact)
-        fail_field(source, f + ".at", "names an actuator the configuration does not have", "'" + in.at + "'");
-      if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", "'" + in.kind + "'");
-      if (std::abs(d[2]) > 1e-12)
-        fail_field(source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
-      // Slider force: +f on the proof mass, −f on the mast at s_k.
-      rows = -fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
-      rows.row(2).setZero();
-      rows(0, full_proof(ne, k, 0)) += 1.0;
-      rows(1, full_proof(ne, k, 1)) += 1.0;
-    } else {
-      fail_field(source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
-                 "'" + in.at + "'");
-    }
+    const Vector3d d = given_direction(inputs[i].direction, source, f + ".direction");
     ModelInput mi;
-    mi.name = in.name;
-    mi.vector = SparseMatrix(fe.T.transpose()) * (rows.transpose() * d);
-    m.inputs.push_back(std::move(mi));
+    mi.name = inputs[i].name;
+    mi.vector = SparseMatrix(fe.T.transpose()) * (input_rows(fe, fr, inputs[i], d, f, source).transpose() * d);
+    fe.model.inputs.push_back(std::move(mi));
   }
-
-  for (std::size_t k = 0; k < sensors.size(); ++k) {
-    const auto& se = sensors[k];
-    const std::string f = "sensors[" + std::to_string(k) + "]";
-    const Vector3d d = direction(se.direction, f + ".direction");
-    Eigen::RowVectorXd row;
-    int order = 0;
-    if (se.kind == "velocity" || se.kind == "acceleration") {
-      // velocity: d/dt of the displacement sensor's quantity (relative to the shuttle frame; the
-      // shuttle's own CM in ground), a row on u̇. acceleration: the inertial acceleration of the
-      // point along d (an accelerometer), the absolute displacement's row on ü.
-      order = se.kind == "velocity" ? 1 : 2;
-      if (se.at != "shuttle" && se.at != "mast" && se.at != "reflector")
-        fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
-      const bool mast = se.at == "mast";
-      if (mast) check_station(se.location, f + ".location");
-      const MatrixXd absolute = se.at == "shuttle" ? fr.shuttle_rigid(Vector3d::Zero())
-                                : mast           ? fr.displacement(se.location)
-                                                 : fr.reflector();
-      const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
-      row = d.transpose() * (order == 2 || se.at == "shuttle" ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
-    } else if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight") {
-      fail_field(source, f + ".kind",
-                 "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
-                 "'" + se.kind + "'");
-    } else if (se.at == "shuttle") {
-      if (se.kind == "line_of_sight")
-        fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
-      // Reference: ground; the shuttle's CM displacement and attitude.
-      row = d.transpose() * (se.kind == "rotation" ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
-    } else if (se.at == "mast" || se.at == "reflector") {
-      const bool mast = se.at == "mast";
-      if (mast) check_station(se.location, f + ".location");
-      const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
-      if (se.kind == "rotation") {
-        row = d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
-      } else {
-        // Displacement relative to the shuttle frame.
-        const MatrixXd rel = (mast ? fr.displacement(se.location) : fr.reflector()) - fr.shuttle_rigid(p0);
-        if (se.kind == "displacement") {
-          row = d.transpose() * rel;
-        } else {
-          const Vector3d chord = p0 - vec3(sc.mast_root);
-          const double ell = chord.norm();
-          if (!(ell > 0.0))
-            fail_field(source, f + ".location", "must be > 0 for a line of sight (the line starts at the root)",
-                       format_value(se.location));
-          const Vector3d u0 = chord / ell;
-          row = d.cross(u0).transpose() * rel / ell;
-        }
-      }
-    } else {
-      fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
-    }
-    ModelSensor ms;
-    ms.name = se.name;
-    ms.kind = se.kind;
-    ms.order = order;
-    ms.row = row * fe.T;
-    m.sensors.push_back(std::move(ms));
-  }
+  for (std::size_t k = 0; k < sensors.size(); ++k)
+    fe.model.sensors.push_back(sensor_of(fe, fr, sensors[k], "sensors[" + std::to_string(k) + "]", source));
   return fe;
 }
 

@@ -68,11 +68,11 @@ const std::map<std::string, Factory>& registry() {
 }  // namespace
 
 std::unique_ptr<FEStructure> make_structure(const io::Scenario& sc, int elements) {
-  const auto it = registry().find(sc.structure);
+  const auto it = registry().find(io::to_string(sc.structure));
   if (it == registry().end()) {
     std::string list;
     for (const auto& k : structure_kinds()) list += (list.empty() ? "" : "|") + k;
-    io::fail_field(sc.source, "structure", "is not supported by this identifier (" + list + ")", "'" + sc.structure + "'");
+    io::fail_field(sc.source, "structure", "is not supported by this identifier (" + list + ")", "'" + std::string(io::to_string(sc.structure)) + "'");
   }
   return it->second(sc, elements);
 }

@@ -15,10 +15,9 @@ bool OptimizerOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (method != "gauss-newton" && method != "gauss-newton-krylov" && method != "lbfgs" && method != "steepest-descent")
-    return bad("method must be gauss-newton, gauss-newton-krylov, lbfgs or steepest-descent");
+  if (method == io::Method::Auto) return bad("method auto must be resolved before the optimiser (run/strategy.h)");
   if (!(smoothness_weight >= 0)) return bad("smoothness_weight must be >= 0");
-  if (smoothness_weight > 0 && method != "gauss-newton-krylov" && method != "gauss-newton")
+  if (smoothness_weight > 0 && method != io::Method::GaussNewtonKrylov && method != io::Method::GaussNewton)
     return bad("the smoothness prior needs method gauss-newton or gauss-newton-krylov");
   if (!(max_krylov_iterations >= 1)) return bad("max_krylov_iterations must be >= 1");
   if (max_iterations < 0) return bad("max_iterations must be >= 0");
@@ -148,33 +147,39 @@ struct Smoothness {
   }
 };
 
-void gauss_newton(Run& r, VectorXd x) {
+// One trust-region loop for both Gauss–Newton methods (header): acceptance, radius, horizon
+// continuation and termination live here; the step is the strategy's (explicit Levenberg step,
+// gauss_newton_step.h, or truncated CG on matrix-free products). The point the loop stands on:
+struct Point {
+  double J = 0.0;   // cost with the prior's share, on the current horizon
+  double Jd = 0.0;  // the data's share (what the matrix-free strategy tracks)
+  VectorXd g;       // ∂J/∂x
+  MatrixXd H;       // the Gauss–Newton matrix in x (explicit strategy only)
+};
+
+class StepStrategy {
+public:
+  virtual ~StepStrategy() = default;
+  // J and g (and what the step needs) at x on the current horizon; false outside the model's
+  // domain. `with_profile`: the strategy may keep the misfit profile of this evaluation.
+  virtual bool evaluate(const VectorXd& x, Point& p, bool with_profile) = 0;
+  virtual void start(const Point&) {}
+  // The step from (x, p) inside `radius`; `lambda_floor` the Levenberg floor on a short horizon.
+  virtual TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double lambda_floor) = 0;
+  // After an accepted step whose decrease beat the prediction by `rho`: a longer step along it.
+  virtual void extrapolate(const VectorXd&, const TrustRegionStep&, double, bool, Point&, VectorXd&, double&) {}
+  // The misfit profile over the whole record at the accepted point x.
+  virtual Misfit::MisfitProfile accepted_profile(const VectorXd& x) = 0;
+  virtual const char* no_decrease() const = 0;
+  virtual double prior_cost(const VectorXd& x, const Point& p) const = 0;
+};
+
+void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   Misfit& obj = r.obj;
   const double t0 = obj.data_start(), t_end = obj.data_end();
-  auto choose_horizon = [&](const Misfit::MisfitProfile& p, double current) { return r.horizon_from(p, current); };
   const bool continuation = r.opt.continuation;
   auto full = [&]() { return obj.horizon() >= t_end; };
-
-  Misfit::MisfitProfile prof;
-  // With a smoothness prior (§7.8) its value, gradient and (constant) matrix are added to the
-  // data's: the Gauss–Newton model of the whole cost.
-  const Smoothness prior{r.opt.smoothness_weight, r.opt.smoothness_chains};
-  const MatrixXd prior_matrix = prior.matrix(x.size());
-  auto gn_at = [&](const VectorXd& xx, double& J, VectorXd& gx, MatrixXd& Hx, bool with_profile) {
-    try {
-      const VectorXd q = xx.array().exp();
-      VectorXd g;
-      MatrixXd H;
-      J = obj.gauss_newton(q, g, H, with_profile ? &prof : nullptr) + prior.value(xx);
-      gx = q.cwiseProduct(g) + prior.apply(xx);
-      Hx = q.asDiagonal() * H * q.asDiagonal() + prior_matrix;
-      return std::isfinite(J) && gx.allFinite() && Hx.allFinite();
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
-      return false;
-    }
-  };
+  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
   auto fail_start = [&]() {
     r.sum.termination = T::LineSearchFailed;
     r.sum.message = "cost cannot be evaluated at the starting point";
@@ -183,18 +188,17 @@ void gauss_newton(Run& r, VectorXd x) {
   obj.set_horizon(t_end);
   if (continuation) {
     try {
-      obj.set_horizon(choose_horizon(obj.misfit_profile(x.array().exp()), t0));
+      obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
     } catch (const io::Interrupted&) {
       throw;
     } catch (const std::exception&) {
       return fail_start();
     }
   }
-  double J;
-  VectorXd gx;
-  MatrixXd Hx;
-  if (!gn_at(x, J, gx, Hx, false)) return fail_start();
-  r.record(0, J, x.array().exp(), gx);
+  Point cur;
+  if (!s.evaluate(x, cur, false)) return fail_start();
+  r.record(0, cur.J, x.array().exp(), cur.g);
+  s.start(cur);
   double radius = r.opt.trust_radius;
   int k = 0;
   r.sum.termination = T::MaxIterations;
@@ -202,85 +206,49 @@ void gauss_newton(Run& r, VectorXd x) {
   auto extend = [&](double T_new) {
     if (full() || !(T_new > obj.horizon())) return false;
     obj.set_horizon(T_new);
-    if (!gn_at(x, J, gx, Hx, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    if (!s.evaluate(x, cur, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
     return true;
   };
   try {
     while (true) {
-      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
-        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
-        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+      if (cur.J <= r.opt.cost_floor || r.small_gradient(cur.g, cur.J)) {
+        if (extend(doubled())) continue;
+        r.sum.termination = cur.J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
         break;
       }
       if (k >= r.opt.max_iterations) break;
-      const TrustRegionStep st = trust_region_step(Hx, gx, radius, full() ? 0.0 : r.opt.short_horizon_floor * J);
-      double Jn;
-      VectorXd gn;
-      MatrixXd Hn;
+      const TrustRegionStep st = s.step(x, cur, radius, full() ? 0.0 : r.opt.short_horizon_floor * cur.J);
+      Point trial;
       const bool profile = continuation && !full();
-      const bool ok = gn_at(x + st.delta, Jn, gn, Hn, profile) && Jn < J;
-      const double rho = ok && st.predicted > 0 ? (J - Jn) / st.predicted : -1.0;
+      const bool ok = s.evaluate(x + st.delta, trial, profile) && trial.J < cur.J;
+      const double rho = ok && st.predicted > 0 ? (cur.J - trial.J) / st.predicted : -1.0;
       radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
       if (!ok) {
         if (radius < r.opt.step_tolerance) {
-          if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) {
+          if (extend(doubled())) {
             radius = r.opt.trust_radius;
             continue;
           }
           r.sum.termination = T::StepTolerance;
-          r.sum.message = "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
+          r.sum.message = s.no_decrease();
           break;
         }
         continue;
       }
-      // The cost fell by clearly more than the Gauss–Newton model predicted: the minimum along δ
-      // lies further out (the model's curvature along δ is too large — a curved valley, a large
-      // residual). Try 2δ, 4δ, … with one state solve each while the cost keeps falling.
       VectorXd delta = st.delta;
-      if (rho > r.opt.extrapolation_ratio) {
-        double best = 1.0, Jb = Jn;
-        for (double a = 2.0; a <= r.opt.max_extrapolation && a * st.delta.norm() <= r.opt.max_trust_radius; a *= 2.0) {
-          double Ja = 0.0;
-          try {
-            Ja = obj.cost((x + a * st.delta).array().exp()) + prior.value(x + a * st.delta);
-          } catch (const io::Interrupted&) {
-            throw;
-          } catch (const std::exception&) {
-            break;
-          }
-          if (!(Ja < Jb)) break;
-          best = a;
-          Jb = Ja;
-        }
-        if (best > 1.0) {
-          VectorXd g2;
-          MatrixXd H2;
-          double J2;
-          if (gn_at(x + best * st.delta, J2, g2, H2, profile) && J2 < Jn) {
-            delta = best * st.delta;
-            Jn = J2;
-            gn = g2;
-            Hn = H2;
-            radius = std::max(radius, std::min(delta.norm(), r.opt.max_trust_radius));
-          } else if (profile) {
-            gn_at(x + st.delta, Jn, gn, Hn, profile);  // restore the profile of the accepted point
-          }
-        }
-      }
-      x += delta;
+      if (rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
       const double step = delta.cwiseAbs().maxCoeff();
-      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
-      J = Jn;
-      gx = gn;
-      Hx = Hn;
+      const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
+      x += delta;
+      cur = std::move(trial);
       ++k;
       // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
       // with its cost on the horizon the next step is taken on.
-      const bool extended = profile && extend(choose_horizon(prof, obj.horizon()));
-      r.record(k, J, x.array().exp(), gx);
+      const bool extended = profile && extend(r.horizon_from(s.accepted_profile(x), obj.horizon()));
+      r.record(k, cur.J, x.array().exp(), cur.g);
       if (extended) continue;
       if (step < r.opt.step_tolerance || stalled) {
-        if (extend(std::min(t_end, obj.horizon() + (obj.horizon() - t0)))) continue;
+        if (extend(doubled())) continue;
         r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
         break;
       }
@@ -293,9 +261,116 @@ void gauss_newton(Run& r, VectorXd x) {
   }
   r.sum.iterations_done = k;
   r.sum.q = x.array().exp();
-  r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
-  r.sum.prior_cost = prior.value(x);
+  r.sum.cost = cur.J;  // on the last horizon (the whole record unless stopped early)
+  r.sum.prior_cost = s.prior_cost(x, cur);
   obj.set_horizon(t_end);
+}
+
+// Explicit Gauss–Newton: J, g and H from forward sensitivities at every trial point (the misfit
+// profile comes with the state solve); the Levenberg step of gauss_newton_step.h. With a
+// smoothness prior (§7.8) its value, gradient and (constant) matrix are added to the data's: the
+// Gauss–Newton model of the whole cost.
+class ExplicitStep final : public StepStrategy {
+public:
+  ExplicitStep(Run& r, Eigen::Index P)
+      : r_(r), prior_{r.opt.smoothness_weight, r.opt.smoothness_chains}, prior_matrix_(prior_.matrix(P)) {}
+  bool evaluate(const VectorXd& xx, Point& p, bool with_profile) override {
+    try {
+      const VectorXd q = xx.array().exp();
+      VectorXd g;
+      MatrixXd H;
+      p.J = r_.obj.gauss_newton(q, g, H, with_profile ? &prof_ : nullptr) + prior_.value(xx);
+      p.g = q.cwiseProduct(g) + prior_.apply(xx);
+      p.H = q.asDiagonal() * H * q.asDiagonal() + prior_matrix_;
+      return std::isfinite(p.J) && p.g.allFinite() && p.H.allFinite();
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  TrustRegionStep step(const VectorXd&, const Point& p, double radius, double lambda_floor) override {
+    return trust_region_step(p.H, p.g, radius, lambda_floor);
+  }
+  // The cost fell by clearly more than the Gauss–Newton model predicted: the minimum along δ lies
+  // further out (the model's curvature along δ is too large — a curved valley, a large residual).
+  // Try 2δ, 4δ, … with one state solve each while the cost keeps falling.
+  void extrapolate(const VectorXd& x, const TrustRegionStep& st, double, bool profile, Point& trial, VectorXd& delta,
+                   double& radius) override {
+    double best = 1.0, Jb = trial.J;
+    for (double a = 2.0; a <= r_.opt.max_extrapolation && a * st.delta.norm() <= r_.opt.max_trust_radius; a *= 2.0) {
+      double Ja = 0.0;
+      try {
+        Ja = r_.obj.cost((x + a * st.delta).array().exp()) + prior_.value(x + a * st.delta);
+      } catch (const io::Interrupted&) {
+        throw;
+      } catch (const std::exception&) {
+        break;
+      }
+      if (!(Ja < Jb)) break;
+      best = a;
+      Jb = Ja;
+    }
+    if (!(best > 1.0)) return;
+    Point far;
+    if (evaluate(x + best * st.delta, far, profile) && far.J < trial.J) {
+      delta = best * st.delta;
+      trial = std::move(far);
+      radius = std::max(radius, std::min(delta.norm(), r_.opt.max_trust_radius));
+    } else if (profile) {
+      evaluate(x + st.delta, trial, profile);  // restore the profile of the accepted point
+    }
+  }
+  Misfit::MisfitProfile accepted_profile(const VectorXd&) override { return prof_; }
+  const char* no_decrease() const override {
+    return "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
+  }
+  double prior_cost(const VectorXd& x, const Point&) const override { return prior_.value(x); }
+
+private:
+  Run& r_;
+  const Smoothness prior_;
+  const MatrixXd prior_matrix_;
+  Misfit::MisfitProfile prof_;
+};
+
+// The gradient methods' search direction in x = log q: the paper's fixed-weight update, steepest
+// descent, or the L-BFGS two-loop recursion over the stored pairs (s, y); a direction that does
+// not descend is replaced by the scaled negative gradient and the pairs are dropped.
+VectorXd lbfgs_direction(const VectorXd& x, const VectorXd& gx, std::deque<std::pair<VectorXd, VectorXd>>& mem, bool steepest,
+                         const VectorXd* weights, double alpha0) {
+  VectorXd d;
+  if (weights) {
+    // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
+    const VectorXd q = x.array().exp();
+    d = -(weights->array() * (gx.array() / q.array()) / q.array()).matrix();
+  } else if (steepest || mem.empty()) {
+    d = -gx;
+    if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
+    if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
+  } else {
+    // two-loop recursion
+    VectorXd qv = gx;
+    std::vector<double> al(mem.size());
+    for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
+      const auto& [s, y] = mem[static_cast<std::size_t>(i)];
+      al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
+      qv -= al[static_cast<std::size_t>(i)] * y;
+    }
+    const auto& [sl, yl] = mem.back();
+    qv *= sl.dot(yl) / yl.dot(yl);
+    for (std::size_t i = 0; i < mem.size(); ++i) {
+      const auto& [s, y] = mem[i];
+      const double b = y.dot(qv) / y.dot(s);
+      qv += (al[i] - b) * s;
+    }
+    d = -qv;
+  }
+  if (gx.dot(d) >= 0) {
+    mem.clear();
+    d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
+  }
+  return d;
 }
 
 void lbfgs(Run& r, VectorXd x, bool steepest) {
@@ -361,37 +436,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
         break;
       }
       if (k >= r.opt.max_iterations) break;
-      VectorXd d;
-      if (fixed_weights) {
-        // q ← q − w ∘ ∂J/∂q, taken in x = log q to first order: dx_i = −w_i ∂J/∂q_i / q_i.
-        const VectorXd q = x.array().exp();
-        d = -(w.array() * (gx.array() / q.array()) / q.array()).matrix();
-      } else if (steepest || mem.empty()) {
-        d = -gx;
-        if (mem.empty() && !steepest) d *= 0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff());
-        if (steepest) d *= alpha0 / std::max(1e-300, gx.cwiseAbs().maxCoeff()) * 0.1;
-      } else {
-        // two-loop recursion
-        VectorXd qv = gx;
-        std::vector<double> al(mem.size());
-        for (int i = static_cast<int>(mem.size()) - 1; i >= 0; --i) {
-          const auto& [s, y] = mem[static_cast<std::size_t>(i)];
-          al[static_cast<std::size_t>(i)] = s.dot(qv) / y.dot(s);
-          qv -= al[static_cast<std::size_t>(i)] * y;
-        }
-        const auto& [sl, yl] = mem.back();
-        qv *= sl.dot(yl) / yl.dot(yl);
-        for (std::size_t i = 0; i < mem.size(); ++i) {
-          const auto& [s, y] = mem[i];
-          const double b = y.dot(qv) / y.dot(s);
-          qv += (al[i] - b) * s;
-        }
-        d = -qv;
-      }
-      if (gx.dot(d) >= 0) {
-        mem.clear();
-        d = -gx * (0.1 / std::max(1e-300, gx.cwiseAbs().maxCoeff()));
-      }
+      VectorXd d = lbfgs_direction(x, gx, mem, steepest, fixed_weights ? &w : nullptr, alpha0);
       const double mx = d.cwiseAbs().maxCoeff();
       if (mx > 1.0) d *= 1.0 / mx;
       double a = 1.0, Jn = 0.0;
@@ -448,153 +493,90 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
 // curvature. Each CG iteration costs one product (a tangent and a costate solve); the number of
 // iterations follows the directions the data inform, not P. Horizon continuation as for the
 // gradient methods (one extra state solve per accepted step while the horizon is short).
-void gauss_newton_krylov(Run& r, VectorXd x) {
-  Misfit& obj = r.obj;
-  if (!obj.has_matrix_free_products())
-    throw std::invalid_argument("gauss-newton-krylov: velocity and acceleration sensors are not supported (use gauss-newton)");
-  const double t0 = obj.data_start(), t_end = obj.data_end();
-  const Smoothness prior{r.opt.smoothness_weight, r.opt.smoothness_chains};
-  const bool continuation = r.opt.continuation;
-  auto full = [&]() { return obj.horizon() >= t_end; };
-  double J = 0.0, Jd = 0.0;  // total and data misfit
-  VectorXd gx;
-  auto eval = [&](const VectorXd& xx, double& Jt, double& Jdata, VectorXd& g) {
-    if (!r.eval_grad(xx, Jdata, g)) return false;
-    Jt = Jdata + prior.value(xx);
-    g += prior.apply(xx);
-    return true;
-  };
-  auto extend = [&](double T_new) {
-    if (full() || !(T_new > obj.horizon())) return false;
-    obj.set_horizon(T_new);
-    if (!eval(x, J, Jd, gx)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
-    return true;
-  };
-  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
-  obj.set_horizon(t_end);
-  bool start_ok = true;
-  if (continuation) {
-    try {
-      obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
-      start_ok = false;
-    }
+class KrylovStep final : public StepStrategy {
+public:
+  explicit KrylovStep(Run& r) : r_(r), prior_{r.opt.smoothness_weight, r.opt.smoothness_chains} {
+    if (!r.obj.has_matrix_free_products())
+      throw std::invalid_argument(std::string(io::to_string(io::Method::GaussNewtonKrylov)) +
+                                  ": velocity and acceleration sensors are not supported (use " +
+                                  io::to_string(io::Method::GaussNewton) + ")");
   }
-  if (!start_ok || !eval(x, J, Jd, gx)) {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = "cost cannot be evaluated at the starting point";
-    r.sum.q = x.array().exp();
-    obj.set_horizon(t_end);
-    return;
+  bool evaluate(const VectorXd& xx, Point& p, bool) override {
+    if (!r_.eval_grad(xx, p.Jd, p.g)) return false;
+    p.J = p.Jd + prior_.value(xx);
+    p.g += prior_.apply(xx);
+    return true;
   }
-  r.record(0, J, x.array().exp(), gx);
-  const double g0 = gx.norm();
-  double radius = r.opt.trust_radius;
-  int k = 0;
-  r.sum.termination = T::MaxIterations;
-  // H_x y = q ∘ H_q (q ∘ y) + β LᵀL y
+  void start(const Point& p) override { g0_ = p.g.norm(); }
+  TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double) override;
+  Misfit::MisfitProfile accepted_profile(const VectorXd& x) override { return r_.obj.misfit_profile(x.array().exp()); }
+  const char* no_decrease() const override {
+    return "no decrease along the truncated Gauss-Newton step: at the minimum to integration accuracy";
+  }
+  double prior_cost(const VectorXd&, const Point& p) const override { return p.J - p.Jd; }
+
+private:
+  Run& r_;
+  const Smoothness prior_;
+  double g0_ = 0.0;
+};
+
+// Steihaug–Toint CG on H δ = −g inside ‖δ‖ <= radius, H_x y = q ∘ H_q (q ∘ y) + β LᵀL y.
+TrustRegionStep KrylovStep::step(const VectorXd& x, const Point& p, double radius, double) {
+  const VectorXd q = x.array().exp();
   auto product = [&](const VectorXd& y) {
-    const VectorXd q = x.array().exp();
-    return VectorXd(q.cwiseProduct(obj.gauss_newton_product(q, q.cwiseProduct(y))) + prior.apply(y));
+    return VectorXd(q.cwiseProduct(r_.obj.gauss_newton_product(q, q.cwiseProduct(y))) + prior_.apply(y));
   };
-  try {
-    while (true) {
-      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
-        if (extend(doubled())) continue;
-        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
-        break;
-      }
-      if (k >= r.opt.max_iterations) break;
-      // Steihaug–Toint CG on H δ = −g inside ‖δ‖ <= radius.
-      const double eta = std::min(0.5, std::sqrt(gx.norm() / std::max(g0, 1e-300)));
-      VectorXd delta = VectorXd::Zero(x.size()), res = gx, d = -gx;
-      bool boundary = false;
-      int cg = 0;
-      // In exact arithmetic CG ends within P iterations; beyond that the products' own error rules.
-      const int max_cg = std::min(r.opt.max_krylov_iterations, static_cast<int>(x.size()));
-      for (; cg < max_cg; ++cg) {
-        io::check_interrupt();
-        const VectorXd Hd = product(d);
-        ++r.sum.krylov_iterations;
-        const double curv = d.dot(Hd);
-        auto to_boundary = [&]() {
-          // τ >= 0 with ‖δ + τ d‖ = radius
-          const double a = d.squaredNorm(), b = 2 * delta.dot(d), c = delta.squaredNorm() - radius * radius;
-          const double tau = (-b + std::sqrt(std::max(0.0, b * b - 4 * a * c))) / (2 * a);
-          delta += tau * d;
-          res += tau * Hd;
-          boundary = true;
-        };
-        if (curv <= 0) {
-          to_boundary();
-          break;
-        }
-        const double alpha = res.squaredNorm() / curv;
-        if ((delta + alpha * d).norm() >= radius) {
-          to_boundary();
-          break;
-        }
-        const double rr = res.squaredNorm();
-        delta += alpha * d;
-        res += alpha * Hd;
-        if (res.norm() <= eta * gx.norm()) {
-          ++cg;
-          break;
-        }
-        d = -res + (res.squaredNorm() / rr) * d;
-      }
-      // m(0) − m(δ) = −(gᵀδ + ½ δᵀHδ) with Hδ = res − g.
-      const double predicted = -0.5 * (gx.dot(delta) + delta.dot(res));
-      double Jn = 0.0, Jdn = 0.0;
-      VectorXd gn;
-      const bool ok = eval(x + delta, Jn, Jdn, gn) && Jn < J;
-      const double rho = ok && predicted > 0 ? (J - Jn) / predicted : -1.0;
-      TrustRegionStep st;
-      st.delta = delta;
-      st.predicted = predicted;
-      st.on_boundary = boundary;
-      radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
-      if (!ok) {
-        if (radius < r.opt.step_tolerance) {
-          if (extend(doubled())) {
-            radius = r.opt.trust_radius;
-            continue;
-          }
-          r.sum.termination = T::StepTolerance;
-          r.sum.message = "no decrease along the truncated Gauss-Newton step: at the minimum to integration accuracy";
-          break;
-        }
-        continue;
-      }
-      const double step = delta.cwiseAbs().maxCoeff();
-      const bool stalled = J - Jn <= r.gauss_newton_stall() * J;
-      x += delta;
-      J = Jn;
-      Jd = Jdn;
-      gx = gn;
-      ++k;
-      const bool extended = continuation && !full() && extend(r.horizon_from(obj.misfit_profile(x.array().exp()), obj.horizon()));
-      r.record(k, J, x.array().exp(), gx);
-      if (extended) continue;
-      if (step < r.opt.step_tolerance || stalled) {
-        if (extend(doubled())) continue;
-        r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
-        break;
-      }
+  const VectorXd& gx = p.g;
+  const double eta = std::min(0.5, std::sqrt(gx.norm() / std::max(g0_, 1e-300)));
+  VectorXd delta = VectorXd::Zero(x.size()), res = gx, d = -gx;
+  bool boundary = false;
+  // In exact arithmetic CG ends within P iterations; beyond that the products' own error rules.
+  const int max_cg = std::min(r_.opt.max_krylov_iterations, static_cast<int>(x.size()));
+  for (int cg = 0; cg < max_cg; ++cg) {
+    io::check_interrupt();
+    const VectorXd Hd = product(d);
+    ++r_.sum.krylov_iterations;
+    const double curv = d.dot(Hd);
+    auto to_boundary = [&]() {
+      // τ >= 0 with ‖δ + τ d‖ = radius
+      const double a = d.squaredNorm(), b = 2 * delta.dot(d), c = delta.squaredNorm() - radius * radius;
+      const double tau = (-b + std::sqrt(std::max(0.0, b * b - 4 * a * c))) / (2 * a);
+      delta += tau * d;
+      res += tau * Hd;
+      boundary = true;
+    };
+    if (curv <= 0) {
+      to_boundary();
+      break;
     }
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = e.what();
+    const double alpha = res.squaredNorm() / curv;
+    if ((delta + alpha * d).norm() >= radius) {
+      to_boundary();
+      break;
+    }
+    const double rr = res.squaredNorm();
+    delta += alpha * d;
+    res += alpha * Hd;
+    if (res.norm() <= eta * gx.norm()) break;
+    d = -res + (res.squaredNorm() / rr) * d;
   }
-  r.sum.iterations_done = k;
-  r.sum.q = x.array().exp();
-  r.sum.cost = J;
-  r.sum.prior_cost = J - Jd;
-  obj.set_horizon(t_end);
+  TrustRegionStep st;
+  // m(0) − m(δ) = −(gᵀδ + ½ δᵀHδ) with Hδ = res − g.
+  st.predicted = -0.5 * (gx.dot(delta) + delta.dot(res));
+  st.delta = std::move(delta);
+  st.on_boundary = boundary;
+  return st;
+}
+
+void gauss_newton(Run& r, VectorXd x) {
+  ExplicitStep s(r, x.size());
+  trust_region(r, std::move(x), s);
+}
+
+void gauss_newton_krylov(Run& r, VectorXd x) {
+  KrylovStep s(r);
+  trust_region(r, std::move(x), s);
 }
 
 }  // namespace
@@ -611,9 +593,13 @@ OptimizerSummary minimize(Misfit& objective, const VectorXd& q0, const Optimizer
     Misfit& o;
     ~HorizonGuard() { o.set_horizon(o.data_end()); }
   } guard{objective};
-  if (options.method == "gauss-newton") gauss_newton(r, x0);
-  else if (options.method == "gauss-newton-krylov") gauss_newton_krylov(r, x0);
-  else lbfgs(r, x0, options.method == "steepest-descent");
+  switch (options.method) {
+    case io::Method::GaussNewton: gauss_newton(r, x0); break;
+    case io::Method::GaussNewtonKrylov: gauss_newton_krylov(r, x0); break;
+    case io::Method::Lbfgs:
+    case io::Method::SteepestDescent: lbfgs(r, x0, options.method == io::Method::SteepestDescent); break;
+    case io::Method::Auto: break;  // refused by IsValid
+  }
   r.sum.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r.sum;
 }

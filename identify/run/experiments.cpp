@@ -1,4 +1,6 @@
 #include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/run/assessment.h"
+#include "scoleid/identify/run/strategy.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -152,12 +154,12 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     if (sc.identification.smoothness != 0.0)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario", "sets identification.smoothness, which a joint run does not take",
           r.scenario);
-    if (sc.identification.start != "auto")
+    if (sc.identification.start != io::Start::Auto)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           "sets identification.start, which a joint run does not take (it starts plain, without restarts)", r.scenario);
-    if (sc.identification.model != "linear")
+    if (sc.identification.model != io::Model::Linear)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
-          "sets identification.model: " + sc.identification.model + ", which a joint run does not take (linear model only)",
+          std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",
           r.scenario);
     ep->runs.push_back(make_problem(sc, r.data));
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
@@ -210,6 +212,68 @@ bool ExperimentsResult::converged() const {
   return true;
 }
 
+namespace {
+
+// A time run's part of the joint result at the estimate: its fit test, residual RMS per sensor and,
+// with compute_std, its own Fisher information.
+FisherInformation time_experiment(Problem& p, Objective& obj, const VectorXd& estimate, bool compute_std,
+                                  ExperimentsResult::Experiment& x) {
+  FisherInformation fi;
+  x.kind = "time";
+  x.data_source = p.data_source;
+  x.data_values = static_cast<long>(p.data.t.size()) * p.data.sensors();
+  const FitTest f = test_fit(p, obj, estimate);
+  x.explains_data = f.explains_data;
+  x.fit_message = f.message;
+  for (const auto& s : f.sensors) {
+    x.channels.push_back(s.name);
+    x.residual_rms.push_back(s.rms_residual);
+  }
+  if (compute_std) {
+    fi = fisher_information(obj, sensors_with_noise(p), estimate);
+  }
+  x.counters = obj.counters();
+  return fi;
+}
+
+// The modal data's part: χ² against its degrees of freedom, and its Fisher information.
+FisherInformation modal_experiment(ModalMisfit& modal, const io::ModalData& modes, const std::string& file, int components,
+                                   int parameters, const VectorXd& estimate, bool compute_std,
+                                   ExperimentsResult::Experiment& x) {
+  FisherInformation fi;
+  x.kind = "modal";
+  x.data_source = file;
+  VectorXd res;
+  modal.residuals(estimate, res);
+  const auto N = static_cast<double>(res.size());
+  x.data_values = static_cast<long>(res.size());
+  const double chi2 = res.squaredNorm();
+  // Degrees of freedom: a unit-normalised shape's residual has one component fewer than its
+  // stations (it is orthogonal to the shape to first order); with the modes the only data the
+  // P fitted parameters take P more.
+  const double shapes = modes.has_shapes() ? static_cast<double>(modes.modes.size()) : 0.0;
+  const double nu = std::max(1.0, N - shapes - (components == 1 ? static_cast<double>(parameters) : 0.0));
+  x.explains_data = chi2 <= nu + 3.0 * std::sqrt(2.0 * nu);
+  char buf[240];
+  std::snprintf(buf, sizeof buf, "chi2 %.4g over %ld modal residuals, %.0f degrees of freedom (band up to %.4g)%s", chi2,
+                x.data_values, nu, nu + 3.0 * std::sqrt(2.0 * nu),
+                x.explains_data ? "" : ": the modes are not explained within their stated uncertainties");
+  x.fit_message = buf;
+  x.channels.push_back("all (in stated stds)");
+  x.residual_rms.push_back(N > 0 ? std::sqrt(chi2 / N) : 0.0);
+  if (compute_std) {
+    fi.F = modal.fisher(estimate);
+    fi.chi2 = chi2;
+    fi.data_values = x.data_values;
+    fi.systematic = std::max(0.0, chi2 - nu - 2.0 * std::sqrt(2.0 * nu));
+    fi.stated_noise = true;
+    fi.noise_std.clear();
+  }
+  return fi;
+}
+
+}  // namespace
+
 ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo) {
   const auto t_start = std::chrono::steady_clock::now();
   ExperimentsResult r;
@@ -241,18 +305,12 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   JointMisfit joint(parts, jo);
   r.threads = joint.threads();
 
-  std::string method = eo.method.empty() ? lead.identification.method : eo.method;
-  if (method == "auto") method = params.size() <= 16 ? "gauss-newton" : "lbfgs";
-  if (method == "gauss-newton-krylov" && !joint.has_matrix_free_products())
-    bad(ep.spec.source, "method", "gauss-newton-krylov needs displacement sensors only in every run", method);
-  r.method = method;
-  OptimizerOptions oo;
-  oo.method = method;
-  oo.max_iterations = eo.max_iterations.value_or(lead.identification.max_iterations);
-  oo.gradient_tolerance = lead.identification.gradient_tolerance;
-  oo.step_tolerance = lead.identification.step_tolerance;
-  oo.continuation = lead.identification.continuation_misfit > 0;
-  if (oo.continuation) oo.continuation_misfit = lead.identification.continuation_misfit;
+  // A joint run takes no smoothness prior (refused by make_experiments).
+  r.method = resolve_method(eo.method.value_or(lead.identification.method), params.size(), false,
+                            joint.has_matrix_free_products());
+  if (r.method == io::Method::GaussNewtonKrylov && !joint.has_matrix_free_products())
+    bad(ep.spec.source, "method", "needs displacement sensors only in every run", io::to_string(r.method));
+  const OptimizerOptions oo = optimizer_options(lead.identification, r.method, params.size(), eo.max_iterations, lead.source);
   if (eo.verbose) {
     std::printf("%5s", "iter");
     for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) std::printf(" %13s", r.names[i].c_str());
@@ -285,56 +343,12 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
     x.name = joint.name(e);
     x.cost = joint.last_costs()[static_cast<std::size_t>(e)];
     x.share = J > 0 ? x.cost / J : 0.0;
-    FisherInformation fi;
-    if (e < static_cast<int>(ep.runs.size())) {
-      Problem& p = *ep.runs[static_cast<std::size_t>(e)];
-      Objective& obj = *objs[static_cast<std::size_t>(e)];
-      x.kind = "time";
-      x.data_source = p.data_source;
-      x.data_values = static_cast<long>(p.data.t.size()) * p.data.sensors();
-      const FitTest f = test_fit(p, obj, r.estimate);
-      x.explains_data = f.explains_data;
-      x.fit_message = f.message;
-      for (const auto& s : f.sensors) {
-        x.channels.push_back(s.name);
-        x.residual_rms.push_back(s.rms_residual);
-      }
-      if (eo.compute_std) {
-        std::vector<io::SensorSpec> sensors = p.scenario.sensors;
-        for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
-        fi = fisher_information(obj, sensors, r.estimate);
-      }
-      x.counters = obj.counters();
-    } else {
-      x.kind = "modal";
-      x.data_source = *ep.spec.modes_file;
-      VectorXd res;
-      modal->residuals(r.estimate, res);
-      const auto N = static_cast<double>(res.size());
-      x.data_values = static_cast<long>(res.size());
-      const double chi2 = res.squaredNorm();
-      // Degrees of freedom: a unit-normalised shape's residual has one component fewer than its
-      // stations (it is orthogonal to the shape to first order); with the modes the only data the
-      // P fitted parameters take P more.
-      const double shapes = ep.modes->has_shapes() ? static_cast<double>(ep.modes->modes.size()) : 0.0;
-      const double nu = std::max(1.0, N - shapes - (joint.components() == 1 ? static_cast<double>(params.size()) : 0.0));
-      x.explains_data = chi2 <= nu + 3.0 * std::sqrt(2.0 * nu);
-      char buf[240];
-      std::snprintf(buf, sizeof buf, "chi2 %.4g over %ld modal residuals, %.0f degrees of freedom (band up to %.4g)%s", chi2,
-                    x.data_values, nu, nu + 3.0 * std::sqrt(2.0 * nu),
-                    x.explains_data ? "" : ": the modes are not explained within their stated uncertainties");
-      x.fit_message = buf;
-      x.channels.push_back("all (in stated stds)");
-      x.residual_rms.push_back(N > 0 ? std::sqrt(chi2 / N) : 0.0);
-      if (eo.compute_std) {
-        fi.F = modal->fisher(r.estimate);
-        fi.chi2 = chi2;
-        fi.data_values = x.data_values;
-        fi.systematic = std::max(0.0, chi2 - nu - 2.0 * std::sqrt(2.0 * nu));
-        fi.stated_noise = true;
-        fi.noise_std.clear();
-      }
-    }
+    const auto u = static_cast<std::size_t>(e);
+    const FisherInformation fi =
+        e < static_cast<int>(ep.runs.size())
+            ? time_experiment(*ep.runs[u], *objs[u], r.estimate, eo.compute_std, x)
+            : modal_experiment(*modal, *ep.modes, *ep.spec.modes_file, joint.components(), params.size(), r.estimate,
+                               eo.compute_std, x);
     if (eo.compute_std) {
       x.alone = identifiability_from(fi, r.estimate);
       if (x.kind == "modal") x.alone.noise_source = "the modal data file's stds";
@@ -371,7 +385,7 @@ nlohmann::json ExperimentsResult::to_json() const {
   };
   json out;
   out["experiments"] = name;
-  out["method"] = method;
+  out["method"] = io::to_string(method);
   out["weighting"] = weighting;
   out["threads"] = threads;
   out["converged"] = converged();

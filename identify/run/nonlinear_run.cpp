@@ -11,7 +11,9 @@
 #include <tuple>
 
 #include "scoleid/identify/inverse/nonlinear_objective.h"
+#include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
@@ -57,58 +59,30 @@ FitTest nonlinear_fit(const Problem& p, NonlinearObjective& obj, const VectorXd&
   return fit_test(in);
 }
 
-}  // namespace
-
-RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto& id = p.scenario.identification;
-  RunResult r;
-  r.model = "nonlinear";
-  r.scenario = p.scenario.name;
-  r.names = p.params->names();
-  r.initial = p.params->initial();
-  r.truth = p.true_values;
-  std::string method = ro.method.empty() ? id.method : ro.method;
-  if (method == "auto") method = "gauss-newton";
-  if (method == "gauss-newton-krylov")
-    io::fail_field(p.scenario.source, "identification.method",
-                   "'gauss-newton-krylov' needs matrix-free products, which the nonlinear model does not offer", method);
-  if (id.smoothness != 0.0)
-    io::fail_field(p.scenario.source, "identification.smoothness", "is not available with the nonlinear model",
-                   id.smoothness < 0 ? "discrepancy" : io::format_value(id.smoothness));
-  r.method = method;
-  const ScoleNonlinear model = scole_nonlinear(p.scenario, p.structure->elements());
+// One nonlinear run's model, objective and table.
+struct NonlinearRun {
+  const Problem& p;
+  const ScoleNonlinear model;
   NonlinearForwardOptions fo;
-  fo.max_step = p.objective_options.solver.step > 0 ? p.objective_options.solver.step
-                                                    : (p.data.t[1] - p.data.t[0]) / 4.0;
-  NonlinearObjective obj(model, *p.params, p.signals, p.data, fo);
+  NonlinearObjective obj;
+  bool verbose;
+  RunResult& r;
+  NonlinearRun(const Problem& problem, const NonlinearForwardOptions& options, bool verbose_, RunResult& result)
+      : p(problem), model(scole_nonlinear(problem.scenario, problem.structure->elements())), fo(options),
+        obj(model, *problem.params, problem.signals, problem.data, options), verbose(verbose_), r(result) {}
 
-  OptimizerOptions oo;
-  oo.method = method;
-  oo.max_iterations = ro.max_iterations.value_or(id.max_iterations);
-  oo.gradient_tolerance = id.gradient_tolerance;
-  oo.step_tolerance = id.step_tolerance;
-  oo.steepest_weights = id.steepest_weights;
-  oo.continuation = id.continuation_misfit > 0;
-  if (oo.continuation) oo.continuation_misfit = id.continuation_misfit;
-  if (!oo.steepest_weights.empty() && static_cast<int>(oo.steepest_weights.size()) != p.params->size())
-    io::fail_field(p.scenario.source, "identification.steepest_weights",
-                   "must hold one weight per estimated parameter (" + std::to_string(p.params->size()) + ")",
-                   std::to_string(oo.steepest_weights.size()) + " values");
-  auto progress = [&](const IterationRecord& rec) {
+  void progress(const IterationRecord& rec) const {
     io::check_interrupt();
-    if (ro.verbose) {
-      std::printf("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
-      for (std::size_t i = 0; i < r.names.size(); ++i)
-        std::printf("  %s = %.7g", r.names[i].c_str(), rec.q[static_cast<Eigen::Index>(i)]);
-      std::printf("\n");
-      std::fflush(stdout);
-    }
-  };
-  if (ro.verbose)
-    std::printf("nonlinear model: %d elastic DOFs, step %.4g s, %s\n", model.elastic(), fo.max_step, method.c_str());
-  auto attempt = [&](const std::string& label, const OptimizerOptions& o) {
-    OptimizerSummary s = minimize(obj, r.initial, o, progress);
+    if (!verbose) return;
+    std::printf("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
+    for (std::size_t i = 0; i < r.names.size(); ++i) std::printf("  %s = %.7g", r.names[i].c_str(), rec.q[static_cast<Eigen::Index>(i)]);
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+
+  // One attempt from the starting values; appended to r.attempts.
+  std::tuple<OptimizerSummary, FitTest, MatrixXd> attempt(const std::string& label, const OptimizerOptions& o) {
+    OptimizerSummary s = minimize(obj, r.initial, o, [this](const IterationRecord& rec) { progress(rec); });
     MatrixXd pred;
     const FitTest f = nonlinear_fit(p, obj, s.q, fo, pred);
     RunResult::Attempt a;
@@ -134,44 +108,36 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
     a.fit_message = f.message;
     r.attempts.push_back(a);
     return std::make_tuple(s, f, pred);
-  };
-  {
-    auto [s, f, pred] = attempt("plain " + method, oo);
-    r.summary = s;
-    r.fit = f;
-    r.predicted = pred;
   }
-  // A false convergence: one more attempt with a horizon continuation four times as cautious.
-  if (id.restarts > 0 && r.summary.converged() && !r.fit.explains_data) {
-    OptimizerOptions oc = oo;
-    oc.continuation = true;
-    oc.continuation_misfit = (id.continuation_misfit > 0 ? id.continuation_misfit : OptimizerOptions{}.continuation_misfit) / 4.0;
-    if (ro.verbose) std::printf("fit test: %s\nrestart (cautious continuation)\n", r.fit.message.c_str());
-    auto [s, f, pred] = attempt(oc.method + ", horizon continuation at misfit " + io::format_value(oc.continuation_misfit), oc);
-    if (better_attempt(r.attempts.back(), r.attempts.front())) {
-      r.chosen_attempt = 1;
-      r.summary = s;
-      r.fit = f;
-      r.predicted = pred;
+
+  // The plain attempt, and after a false convergence one with a cautious horizon continuation.
+  void attempts(const OptimizerOptions& oo) {
+    const auto& id = p.scenario.identification;
+    std::tie(r.summary, r.fit, r.predicted) = attempt(std::string("plain ") + io::to_string(oo.method), oo);
+    if (id.restarts > 0 && r.summary.converged() && !r.fit.explains_data) {
+      const OptimizerOptions oc = cautious_continuation(oo, id);
+      if (verbose) std::printf("fit test: %s\nrestart (cautious continuation)\n", r.fit.message.c_str());
+      auto [s, f, pred] = attempt(cautious_continuation_label(oc), oc);
+      if (better_attempt(r.attempts.back(), r.attempts.front())) {
+        r.chosen_attempt = 1;
+        r.summary = s;
+        r.fit = f;
+        r.predicted = pred;
+      }
     }
+    r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;
+    if (verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
   }
-  r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;
-  if (ro.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
-  r.estimate = r.summary.q;
-  if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) {
-    // Fisher information from differenced output sensitivities (2P forward runs), each sensor's
-    // stated noise or, without one, its residual RMS (identifiability.h).
+
+  // Fisher information from differenced output sensitivities (2P forward runs), each sensor's
+  // stated noise or, without one, its residual RMS (identifiability.h); the interval from it and
+  // the half-record refit, unless uncertainties are declared (not propagated through this model).
+  void assess(const OptimizerOptions& oo) {
     const auto ti = std::chrono::steady_clock::now();
-    std::vector<io::SensorSpec> sensors = p.scenario.sensors;
-    for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
     obj.set_horizon(obj.data_end());
-    const FisherInformation fi = fisher_information(p.data, r.predicted, obj.output_sensitivities(r.estimate), sensors);
+    const FisherInformation fi = fisher_information(p.data, r.predicted, obj.output_sensitivities(r.estimate), sensors_with_noise(p));
     r.ident = identifiability_from(fi, r.estimate);
-    if (r.ident.noise_source == "scenario") {
-      std::string origin;
-      for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
-      r.ident.noise_source = origin;
-    }
+    r.ident.noise_source = noise_origin(p, r.ident.noise_source);
     if (!p.scenario.identification.uncertain.empty()) {
       r.interval.note =
           "no uncertainty interval: declared uncertainties (identification.uncertain) are not propagated through the "
@@ -195,7 +161,33 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
     }
     r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
   }
-  r.counters = obj.counters();
+};
+
+}  // namespace
+
+RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto& id = p.scenario.identification;
+  RunResult r = start_result(p, io::Model::Nonlinear);
+  // The nonlinear model has no matrix-free products and takes no smoothness prior.
+  r.method = resolve_method(ro.method.value_or(id.method), p.params->size(), false, false);
+  if (r.method == io::Method::GaussNewtonKrylov)
+    io::fail_field(p.scenario.source, "identification.method",
+                   "'gauss-newton-krylov' needs matrix-free products, which the nonlinear model does not offer",
+                   io::to_string(r.method));
+  if (id.smoothness != 0.0)
+    io::fail_field(p.scenario.source, "identification.smoothness", "is not available with the nonlinear model",
+                   id.smoothness < 0 ? "discrepancy" : io::format_value(id.smoothness));
+  NonlinearForwardOptions fo;
+  fo.max_step = p.objective_options.solver.step > 0 ? p.objective_options.solver.step : (p.data.t[1] - p.data.t[0]) / 4.0;
+  NonlinearRun run(p, fo, ro.verbose, r);
+  const OptimizerOptions oo = optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source);
+  if (ro.verbose)
+    std::printf("nonlinear model: %d elastic DOFs, step %.4g s, %s\n", run.model.elastic(), fo.max_step, io::to_string(r.method));
+  run.attempts(oo);
+  r.estimate = r.summary.q;
+  if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) run.assess(oo);
+  r.counters = run.obj.counters();
   r.integrator_step = fo.max_step;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -181,7 +181,7 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   // Resolve (ω h <= 0.3) modes 1 … K, K = min(P + 2, modes below Nyquist) (data_content): an
   // L-stable step damps what it does not resolve, keeping its quasi-static part.
   const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
-                                           sc.identification.step_rule == "data");
+                                           sc.identification.step_rule == io::StepRule::Data);
   const double w = content.omega;
   double h = sc.simulation.sample_interval;
   if (w > 0) h = std::min(h, 0.3 / w);
@@ -218,12 +218,12 @@ void check_step(const io::Scenario& sc, const StructuralModel& model, const Para
                                            : std::to_string(id.elements) + " (automatic time step " + io::format_value(h) + ")";
   if (id.time_step > 0 && id.integrator != "bdf") {
     const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
-                                             id.step_rule == "data");
+                                             id.step_rule == io::StepRule::Data);
     const double w = content.omega;
     if (w * h > 1.0)
       fail_field(sc.source, "identification.time_step",
                  "must resolve flexible mode " + std::to_string(content.mode) +
-                     (id.step_rule == "data" ? std::string(" = the highest the data visibly contain (")
+                     (id.step_rule == io::StepRule::Data ? std::string(" = the highest the data visibly contain (")
                                              : std::string(" = min(P + 2, modes below Nyquist) (")) +
                      io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
                      io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
@@ -328,8 +328,8 @@ Measurements synthesize_nonlinear(const io::Scenario& sc, int elements, double s
 }
 
 ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
-  if (sc.structure != "scole")
-    fail_field(sc.source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'" + sc.structure + "'");
+  if (sc.structure != io::Structure::Scole)
+    fail_field(sc.source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'" + std::string(io::to_string(sc.structure)) + "'");
   if (sc.identification.sections > 0)
     fail_field(sc.source, "identification.sections", "is not available with the nonlinear model (model: nonlinear)",
                std::to_string(sc.identification.sections));
@@ -337,23 +337,25 @@ ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
   return ScoleNonlinear(fe, sc.inputs, sc.sensors);
 }
 
-std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
+namespace {
+
+// The true values of the estimated parameters for a structure (the truth's), translated to the
+// problem's parameterization.
+void set_true_values(Problem& p, const io::Scenario& truth_sc) {
+  const VectorXd tv = p.structure->parameterize(truth_sc)->truth();
+  for (int i = 0; i < tv.size(); ++i)
+    if (std::isfinite(tv[i])) p.true_values[p.params->names()[static_cast<std::size_t>(i)]] = tv[i];
+}
+
+// The structure, its parameters, the scenario's signals and the stated noise levels.
+std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc) {
   if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
   if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
   auto p = std::make_unique<Problem>();
   p->scenario = sc;
-  const auto& id = sc.identification;
-  p->structure = make_structure(sc, id.elements);
+  p->structure = make_structure(sc, sc.identification.elements);
   p->params = p->structure->parameterize(sc);
-  // True values of the estimated parameters for a structure (the truth's), translated to this
-  // parameterization.
-  const auto set_true_values = [&](const io::Scenario& truth_sc) {
-    const VectorXd tv = p->structure->parameterize(truth_sc)->truth();
-    for (int i = 0; i < tv.size(); ++i)
-      if (std::isfinite(tv[i])) p->true_values[p->params->names()[static_cast<std::size_t>(i)]] = tv[i];
-  };
   p->signals = scenario_signals(sc);
-
   p->noise_std.assign(sc.sensors.size(), 0.0);
   p->noise_origin.assign(sc.sensors.size(), "");
   for (std::size_t j = 0; j < sc.sensors.size(); ++j)
@@ -361,149 +363,196 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       p->noise_std[j] = sc.sensors[j].noise_std;
       p->noise_origin[j] = "scenario";
     }
-  // The identifier's step (each call solves an eigenproblem): once, from the inputs as they will
-  // drive the model (a data column replaces a scenario signal).
-  double step = 0.0;
-  if (data_csv) {
-    const io::DataTable tab = io::read_csv(*data_csv);
-    // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
-    const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
-    std::map<std::string, double> meta_truth;
-    if (std::filesystem::exists(meta_path)) {
-      const io::TruthMeta meta = io::read_truth_meta(meta_path.string());
-      meta_truth = meta.true_parameters;
-      // The two files must come from one run: the same columns.
-      std::vector<std::string> described;
-      for (const auto& c : meta.columns) described.push_back(c.name);
-      for (const auto& n : tab.names)
-        if (std::find(described.begin(), described.end(), n) == described.end())
-          throw InputError(meta_path.string() + ": does not describe column '" + n + "' of data file '" + *data_csv +
-                           "'; the two files are not from the same run");
-      for (const auto& n : described)
-        if (tab.find(n) < 0)
-          throw InputError(meta_path.string() + ": describes column '" + n + "', which data file '" + *data_csv +
-                           "' lacks; the two files are not from the same run");
-      for (const auto& c : meta.columns) {
-        for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-          const auto& s = sc.sensors[j];
-          if (s.name != c.name) continue;
-          if (c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
-            throw InputError(meta_path.string() + ": column '" + c.name + "' is a " + c.quantity +
-                             " but the scenario's sensor is a " + s.kind);
-          if (p->noise_std[j] <= 0 && c.noise_std > 0) {
-            p->noise_std[j] = c.noise_std;
-            p->noise_origin[j] = "truth.json";
-          }
-        }
-      }
-    }
-    p->data.t = tab.t;
-    p->data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
+  return p;
+}
+
+// Truth metadata beside the data (truth.json): the two must describe the same columns; its noise
+// levels stand for sensors without a stated one. Returns its true parameters.
+std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& tab, const std::string& csv,
+                                               const io::TruthMeta& meta, const std::string& meta_path) {
+  const auto& sc = p.scenario;
+  std::vector<std::string> described;
+  for (const auto& c : meta.columns) described.push_back(c.name);
+  for (const auto& n : tab.names)
+    if (std::find(described.begin(), described.end(), n) == described.end())
+      throw InputError(meta_path + ": does not describe column '" + n + "' of data file '" + csv +
+                       "'; the two files are not from the same run");
+  for (const auto& n : described)
+    if (tab.find(n) < 0)
+      throw InputError(meta_path + ": describes column '" + n + "', which data file '" + csv +
+                       "' lacks; the two files are not from the same run");
+  for (const auto& c : meta.columns)
     for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-      const int col = tab.find(sc.sensors[j].name);
-      if (col < 0)
-        throw InputError("data file '" + *data_csv + "': no column for sensor '" + sc.sensors[j].name +
-                         "' (sensors[" + std::to_string(j) + "] of " + sc.source + ")");
-      for (std::size_t k = 0; k < tab.t.size(); ++k)
-        p->data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
-      p->data.names.push_back(sc.sensors[j].name);
-    }
-    std::vector<bool> used(tab.names.size(), false);
-    for (const auto& s : sc.sensors) {
-      used[static_cast<std::size_t>(tab.find(s.name))] = true;
-      p->columns.sensors.push_back(s.name);
-    }
-    for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
-      const auto& in = sc.inputs[i];
-      const int col = tab.find(in.name);
-      const std::string field = "inputs[" + std::to_string(i) + "]";
-      if (in.signal_from == "data" && col < 0)
-        throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' (" + field +
-                         ".signal_from is data, in " + sc.source + ")");
-      if (in.signal_from != "scenario" && col >= 0) {
-        const auto& f = tab.columns[static_cast<std::size_t>(col)];
-        p->signals[i] = io::Signal::table(tab.t, f);
-        used[static_cast<std::size_t>(col)] = true;
-        p->columns.inputs_from_data.push_back(in.name);
-        const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
-        ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
-        for (std::size_t k = 1; k < f.size(); ++k)
-          if (std::abs(f[k] - f[k - 1]) > st.jump) {
-            st.jump = std::abs(f[k] - f[k - 1]);
-            st.at = tab.t[k];
-            st.sample = tab.t[k] - tab.t[k - 1];
-          }
-        if (*hi > *lo && st.jump > 0.25 * (*hi - *lo)) p->columns.stepped_inputs.push_back(st);
-      } else {
-        if (in.signal.terms().empty())
-          throw InputError("data file '" + *data_csv + "': no column for input '" + in.name + "' and " + field +
-                           " of " + sc.source + " gives no signal");
-        p->columns.inputs_from_scenario.push_back(in.name);
+      const auto& s = sc.sensors[j];
+      if (s.name != c.name) continue;
+      if (c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
+        throw InputError(meta_path + ": column '" + c.name + "' is a " + c.quantity + " but the scenario's sensor is a " + s.kind);
+      if (p.noise_std[j] <= 0 && c.noise_std > 0) {
+        p.noise_std[j] = c.noise_std;
+        p.noise_origin[j] = "truth.json";
       }
     }
-    for (std::size_t c = 0; c < tab.names.size(); ++c)
-      if (!used[c]) p->columns.unused.push_back(tab.names[c]);
-    if (tab.t.size() < 3)
-      throw InputError("data file '" + *data_csv + "': " + std::to_string(tab.t.size()) + " rows: at least 3 samples are needed");
-    if (tab.t.front() < 0.0)
-      throw InputError("data file '" + *data_csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
-    p->data_source = *data_csv;
-    // True values from the metadata, translated to this parameterization.
-    if (!meta_truth.empty()) {
-      io::Scenario truth_sc = sc;
-      io::set_structure_parameters(truth_sc, meta_truth);
-      set_true_values(truth_sc);
+  return meta.true_parameters;
+}
+
+// An input driven by its column (piecewise linear), with its largest jump within one sample.
+void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
+  const auto& in = p.scenario.inputs[i];
+  const auto& f = tab.columns[static_cast<std::size_t>(col)];
+  p.signals[i] = io::Signal::table(tab.t, f);
+  p.columns.inputs_from_data.push_back(in.name);
+  const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
+  ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
+  for (std::size_t k = 1; k < f.size(); ++k)
+    if (std::abs(f[k] - f[k - 1]) > st.jump) {
+      st.jump = std::abs(f[k] - f[k - 1]);
+      st.at = tab.t[k];
+      st.sample = tab.t[k] - tab.t[k - 1];
     }
-  } else {
-    const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
-    if (data_elements < 2 * id.elements)
-      fail_field(sc.source, "identification.data_elements",
-                 "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
-                 std::to_string(data_elements));
-    step = identifier_step(sc, p->model(), *p->params, p->signals);
-    check_step(sc, p->model(), *p->params, p->signals, step, true);
-    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
-                              id.step_rule == "data");
-    // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step
-    // 4x finer than the identifier's.
-    const io::Scenario truth_sc = io::truth_scenario(sc);
-    if (truth_sc.structure == "scole" && truth_sc.scole.actuator_lag > 0)
-      fail_field(sc.source, "truth.overrides.scole.actuator_lag",
-                 "is a servo lag of the Simbody truth only: the finite-element synthesis cannot produce it (generate the "
-                 "data with scole-truth and pass them with --data)",
-                 io::format_value(truth_sc.scole.actuator_lag));
-    p->data = id.model == "nonlinear" ? synthesize_nonlinear(truth_sc, data_elements, step / 4.0, true)
-                                      : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
-    p->data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
-    set_true_values(truth_sc);
+  if (*hi > *lo && st.jump > 0.25 * (*hi - *lo)) p.columns.stepped_inputs.push_back(st);
+}
+
+// The measurements from the table's sensor columns, the inputs from theirs (signal_from), and
+// which columns were used (ColumnUse).
+void measurements_from_table(Problem& p, const io::DataTable& tab, const std::string& csv) {
+  const auto& sc = p.scenario;
+  p.data.t = tab.t;
+  p.data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+    const int col = tab.find(sc.sensors[j].name);
+    if (col < 0)
+      throw InputError("data file '" + csv + "': no column for sensor '" + sc.sensors[j].name + "' (sensors[" +
+                       std::to_string(j) + "] of " + sc.source + ")");
+    for (std::size_t k = 0; k < tab.t.size(); ++k)
+      p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
+    p.data.names.push_back(sc.sensors[j].name);
   }
-  if (data_csv) {
-    step = identifier_step(sc, p->model(), *p->params, p->signals);
-    check_step(sc, p->model(), *p->params, p->signals, step, false);
-    // The record's own span, not the scenario's duration, sets the number of steps.
-    const double span = p->data.t.back() - p->data.t.front(), steps = step > 0 ? span / step : 0.0;
-    if (!(steps <= io::limits::kMaxSteps))
-      throw InputError("data file '" + *data_csv + "': column t spans " + io::format_value(span) + " s, " +
-                       io::format_value(std::ceil(steps)) + " steps of the identifier's " + io::format_value(step) +
-                       " s; the limit is " + io::format_value(io::limits::kMaxSteps) + " steps");
-    p->content = data_content(p->model(), *p->params, p->signals, sc.simulation.duration, sc.simulation.sample_interval,
-                              id.step_rule == "data");
+  std::vector<bool> used(tab.names.size(), false);
+  for (const auto& s : sc.sensors) {
+    used[static_cast<std::size_t>(tab.find(s.name))] = true;
+    p.columns.sensors.push_back(s.name);
   }
-  // A record in which no sensor moves holds nothing to identify from (every parameter fits it the
-  // same until the model moves, and then only worse).
-  if (p->data.z.size() > 0 && (p->data.z.array() == 0.0).all()) {
-    if (data_csv) throw InputError("data file '" + *data_csv + "': every sensor's column is zero: nothing to identify from");
-    fail_field(sc.source, "sensors",
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    const auto& in = sc.inputs[i];
+    const int col = tab.find(in.name);
+    const std::string field = "inputs[" + std::to_string(i) + "]";
+    if (in.signal_from == "data" && col < 0)
+      throw InputError("data file '" + csv + "': no column for input '" + in.name + "' (" + field +
+                       ".signal_from is data, in " + sc.source + ")");
+    if (in.signal_from != "scenario" && col >= 0) {
+      input_from_column(p, i, tab, col);
+      used[static_cast<std::size_t>(col)] = true;
+    } else {
+      if (in.signal.terms().empty())
+        throw InputError("data file '" + csv + "': no column for input '" + in.name + "' and " + field + " of " + sc.source +
+                         " gives no signal");
+      p.columns.inputs_from_scenario.push_back(in.name);
+    }
+  }
+  for (std::size_t c = 0; c < tab.names.size(); ++c)
+    if (!used[c]) p.columns.unused.push_back(tab.names[c]);
+  if (tab.t.size() < 3)
+    throw InputError("data file '" + csv + "': " + std::to_string(tab.t.size()) + " rows: at least 3 samples are needed");
+  if (tab.t.front() < 0.0)
+    throw InputError("data file '" + csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
+  p.data_source = csv;
+}
+
+// Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step 4x
+// finer than the identifier's. Returns the identifier's step.
+double synthesize_data(Problem& p) {
+  const auto& sc = p.scenario;
+  const auto& id = sc.identification;
+  const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
+  if (data_elements < 2 * id.elements)
+    fail_field(sc.source, "identification.data_elements",
+               "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
+               std::to_string(data_elements));
+  const double step = identifier_step(sc, p.model(), *p.params, p.signals);
+  check_step(sc, p.model(), *p.params, p.signals, step, true);
+  p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
+                           id.step_rule == io::StepRule::Data);
+  const io::Scenario truth_sc = io::truth_scenario(sc);
+  if (truth_sc.structure == io::Structure::Scole && truth_sc.scole.actuator_lag > 0)
+    fail_field(sc.source, "truth.overrides.scole.actuator_lag",
+               "is a servo lag of the Simbody truth only: the finite-element synthesis cannot produce it (generate the "
+               "data with scole-truth and pass them with --data)",
+               io::format_value(truth_sc.scole.actuator_lag));
+  p.data = id.model == io::Model::Nonlinear ? synthesize_nonlinear(truth_sc, data_elements, step / 4.0, true)
+                                            : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
+  p.data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
+  set_true_values(p, truth_sc);
+  return step;
+}
+
+// The identifier's step for measured data (the inputs as they will drive the model: a data column
+// replaces a scenario signal), within the limits for the record's own span.
+double measured_data_step(Problem& p, const std::string& csv) {
+  const auto& sc = p.scenario;
+  const double step = identifier_step(sc, p.model(), *p.params, p.signals);
+  check_step(sc, p.model(), *p.params, p.signals, step, false);
+  const double span = p.data.t.back() - p.data.t.front(), steps = step > 0 ? span / step : 0.0;
+  if (!(steps <= io::limits::kMaxSteps))
+    throw InputError("data file '" + csv + "': column t spans " + io::format_value(span) + " s, " +
+                     io::format_value(std::ceil(steps)) + " steps of the identifier's " + io::format_value(step) +
+                     " s; the limit is " + io::format_value(io::limits::kMaxSteps) + " steps");
+  p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
+                           sc.identification.step_rule == io::StepRule::Data);
+  return step;
+}
+
+// The solver's options, once the data are in: a record in which no sensor moves is refused (every
+// parameter fits it the same until the model moves, and then only worse).
+void finish_problem(Problem& p, double step, const std::string* csv) {
+  const auto& id = p.scenario.identification;
+  if (p.data.z.size() > 0 && (p.data.z.array() == 0.0).all()) {
+    if (csv) throw InputError("data file '" + *csv + "': every sensor's column is zero: nothing to identify from");
+    fail_field(p.scenario.source, "sensors",
                "record nothing: every sensor's synthetic record is zero (no input within the record, zero amplitudes, or "
                "sensors where the structure cannot move)",
-               std::to_string(p->data.sensors()) + " sensor" + (p->data.sensors() == 1 ? "" : "s"));
+               std::to_string(p.data.sensors()) + " sensor" + (p.data.sensors() == 1 ? "" : "s"));
   }
-  p->objective_options.solver.rtol = id.rtol;
-  p->objective_options.solver.step = step;
-  p->objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
-                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
-                                                                              : SolverOptions::Integrator::Esdirk;
+  p.objective_options.solver.rtol = id.rtol;
+  p.objective_options.solver.step = step;
+  p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
+                                          : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
+                                                                             : SolverOptions::Integrator::Esdirk;
+}
+
+// The problem from measured data: the table's columns, the metadata beside it.
+std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTable& tab, const std::string& source,
+                                    const io::TruthMeta* meta, const std::string& meta_source) {
+  std::map<std::string, double> meta_truth;
+  if (meta) meta_truth = apply_truth_meta(*p, tab, source, *meta, meta_source);
+  measurements_from_table(*p, tab, source);
+  if (!meta_truth.empty()) {
+    io::Scenario truth_sc = p->scenario;
+    io::set_structure_parameters(truth_sc, meta_truth);
+    set_true_values(*p, truth_sc);
+  }
+  finish_problem(*p, measured_data_step(*p, source), &source);
   return p;
+}
+
+}  // namespace
+
+std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const io::DataTable& table, const std::string& source,
+                                      const io::TruthMeta* meta, const std::string& meta_source) {
+  return from_table(problem_skeleton(sc), table, source, meta, meta_source);
+}
+
+std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
+  auto p = problem_skeleton(sc);
+  if (!data_csv) {
+    finish_problem(*p, synthesize_data(*p), nullptr);
+    return p;
+  }
+  const io::DataTable tab = io::read_csv(*data_csv);
+  // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
+  const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
+  if (!std::filesystem::exists(meta_path)) return from_table(std::move(p), tab, *data_csv, nullptr, "");
+  const io::TruthMeta meta = io::read_truth_meta(meta_path.string());
+  return from_table(std::move(p), tab, *data_csv, &meta, meta_path.string());
 }
 
 }  // namespace scoleid::identify

@@ -146,7 +146,7 @@ TEST(ChainModalData, StdsAreTheLumpingErrorAndTheModesIdentifyTheMast) {
               d.modes.size(), worst, r.squaredNorm(), N);
   EXPECT_LT(r.squaredNorm(), N + 3.0 * std::sqrt(2.0 * N));
   identify::OptimizerOptions oo;
-  oo.method = "gauss-newton";
+  oo.method = scoleid::io::Method::GaussNewton;
   const auto s = identify::minimize(misfit, params->initial(), oo);
   ASSERT_TRUE(s.converged()) << s.message;
   const Eigen::VectorXd t = params->truth();

@@ -21,7 +21,7 @@ RunResult identify_builtin(Problem& p, const std::string& method = "", int max_i
   RunOptions ro;
   ro.verbose = false;
   ro.compute_std = false;
-  ro.method = method;
+  if (!method.empty()) ro.method = scoleid::io::parse<scoleid::io::Method>(method).value();
   if (max_iterations >= 0) ro.max_iterations = max_iterations;
   return run_identification(p, ro);
 }

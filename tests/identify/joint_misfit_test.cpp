@@ -105,7 +105,7 @@ TEST(JointMisfit, HorizonIsTheSameFractionOfEveryRecord) {
 TEST(JointMisfit, TwoRunsRecoverTheBeamAndTheIterationTableIsTheSameOnOneOrTwoThreads) {
   TwoBeamRuns r;
   OptimizerOptions oo;
-  oo.method = "gauss-newton";
+  oo.method = scoleid::io::Method::GaussNewton;
   std::vector<OptimizerSummary> s;
   for (int threads : {1, 2}) {
     r.a.obj->reset_counters();

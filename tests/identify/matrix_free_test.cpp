@@ -126,7 +126,7 @@ scoleid::io::Scenario sections_scenario(const std::string& smoothness, int N, in
   sc.simulation.seed = 3;
   sc.identification.estimate.clear();
   for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
-  sc.identification.method = "gauss-newton-krylov";
+  sc.identification.method = scoleid::io::Method::GaussNewtonKrylov;
   // Noise of `noise` times each sensor's RMS, from the noise-free data.
   const auto clean = make_problem(sc, std::nullopt);
   for (int i = 0; i < sensors; ++i)
@@ -179,7 +179,7 @@ TEST(SmoothnessPrior, ExplicitAndMatrixFreeGaussNewtonReachTheSameMinimiser) {
   Eigen::Index points = 1;
   for (const std::string method : {"gauss-newton", "gauss-newton-krylov"}) {
     auto sc = sections_scenario("1e-2", 8, 4, 0.01);
-    sc.identification.method = method;
+    sc.identification.method = *scoleid::io::parse<scoleid::io::Method>(method);
     sc.identification.restarts = 0;
     auto p = make_problem(sc, std::nullopt);
     points = p->data.z.size();

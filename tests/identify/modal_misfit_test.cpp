@@ -446,7 +446,7 @@ TEST(ModalMisfit, RecoversScoleBendingStiffnessAndMassFromModesOfAFinerMesh) {
   ModalMisfit mis(s.model(), *s.params, d);
   const VectorXd q0 = qt.cwiseProduct(Eigen::Vector2d(1.1, 0.9));
   OptimizerOptions opt;
-  opt.method = "gauss-newton";
+  opt.method = scoleid::io::Method::GaussNewton;
   const OptimizerSummary sum = minimize(mis, q0, opt);
   const VectorXd err = (sum.q.array() / qt.array() - 1.0).abs();
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -274,7 +274,7 @@ TEST(Identification, ManySectionsStartFromTheLadderWhichStopsWhereTheDataAreExpl
   std::vector<double> ei(24, 26000.0);
   for (std::size_t k = 12; k < ei.size(); ++k) ei[k] = 31000.0;
   auto sc = beam_sections(ei);
-  sc.identification.method = "gauss-newton-krylov";
+  sc.identification.method = scoleid::io::Method::GaussNewtonKrylov;
   sc.simulation.duration = 3.0;
   auto p = make_problem(sc, std::nullopt);
   RunOptions ro;
@@ -306,7 +306,7 @@ TEST(Identification, ALadderThatEndsInAWrongBasinIsFollowedByThePlainStart) {
   // times the allowance); the plain start, tried next, reaches the truth. The ladder's attempt
   // is reported, not chosen.
   auto sc = scoleid::io::load_scenario("beam-ei8");
-  sc.identification.start = "coarse-to-fine";
+  sc.identification.start = scoleid::io::Start::CoarseToFine;
   sc.identification.elements = 16;
   auto p = make_problem(sc, std::nullopt);
   RunOptions ro;
@@ -333,7 +333,7 @@ TEST(Identification, AutoWithAPriorAndARateSensorKeepsTheExplicitMatrix) {
   // 17 sections with a prior would take the matrix-free products, which rate sensors rule out
   // (objective.h): auto falls back to explicit Gauss–Newton, which takes the prior too.
   auto sc = beam_sections(std::vector<double>(17, 30000.0));
-  sc.identification.method = "auto";
+  sc.identification.method = scoleid::io::Method::Auto;
   sc.identification.smoothness = 1e-3;
   sc.sensors[3].kind = "velocity";
   sc.simulation.duration = 1.0;
@@ -343,7 +343,7 @@ TEST(Identification, AutoWithAPriorAndARateSensorKeepsTheExplicitMatrix) {
   ro.compute_std = false;
   ro.max_iterations = 1;
   const RunResult r = run_identification(*p, ro);
-  EXPECT_EQ(r.method, "gauss-newton");
+  EXPECT_EQ(r.method, scoleid::io::Method::GaussNewton);
   ASSERT_FALSE(r.attempts.empty());
   EXPECT_EQ(r.attempts[0].strategy.rfind("coarse-to-fine", 0), 0u);  // 17 sections: the ladder first
 }
@@ -388,7 +388,7 @@ TEST(Identifiability, AProfileThatItsMirrorFitsAsWellIsFlaggedAndOneThatItDoesNo
 
 TEST(Identification, StartCoarseToFineNeedsSections) {
   auto sc = scoleid::io::load_scenario("paper-beam-1");
-  sc.identification.start = "coarse-to-fine";
+  sc.identification.start = scoleid::io::Start::CoarseToFine;
   auto p = make_problem(sc, std::nullopt);
   RunOptions ro;
   ro.verbose = false;
@@ -420,7 +420,7 @@ double step_and_content(const scoleid::io::Scenario& sc, DataContent* content) {
   std::vector<scoleid::io::Signal> signals;
   for (const auto& in : sc.inputs) signals.push_back(in.signal);
   *content = data_content(st->model(), *params, signals, sc.simulation.duration, sc.simulation.sample_interval,
-                          sc.identification.step_rule == "data");
+                          sc.identification.step_rule == scoleid::io::StepRule::Data);
   return identifier_step(sc, st->model(), *params, signals);
 }
 }  // namespace
@@ -460,7 +460,7 @@ TEST(TimeStep, TheDataRuleGivesOneStepForEveryNumberOfParametersAndFollowsTheInp
   // step is longer.
   auto step_for = [](int N, bool smooth, DataContent* content) {
     auto sc = sections_scenario(N);
-    sc.identification.step_rule = "data";
+    sc.identification.step_rule = scoleid::io::StepRule::Data;
     if (smooth) {  // one slow haversine instead of the step and the short pulse
       sc.inputs.resize(1);
       scoleid::io::SignalTerm slow;

@@ -1,6 +1,8 @@
 #pragma once
 // Helpers shared by the identifier tests: the Taylor remainder sequence of a gradient, and
 // relative errors of estimates against a problem's true values.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -72,6 +74,20 @@ inline int first_within(const Problem& p, const RunResult& r, double tol) {
   for (const auto& it : r.summary.iterations)
     if (max_rel_error(p, it.q) <= tol) return it.k;
   return -1;
+}
+
+// The costate gradient and the Gauss–Newton (forward-sensitivity) gradient at q against central
+// differences of the cost (ESDIRK, fixed step): both agree to 1e-4 relative. Returns the differences.
+inline VectorXd expect_gradients_match_differences(Objective& obj, const VectorXd& q) {
+  VectorXd g_adj, g_gn;
+  MatrixXd H;
+  obj.cost_and_gradient(q, g_adj);
+  obj.gauss_newton(q, g_gn, H);
+  const VectorXd g_fd = obj.finite_difference_gradient(q, 1e-5);
+  std::printf("  esdirk: adjoint vs FD %.2e, Gauss-Newton vs FD %.2e\n", max_rel(g_adj, g_fd), max_rel(g_gn, g_fd));
+  EXPECT_LT(max_rel(g_adj, g_fd), 1e-4);
+  EXPECT_LT(max_rel(g_gn, g_fd), 1e-4);
+  return g_fd;
 }
 
 }  // namespace scoleid::identify::test_support

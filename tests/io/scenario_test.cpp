@@ -372,19 +372,19 @@ identification:
   EXPECT_NE(error_of(head + "  smoothness: -1\n").find("identification.smoothness"), std::string::npos);
   EXPECT_NE(error_of(head + "  smoothness: lots\n").find("identification.smoothness"), std::string::npos);
   // How the first attempt starts: auto, plain or coarse-to-fine.
-  EXPECT_EQ(automatic.identification.start, "auto");
+  EXPECT_EQ(automatic.identification.start, Start::Auto);
   const Scenario ladder = parse_scenario(head + "  start: coarse-to-fine\n", "scenario 'x.yaml'");
-  EXPECT_EQ(ladder.identification.start, "coarse-to-fine");
+  EXPECT_EQ(ladder.identification.start, Start::CoarseToFine);
   EXPECT_EQ(to_json(ladder)["identification"]["start"].get<std::string>(), "coarse-to-fine");
   EXPECT_NE(error_of(head + "  start: random\n").find("identification.start"), std::string::npos);
   // The automatic step's rule: parameters by default, or data.
-  EXPECT_EQ(automatic.identification.step_rule, "parameters");
+  EXPECT_EQ(automatic.identification.step_rule, StepRule::Parameters);
   const Scenario by_data = parse_scenario(head + "  step_rule: data\n", "scenario 'x.yaml'");
-  EXPECT_EQ(by_data.identification.step_rule, "data");
+  EXPECT_EQ(by_data.identification.step_rule, StepRule::Data);
   EXPECT_EQ(to_json(by_data)["identification"]["step_rule"].get<std::string>(), "data");
   EXPECT_NE(error_of(head + "  step_rule: sometimes\n").find("identification.step_rule"), std::string::npos);
   // The identifier's model: linear by default; nonlinear is SCOLE's only.
-  EXPECT_EQ(automatic.identification.model, "linear");
+  EXPECT_EQ(automatic.identification.model, Model::Linear);
   EXPECT_EQ(to_json(automatic)["identification"]["model"].get<std::string>(), "linear");
   EXPECT_NE(error_of(head + "  model: nonlinear\n").find("identification.model"), std::string::npos);
   EXPECT_NE(error_of(head + "  model: quadratic\n").find("identification.model"), std::string::npos);
@@ -398,6 +398,6 @@ identification:
   model: nonlinear
 )";
   const Scenario nonlinear = parse_scenario(scole, "scenario 'x.yaml'");
-  EXPECT_EQ(nonlinear.identification.model, "nonlinear");
+  EXPECT_EQ(nonlinear.identification.model, Model::Nonlinear);
   EXPECT_EQ(to_json(nonlinear)["identification"]["model"].get<std::string>(), "nonlinear");
 }

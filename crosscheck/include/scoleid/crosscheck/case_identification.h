@@ -14,7 +14,7 @@ namespace scoleid::crosscheck {
 //    half_record_shift, half_width, relative_half_width, identifiable, covered}]}
 // `covered`: the truth lies inside the reported interval (identifiable parameters only).
 // Throws io::InputError if the truth file has no true value for an estimated parameter.
-nlohmann::json identify_row(identify::Problem& p);
+nlohmann::json identify_row(std::shared_ptr<identify::Problem> problem);
 
 // Adds Gaussian noise of `relative` × each sensor's RMS, drawn from mt19937_64(seed), and states
 // that level to the identifier (it is what a test engineer knows of the instrument).

@@ -32,6 +32,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "scoleid/io/signal.h"
+#include "scoleid/io/types.h"
 
 namespace scoleid::io {
 
@@ -131,9 +132,12 @@ struct InputSpec {
   Signal signal;
 };
 
-// A sensor. kind: displacement | rotation | velocity | acceleration | line_of_sight.
-// For beams: transverse displacement w(s) or slope w_s(s) at `location`. For SCOLE: the mast
-// station at `location` (or the reflector), measured in the shuttle frame along `direction`.
+// A sensor. kind: displacement | rotation | velocity | acceleration | line_of_sight | strain.
+// For beams: transverse displacement w(s) or slope w_s(s) at `location`; a strain gauge (beams
+// only) reads the axial surface strain ε = −offset · w_ss(s), `offset` the gauge's signed distance
+// from the neutral axis (+ on the side w points to: a positive curvature w_ss shortens it),
+// dimensionless (docs/theory.md §3.5). For SCOLE: the mast station at `location` (or the
+// reflector), measured in the shuttle frame along `direction`.
 struct SensorSpec {
   std::string name;
   std::string at = "beam";
@@ -142,6 +146,7 @@ struct SensorSpec {
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;
   double noise_std = 0.0;
+  double offset = 0.0;  // strain: distance of the gauge from the neutral axis (≠ 0); other kinds: 0
   // The sensor's own error in the truth, in its unit: the truth writes
   //   y(t) = y_ideal(t) + bias + drift·t + noise,
   // bias a constant offset, drift a rate [unit/s]. Set only under truth.overrides.sensors (the
@@ -180,7 +185,7 @@ struct IdentificationSpec {
   int elements = 10;          // identifier mesh
   int sections = 0;           // equal sections carrying EI_k in the identifier (0 = the beam's own)
   int data_elements = 0;      // mesh that synthesises data; 0 = 2 x elements (at least 2x)
-  std::string method = "auto";  // auto | gauss-newton | gauss-newton-krylov | lbfgs | steepest-descent
+  Method method = Method::Auto;  // auto | gauss-newton | gauss-newton-krylov | lbfgs | steepest-descent
   int max_iterations = 50;
   double gradient_tolerance = 1e-9;  // on the scaled gradient
   double step_tolerance = 1e-5;      // relative parameter change (GN converges quadratically below it)
@@ -195,7 +200,7 @@ struct IdentificationSpec {
   // min(P + 2, modes below Nyquist) (P the estimated parameters; the default), "data" the modes
   // the inputs visibly excite at the sensors (K_data, below Nyquist) whatever P: a step independent
   // of the number of parameters, shorter for few parameters on rich data.
-  std::string step_rule = "parameters";
+  StepRule step_rule = StepRule::Parameters;
   double rtol = 1e-8;                 // bdf tolerance (and Newton tolerance)
   std::vector<UncertainSpec> uncertain;  // declared tolerances of fixed quantities (consider terms)
   // The model-form error the data are expected to carry, as a fraction of each sensor's RMS
@@ -209,11 +214,11 @@ struct IdentificationSpec {
   // How the first attempt starts (docs/theory.md §7.6): "plain" from the initial values,
   // "coarse-to-fine" from the ladder over sectional parameters, "auto" = the ladder for a family of
   // more than 16 sections, plain otherwise.
-  std::string start = "auto";
+  Start start = Start::Auto;
   // The identifier's model (docs/theory.md §3.8): "linear" (small motions, the default) or
   // "nonlinear" (SCOLE only: finite shuttle rotation, the mast's deflection in the shuttle's
   // rotating frame; for slews).
-  std::string model = "linear";
+  Model model = Model::Linear;
   // Smoothness prior on the logarithm of sectional parameters (EI_1 … EI_N and the like, neighbours
   // tied by ½ β Σ (log q_{j+1} − log q_j)²; method gauss-newton or gauss-newton-krylov): β >= 0, 0 = off (the
   // default), < 0 ("discrepancy" in YAML) = β chosen by the discrepancy principle from the stated
@@ -243,7 +248,7 @@ struct Scenario {
   std::string name;
   std::string description;
   std::string source;       // file path or "built-in scenario 'NAME'", used in messages
-  std::string structure = "beam";  // beam | scole
+  Structure structure = Structure::Beam;
   BeamSpec beam;
   ScoleSpec scole;
   std::vector<InputSpec> inputs;

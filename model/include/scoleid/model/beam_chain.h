@@ -30,7 +30,7 @@ namespace scoleid::model {
 class BeamChain : public Structure {
 public:
   BeamChain(const io::BeamSpec& beam, int segments);
-  std::string kind() const override { return "beam"; }
+  io::Structure kind() const override { return io::Structure::Beam; }
   SimTK::MobilizedBodyIndex reference_body() const override { return SimTK::GroundIndex; }
   const HenckyLumping& lumping() const { return lumping_; }
 

@@ -27,7 +27,7 @@ namespace scoleid::model {
 class ScoleSystem : public Structure {
 public:
   ScoleSystem(const io::ScoleSpec& scole, int segments);
-  std::string kind() const override { return "scole"; }
+  io::Structure kind() const override { return io::Structure::Scole; }
   SimTK::MobilizedBodyIndex reference_body() const override { return shuttle_; }
   Station named_station(const std::string& at) const override;
   SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const override;

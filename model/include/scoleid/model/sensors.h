@@ -14,6 +14,11 @@
 //                  gravity in orbit; beam: w_tt)
 //   line_of_sight  the angle, about d, through which the line from the mast root to the point
 //                  (the feed-to-reflector line) has turned in R: (u0 x u) . d, u unit vectors.
+//   strain         (beams) −offset · M(s) / EI(s): the bending moment at joint j of the chain is
+//                  its spring's k_j φ_j (φ_j the relative rotation of the bodies it joins, the
+//                  clamped end's against ground; pinned and free ends carry none), k_j φ_j =
+//                  EI w_ss(s_j) to O(h²) (hencky.h), and M is linear between the two joints
+//                  around s (exact for point loads between them).
 // Shuttle sensors ("at: shuttle") measure the shuttle itself in ground: CM displacement and the
 // attitude rotation vector relative to its initial orientation.
 // d need not be an axis: every read-out is linear in d (a projection onto it, or the rotation
@@ -33,7 +38,7 @@
 namespace scoleid::model {
 
 struct ResolvedSensor {
-  enum class Kind { Displacement, Rotation, Velocity, Acceleration, LineOfSight };
+  enum class Kind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain };
   Kind kind = Kind::Displacement;
   Station station;
   SimTK::MobilizedBodyIndex second;      // rotation: (1 - w) rot(station.body) + w rot(second)
@@ -41,6 +46,14 @@ struct ResolvedSensor {
   SimTK::Vec3 d_R{0.0};
   SimTK::MobilizedBodyIndex reference;   // R
   SimTK::Vec3 root_R{0.0};               // for line_of_sight
+  // strain: the two joints around s, each M = k (θ(b) − θ(a)) (an invalid body: ground, θ = 0),
+  // M(s) = (1 − weight) M_0 + weight M_1, and the read-out scale · M(s), scale = −offset / EI(s).
+  struct Joint {
+    SimTK::MobilizedBodyIndex a, b;
+    double k = 0.0;
+  };
+  Joint joints[2];
+  double scale = 0.0;
 };
 
 std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& scenario, const Structure& structure);

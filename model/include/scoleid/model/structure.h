@@ -11,6 +11,7 @@
 
 #include <Simbody.h>
 
+#include "scoleid/io/types.h"
 #include "scoleid/model/hencky.h"
 
 namespace scoleid::model {
@@ -43,7 +44,7 @@ public:
   SimTK::GeneralForceSubsystem& forces() { return forces_; }
 
   // "beam" or "scole".
-  virtual std::string kind() const = 0;
+  virtual io::Structure kind() const = 0;
   // The body in which displacements are measured (ground or shuttle).
   virtual SimTK::MobilizedBodyIndex reference_body() const = 0;
   // The point at arc position s on the rigid segment that contains it.

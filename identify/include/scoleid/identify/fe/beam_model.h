@@ -41,6 +41,7 @@ struct BeamFE {
   // Rows acting on the reduced DOF vector.
   Eigen::RowVectorXd displacement_row(double s) const;
   Eigen::RowVectorXd rotation_row(double s) const;
+  Eigen::RowVectorXd curvature_row(double s) const;  // w_ss(s) (a strain gauge reads −offset times it)
 };
 
 // `source` names the scenario in error messages. Inputs of kind force/moment at `location`;

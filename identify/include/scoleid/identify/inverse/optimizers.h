@@ -56,11 +56,12 @@
 #include <vector>
 
 #include "scoleid/identify/inverse/objective.h"
+#include "scoleid/io/types.h"
 
 namespace scoleid::identify {
 
 struct OptimizerOptions {
-  std::string method = "gauss-newton";  // gauss-newton | lbfgs | steepest-descent
+  io::Method method = io::Method::GaussNewton;  // not Auto: resolved before (run/strategy.h)
   int max_iterations = 50;
   double gradient_tolerance = 1e-9;
   double step_tolerance = 1e-5;

@@ -62,7 +62,7 @@ struct ExperimentsSpec {
 ExperimentsSpec load_experiments(const std::string& path);
 
 struct ExperimentsOptions {
-  std::string method;  // "" = the scenario's
+  std::optional<io::Method> method;  // unset = the lead scenario's (auto resolved by run/strategy.h)
   bool compute_std = true;
   bool verbose = true;
   std::optional<int> threads;  // overrides the file's
@@ -70,7 +70,8 @@ struct ExperimentsOptions {
 };
 
 struct ExperimentsResult {
-  std::string name, method;
+  std::string name;
+  io::Method method = io::Method::GaussNewton;
   std::vector<std::string> names;
   VectorXd initial, estimate;
   std::map<std::string, double> truth;

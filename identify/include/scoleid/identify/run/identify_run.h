@@ -36,7 +36,7 @@ namespace scoleid::identify {
 
 struct RunOptions {
   std::optional<std::string> data_csv;
-  std::string method;          // empty = the scenario's (auto → gauss-newton for ≤ 16 parameters, else lbfgs)
+  std::optional<io::Method> method;  // unset = the scenario's (auto resolved by run/strategy.h)
   bool compute_std = true;     // identifiability and the uncertainty interval
   bool verbose = true;         // print the iteration table on stdout as it goes
   std::optional<int> max_iterations;
@@ -44,8 +44,8 @@ struct RunOptions {
 
 struct RunResult {
   std::string scenario;
-  std::string model = "linear";  // identification.model
-  std::string method;
+  io::Model model = io::Model::Linear;  // identification.model
+  io::Method method = io::Method::GaussNewton;  // the optimiser used (auto resolved)
   std::vector<std::string> names;
   VectorXd initial, estimate;
   std::map<std::string, double> truth;
@@ -56,7 +56,7 @@ struct RunResult {
   FitTest fit;  // at the estimate
   struct Attempt {
     std::string strategy;
-    std::string method;  // the optimiser of its last stage
+    io::Method method = io::Method::GaussNewton;  // the optimiser of its last stage
     std::string termination;
     bool optimizer_converged = false;
     double cost = 0;  // J over the whole record
@@ -105,7 +105,13 @@ struct RunResult {
   MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
   double integrator_step = 0.0;  // the nonlinear model's largest step (identify.json integrator.step)
   nlohmann::json to_json(const Problem& p) const;
+  // The summary table scole-identify prints: per parameter initial, estimate, truth, relative
+  // error, std, resolution and interval (or why not identifiable); then the optimiser's brief
+  // report with the solve counts and the wall time.
+  std::string FullReport() const;
 };
+// A result with the problem's scenario, names, starting values and truth filled in.
+RunResult start_result(const Problem& problem, io::Model model);
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
 // The rank of two attempts: converged and explaining the data, then explaining it, then the cost.

@@ -81,6 +81,10 @@ struct Problem {
 
 // Throws io::InputError for anything wrong with the scenario or the data.
 std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::optional<std::string>& data_csv);
+// The same from a table in memory (columns matched as a file's are; `source` names it in messages),
+// with the truth metadata that came with it, if any (`meta_source` names that).
+std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const io::DataTable& table, const std::string& source,
+                                      const io::TruthMeta* meta = nullptr, const std::string& meta_source = "");
 
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);

@@ -1,0 +1,85 @@
+#include "scoleid/identify.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "scoleid/io/error.h"
+#include "scoleid/io/validation.h"
+
+namespace scoleid {
+
+bool IdentifyOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (max_iterations && *max_iterations < 0) return bad("max_iterations must be >= 0, got " + std::to_string(*max_iterations));
+  return true;
+}
+
+Identification::Identification(std::shared_ptr<identify::Problem> problem, identify::RunResult result)
+    : problem_(std::move(problem)), result_(std::move(result)) {}
+
+std::string Identification::verdict() const {
+  const auto& r = result_;
+  char buf[1024];
+  if (r.summary.converged() && !r.fit.explains_data) {
+    std::snprintf(buf, sizeof buf, "stopped at a point that does not explain the data (%s); %zu attempt%s",
+                  io::one_line(r.fit.message).c_str(), r.attempts.size(), r.attempts.size() > 1 ? "s" : "");
+    return buf;
+  }
+  if (!r.summary.converged()) {
+    std::snprintf(buf, sizeof buf, "did not converge (%s%s%s)", identify::to_string(r.summary.termination),
+                  r.summary.message.empty() ? "" : ": ", io::one_line(r.summary.message).c_str());
+    return buf;
+  }
+  if (!r.converged()) {  // the discrepancy principle found no weight (docs/theory.md §7.8)
+    std::snprintf(buf, sizeof buf,
+                  "no smoothness weight fits the data within the noise band (discrepancy principle not met down to %g)",
+                  r.smoothness_weight);
+    return buf;
+  }
+  return "";
+}
+
+std::vector<std::string> Identification::warnings() const {
+  std::vector<std::string> w;
+  const auto& id = result_.ident.identifiable;
+  if (!id.empty() && std::none_of(id.begin(), id.end(), [](bool b) { return b; }))
+    w.push_back("none of the " + std::to_string(id.size()) +
+                " estimated parameters is identifiable from these data (each row says why); the estimates are not "
+                "determined by the data");
+  return w;
+}
+
+void Identification::write(io::RunDirectory& dir) const { identify::write_outputs(dir, *problem_, result_); }
+
+void Identification::write(const std::string& dir) const {
+  io::RunDirectory run_dir(dir, output_files(), "scoleid");
+  write(run_dir);
+  run_dir.commit();
+}
+
+std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data) {
+  io::validate_scenario(scenario);
+  if (data.table) return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.name + " (metadata)");
+  return identify::make_problem(scenario, data.csv);
+}
+
+Identification identify_parameters(std::shared_ptr<identify::Problem> problem, const IdentifyOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw io::InputError("identify options: " + why);
+  identify::RunOptions ro;
+  ro.method = options.method;
+  ro.max_iterations = options.max_iterations;
+  ro.compute_std = options.compute_std;
+  ro.verbose = options.verbose;
+  identify::RunResult r = identify::run_identification(*problem, ro);
+  return Identification(std::move(problem), std::move(r));
+}
+
+Identification identify_parameters(const io::Scenario& scenario, const DataSource& data, const IdentifyOptions& options) {
+  return identify_parameters(prepare(scenario, data), options);
+}
+
+}  // namespace scoleid

@@ -1,0 +1,20 @@
+#pragma once
+// The assessment of a linear identification's estimate (docs/theory.md §8): the Fisher information
+// at q̂ (standard deviations, resolution and the identifiability flags, identifiability.h), the
+// mirror test of sectional profiles, the half-record refit, the smoothing shift of a prior, the
+// consider terms of the declared uncertainties and of the identifier's own discretisation, and from
+// them the uncertainty interval (interval.h); a parameter whose interval is too wide is flagged.
+#include "scoleid/identify/run/identify_run.h"
+
+namespace scoleid::identify {
+
+// Fills r.ident, r.interval, r.half_record_* and r.identifiability_seconds. `options`: the run's
+// optimiser options (with the prior's chosen weight), for the refits.
+void assess_estimate(const Problem& problem, Objective& objective, const OptimizerOptions& options, RunResult& r);
+
+// The sensors with each one's stated noise level: the scenario's, else truth.json's (make_problem).
+std::vector<io::SensorSpec> sensors_with_noise(const Problem& problem);
+// Where the noise levels came from: "scenario", "truth.json", both, or the identifiability's own word.
+std::string noise_origin(const Problem& problem, const std::string& fisher_source);
+
+}  // namespace scoleid::identify

@@ -1,0 +1,27 @@
+#pragma once
+// The attempts of a linear identification run (docs/theory.md §7.6): the first attempt — plain from
+// the starting values, or from the coarse-to-fine ladder over sectional parameters — with the
+// smoothness prior at its given weight or chosen by the discrepancy principle (§7.8); then, when the
+// fit test says the model at the estimate does not explain the data, up to identification.restarts
+// more from the starting point (the other start of a sectional family, then the cautious horizon
+// continuation, run/strategy.h). The best attempt (converged and explaining the data, else
+// explaining it, else the lowest cost over the whole record; better_attempt) is the result.
+#include <functional>
+
+#include "scoleid/identify/run/identify_run.h"
+
+namespace scoleid::identify {
+
+struct AttemptsContext {
+  const Problem& problem;
+  Objective& objective;
+  OptimizerOptions options;  // the run's; the discrepancy principle leaves its chosen weight here
+  bool verbose = true;
+  ObjectiveCounters extra{};  // solves of the coarse-to-fine levels' own objectives
+};
+
+// Fills r.summary, r.fit, r.attempts, r.chosen_attempt and the smoothness fields; r.summary.cost is
+// the chosen attempt's cost over the whole record.
+void run_attempts(AttemptsContext& c, RunResult& r);
+
+}  // namespace scoleid::identify

@@ -1,0 +1,48 @@
+#pragma once
+// The strategy of an identification: what the scenario's identification section and the caller's
+// overrides resolve to before any solve. One place for every pipeline (a single run, the nonlinear
+// model, several experiments), so `method: auto` and the optimiser's options mean the same
+// everywhere (docs/theory.md §7.7).
+//
+// method: auto resolves by the number of parameters P and the misfit's abilities:
+//   P ≤ kExplicitGaussNewtonParameters      gauss-newton (P tangent solves per iteration are cheap)
+//   more, with a smoothness prior           gauss-newton-krylov where the misfit offers matrix-free
+//                                           products (displacement sensors), else gauss-newton
+//   more, without a prior                   lbfgs
+// A sectional family of more sections than the same limit starts from the coarse-to-fine ladder
+// (identification.start: auto; docs/theory.md §7.6).
+#include <optional>
+#include <string>
+
+#include "scoleid/identify/inverse/optimizers.h"
+#include "scoleid/io/scenario.h"
+#include "scoleid/io/types.h"
+
+namespace scoleid::identify {
+
+// More parameters than this: `auto` leaves the explicit Gauss–Newton matrix for products or
+// L-BFGS, and a sectional family starts from the coarse-to-fine ladder.
+inline constexpr int kExplicitGaussNewtonParameters = 16;
+
+// `requested` with auto resolved (above).
+io::Method resolve_method(io::Method requested, int parameters, bool smoothness_prior, bool matrix_free_products);
+
+// The optimiser's options from the identification section: method, iteration limit (the override
+// if given), tolerances, the paper's steepest-descent weights and the horizon continuation.
+// Throws io::InputError (naming `source`) when steepest_weights does not hold one weight per
+// parameter.
+OptimizerOptions optimizer_options(const io::IdentificationSpec& id, io::Method method, int parameters,
+                                   std::optional<int> max_iterations, const std::string& source);
+
+// The options of the cautious restart: the same run with a horizon continuation four times as
+// cautious as the scenario's (or the default's) misfit bound.
+OptimizerOptions cautious_continuation(const OptimizerOptions& options, const io::IdentificationSpec& id);
+// The label an attempt with those options carries in the report.
+std::string cautious_continuation_label(const OptimizerOptions& options);
+
+// Whether the first attempt starts from the coarse-to-fine ladder: identification.start says so, or
+// it is auto and a sectional family has more sections than the explicit Gauss–Newton limit.
+// `sections` is the longest family's length (0: none; then coarse-to-fine is refused).
+bool ladder_first(const io::IdentificationSpec& id, std::size_t sections, const std::string& source);
+
+}  // namespace scoleid::identify

@@ -1,0 +1,252 @@
+#include "scoleid/identify/run/assessment.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "scoleid/identify/inverse/tied_parameterization.h"
+
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/scenario_fields.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+// Consider terms (interval.h): for each declared tolerance, the bias of the least-squares
+// estimate when the structure's value is θ + Δθ and the model's θ: F⁻¹ Gᵀ W G_θ Δθ, with G_θ Δθ
+// the central difference of the model's outputs at q̂ (or the difference to the alternative model
+// form), over the parameters the Fisher test kept. A quantity the outputs do not depend on at q̂
+// (an estimated one: the parameters overwrite it) is refused.
+// Y0 and G: the model's outputs and their sensitivities at q (the Fisher step's). `discretisation`:
+// the fit test's estimate d of the identifier's discretisation error at q (empty: none).
+std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability& id, const VectorXd& q, const MatrixXd& Y0,
+                                         const MatrixXd& G, const MatrixXd& discretisation) {
+  std::vector<ConsiderTerm> terms;
+  const auto& uncertain = p.scenario.identification.uncertain;
+  if (uncertain.empty() && discretisation.size() == 0) return terms;
+  const int P = static_cast<int>(q.size()), ns = static_cast<int>(Y0.cols());
+  std::vector<int> keep;
+  for (int i = 0; i < P; ++i)
+    if (std::isfinite(id.std[i])) keep.push_back(i);
+  const auto K = static_cast<Eigen::Index>(keep.size());
+  MatrixXd Gk(G.rows(), K);
+  for (Eigen::Index a = 0; a < K; ++a) Gk.col(a) = G.col(keep[static_cast<std::size_t>(a)]);
+  VectorXd w(G.rows());
+  for (Eigen::Index r = 0; r < G.rows(); ++r) {
+    const double sd = id.noise_std[static_cast<std::size_t>(r % ns)];
+    w[r] = 1.0 / (sd * sd);
+  }
+  const MatrixXd F = Gk.transpose() * w.asDiagonal() * Gk;
+  const Eigen::LDLT<MatrixXd> ldlt(F);
+  auto flat = [&](const MatrixXd& Y) {  // row i*ns + k, as G
+    VectorXd v(Y.size());
+    for (Eigen::Index i = 0; i < Y.rows(); ++i)
+      for (Eigen::Index k = 0; k < Y.cols(); ++k) v[i * ns + k] = Y(i, k);
+    return v;
+  };
+  // The model's outputs at q̂ with the scenario changed (the same data, inputs and time step).
+  auto outputs = [&](const io::Scenario& sc) {
+    const auto st = make_structure(sc, sc.identification.elements);
+    const auto params = st->parameterize(sc);
+    Objective o(st->model(), *params, p.signals, p.data, p.objective_options);
+    return flat(o.predict(q));
+  };
+  // The identifier's own discretisation (docs/theory.md §8.2): the refined model's outputs differ
+  // from the identifier's by d at q̂, and the least-squares fit absorbs the part of d the
+  // parameters can mimic — a bias the residual does not show. Taken at 2d, as the fit test's
+  // allowance (the refined model's own error and the fit's redistribution of it).
+  if (discretisation.rows() == Y0.rows() && discretisation.cols() == Y0.cols() && discretisation.allFinite() && K > 0) {
+    ConsiderTerm t;
+    t.field = "discretisation";
+    t.value = static_cast<double>(p.structure->elements());
+    t.delta = 0.0;
+    const VectorXd d = 2.0 * flat(discretisation);
+    const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
+    t.shift = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
+    if (t.shift.allFinite()) terms.push_back(t);
+  }
+  for (const auto& u : uncertain) {
+    ConsiderTerm t;
+    t.field = u.field;
+    io::Scenario hi = p.scenario, lo = p.scenario;
+    VectorXd d;
+    if (u.is_switch) {
+      *io::bool_field(hi, u.field) = u.alternative;
+      t.value = *io::bool_field(lo, u.field) ? 1.0 : 0.0;
+      t.delta = 1.0;
+      d = outputs(hi) - flat(Y0);
+    } else {
+      double* vh = io::numeric_field(hi, u.field);
+      double* vl = io::numeric_field(lo, u.field);
+      t.value = *vh;
+      t.delta = u.tolerance;
+      *vh += u.tolerance;
+      *vl -= u.tolerance;
+      // Central where both sides are valid scenarios; one-sided at the edge of the valid range (a
+      // sensor at the tip of the mast cannot move beyond it).
+      std::optional<VectorXd> yh, yl;
+      try { yh = outputs(hi); } catch (const io::InputError&) {}
+      // A quantity that cannot be negative (a stiffness, a mass) is not moved through zero.
+      const bool lo_valid = io::signed_field(u.field) || (t.value > 0 ? *vl > 0 : *vl >= 0);
+      if (lo_valid) try { yl = outputs(lo); } catch (const io::InputError&) {}
+      if (yh && yl) d = 0.5 * (*yh - *yl);
+      else if (yh) d = *yh - flat(Y0);
+      else if (yl) d = flat(Y0) - *yl;
+      else
+        io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
+                       "moves the scenario out of its valid range on both sides", io::format_value(u.tolerance));
+    }
+    if (!(d.squaredNorm() > 0) || !d.allFinite())
+      io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
+                     d.allFinite() ? "does not change the model's outputs (an estimated quantity, or one the sensors do not depend on)"
+                                   : "makes the model's response non-finite",
+                     u.is_switch ? (u.alternative ? "true" : "false") : io::format_value(u.tolerance));
+    const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
+    t.shift = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
+    terms.push_back(t);
+  }
+  return terms;
+}
+
+// The mirror test (docs/theory.md §8.1): the Fisher matrix sees only the estimate's neighbourhood,
+// so a second profile that explains the data as well is invisible to it. A beam's sections have one
+// such candidate by construction — the profile reversed end for end, which a symmetric support,
+// load and sensor layout cannot tell from the original. Each family of sections X_1 … X_N is
+// reversed (the other parameters kept) and the model's χ² there compared with the estimate's,
+// with the same noise levels as the Fisher step: if the difference is below 4 (the
+// likelihood-ratio bound of one degree of freedom at 95 %, rounded) the data cannot tell the two
+// profiles apart, and every section whose mirrored value lies more than 2 std from its estimate is
+// flagged. One state solve; none when the estimate is its own mirror within 2 std.
+void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const MatrixXd& Y) {
+  const auto families = section_families(r.names);
+  if (families.empty() || r.ident.identifiable.empty()) return;
+  VectorXd qm = r.estimate;
+  for (const auto& f : families)
+    for (std::size_t j = 0; j < f.size(); ++j) qm[f[j]] = r.estimate[f[f.size() - 1 - j]];
+  std::vector<int> differ;
+  for (const auto& f : families)
+    for (int i : f) {
+      const auto u = static_cast<std::size_t>(i);
+      if (!r.ident.identifiable[u]) continue;
+      if (std::abs(qm[i] - r.estimate[i]) > 2.0 * r.ident.std[i]) differ.push_back(i);
+    }
+  if (differ.empty()) return;
+  MatrixXd Ym;
+  try {
+    Ym = obj.predict(qm);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    return;  // the mirrored profile cannot be solved: no second candidate
+  }
+  double c0 = 0.0, c1 = 0.0;
+  for (Eigen::Index i = 0; i < Y.rows(); ++i)
+    for (Eigen::Index k = 0; k < Y.cols(); ++k) {
+      const double sd = static_cast<std::size_t>(k) < r.ident.noise_std.size() ? r.ident.noise_std[static_cast<std::size_t>(k)] : 0.0;
+      if (!(sd > 0.0)) continue;
+      const double w = 1.0 / (sd * sd);
+      c0 += w * std::pow(Y(i, k) - p.data.z(i, k), 2);
+      c1 += w * std::pow(Ym(i, k) - p.data.z(i, k), 2);
+    }
+  r.ident.mirror_chi2_difference = c1 - c0;
+  if (!(c1 - c0 < 4.0)) return;
+  for (int i : differ) {
+    const auto u = static_cast<std::size_t>(i);
+    r.ident.identifiable[u] = false;
+    char buf[260];
+    if (c1 - c0 > -4.0)
+      std::snprintf(buf, sizeof buf,
+                    "the profile reversed end for end (this section %.6g instead of %.6g) fits the data as well (chi-square "
+                    "difference %.3g, below 4): the data cannot tell the two apart",
+                    qm[i], r.estimate[i], c1 - c0);
+    else  // the mirror is the better fit: the estimate is not the best one
+      std::snprintf(buf, sizeof buf,
+                    "the profile reversed end for end (this section %.6g instead of %.6g) fits the data better (chi-square "
+                    "lower by %.3g): the estimate is not the best fit",
+                    qm[i], r.estimate[i], c0 - c1);
+    r.ident.reason[u] = buf;
+  }
+}
+// The half-record refit (interval.h): the same fit on the first half of the record, from q̂ (a
+// record too short to halve into two samples gets none: the interval is then not assessed); and
+// the smoothing shift: the refit at a tenth of the prior's weight, from q̂.
+IntervalInputs refits(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r) {
+  IntervalInputs ii;
+  ii.estimate = r.estimate;
+  if (const Measurements half_data = first_half(p.data); half_data.t.size() >= 2) {
+    Objective half(p.model(), *p.params, p.signals, half_data, p.objective_options);
+    OptimizerOptions oh = oo;
+    oh.continuation = false;
+    const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+    r.half_record_estimate = ii.half_record_estimate = s.q;
+    r.half_record_converged = ii.half_record_converged = s.converged();
+  }
+  if (oo.smoothness_weight > 0.0) {
+    OptimizerOptions os = oo;
+    os.smoothness_weight = oo.smoothness_weight / 10.0;
+    os.continuation = false;
+    const OptimizerSummary s = minimize(obj, r.estimate, os, [&](const IterationRecord&) { io::check_interrupt(); });
+    ii.smoothing_estimate = s.q;
+    ii.smoothing_converged = s.converged();
+  }
+  return ii;
+}
+
+}  // namespace
+
+std::vector<io::SensorSpec> sensors_with_noise(const Problem& p) {
+  std::vector<io::SensorSpec> sensors = p.scenario.sensors;
+  for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
+  return sensors;
+}
+
+std::string noise_origin(const Problem& p, const std::string& fisher_source) {
+  if (fisher_source != "scenario") return fisher_source;
+  std::string origin;
+  for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
+  return origin;
+}
+
+void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r) {
+  const auto ti = std::chrono::steady_clock::now();
+  // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval.
+  const MatrixXd Y = obj.predict(r.estimate);
+  const MatrixXd G = obj.output_sensitivities(r.estimate);
+  r.ident = identifiability_from(fisher_information(obj.data(), Y, G, sensors_with_noise(p)), r.estimate);
+  flag_mirror_ambiguity(p, obj, r, Y);
+  r.ident.noise_source = noise_origin(p, r.ident.noise_source);
+  IntervalInputs ii = refits(p, obj, oo, r);
+  ii.consider = consider_terms(p, r.ident, r.estimate, Y, G, r.fit.discretisation);
+  r.interval = uncertainty_interval(r.ident, ii);
+  flag_wide_intervals(r);
+  r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
+}
+
+Measurements first_half(const Measurements& data) {
+  Measurements first = data;
+  const double t_half = first.t.front() + 0.5 * (first.t.back() - first.t.front());
+  std::size_t n = 0;
+  while (n < first.t.size() && first.t[n] <= t_half) ++n;
+  first.t.resize(n);
+  first.z.conservativeResize(static_cast<Eigen::Index>(n), Eigen::NoChange);
+  return first;
+}
+
+void flag_wide_intervals(RunResult& r) {
+  for (std::size_t i = 0; i < r.names.size() && i < r.interval.too_wide.size(); ++i)
+    if (r.ident.identifiable[i] && r.interval.too_wide[i]) {
+      r.ident.identifiable[i] = false;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "uncertainty interval ±%.3g is %.3g of the estimate: above 0.5",
+                    r.interval.half_width[static_cast<Eigen::Index>(i)],
+                    r.interval.half_width[static_cast<Eigen::Index>(i)] / std::abs(r.estimate[static_cast<Eigen::Index>(i)]));
+      r.ident.reason[i] = buf;
+    }
+}
+
+}  // namespace scoleid::identify

@@ -1,0 +1,326 @@
+#include "scoleid/identify/run/attempts.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "scoleid/identify/inverse/tied_parameterization.h"
+#include "scoleid/identify/run/strategy.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+// Paper-style iteration table: iteration, parameters, physical values, cost.
+class Table {
+public:
+  // The physical columns of the paper form: rho_A, EI and what q3 stands for (the beam's
+  // Kelvin–Voigt c_kv; zeta where there is no q3).
+  Table(const Parameterization& p, bool physical_columns)
+      : p_(p), phys_(physical_columns),
+        columns_{"rho_A", "EI", physical_columns && p.physical(p.initial()).count("c_kv") ? "c_kv" : "zeta"} {}
+  void header() const {
+    std::printf("%5s", "iter");
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
+    if (p_.size() > kMaxCols) std::printf(" %5s", "...");
+    if (phys_)
+      for (const char* n : columns_) std::printf(" %13s", n);
+    std::printf(" %13s %8s\n", "cost", "horizon");
+  }
+  void row(const IterationRecord& r) const {
+    std::printf("%5d", r.k);
+    const int P = std::min(p_.size(), kMaxCols);
+    for (int i = 0; i < P; ++i) std::printf(" %13.6g", r.q[i]);
+    if (p_.size() > kMaxCols) std::printf(" %5s", "");
+    if (phys_) {
+      const auto ph = p_.physical(r.q);
+      for (const char* n : columns_) {
+        const auto it = ph.find(n);
+        std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
+      }
+    }
+    std::printf(" %13.6e %8.4g\n", r.cost, r.horizon);
+    std::fflush(stdout);
+  }
+
+private:
+  static constexpr int kMaxCols = 8;
+  const Parameterization& p_;
+  bool phys_;
+  std::array<const char*, 3> columns_;
+};
+
+// One run's optimiser and its table.
+struct Runner {
+  AttemptsContext& c;
+  Table table;
+  void header() const {
+    if (c.verbose) table.header();
+  }
+  OptimizerSummary minimize_from(const VectorXd& start, const OptimizerOptions& o) const {
+    return minimize(c.objective, start, o, [this](const IterationRecord& rec) {
+      io::check_interrupt();
+      if (c.verbose) table.row(rec);
+    });
+  }
+};
+
+// The noise's expected misfit for the discrepancy principle: E J = Σ_k c_k W, c_k = ½ R_k σ_k²,
+// W = E∫ñ² (Measurements::white_noise_integral), plus two standard deviations √(Σ_k c_k² V),
+// V = Var ∫ñ² (the weights R_k differ by sensor, so a few sensors can carry most of J and the band
+// is wider than that of N equal terms).
+double noise_misfit(const Problem& p, const Objective& obj) {
+  double expected = 0.0, variance = 0.0;
+  const auto& R = obj.weights();
+  const double W = p.data.white_noise_integral(obj.data_start(), obj.data_end());
+  const double V = p.data.white_noise_integral_variance(obj.data_start(), obj.data_end());
+  for (std::size_t k = 0; k < R.size(); ++k) {
+    const double sd = k < p.noise_std.size() ? p.noise_std[k] : 0.0;
+    if (!(sd > 0.0))
+      io::fail_field(p.scenario.source, "identification.smoothness",
+                     "discrepancy needs every sensor's noise level stated (sensor '" + p.data.names[k] + "' has none)", "discrepancy");
+    const double c = 0.5 * R[k] * sd * sd;
+    expected += c * W;
+    variance += c * c * V;
+  }
+  return expected + 2.0 * std::sqrt(variance);
+}
+
+// The fit test's floor beyond noise at q, ½ Σ_k R_k ((2 d_k)² + (m z_k)²)(T − t0) (fit_test.h: the
+// discretisation estimate d_k and the declared model error m of the RMS signal z_k — a weight is
+// chosen only if its fit would pass the fit test), plus what sampling leaves between the samples
+// of a perfect fit (Objective::interpolation_misfit).
+double fit_floor(const Problem& p, Objective& obj, const VectorXd& q) {
+  const FitTest f = test_fit(p, obj, q);
+  const auto& R = obj.weights();
+  const double span = obj.data_end() - obj.data_start();
+  double floor = 0.0;
+  for (std::size_t k = 0; k < R.size() && k < f.sensors.size(); ++k) {
+    const double d = std::isfinite(f.sensors[k].discretisation) ? f.sensors[k].discretisation : 0.0;
+    const double m = f.model_error * f.sensors[k].rms_signal;
+    floor += 0.5 * R[k] * (4.0 * d * d + m * m) * span;
+  }
+  return floor + obj.interpolation_misfit(q);
+}
+
+// The smoothness weight by the discrepancy principle (docs/theory.md §7.8): β from 1 down by
+// factors of 10, each solve from the previous estimate, until the data misfit is within the noise's
+// expected misfit plus the fit test's floor at the first weight's estimate. That β (the largest
+// meeting it) and its estimate are kept. The stated noise levels are needed.
+OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorXd& start, OptimizerOptions oo) {
+  const Problem& p = run.c.problem;
+  double expected = r.smoothness_expected_misfit = noise_misfit(p, run.c.objective);
+  VectorXd q = start;
+  OptimizerSummary chosen;
+  bool have = false, floor_added = false;
+  for (double beta = 1.0; beta >= 1e-10; beta /= 10.0) {
+    oo.smoothness_weight = beta;
+    OptimizerSummary s = run.minimize_from(q, oo);
+    const double misfit = s.cost - s.prior_cost;
+    if (!floor_added && s.q.allFinite()) {
+      floor_added = true;
+      r.smoothness_expected_misfit = expected += fit_floor(p, run.c.objective, s.q);
+      if (run.c.verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
+    }
+    r.smoothness_path.push_back({beta, misfit, s.prior_cost, s.iterations_done, s.converged()});
+    if (run.c.verbose)
+      std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
+                  to_string(s.termination));
+    if (s.q.allFinite()) q = s.q;
+    chosen = s;
+    r.smoothness_weight = beta;
+    have = true;
+    if (misfit <= expected) {
+      r.smoothness_met = true;
+      break;
+    }
+  }
+  if (!have) throw std::logic_error("discrepancy_path: no weight tried");
+  return chosen;
+}
+
+// The coarse-to-fine ladder (docs/theory.md §7.6): every sectional family tied into B = 1, 2, 4, …
+// contiguous blocks, each level solved from the end of the previous one, until a level's fit is
+// within noise and discretisation on the full model (finer levels would only refit what the data
+// already hold) or B reaches the sections. Each level has its own automatic step (§5.2 for the
+// level's P tied parameters: modes up to P + 2, never finer than the full run's; unless the scenario
+// fixes the step or BDF chooses it): the coarse levels need only the low modes. Returns the start
+// of the full parameterization's run.
+struct Ladder {
+  VectorXd q;
+  int iterations = 0;
+  std::string label;
+  std::vector<RunResult::Attempt::Level> levels;
+};
+Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& families, const VectorXd& start) {
+  const Problem& p = c.problem;
+  std::size_t N = 0;
+  for (const auto& f : families) N = std::max(N, f.size());
+  Ladder out;
+  out.q = start;
+  out.label = "coarse-to-fine over";
+  for (int B = 1; B < static_cast<int>(N); B *= 2) {
+    auto [group, gnames] = block_grouping(p.params->names(), families, B);
+    TiedParameterization tied(*p.params, out.q, group, gnames);
+    ObjectiveOptions lo = p.objective_options;
+    // (BDF chooses its own steps: the level keeps the full run's options.)
+    if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
+        lo.solver.integrator != SolverOptions::Integrator::Bdf)
+      lo.solver.step = std::max(lo.solver.step, identifier_step(p.scenario, p.model(), tied, p.signals));
+    Objective level(p.model(), tied, p.signals, p.data, lo);
+    OptimizerOptions ol = c.options;
+    ol.method = resolve_method(io::Method::Auto, tied.size(), true, level.has_matrix_free_products());
+    ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
+    ol.smoothness_chains.clear();
+    ol.continuation = p.scenario.identification.continuation_misfit > 0;
+    const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
+    c.extra.Accumulate(level.counters());
+    out.iterations += sl.iterations_done;
+    if (sl.q.allFinite()) out.q = tied.expand(sl.q);
+    out.label += " " + std::to_string(B);
+    const bool explained = sl.q.allFinite() && test_fit(p, c.objective, out.q).within_noise_and_discretisation;
+    out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
+    if (c.verbose)
+      std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,
+                  sl.BriefReport().c_str(), explained ? "; the fit is within noise and discretisation" : "");
+    if (explained) break;
+  }
+  out.label += " blocks, then " + std::to_string(N) + " sections";
+  return out;
+}
+
+// An attempt's record: its cost over the whole record, whatever horizon the run ended on.
+RunResult::Attempt attempt_record(AttemptsContext& c, const std::string& strategy, const OptimizerSummary& s,
+                                  const FitTest& f, int iterations, std::vector<RunResult::Attempt::Level> levels) {
+  RunResult::Attempt a;
+  a.strategy = strategy;
+  a.method = c.options.method;
+  a.termination = to_string(s.termination);
+  a.optimizer_converged = s.converged();
+  c.objective.set_horizon(c.objective.data_end());
+  a.cost = INFINITY;
+  try {
+    if (s.q.allFinite()) a.cost = c.objective.cost(s.q);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+  }
+  if (!std::isfinite(a.cost)) a.cost = INFINITY;
+  a.iterations = iterations;
+  a.explains_data = f.explains_data;
+  a.fit_message = f.message;
+  a.levels = std::move(levels);
+  return a;
+}
+
+std::size_t longest(const std::vector<std::vector<int>>& families) {
+  std::size_t n = 0;
+  for (const auto& f : families) n = std::max(n, f.size());
+  return n;
+}
+
+// The first attempt: plain or from the ladder, with the prior's given or discrepancy weight.
+void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, bool from_ladder) {
+  AttemptsContext& c = run.c;
+  VectorXd start = r.initial;
+  std::string label = std::string("plain ") + io::to_string(c.options.method);
+  int iterations = 0;
+  std::vector<RunResult::Attempt::Level> levels;
+  if (from_ladder) {
+    if (c.verbose) std::printf("%zu sections: coarse to fine from the start\n", longest(families));
+    Ladder lad = coarse_to_fine(c, families, r.initial);
+    start = lad.q;
+    label = lad.label;
+    iterations = lad.iterations;
+    levels = std::move(lad.levels);
+  }
+  run.header();
+  const double smoothness = c.problem.scenario.identification.smoothness;
+  if (smoothness >= 0.0) {
+    c.options.smoothness_weight = smoothness;
+    r.summary = run.minimize_from(start, c.options);
+    r.smoothness_weight = smoothness;
+  } else {
+    r.summary = discrepancy_path(run, r, start, c.options);
+    c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
+  }
+  r.fit = test_fit(c.problem, c.objective, r.summary.q);
+  r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
+}
+
+// One restart from the starting point: "coarse-to-fine", "plain" or "cautious-continuation".
+void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, const std::string& how) {
+  AttemptsContext& c = run.c;
+  OptimizerSummary s;
+  int iterations = 0;
+  std::string label;
+  std::vector<RunResult::Attempt::Level> levels;
+  if (how == "coarse-to-fine") {
+    Ladder lad = coarse_to_fine(c, families, r.initial);
+    iterations += lad.iterations;
+    label = lad.label;
+    levels = std::move(lad.levels);
+    run.header();
+    s = run.minimize_from(lad.q, c.options);
+  } else if (how == "plain") {
+    label = std::string("plain ") + io::to_string(c.options.method);
+    run.header();
+    s = run.minimize_from(r.initial, c.options);
+  } else {
+    const OptimizerOptions oc = cautious_continuation(c.options, c.problem.scenario.identification);
+    label = cautious_continuation_label(oc);
+    run.header();
+    s = run.minimize_from(r.initial, oc);
+  }
+  iterations += s.iterations_done;
+  const FitTest f = test_fit(c.problem, c.objective, s.q);
+  r.attempts.push_back(attempt_record(c, label, s, f, iterations, std::move(levels)));
+  if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
+    r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
+    r.summary = s;
+    r.fit = f;
+  }
+}
+
+}  // namespace
+
+void run_attempts(AttemptsContext& c, RunResult& r) {
+  const Problem& p = c.problem;
+  const Runner run{c, Table(*p.params, p.params->names().size() <= 3 && p.params->paper_form())};
+  const auto families = section_families(r.names);
+  const bool from_ladder = ladder_first(p.scenario.identification, longest(families), p.scenario.source);
+  first_attempt(run, r, families, from_ladder);
+  // The second of the two starts of a sectional family: coarse to fine after a plain run, the plain
+  // run after the ladder (a coarse level can land in a basin the full profile does not leave:
+  // beam-ei8 started coarse to fine stops at J = 0.099 where the plain run reaches 4e-8).
+  std::vector<std::string> strategies;
+  if (!families.empty()) strategies.push_back(from_ladder ? "plain" : "coarse-to-fine");
+  strategies.push_back("cautious-continuation");
+  for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
+    const std::string& how = strategies[k];
+    // Restarts answer a false convergence: the optimiser stopped on a convergence test where the
+    // model does not explain the data. The other start of a sectional family is tried whenever the
+    // residual exceeds noise and discretisation (a local minimum of a sectional profile may still
+    // fit within a declared model error), and also after a run that used up its iterations
+    // (sections the sensors barely see wander through any budget: EI on 64 sections,
+    // docs/theory.md §7.8); the cautious continuation only when a converged fit does not explain
+    // the data.
+    const bool other_start = how == "coarse-to-fine" || how == "plain";
+    const bool out_of_iterations = r.summary.termination == OptimizerSummary::Termination::MaxIterations;
+    if (!r.summary.converged() && !(other_start && out_of_iterations)) break;
+    if (other_start ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
+    if (c.verbose)
+      std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
+                  r.fit.explains_data ? "the residual exceeds noise and discretisation" : r.fit.message.c_str(), k + 1,
+                  how.c_str());
+    restart(run, r, families, how);
+    if (r.converged()) break;
+  }
+  r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record
+  if (c.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
+}
+
+}  // namespace scoleid::identify

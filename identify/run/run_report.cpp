@@ -1,0 +1,291 @@
+// identify.json, fit.csv / fit.gp / fit.png and the printed summary of one identification run
+// (identify_run.h; the file format: docs/theory.md §10).
+#include <cmath>
+#include <cstdio>
+
+#include "scoleid/identify/run/fit_plot.h"
+#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/run_directory.h"
+
+namespace scoleid::identify {
+
+using nlohmann::json;
+
+namespace {
+
+double safe(double v) { return std::isfinite(v) ? v : 0.0; }
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+const char* integrator_name(SolverOptions::Integrator i) {
+  switch (i) {
+    case SolverOptions::Integrator::Esdirk: return "esdirk324l2sa";
+    case SolverOptions::Integrator::EsdirkArkode: return "arkode-esdirk324l2sa";
+    case SolverOptions::Integrator::Bdf: return "cvodes-bdf";
+  }
+  return "?";
+}
+
+// The interval (interval.h) of parameter i: ±half_width about the estimate, and what it is made of.
+json interval_json(const RunResult& r, Eigen::Index i, const double* truth) {
+  const double hw = r.interval.half_width.size() > i ? r.interval.half_width[i] : std::nan("");
+  if (!std::isfinite(hw)) return nullptr;
+  const auto& in = r.interval;
+  json comp{{"noise_2std", in.noise[i]},
+            {"residual_2resolution", in.residual[i]},
+            {"half_record_shift", in.half_record_shift[i]},
+            {"smoothing_shift", in.smoothing_shift[i]},
+            {"consider", in.consider[i]}};
+  const double q = r.estimate[i];
+  json e{{"half_width", hw}, {"low", q - hw}, {"high", q + hw}, {"relative_half_width", hw / std::abs(q)}, {"components", comp}};
+  if (truth) e["covers_truth"] = std::abs(q - *truth) <= hw;
+  return e;
+}
+
+json parameter_json(const RunResult& r, std::size_t i) {
+  const auto ie = static_cast<Eigen::Index>(i);
+  json e{{"name", r.names[i]}, {"initial", r.initial[ie]}, {"estimate", r.estimate[ie]}};
+  const auto it = r.truth.find(r.names[i]);
+  const double* truth = it != r.truth.end() ? &it->second : nullptr;
+  if (truth) {
+    e["truth"] = *truth;
+    e["relative_error"] = r.estimate[ie] / *truth - 1.0;
+  }
+  if (r.ident.std.size() <= ie) {
+    // --no-std: not assessed, which is not the same as identifiable.
+    e["std"] = e["resolution"] = e["identifiable"] = e["interval"] = nullptr;
+    return e;
+  }
+  // A flagged parameter has no standard deviation worth the name: null, with the reason.
+  const bool ok = r.ident.identifiable[i];
+  e["std"] = ok ? finite_or_null(r.ident.std[ie]) : json(nullptr);
+  e["resolution"] = ok ? finite_or_null(r.ident.resolution[ie]) : json(nullptr);
+  e["identifiable"] = ok;
+  if (!ok && i < r.ident.reason.size()) e["not_identifiable_because"] = r.ident.reason[i];
+  e["interval"] = ok ? interval_json(r, ie, truth) : json(nullptr);
+  if (r.half_record_estimate.size() > ie) e["half_record_estimate"] = r.half_record_estimate[ie];
+  return e;
+}
+
+json fit_test_json(const FitTest& fit) {
+  json sens = json::array();
+  for (const auto& sf : fit.sensors)
+    sens.push_back({{"name", sf.name}, {"rms_signal", sf.rms_signal}, {"rms_residual", sf.rms_residual},
+                    {"noise", sf.noise}, {"noise_estimated", sf.noise_estimated}, {"systematic", sf.systematic},
+                    {"discretisation", finite_or_null(sf.discretisation)},
+                    {"allowed", sf.allowed}, {"explained", sf.explained}});
+  return {{"explains_data", fit.explains_data},
+          {"within_noise_and_discretisation", fit.within_noise_and_discretisation},
+          {"model_error", fit.model_error}, {"ratio", fit.ratio},
+          {"message", fit.message}, {"sensors", sens}};
+}
+
+json attempts_json(const RunResult& r) {
+  json a = json::array();
+  for (std::size_t k = 0; k < r.attempts.size(); ++k) {
+    const auto& at = r.attempts[k];
+    a.push_back({{"strategy", at.strategy}, {"method", io::to_string(at.method)},
+                 {"termination", at.termination}, {"optimizer_converged", at.optimizer_converged},
+                 {"cost", finite_or_null(at.cost)},
+                 {"iterations", at.iterations}, {"explains_data", at.explains_data},
+                 {"fit_message", at.fit_message}, {"chosen", static_cast<int>(k) == r.chosen_attempt}});
+    for (const auto& l : at.levels)
+      a.back()["levels"].push_back({{"blocks", l.blocks}, {"step", l.step}, {"cost", finite_or_null(l.cost)},
+                                    {"iterations", l.iterations}, {"termination", l.termination},
+                                    {"explained", l.explained}});
+  }
+  return a;
+}
+
+json smoothness_json(const RunResult& r) {
+  json sm{{"weight", r.smoothness_weight}, {"prior_cost", r.summary.prior_cost}};
+  if (r.smoothness_path.empty()) return sm;
+  sm["rule"] = "discrepancy";
+  sm["expected_misfit"] = r.smoothness_expected_misfit;  // noise and the fit test's floor
+  sm["discrepancy_met"] = r.smoothness_met;
+  json path = json::array();
+  for (const auto& e : r.smoothness_path)
+    path.push_back({{"weight", e.weight}, {"data_misfit", e.data_misfit}, {"prior_cost", e.prior_cost},
+                    {"iterations", e.iterations}, {"converged", e.converged}});
+  sm["path"] = path;
+  return sm;
+}
+
+json integrator_json(const RunResult& r, const Problem& p) {
+  const bool nonlinear = r.model == io::Model::Nonlinear;
+  const auto& id = p.scenario.identification;
+  return {{"name", nonlinear ? std::string("esdirk-newton (nonlinear model)")
+                             : std::string(integrator_name(p.objective_options.solver.integrator))},
+          {"step", nonlinear ? r.integrator_step : p.objective_options.solver.step},
+          {"rtol", nonlinear ? json(nullptr) : json(p.objective_options.solver.rtol)},
+          {"steps", r.counters.solver.steps},
+          {"step_rule", id.time_step > 0 ? std::string("given") : std::string(io::to_string(id.step_rule))},
+          {"resolved_modes", p.content.mode},
+          {"modes_below_nyquist", p.content.modes_below_nyquist},
+          {"visible_content_modes", p.content.content_mode}};
+}
+
+json identifiability_json(const RunResult& r) {
+  if (r.ident.std.size() == 0)
+    return {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
+  json consider = json::array();
+  for (const auto& t : r.interval.terms) {
+    json sh = json::object();
+    for (std::size_t i = 0; i < r.names.size() && static_cast<Eigen::Index>(i) < t.shift.size(); ++i)
+      sh[r.names[i]] = t.shift[static_cast<Eigen::Index>(i)];
+    consider.push_back({{"field", t.field}, {"value", t.value}, {"tolerance", t.delta}, {"shift", sh}});
+  }
+  return {{"assessed", true},
+          {"condition_number", safe(r.ident.condition_number)},
+          {"noise_std", r.ident.noise_std},
+          {"noise_source", r.ident.noise_source},
+          {"chi2", r.ident.chi2},
+          {"data_values", r.ident.data_values},
+          {"mirror_chi2_difference", finite_or_null(r.ident.mirror_chi2_difference)},
+          {"half_record_refit_converged", r.half_record_estimate.size() != 0 ? json(r.half_record_converged) : json(nullptr)},
+          {"consider", consider},
+          {"interval_note", r.interval.note}};
+}
+
+json data_columns_json(const ColumnUse& c) {
+  json stepped = json::array();
+  for (const auto& st : c.stepped_inputs)
+    stepped.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at}, {"switch_shift_up_to", 0.5 * st.sample},
+                       {"scenario_gives_signal", st.scenario_signal}});
+  return {{"sensors", c.sensors},
+          {"inputs_from_data", c.inputs_from_data},
+          {"inputs_from_scenario", c.inputs_from_scenario},
+          {"unused", c.unused},
+          {"stepped_inputs", stepped}};
+}
+
+json counts_json(const RunResult& r, json& out) {
+  const auto& c = r.counters;
+  out["krylov_iterations"] = r.summary.krylov_iterations;
+  // Every attempt's iterations with its coarse-to-fine levels (`iterations` is the chosen run's
+  // history alone).
+  out["iterations_all_attempts"] = r.iterations_all_attempts();
+  out["gradient_evaluations"] = c.gradient_evaluations;
+  out["forward_solves"] = c.forward_solves;
+  out["costate_solves"] = c.costate_solves;
+  out["sensitivity_solves"] = c.sensitivity_solves;
+  out["checkpointed_passes"] = c.checkpointed_passes;
+  out["checkpoint_resolves"] = c.checkpoint_resolves;
+  out["wall_seconds"] = r.wall_seconds;
+  out["timing_seconds"] = {{"forward", c.forward_seconds},
+                           {"costate", c.costate_seconds},
+                           {"sensitivity", c.sensitivity_seconds},
+                           {"quadrature", c.quadrature_seconds},
+                           {"optimizer_total", r.summary.wall_seconds},
+                           {"identifiability", r.identifiability_seconds}};
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json RunResult::to_json(const Problem& p) const {
+  json params = json::array();
+  for (std::size_t i = 0; i < names.size(); ++i) params.push_back(parameter_json(*this, i));
+  json iters = json::array();
+  for (const auto& it : summary.iterations) {
+    json values = json::object();
+    for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = it.q[static_cast<Eigen::Index>(i)];
+    iters.push_back({{"k", it.k}, {"cost", it.cost}, {"values", values}, {"physical", p.params->physical(it.q)},
+                     {"gradient_norm", it.gradient_norm}, {"horizon", it.horizon}});
+  }
+  json out{{"scenario", scenario},
+           {"model", io::to_string(model)},
+           {"method", io::to_string(method)},
+           {"parameters", params},
+           {"physical_estimate", p.params->physical(estimate)},
+           {"iterations", iters},
+           {"termination", to_string(summary.termination)},
+           {"termination_message", summary.message},
+           {"converged", converged()},
+           {"optimizer_converged", summary.converged()},
+           {"fit_test", fit_test_json(fit)},
+           {"attempts", attempts_json(*this)},
+           {"cost", summary.cost},
+           {"smoothness", smoothness_json(*this)},
+           {"integrator", integrator_json(*this, p)},
+           {"data_source", p.data_source},
+           {"elements", p.structure->elements()},
+           {"settings", io::to_json(p.scenario)},
+           {"identifiability", identifiability_json(*this)}};
+  counts_json(*this, out);
+  if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0) out["data_columns"] = data_columns_json(p.columns);
+  return out;
+}
+
+std::string RunResult::FullReport() const {
+  std::string s;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-10s %14s %14s %14s %12s %12s %12s %12s\n", "parameter", "initial", "estimate", "truth",
+                "rel.error", "std", "resolution", "± interval");
+  s += line;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto it = truth.find(names[i]);
+    const auto e = static_cast<Eigen::Index>(i);
+    const double est = estimate[e];
+    auto cell = [&](const VectorXd& v) {
+      char buf[32] = "-";
+      if (v.size() > e && std::isfinite(v[e])) std::snprintf(buf, sizeof buf, "%12.3e", v[e]);
+      return std::string(buf);
+    };
+    const bool flagged = ident.identifiable.size() && !ident.identifiable[i];
+    const char* flag = flagged ? "  NOT IDENTIFIABLE" : ident.identifiable.empty() ? "  (not assessed)" : "";
+    const std::string sd = flagged ? "-" : cell(ident.std), res = flagged ? "-" : cell(ident.resolution),
+                      hw = flagged ? "-" : cell(interval.half_width);
+    if (it != truth.end())
+      std::snprintf(line, sizeof line, "%-10s %14.7g %14.7g %14.7g %12.3e %12s %12s %12s%s\n", names[i].c_str(), initial[e], est,
+                    it->second, est / it->second - 1.0, sd.c_str(), res.c_str(), hw.c_str(), flag);
+    else
+      std::snprintf(line, sizeof line, "%-10s %14.7g %14.7g %14s %12s %12s %12s %12s%s\n", names[i].c_str(), initial[e], est, "-",
+                    "-", sd.c_str(), res.c_str(), hw.c_str(), flag);
+    s += line;
+  }
+  std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
+                summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
+                wall_seconds);
+  return s + line;
+}
+
+io::DataTable fit_table(const Measurements& data, const MatrixXd& Y) {
+  io::DataTable tab;
+  tab.t = data.t;
+  for (int k = 0; k < data.sensors(); ++k) {
+    const std::string& n = data.names[static_cast<std::size_t>(k)];
+    std::vector<double> m(data.t.size()), y(data.t.size()), e(data.t.size());
+    for (std::size_t i = 0; i < data.t.size(); ++i) {
+      m[i] = data.z(static_cast<Eigen::Index>(i), k);
+      y[i] = Y(static_cast<Eigen::Index>(i), k);
+      e[i] = y[i] - m[i];
+    }
+    tab.names.insert(tab.names.end(), {n + "_measured", n + "_predicted", n + "_residual"});
+    tab.columns.insert(tab.columns.end(), {m, y, e});
+  }
+  return tab;
+}
+
+void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
+  // fit.csv: measured, predicted and residual per sensor at the sample times.
+  MatrixXd predicted = r.predicted;
+  if (predicted.size() == 0) {
+    Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+    predicted = obj.predict(r.estimate);
+  }
+  const io::DataTable tab = fit_table(p.data, predicted);
+  io::write_csv(dir.path("fit.csv"), tab);
+  // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
+  std::vector<std::pair<int, double>> cost;
+  for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
+  io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost));
+  switch (render_gnuplot(dir.staging(), "fit.gp")) {
+    case RenderStatus::Rendered: break;
+    case RenderStatus::NoGnuplot: std::fprintf(stderr, "scole-identify: note: gnuplot is not installed; no fit.png\n"); break;
+    case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n"); break;
+  }
+  io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
+}
+
+}  // namespace scoleid::identify

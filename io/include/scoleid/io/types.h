@@ -1,0 +1,91 @@
+#pragma once
+// The closed choices of a scenario and of the programs' options, as types. Strings exist only at
+// the edge: the scenario reader, the command lines and the JSON writers convert with the one table
+// per type below; everything inside compares enums.
+//
+//   Structure   structure                           the structure kind (beam | scole)
+//   Method      identification.method, --method     the optimiser (identify/inverse/optimizers.h)
+//   Start       identification.start                how the first attempt starts (docs/theory.md §7.6)
+//   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
+//   StepRule    identification.step_rule            the automatic time step's rule (§5.2)
+//
+// Adding a value: one enumerator and one row of its table, here; the reader, --help and the JSON
+// writers follow, and a switch over the type that misses it is a compiler warning.
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace scoleid::io {
+
+enum class Structure { Beam, Scole };
+enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent };
+enum class Start { Auto, Plain, CoarseToFine };
+enum class Model { Linear, Nonlinear };
+enum class StepRule { Parameters, Data };
+
+// Each type's names, in declaration order (the first is the default where a field has one).
+template <class E>
+struct Names;
+template <>
+struct Names<Structure> {
+  static constexpr std::array<std::pair<Structure, const char*>, 2> rows{{{Structure::Beam, "beam"}, {Structure::Scole, "scole"}}};
+};
+template <>
+struct Names<Method> {
+  static constexpr std::array<std::pair<Method, const char*>, 5> rows{{{Method::Auto, "auto"},
+                                                                      {Method::GaussNewton, "gauss-newton"},
+                                                                      {Method::GaussNewtonKrylov, "gauss-newton-krylov"},
+                                                                      {Method::Lbfgs, "lbfgs"},
+                                                                      {Method::SteepestDescent, "steepest-descent"}}};
+};
+template <>
+struct Names<Start> {
+  static constexpr std::array<std::pair<Start, const char*>, 3> rows{
+      {{Start::Auto, "auto"}, {Start::Plain, "plain"}, {Start::CoarseToFine, "coarse-to-fine"}}};
+};
+template <>
+struct Names<Model> {
+  static constexpr std::array<std::pair<Model, const char*>, 2> rows{{{Model::Linear, "linear"}, {Model::Nonlinear, "nonlinear"}}};
+};
+template <>
+struct Names<StepRule> {
+  static constexpr std::array<std::pair<StepRule, const char*>, 2> rows{
+      {{StepRule::Parameters, "parameters"}, {StepRule::Data, "data"}}};
+};
+
+// The name a scenario, a command line and identify.json use.
+template <class E, class = decltype(Names<E>::rows)>
+const char* to_string(E v) {
+  for (const auto& [value, name] : Names<E>::rows)
+    if (value == v) return name;
+  return "?";
+}
+
+// The value of a name (nullopt if it names none): parse<Method>(name).
+template <class E>
+std::optional<E> parse(std::string_view name) {
+  for (const auto& [value, n] : Names<E>::rows)
+    if (name == n) return value;
+  return std::nullopt;
+}
+
+// Every name of the type, in declaration order (for messages and --help).
+template <class E>
+std::vector<std::string> names() {
+  std::vector<std::string> out;
+  for (const auto& row : Names<E>::rows) out.emplace_back(row.second);
+  return out;
+}
+
+// The same joined by `sep` ("auto|gauss-newton|…").
+template <class E>
+std::string names_joined(const char* sep = "|") {
+  std::string out;
+  for (const auto& row : Names<E>::rows) out += (out.empty() ? "" : sep) + std::string(row.second);
+  return out;
+}
+
+}  // namespace scoleid::io

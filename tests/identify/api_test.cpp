@@ -1,0 +1,163 @@
+// The identifier's front door (scoleid/identify.h) and the strategy behind it (run/strategy.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scoleid/identify.h"
+#include "scoleid/identify/run/strategy.h"
+#include "scoleid/io/error.h"
+
+namespace fs = std::filesystem;
+using namespace scoleid;
+
+namespace {
+
+// paper-beam-1's record as a lab would hand it over: t, the load, the midspan sensor (synthesised
+// on a mesh four times finer than the identifier's, with 20 µm of noise).
+io::DataTable measured_table(const io::Scenario& sc) {
+  const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 1e-3, true);
+  io::DataTable t;
+  t.t = m.t;
+  t.names = {sc.inputs[0].name, sc.sensors[0].name};
+  t.columns.resize(2);
+  for (std::size_t k = 0; k < m.t.size(); ++k) {
+    t.columns[0].push_back(sc.inputs[0].signal(m.t[k]));
+    t.columns[1].push_back(m.z(static_cast<Eigen::Index>(k), 0));
+  }
+  return t;
+}
+
+io::Scenario noisy_beam() {
+  io::Scenario sc = io::load_scenario("paper-beam-1");
+  sc.sensors[0].noise_std = 2e-5;
+  return sc;
+}
+
+}  // namespace
+
+TEST(Api, ATableInMemoryIdentifiesExactlyAsTheSameFile) {
+  const io::Scenario sc = noisy_beam();
+  const io::DataTable table = measured_table(sc);
+  const fs::path dir = fs::temp_directory_path() / "scoleid-api-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string csv = (dir / "measured.csv").string();
+  io::write_csv(csv, table);
+  // The file's values are what the table's become once written at full precision: read them back.
+  const io::DataTable reread = io::read_csv(csv);
+  const Identification from_file = identify_parameters(sc, DataSource::file(csv), {});
+  const Identification from_table = identify_parameters(sc, DataSource::in_memory(reread, csv), {});
+  ASSERT_EQ(from_file.names(), from_table.names());
+  for (Eigen::Index i = 0; i < from_file.estimate().size(); ++i)
+    EXPECT_EQ(from_file.estimate()[i], from_table.estimate()[i]) << from_file.names()[static_cast<std::size_t>(i)];
+  EXPECT_EQ(from_file.result().summary.iterations_done, from_table.result().summary.iterations_done);
+  EXPECT_TRUE(from_file.converged()) << from_file.verdict();
+  EXPECT_EQ(from_file.exit_code(), 0);
+  EXPECT_EQ(from_file.verdict(), "");
+  // The in-memory problem says where its data came from, as a file's does.
+  EXPECT_EQ(from_table.problem().data_source, csv);
+  EXPECT_EQ(from_table.problem().columns.sensors, std::vector<std::string>{sc.sensors[0].name});
+  fs::remove_all(dir);
+}
+
+TEST(Api, TheReportTheJsonAndTheFilesSayTheSame) {
+  const io::Scenario sc = noisy_beam();
+  const Identification id = identify_parameters(sc, DataSource::in_memory(measured_table(sc)), {});
+  const nlohmann::json j = id.to_json();
+  EXPECT_EQ(j["converged"].get<bool>(), id.converged());
+  ASSERT_EQ(j["parameters"].size(), id.names().size());
+  const std::string report = id.FullReport();
+  for (std::size_t i = 0; i < id.names().size(); ++i) {
+    EXPECT_EQ(j["parameters"][i]["estimate"].get<double>(), id.estimate()[static_cast<Eigen::Index>(i)]);
+    EXPECT_NE(report.find(id.names()[i]), std::string::npos) << report;
+  }
+  EXPECT_NE(report.find(id.result().summary.BriefReport()), std::string::npos) << report;
+  const fs::path dir = fs::temp_directory_path() / "scoleid-api-write";
+  fs::remove_all(dir);
+  id.write(dir.string());
+  std::ifstream in(dir / "identify.json");
+  const nlohmann::json written = nlohmann::json::parse(in);
+  EXPECT_EQ(written["parameters"], j["parameters"]);
+  EXPECT_TRUE(fs::exists(dir / "fit.csv"));
+  fs::remove_all(dir);
+}
+
+TEST(Api, ARunOutOfIterationsSaysSoAndExitsOne) {
+  const io::Scenario sc = noisy_beam();
+  IdentifyOptions o;
+  o.max_iterations = 1;
+  o.compute_std = false;
+  const Identification id = identify_parameters(sc, DataSource::in_memory(measured_table(sc)), o);
+  EXPECT_FALSE(id.converged());
+  EXPECT_EQ(id.exit_code(), 1);
+  EXPECT_EQ(id.verdict().rfind("did not converge (max_iterations", 0), 0u) << id.verdict();
+  EXPECT_FALSE(id.to_json()["converged"].get<bool>());
+  // Not assessed is not identifiable: the report says so.
+  EXPECT_NE(id.FullReport().find("(not assessed)"), std::string::npos);
+}
+
+TEST(Api, BadOptionsAndBadDataAreInputErrorsBeforeAnySolve) {
+  const io::Scenario sc = noisy_beam();
+  IdentifyOptions o;
+  o.max_iterations = -1;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("max_iterations"), std::string::npos);
+  EXPECT_THROW(identify_parameters(sc, DataSource::synthetic(), o), io::InputError);
+  io::DataTable t = measured_table(sc);
+  t.names[1] = "elsewhere";  // no column for the sensor
+  try {
+    prepare(sc, DataSource::in_memory(t, "lab table"));
+    FAIL() << "a table without the sensor's column was accepted";
+  } catch (const io::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("lab table"), std::string::npos) << m;
+    EXPECT_NE(m.find(sc.sensors[0].name), std::string::npos) << m;
+  }
+}
+
+TEST(Strategy, AutoResolvesByParametersPriorAndProducts) {
+  using io::Method;
+  const int limit = identify::kExplicitGaussNewtonParameters;
+  EXPECT_EQ(identify::resolve_method(Method::Auto, limit, false, true), Method::GaussNewton);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, false, true), Method::Lbfgs);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, true, true), Method::GaussNewtonKrylov);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, true, false), Method::GaussNewton);
+  for (Method m : {Method::GaussNewton, Method::GaussNewtonKrylov, Method::Lbfgs, Method::SteepestDescent})
+    EXPECT_EQ(identify::resolve_method(m, 64, true, false), m) << "a method given is kept";
+}
+
+TEST(Strategy, TheOptimiserOptionsAreTheScenariosAndTheCautiousRestartIsFourTimesSlower) {
+  io::IdentificationSpec id;
+  id.max_iterations = 17;
+  id.gradient_tolerance = 3e-7;
+  id.step_tolerance = 2e-4;
+  id.continuation_misfit = 0.08;
+  const auto oo = identify::optimizer_options(id, io::Method::Lbfgs, 2, std::nullopt, "x");
+  EXPECT_EQ(oo.method, io::Method::Lbfgs);
+  EXPECT_EQ(oo.max_iterations, 17);
+  EXPECT_EQ(oo.gradient_tolerance, 3e-7);
+  EXPECT_EQ(oo.step_tolerance, 2e-4);
+  EXPECT_TRUE(oo.continuation);
+  EXPECT_EQ(oo.continuation_misfit, 0.08);
+  EXPECT_EQ(identify::optimizer_options(id, io::Method::Lbfgs, 2, 3, "x").max_iterations, 3);
+  EXPECT_DOUBLE_EQ(identify::cautious_continuation(oo, id).continuation_misfit, 0.02);
+  id.continuation_misfit = 0.0;  // no continuation in the scenario: the cautious one from the default
+  const auto off = identify::optimizer_options(id, io::Method::GaussNewton, 2, std::nullopt, "x");
+  EXPECT_FALSE(off.continuation);
+  EXPECT_DOUBLE_EQ(identify::cautious_continuation(off, id).continuation_misfit,
+                   identify::OptimizerOptions{}.continuation_misfit / 4.0);
+  id.steepest_weights = {1.0, 2.0, 3.0};
+  try {
+    identify::optimizer_options(id, io::Method::SteepestDescent, 2, std::nullopt, "scenario 'w.yaml'");
+    FAIL() << "three weights for two parameters were accepted";
+  } catch (const io::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("identification.steepest_weights"), std::string::npos) << m;
+    EXPECT_NE(m.find("3 values"), std::string::npos) << m;
+  }
+}
