@@ -32,8 +32,8 @@ int main(int argc, char** argv) {
   int segments = 0;
   double accuracy = 0.0;
   bool list = false, quiet = false, visualize = false;
-  app.add_option("--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
-  app.add_option("--out", out, "output directory (truth.csv, truth.json)")->capture_default_str();
+  app.add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
+  app.add_option("-o,--out", out, "output directory (truth.csv, truth.json)")->capture_default_str();
   app.add_option("--segments", segments,
                  "override truth.segments (2.." + std::to_string(io::limits::kMaxSegments) + ")");
   app.add_option("--integrator", integrator,
@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   std::string print_name;
   app.add_option("--print-scenario", print_name,
                  "print built-in scenario NAME as YAML and exit (start a scenario file by editing it)");
-  app.add_flag("--quiet", quiet, "no progress or summary on stderr");
+  app.add_flag("-q,--quiet", quiet, "no progress or summary on stderr");
   app.add_flag("--visualize", visualize, "show the run in simbody-visualizer (needs a display)");
   app.footer(
       "Exit codes: 0 success; 1 the run failed (integration failure, or the motion left the identifier's linear "
