@@ -99,6 +99,12 @@ void print_problem(const identify::Problem& problem, bool from_file) {
   std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
                list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
                list(c.unused).c_str());
+  for (const auto& x : c.sources)
+    if (x.column != x.name || !x.from_unit.empty())
+      std::fprintf(stderr, "scole-identify: %s <- column '%s'%s\n", x.name.c_str(), x.column.c_str(),
+                   x.from_unit.empty() ? ""
+                                       : (" [" + x.from_unit + ", " + x.unit_stated_by + "] x " + io::format_value(x.scale) +
+                                          " -> [" + x.to_unit + "]").c_str());
   for (const auto& st : c.stepped_inputs)
     std::fprintf(stderr,
                  "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g): "

@@ -8,12 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/validation.h"
 
 #include "scoleid/io/limits.h"
+#include "scoleid/io/units.h"
 
 namespace scoleid::io {
 
@@ -47,45 +49,76 @@ double DataTable::interpolate(int j, double tt) const {
   return (1.0 - a) * v[k - 1] + a * v[k];
 }
 
-std::vector<std::string> split_csv_line(const std::string& line) {
+std::string DataTable::unit(int j) const {
+  return j >= 0 && static_cast<std::size_t>(j) < units.size() ? units[static_cast<std::size_t>(j)] : std::string();
+}
+
+namespace {
+
+std::string trim_field(const std::string& s, const char* chars) {
+  const auto b = s.find_first_not_of(chars);
+  const auto e = s.find_last_not_of(chars);
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+std::vector<std::string> split_csv_line(const std::string& line, char separator) {
   std::vector<std::string> out;
   std::string cur;
-  for (char c : line) {
-    if (c == ',') {
-      out.push_back(cur);
+  bool quoted = false, was_quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == '"') {
+      if (quoted && i + 1 < line.size() && line[i + 1] == '"') {
+        cur.push_back('"');
+        ++i;
+      } else {
+        quoted = !quoted;
+        was_quoted = true;
+      }
+    } else if (c == separator && !quoted) {
+      out.push_back(was_quoted ? cur : trim_field(cur, " \t\""));
       cur.clear();
+      was_quoted = false;
     } else if (c != '\r') {
       cur.push_back(c);
     }
   }
-  out.push_back(cur);
-  for (auto& s : out) {
-    const auto b = s.find_first_not_of(" \t\"");
-    const auto e = s.find_last_not_of(" \t\"");
-    s = (b == std::string::npos) ? std::string() : s.substr(b, e - b + 1);
-  }
+  out.push_back(was_quoted ? cur : trim_field(cur, " \t\""));
   return out;
 }
 
-DataTable read_csv(const std::string& path) {
+DataTable read_csv(const std::string& path, const CsvOptions& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError("data file '" + path + "': is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("data file '" + path + "': cannot be opened");
-  return read_csv_stream(in, path);
+  return read_csv_stream(in, path, options);
 }
 
-DataTable read_csv_text(const std::string& text, const std::string& path) {
+DataTable read_csv_text(const std::string& text, const std::string& path, const CsvOptions& options) {
   std::istringstream in(text);
-  return read_csv_stream(in, path);
+  return read_csv_stream(in, path, options);
 }
 
-DataTable read_csv_stream(std::istream& in, const std::string& path) {
-  DataTable tab;
-  tab.source = path;
+namespace {
+
+// The separator a header line uses: ';' or a tab where it has one outside quotes, else ','.
+char separator_of(const std::string& header) {
+  bool quoted = false, semicolon = false, tab = false;
+  for (char c : header) {
+    if (c == '"') quoted = !quoted;
+    if (quoted) continue;
+    semicolon = semicolon || c == ';';
+    tab = tab || c == '\t';
+  }
+  return semicolon ? ';' : tab ? '\t' : ',';
+}
+
+// The header line (after '#' comments, blank lines and a byte-order mark); lineno counts lines.
+std::string header_line(std::istream& in, const std::string& path, std::size_t& lineno) {
   std::string line;
-  std::size_t lineno = 0;
-  // Header (skipping '#' comment lines).
   while (std::getline(in, line)) {
     ++lineno;
     // A UTF-8 byte-order mark (spreadsheets write one) belongs to no line's content.
@@ -95,7 +128,7 @@ DataTable read_csv_stream(std::istream& in, const std::string& path) {
     break;
   }
   if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos)
-    throw InputError("data file '" + path + "': empty, expected a header line starting with 't'");
+    throw InputError("data file '" + path + "': empty, expected a header line (time column first)");
   // Lines ended by CR alone (classic Mac) arrive as one line: say so rather than misread it. A CR
   // followed by anything but another CR is inside the line (CR CR LF endings are read as before).
   for (std::size_t i = 0; i + 1 < line.size(); ++i)
@@ -103,60 +136,104 @@ DataTable read_csv_stream(std::istream& in, const std::string& path) {
       throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
                        ": lines end in CR alone; save the file with LF or CR LF line endings");
   check_utf8(line, "data file '" + path + "': line " + std::to_string(lineno));
-  const auto header = split_csv_line(line);
-  if (header.empty() || header[0] != "t")
-    throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
-                     ": first column must be 't', got '" + (header.empty() ? "" : header[0]) + "'");
-  if (header.size() < 2)
-    throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": no data columns after 't'");
-  for (std::size_t j = 1; j < header.size(); ++j) {
-    if (header[j].empty())
-      throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": column " +
-                       std::to_string(j + 1) + " has an empty name");
-    if (std::find(tab.names.begin(), tab.names.end(), header[j]) != tab.names.end())
-      throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": duplicate column '" +
-                       header[j] + "'");
-    tab.names.push_back(header[j]);
+  return line;
+}
+
+// The time column's index and the table's names and units from the header.
+std::size_t read_header(const std::vector<std::string>& header, const CsvOptions& options, DataTable& tab,
+                        std::size_t lineno) {
+  const std::string where = "data file '" + tab.source + "': line " + std::to_string(lineno);
+  std::size_t time = 0;
+  if (!options.time_column.empty()) {
+    const auto it = std::find(header.begin(), header.end(), options.time_column);
+    if (it == header.end())
+      throw InputError(where + ": no time column '" + one_line(options.time_column) + "' (data.time_column); the header's first is '" +
+                       one_line(header[0]) + "'");
+    time = static_cast<std::size_t>(it - header.begin());
   }
+  if (header.size() < 2) throw InputError(where + ": no data columns beside the time column '" + one_line(header[time]) + "'");
+  std::set<std::string> seen;
+  for (std::size_t j = 0; j < header.size(); ++j) {
+    if (header[j].empty())
+      throw InputError(where + ": column " + std::to_string(j + 1) + " has an empty name");
+    if (!seen.insert(header[j]).second) throw InputError(where + ": duplicate column '" + one_line(header[j]) + "'");
+    if (j == time) continue;
+    tab.names.push_back(header[j]);
+    tab.units.push_back(units::bracketed_unit(header[j]));
+  }
+  tab.time_name = header[time];
+  tab.time_unit = units::bracketed_unit(header[time]);
+  if (tab.time_unit.empty()) tab.time_unit = options.time_unit;
+  return time;
+}
+
+// One field's number (a decimal comma read as a point where the separator is not ',').
+bool parse_number(std::string f, bool decimal_comma, double& v) {
+  if (f.empty()) return false;
+  if (decimal_comma) std::replace(f.begin(), f.end(), ',', '.');
+  char* end = nullptr;
+  v = std::strtod(f.c_str(), &end);
+  return end && *end == '\0';
+}
+
+// t into seconds from the time column's unit.
+void time_in_seconds(DataTable& tab) {
+  if (tab.time_unit.empty() || tab.time_unit == "s") return;
+  units::Conversion c;
+  try {
+    c = units::conversion(tab.time_unit, "s", units::Quantity::Time);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("data file '" + tab.source + "': time column '" + one_line(tab.time_name) + "': unit " + e.what());
+  }
+  for (double& x : tab.t) x = c.apply(x);
+  for (std::size_t k = 1; k < tab.t.size(); ++k)
+    if (!(tab.t[k] > tab.t[k - 1]))
+      throw InputError("data file '" + tab.source + "': time column '" + one_line(tab.time_name) + "': sample " + std::to_string(k + 1) +
+                       " is not after the one before once converted from " + tab.time_unit + " into s (" + format_value(tab.t[k]) + ")");
+}
+
+}  // namespace
+
+DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options) {
+  DataTable tab;
+  tab.source = path;
+  std::size_t lineno = 0;
+  std::string line = header_line(in, path, lineno);
+  const char sep = separator_of(line);
+  const bool decimal_comma = sep != ',';
+  const auto header = split_csv_line(line, sep);
+  const std::size_t time = read_header(header, options, tab, lineno);
   tab.columns.assign(tab.names.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     if (line[0] == '#') continue;
-    const auto f = split_csv_line(line);
+    const auto f = split_csv_line(line, sep);
     if (f.size() != header.size())
       throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": expected " +
                        std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));
+    if (tab.t.size() >= static_cast<std::size_t>(limits::kMaxSamples))
+      throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": more than " +
+                       format_value(limits::kMaxSamples) + " samples (the limit of one record)");
     for (std::size_t j = 0; j < f.size(); ++j) {
+      const std::string where = "data file '" + path + "': line " + std::to_string(lineno) + ", column '" + one_line(header[j]) + "'";
       double v = 0.0;
-      bool ok = !f[j].empty();
-      if (ok) {
-        char* end = nullptr;
-        v = std::strtod(f[j].c_str(), &end);
-        ok = end && *end == '\0';
-      }
-      if (!ok)
-        throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ", column '" + header[j] +
-                         "': not a number, got '" + f[j] + "'");
-      if (!std::isfinite(v))
-        throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ", column '" + header[j] +
-                         "': must be finite, got " + f[j]);
+      if (!parse_number(f[j], decimal_comma, v)) throw InputError(where + ": not a number, got '" + one_line(f[j]) + "'");
+      if (!std::isfinite(v)) throw InputError(where + ": must be finite, got " + f[j]);
       if (!(std::abs(v) <= limits::kMaxMagnitude))  // (tiny values are data; huge ones overflow the fit)
-        throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ", column '" + header[j] +
-                         "': magnitude must be at most " + format_value(limits::kMaxMagnitude) + ", got " + format_value(v));
-      if (j == 0) {
+        throw InputError(where + ": magnitude must be at most " + format_value(limits::kMaxMagnitude) + ", got " + format_value(v));
+      if (j == time) {
         if (!tab.t.empty() && !(v > tab.t.back()))
-          throw InputError("data file '" + path + "': line " + std::to_string(lineno) +
-                           ", column 't': time must be strictly increasing, got " + f[j] + " after " +
-                           format_value(tab.t.back()));
+          throw InputError(where + ": time must be strictly increasing, got " + f[j] + " after " + format_value(tab.t.back()));
         tab.t.push_back(v);
       } else {
-        tab.columns[j - 1].push_back(v);
+        tab.columns[j < time ? j : j - 1].push_back(v);
       }
     }
   }
   if (tab.t.size() < 2)
     throw InputError("data file '" + path + "': needs at least 2 data rows, got " + std::to_string(tab.t.size()));
+  time_in_seconds(tab);
   return tab;
 }
 
@@ -184,10 +261,24 @@ void write_text_atomic(const std::string& path, const std::string& text) {
   }
 }
 
+namespace {
+
+// A header field as CSV writes it: quoted when it holds a separator, a quote or outer blanks.
+std::string csv_field(const std::string& name) {
+  const bool plain = name.find_first_of(",;\"\t") == std::string::npos && !name.empty() && name.front() != ' ' &&
+                     name.back() != ' ' && name.front() != '#';
+  if (plain) return name;
+  std::string q = "\"";
+  for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
 void write_csv(const std::string& path, const DataTable& tab) {
   std::ostringstream os;
   os << "t";
-  for (const auto& n : tab.names) os << ',' << n;
+  for (const auto& n : tab.names) os << ',' << csv_field(n);
   os << '\n' << std::setprecision(17);
   for (std::size_t i = 0; i < tab.t.size(); ++i) {
     os << tab.t[i];

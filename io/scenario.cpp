@@ -399,6 +399,26 @@ void check_location(const Scenario& sc, const std::string& field, const std::str
                format_value(loc));
 }
 
+// A sensor's or input's unit and its column's must be units of its quantity, and the unit the
+// scenario's unit system gives it (no label may disagree with the numbers).
+void check_units(const Scenario& sc, const Reader& r, const std::string& kind, const std::string& unit,
+                 const std::string& column_unit) {
+  const auto q = units::quantity_of_kind(kind);
+  if (!q) return;
+  if (!unit.empty())
+    if (const auto why = units::problem_with(unit, *q)) fail_field(sc.source, r.field("unit"), "must be a unit of " + std::string(units::quantity_name(*q)) + " (" + *why + ")", "'" + unit + "'");
+  if (!column_unit.empty())
+    if (const auto why = units::problem_with(column_unit, *q))
+      fail_field(sc.source, r.field("column_unit"), "must be a unit of " + std::string(units::quantity_name(*q)) + " (" + *why + ")", "'" + column_unit + "'");
+  if (unit.empty() || sc.units == units::System::None) return;
+  const std::string want = units::system_unit(sc.units, *q);
+  if (!units::conversion(unit, want, *q).identity())
+    fail_field(sc.source, r.field("unit"),
+               "must be the " + std::string(units::quantity_name(*q)) + " unit of the scenario's units (" +
+                   units::system_name(sc.units) + ": " + want + ")",
+               "'" + unit + "'");
+}
+
 void parse_inputs(const YAML::Node& n, Scenario& sc) {
   if (!n || n.IsNull()) return;
   if (!n.IsSequence()) fail_field(sc.source, "inputs", "must be a list", Reader::kind(n));
@@ -418,6 +438,9 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     in.unit = r.str("unit", "");
     in.signal_from = r.choice("signal_from", in.signal_from, {"auto", "data", "scenario"});
     in.signal = parse_signal(r.child("signal"), sc.source, r.field("signal"));
+    in.column = r.str("column", "");
+    in.column_unit = r.str("column_unit", "");
+    check_units(sc, r, in.kind, in.unit, in.column_unit);
     sc.inputs.push_back(std::move(in));
   }
 }
@@ -440,6 +463,9 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.direction = parse_direction(r, "direction");
     s.unit = r.str("unit", "");
     s.noise_std = r.nonneg("noise_std", 0.0);
+    s.column = r.str("column", "");
+    s.column_unit = r.str("column_unit", "");
+    check_units(sc, r, s.kind, s.unit, s.column_unit);
     if (s.kind == "strain") {
       if (sc.structure != Structure::Beam)
         fail_field(sc.source, r.field("kind"), "is a beam's strain gauge (structure: beam)", "'strain'");
@@ -610,6 +636,12 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     sc.name = r.str("name", "unnamed");
     sc.description = r.str("description", "");
     sc.structure = r.choice_of("structure", Structure::Beam);
+    if (r.has("units")) {
+      const std::string u = r.str("units", "");
+      const auto system = units::parse_system(u);
+      if (!system) fail_field(source, "units", "must be SI or slug-ft-s", "'" + u + "'");
+      sc.units = *system;
+    }
     if (r.has("beam")) parse_beam(r.child("beam"), source, sc.beam);
     if (r.has("scole")) parse_scole(r.child("scole"), source, sc.scole);
     {
@@ -624,6 +656,14 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     }
     parse_inputs(r.child("inputs"), sc);
     parse_sensors(r.child("sensors"), sc);
+    if (r.has("data")) {
+      Reader d(r.child("data"), source, "data");
+      sc.data.time_column = d.str("time_column", "");
+      sc.data.time_unit = d.str("time_unit", "");
+      if (!sc.data.time_unit.empty())
+        if (const auto why = units::problem_with(sc.data.time_unit, units::Quantity::Time))
+          fail_field(source, "data.time_unit", "must be a unit of time (" + *why + ")", "'" + sc.data.time_unit + "'");
+    }
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
     if (sc.identification.model == Model::Nonlinear && sc.structure != Structure::Scole)
@@ -717,6 +757,9 @@ nlohmann::json to_json(const Scenario& s) {
   j["description"] = s.description;
   j["source"] = s.source;
   j["structure"] = to_string(s.structure);
+  if (s.units != units::System::None) j["units"] = units::system_name(s.units);
+  if (!s.data.time_column.empty() || !s.data.time_unit.empty())
+    j["data"] = {{"time_column", s.data.time_column}, {"time_unit", s.data.time_unit}};
   auto beam = [](const BeamSpec& b) {
     return json{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
                 {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta}, {"c_kv", b.c_kv},
@@ -756,15 +799,20 @@ nlohmann::json to_json(const Scenario& s) {
     }
   }
   j["inputs"] = json::array();
-  for (const auto& in : s.inputs)
+  for (const auto& in : s.inputs) {
     j["inputs"].push_back({{"name", in.name}, {"at", in.at}, {"kind", in.kind}, {"location", in.location},
                            {"direction", in.direction}, {"unit", in.unit}, {"signal_from", in.signal_from},
                            {"signal", signal(in.signal)}});
+    if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
+    if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;
+  }
   j["sensors"] = json::array();
   for (const auto& se : s.sensors) {
     j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", se.kind}, {"location", se.location},
                             {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
     if (se.kind == "strain") j["sensors"].back()["offset"] = se.offset;
+    if (!se.column.empty()) j["sensors"].back()["column"] = se.column;
+    if (!se.column_unit.empty()) j["sensors"].back()["column_unit"] = se.column_unit;
   }
   j["simulation"] = {{"duration", s.simulation.duration}, {"sample_interval", s.simulation.sample_interval},
                      {"seed", s.simulation.seed}};

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <regex>
 #include <set>
 
 #include "scoleid/identify/inverse/joint_misfit.h"
@@ -16,7 +15,10 @@
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/limits.h"
+#include "scoleid/io/validation.h"
 #include <stdexcept>
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
@@ -49,6 +51,60 @@ std::string relative_path(const std::string& value, const std::string& file) {
   return p.is_absolute() ? value : (fs::path(file).parent_path() / p).string();
 }
 
+// A name of at most kMaxNameLength characters: letters, digits and `extra`; when `alnum_first`, its
+// first character a letter or digit.
+bool name_of(const std::string& name, const std::string& extra, bool alnum_first) {
+  if (name.empty() || name.size() > io::limits::kMaxNameLength) return false;
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const bool alnum = std::isalnum(static_cast<unsigned char>(name[i])) != 0;
+    if (!alnum && (extra.find(name[i]) == std::string::npos || (i == 0 && alnum_first))) return false;
+  }
+  return true;
+}
+
+// A finite number.
+double number(const YAML::Node& n, const std::string& file, const std::string& field) {
+  const std::string text = scalar(n, file, field);
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(v)) bad(file, field, "must be a finite number", text);
+  return v;
+}
+
+// modes: {file, scenario} and, for a Universal File's modes, their standard deviations and the
+// stations (io/uff_modes.h).
+void parse_modes(const YAML::Node& m, const std::string& path, ExperimentsSpec& s) {
+  if (!m.IsMap()) bad(path, "modes", "must be a mapping {file, scenario, ...}", YAML::Dump(m));
+  auto& u = s.modes_uff;
+  u.source = path;
+  for (const auto& kv : m) {
+    const std::string key = kv.first.Scalar(), f = "modes." + key;
+    if (key == "file" || key == "scenario") continue;
+    s.modes_uff_given = true;
+    if (key == "frequency_std") u.frequency_std = number(kv.second, path, f);
+    else if (key == "damping_std") u.damping_std = number(kv.second, path, f);
+    else if (key == "shape_std") u.shape_std = number(kv.second, path, f);
+    else if (key == "stations") {
+      if (!kv.second.IsMap()) bad(path, f, "must be a mapping {sensor: <node><sign><axis>}", YAML::Dump(kv.second));
+      for (const auto& st : kv.second) u.stations.emplace_back(st.first.Scalar(), scalar(st.second, path, f + "." + st.first.Scalar()));
+    } else {
+      bad(path, f, "is not a field of modes (file, scenario; for a Universal File: frequency_std, damping_std, shape_std, stations)", key);
+    }
+  }
+  if (!m["file"]) bad(path, "modes.file", "is required (the measured modes: CSV, or a Universal File's datasets 55)", "missing");
+  s.modes_file = relative_path(scalar(m["file"], path, "modes.file"), path);
+  if (m["scenario"]) s.modes_scenario = resolve(scalar(m["scenario"], path, "modes.scenario"), path);
+}
+
+// The measured modes: a Universal File's datasets 55 with the stated deviations, or the CSV.
+io::ModalData read_modes(const ExperimentsSpec& spec) {
+  if (io::is_uff_file(*spec.modes_file)) return io::modal_data_from_uff(io::uff::read_file(*spec.modes_file), spec.modes_uff);
+  if (spec.modes_uff_given)
+    bad(spec.source, "modes", "frequency_std, damping_std, shape_std and stations describe a Universal File's modes; " + *spec.modes_file +
+                                  " is a CSV, which states its own", "a CSV");
+  return io::read_modal_data(*spec.modes_file);
+}
+
 }  // namespace
 
 ExperimentsSpec load_experiments(const std::string& path) {
@@ -69,8 +125,9 @@ ExperimentsSpec load_experiments(const std::string& path) {
   }
   if (!root["experiments"]) bad(path, "experiments", "is required (the name of the run)", "missing");
   s.name = scalar(root["experiments"], path, "experiments");
-  if (!std::regex_match(s.name, std::regex("[A-Za-z0-9][A-Za-z0-9_.-]*")))
-    bad(path, "experiments", "must start with a letter or digit, then letters, digits, '_', '-' or '.'", s.name);
+  if (!name_of(s.name, "_.-", true))
+    bad(path, "experiments", "must start with a letter or digit, then letters, digits, '_', '-' or '.' (at most " +
+                                 std::to_string(io::limits::kMaxNameLength) + ")", io::one_line(s.name.substr(0, 80)));
   if (root["description"]) s.description = scalar(root["description"], path, "description");
   if (root["threads"]) {
     try {
@@ -95,8 +152,9 @@ ExperimentsSpec load_experiments(const std::string& path) {
       ExperimentsSpec::Run run;
       if (!r["name"]) bad(path, f + ".name", "is required", "missing");
       run.name = scalar(r["name"], path, f + ".name");
-      if (!std::regex_match(run.name, std::regex("[A-Za-z0-9_-]+")))
-        bad(path, f + ".name", "must be letters, digits, '_' or '-' (it names the run's output files)", run.name);
+      if (!name_of(run.name, "_-", false))
+        bad(path, f + ".name", "must be letters, digits, '_' or '-', at most " + std::to_string(io::limits::kMaxNameLength) +
+                                   " (it names the run's output files)", io::one_line(run.name.substr(0, 80)));
       if (!names.insert(run.name).second) bad(path, f + ".name", "is used by two runs", run.name);
       if (run.name == "modes") bad(path, f + ".name", "is reserved for the modal data", run.name);
       if (!r["scenario"]) bad(path, f + ".scenario", "is required (a built-in name or a YAML file)", "missing");
@@ -105,17 +163,7 @@ ExperimentsSpec load_experiments(const std::string& path) {
       s.runs.push_back(run);
     }
   }
-  if (root["modes"]) {
-    const YAML::Node m = root["modes"];
-    if (!m.IsMap()) bad(path, "modes", "must be a mapping {file, scenario}", YAML::Dump(m));
-    for (const auto& kv : m) {
-      const std::string key = kv.first.Scalar();
-      if (key != "file" && key != "scenario") bad(path, "modes." + key, "is not a field of modes (file, scenario)", key);
-    }
-    if (!m["file"]) bad(path, "modes.file", "is required (the measured modes, CSV)", "missing");
-    s.modes_file = relative_path(scalar(m["file"], path, "modes.file"), path);
-    if (m["scenario"]) s.modes_scenario = resolve(scalar(m["scenario"], path, "modes.scenario"), path);
-  }
+  if (root["modes"]) parse_modes(root["modes"], path, s);
   if (s.runs.empty() && !s.modes_file) bad(path, "runs", "at least one run or a modes file is needed", "none");
   if (s.runs.empty() && s.modes_scenario.empty())
     bad(path, "modes.scenario", "is required when there are no runs (the model the modes are compared with)", "missing");
@@ -165,7 +213,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
   }
   if (spec.modes_file) {
-    ep->modes = io::read_modal_data(*spec.modes_file);
+    ep->modes = read_modes(spec);
     ep->modes_scenario = std::make_unique<io::Scenario>(spec.modes_scenario.empty() ? ep->runs.front()->scenario
                                                                                       : io::load_scenario(spec.modes_scenario));
     io::validate_scenario(*ep->modes_scenario);

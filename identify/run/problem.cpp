@@ -13,6 +13,9 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/structure_parameters.h"
+#include "scoleid/io/data_source.h"
+#include "scoleid/io/units.h"
+#include "scoleid/io/validation.h"
 
 namespace scoleid::identify {
 
@@ -395,10 +398,50 @@ std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& 
   return meta.true_parameters;
 }
 
+// The table column of a sensor or input: its `column`, else its name (-1 when absent).
+int column_of(const io::DataTable& tab, const std::string& name, const std::string& column) {
+  return tab.find(column.empty() ? name : column);
+}
+
+// The values of column `col` in the unit of a sensor or input of kind `kind` and unit `unit`
+// (or its unit system's): the column's unit from column_unit, else from its file. A column without
+// a stated unit is taken as it is; one with a unit needs a unit to convert into.
+std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col, const std::string& field,
+                                  const std::string& name, const std::string& kind, const std::string& unit,
+                                  const std::string& column_unit) {
+  const auto& sc = p.scenario;
+  const std::string& column = tab.names[static_cast<std::size_t>(col)];
+  ColumnUse::Source src{name, column, column_unit.empty() ? tab.unit(col) : column_unit,
+                        column_unit.empty() ? "file" : field + ".column_unit", unit, 1.0};
+  const auto q = io::units::quantity_of_kind(kind);
+  if (src.to_unit.empty() && q) src.to_unit = io::units::system_unit(sc.units, *q);
+  std::vector<double> v = tab.columns[static_cast<std::size_t>(col)];
+  if (src.from_unit.empty() || !q) {
+    src.unit_stated_by = src.from_unit.empty() ? "none" : src.unit_stated_by;
+    p.columns.sources.push_back(src);
+    return v;
+  }
+  const std::string where = "data file '" + tab.source + "': column '" + io::one_line(column) + "' (" + field + ", '" + name + "')";
+  if (src.to_unit.empty())
+    throw InputError(where + ": is in '" + src.from_unit + "' but " + field +
+                     " states no unit to convert it into: give " + field + ".unit or the scenario's units");
+  io::units::Conversion c;
+  try {
+    c = io::units::conversion(src.from_unit, src.to_unit, *q);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(where + ": cannot convert '" + src.from_unit + "' into '" + src.to_unit + "': " + e.what());
+  }
+  src.scale = c.scale;
+  if (!c.identity())
+    for (double& x : v) x = c.apply(x);
+  p.columns.sources.push_back(src);
+  return v;
+}
+
 // An input driven by its column (piecewise linear), with its largest jump within one sample.
 void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
   const auto& in = p.scenario.inputs[i];
-  const auto& f = tab.columns[static_cast<std::size_t>(col)];
+  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, in.kind, in.unit, in.column_unit);
   p.signals[i] = io::Signal::table(tab.t, f);
   p.columns.inputs_from_data.push_back(in.name);
   const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
@@ -418,27 +461,29 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
   const auto& sc = p.scenario;
   p.data.t = tab.t;
   p.data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
-  for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-    const int col = tab.find(sc.sensors[j].name);
-    if (col < 0)
-      throw InputError("data file '" + csv + "': no column for sensor '" + sc.sensors[j].name + "' (sensors[" +
-                       std::to_string(j) + "] of " + sc.source + ")");
-    for (std::size_t k = 0; k < tab.t.size(); ++k)
-      p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = tab.columns[static_cast<std::size_t>(col)][k];
-    p.data.names.push_back(sc.sensors[j].name);
-  }
   std::vector<bool> used(tab.names.size(), false);
-  for (const auto& s : sc.sensors) {
-    used[static_cast<std::size_t>(tab.find(s.name))] = true;
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
+    const auto& s = sc.sensors[j];
+    const std::string field = "sensors[" + std::to_string(j) + "]";
+    const int col = column_of(tab, s.name, s.column);
+    if (col < 0)
+      throw InputError("data file '" + csv + "': no column " +
+                       (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
+                       " (" + field + " of " + sc.source + ")");
+    const auto v = column_values(p, tab, col, field, s.name, s.kind, s.unit, s.column_unit);
+    for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
+    p.data.names.push_back(s.name);
+    used[static_cast<std::size_t>(col)] = true;
     p.columns.sensors.push_back(s.name);
   }
   for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
     const auto& in = sc.inputs[i];
-    const int col = tab.find(in.name);
+    const int col = column_of(tab, in.name, in.column);
     const std::string field = "inputs[" + std::to_string(i) + "]";
-    if (in.signal_from == "data" && col < 0)
-      throw InputError("data file '" + csv + "': no column for input '" + in.name + "' (" + field +
-                       ".signal_from is data, in " + sc.source + ")");
+    if ((in.signal_from == "data" || !in.column.empty()) && col < 0)
+      throw InputError("data file '" + csv + "': no column " +
+                       (in.column.empty() ? "for input '" + in.name + "'" : "'" + io::one_line(in.column) + "' (" + field + ".column)") +
+                       " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + ")");
     if (in.signal_from != "scenario" && col >= 0) {
       input_from_column(p, i, tab, col);
       used[static_cast<std::size_t>(col)] = true;
@@ -547,7 +592,7 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
     finish_problem(*p, synthesize_data(*p), nullptr);
     return p;
   }
-  const io::DataTable tab = io::read_csv(*data_csv);
+  const io::DataTable tab = io::read_data(*data_csv, {sc.data.time_column, sc.data.time_unit});
   // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.
   const auto meta_path = std::filesystem::path(*data_csv).parent_path() / "truth.json";
   if (!std::filesystem::exists(meta_path)) return from_table(std::move(p), tab, *data_csv, nullptr, "");

@@ -152,7 +152,12 @@ json data_columns_json(const ColumnUse& c) {
   for (const auto& st : c.stepped_inputs)
     stepped.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at}, {"switch_shift_up_to", 0.5 * st.sample},
                        {"scenario_gives_signal", st.scenario_signal}});
+  json sources = json::array();
+  for (const auto& x : c.sources)
+    sources.push_back({{"name", x.name}, {"column", x.column}, {"column_unit", x.from_unit}, {"unit_stated_by", x.unit_stated_by},
+                       {"unit", x.to_unit}, {"scale", x.scale}});
   return {{"sensors", c.sensors},
+          {"sources", sources},
           {"inputs_from_data", c.inputs_from_data},
           {"inputs_from_scenario", c.inputs_from_scenario},
           {"unused", c.unused},

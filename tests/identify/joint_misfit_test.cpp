@@ -273,6 +273,66 @@ std::string input_error(const std::function<void()>& f) {
   return "(no InputError)";
 }
 
+// The modes as a modal-test program exports them: one dataset 55 per mode (normal mode, 3 values
+// per node, E13.5), the station k at node k + 1 along Z.
+std::string uff55(const io::ModalData& d) {
+  std::string s;
+  char buf[160];
+  for (const auto& m : d.modes) {
+    s += "    -1\n    55\nmodes\nNONE\nNONE\nNONE\nNONE\n";
+    std::snprintf(buf, sizeof buf, "%10d%10d%10d%10d%10d%10d\n", 1, 2, 2, 8, 2, 3);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "%10d%10d%10d%10d\n", 2, 4, 1, m.label);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "%13.5e%13.5e%13.5e%13.5e\n", m.frequency_hz, 1.0, 0.0, 0.0);
+    s += buf;
+    for (std::size_t k = 0; k < m.shape.size(); ++k) {
+      std::snprintf(buf, sizeof buf, "%10zu\n%13.5e%13.5e%13.5e\n", k + 1, 0.0, 0.0, m.shape[k]);
+      s += buf;
+    }
+    s += "    -1\n";
+  }
+  return s;
+}
+
+// The same modes from a Universal File (frequencies and shapes to 6 digits, deviations and
+// stations stated in the experiments file) identify what the CSV does, to well within a std.
+TEST(Experiments, ModesFromAUniversalFileIdentifyAsFromTheCsv) {
+  Scratch s;
+  s.write("a.yaml", beam_run("{name: P, at: beam, kind: force, location: 3, unit: N, signal: {type: step, amplitude: 10, t0: 0}}",
+                             "  - {name: w7, at: beam, kind: displacement, location: 7, unit: m, noise_std: 1.0e-5}\n"
+                             "  - {name: w4, at: beam, kind: displacement, location: 4, unit: m, noise_std: 1.0e-5}\n",
+                             2.0));
+  const io::Scenario sc = io::load_scenario((s.dir / "a.yaml").string());
+  const io::ModalData d = fe_modal_data(sc, 4 * sc.identification.elements, 4, 2e-3, 1e-3);
+  io::write_modal_data((s.dir / "m.csv").string(), d);
+  s.write("m.uff", uff55(d));
+  const std::string fc = s.write("c.yaml", "experiments: c\nmodes: {file: m.csv, scenario: a.yaml}\n");
+  const std::string fu = s.write("u.yaml", "experiments: u\nmodes: {file: m.uff, scenario: a.yaml, frequency_std: 2.0e-3, shape_std: 1.0e-3,\n"
+                                           "        stations: {" + d.stations[0] + ": 1+Z, " + d.stations[1] + ": 2+Z}}\n");
+  ExperimentsOptions eo;
+  eo.verbose = false;
+  auto ec = make_experiments(load_experiments(fc));
+  auto eu = make_experiments(load_experiments(fu));
+  ASSERT_EQ(eu->modes->modes.size(), d.modes.size());
+  for (std::size_t m = 0; m < d.modes.size(); ++m)
+    EXPECT_NEAR(eu->modes->modes[m].frequency_std_hz, d.modes[m].frequency_std_hz, 1e-5 * d.modes[m].frequency_std_hz);
+  const ExperimentsResult rc = run_experiments(*ec, eo);
+  const ExperimentsResult ru = run_experiments(*eu, eo);
+  ASSERT_TRUE(rc.converged()) << rc.summary.message;
+  ASSERT_TRUE(ru.converged()) << ru.summary.message;
+  // Modes alone fix EI/rho_A (frequencies ~ sqrt(EI/rho_A); shapes carry no scale): that ratio
+  // agrees to the files' 6 digits, far inside the frequencies' stated 2e-3.
+  const double ratio_c = rc.estimate[0] / rc.estimate[1], ratio_u = ru.estimate[0] / ru.estimate[1];
+  std::printf("EI/rho_A: csv %.10g, uff %.10g, relative difference %.2e\n", ratio_c, ratio_u, ratio_u / ratio_c - 1.0);
+  EXPECT_NEAR(ratio_u / ratio_c, 1.0, 1e-4);
+  EXPECT_NEAR(ratio_c / (23000.0 / 67.0), 1.0, 2e-3);
+  // A CSV with a Universal File's fields is refused (it states its own deviations).
+  const std::string bad = s.write("b.yaml", "experiments: b\nmodes: {file: m.csv, scenario: a.yaml, frequency_std: 0.01}\n");
+  EXPECT_NE(input_error([&] { make_experiments(load_experiments(bad)); }).find("describe a Universal File's modes"), std::string::npos);
+}
+
+
 TEST(Experiments, BadInputIsOneLineNamingFileFieldAndValue) {
   Scratch s;
   s.write("a.yaml", beam_run("{name: P, at: beam, kind: force, location: 3, unit: N, signal: {type: step, amplitude: 10, t0: 0}}",

@@ -51,7 +51,7 @@ TEST(DataFiles, CsvRoundTripIsExact) {
 }
 
 TEST(DataFiles, CsvErrorsNameFileLineColumnValue) {
-  EXPECT_NE(error_of_csv("time,a\n0,1\n1,2\n").find("first column must be 't', got 'time'"), std::string::npos);
+  EXPECT_NE(error_of_csv("time\n0\n1\n").find("line 1: no data columns beside the time column 'time'"), std::string::npos);
   EXPECT_NE(error_of_csv("t,a\n0,1\n0,2\n").find("line 3, column 't': time must be strictly increasing, got 0 after 0"),
             std::string::npos);
   EXPECT_NE(error_of_csv("t,a\n0,1\n1,nan\n").find("line 3, column 'a': must be finite, got nan"), std::string::npos);
@@ -94,4 +94,69 @@ TEST(DataFiles, MalformedJsonIsNamed) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("malformed"), std::string::npos);
   }
+}
+
+// A DAQ export as a test engineer's software writes it: a comment line, a time column named
+// otherwise, channels with free-text names and units in brackets.
+TEST(DataFiles, DaqCsvTimeColumnByPositionNamesAndUnits) {
+  const auto p = write_file(temp_dir() / "daq.csv",
+                            "# exported 2026-11-30, 2 kHz\n"
+                            "Time [ms],Hammer [N],\"Acc1, @0.30m [g]\",Acc3 @tip [g]\n"
+                            "0,0,0.5,1e-3\n0.5,2.5,-0.25,2e-3\n1.0,0,0,3e-3\n");
+  const DataTable t = read_csv(p);
+  EXPECT_EQ(t.time_name, "Time [ms]");
+  EXPECT_EQ(t.time_unit, "ms");
+  ASSERT_EQ(t.names, (std::vector<std::string>{"Hammer [N]", "Acc1, @0.30m [g]", "Acc3 @tip [g]"}));
+  EXPECT_EQ(t.units, (std::vector<std::string>{"N", "g", "g"}));
+  // t in seconds: the header's ms converted (UDUNITS: 1 ms = 1e-3 s)
+  ASSERT_EQ(t.t.size(), 3u);
+  EXPECT_DOUBLE_EQ(t.t[1], 0.5e-3);
+  EXPECT_DOUBLE_EQ(t.t[2], 1.0e-3);
+  // the values stay in the file's units
+  EXPECT_EQ(t.columns[1], (std::vector<double>{0.5, -0.25, 0.0}));
+}
+
+TEST(DataFiles, SemicolonSeparatorReadsDecimalCommas) {
+  const auto p = write_file(temp_dir() / "eu.csv", "Zeit [s];Kraft [N];Beschl. [m/s^2]\r\n0,000;1,5;-2,25\r\n0,001;0;1e-3\r\n");
+  const DataTable t = read_csv(p);
+  EXPECT_EQ(t.names, (std::vector<std::string>{"Kraft [N]", "Beschl. [m/s^2]"}));
+  EXPECT_EQ(t.t, (std::vector<double>{0.0, 0.001}));
+  EXPECT_EQ(t.columns[0], (std::vector<double>{1.5, 0.0}));
+  EXPECT_EQ(t.columns[1], (std::vector<double>{-2.25, 1e-3}));
+  // a comma-separated file keeps its commas as separators: "1,5" there is two fields
+  EXPECT_NE(error_of_csv("t,a\n0,1,5\n").find("line 2: expected 2 fields, got 3"), std::string::npos);
+}
+
+TEST(DataFiles, TimeColumnByNameAndUnitOption) {
+  const auto p = write_file(temp_dir() / "named.csv", "a,stamp,b\n1,0,2\n3,10,4\n5,20,6\n");
+  CsvOptions o;
+  o.time_column = "stamp";
+  o.time_unit = "ms";
+  const DataTable t = read_csv(p, o);
+  EXPECT_EQ(t.names, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(t.columns[0], (std::vector<double>{1, 3, 5}));
+  EXPECT_EQ(t.columns[1], (std::vector<double>{2, 4, 6}));
+  EXPECT_DOUBLE_EQ(t.t[2], 0.02);
+  o.time_column = "clock";
+  try {
+    read_csv(p, o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no time column 'clock' (data.time_column)"), std::string::npos) << e.what();
+  }
+  // a time unit that is no time
+  EXPECT_NE(error_of_csv("t [m],a\n0,1\n1,2\n").find("time column 't [m]': unit 'm' is not a unit of time"), std::string::npos);
+}
+
+TEST(DataFiles, FreeTextNamesRoundTripThroughWriteCsv) {
+  DataTable t;
+  t.names = {"Acc1, @0.30m [g]", "say \"hi\"", "plain"};
+  t.t = {0.0, 1.0};
+  t.columns = {{1, 2}, {3, 4}, {5, 6}};
+  const auto p = (temp_dir() / "free.csv").string();
+  write_csv(p, t);
+  const DataTable r = read_csv(p);
+  EXPECT_EQ(r.names, t.names);
+  EXPECT_EQ(r.columns, t.columns);
+  EXPECT_EQ(r.units, (std::vector<std::string>{"g", "", ""}));
 }

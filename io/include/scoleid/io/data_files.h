@@ -17,10 +17,17 @@
 namespace scoleid::io {
 
 struct DataTable {
-  std::vector<std::string> names;             // column names, without "t"
-  std::vector<double> t;                      // sample times
+  std::vector<std::string> names;             // column names (free text), without the time column
+  std::vector<double> t;                      // sample times [s]
   std::vector<std::vector<double>> columns;   // columns[j][i] = value of names[j] at t[i]
   std::string source;                         // path read from, for messages
+  // Each column's unit as its file states it (a header's bracketed suffix, a UFF record), "" when
+  // it states none; empty or one per column. The values are in that unit, unconverted.
+  std::vector<std::string> units;
+  std::string time_name = "t";                // the time column's header
+  std::string time_unit;                      // its stated unit ("" = s); t is in seconds
+  // The unit of column j ("" when none is stated).
+  std::string unit(int j) const;
 
   // Index of a column, or -1.
   int find(const std::string& name) const;
@@ -28,17 +35,27 @@ struct DataTable {
   double interpolate(int j, double tt) const;
 };
 
+// How a CSV is read. The file's own dialect is detected from its header line: fields separated by
+// ';' (then a decimal comma is read as a point) or a tab (likewise) where the header has one,
+// else ','; fields may be double-quoted ("Acc1, x [g]"); '#' lines are comments. Column names are
+// free text; a bracketed suffix ("Time [ms]", "Acc1 [g]") states a column's unit.
+struct CsvOptions {
+  std::string time_column;  // the time column's header; "" = the first column, whatever its name
+  std::string time_unit;    // its unit when the header states none ("" = s)
+};
+
 // Throws InputError naming the file, line, column and value for: missing file, empty file,
-// header not starting with t, duplicate names, wrong field count, non-numeric or non-finite
-// values, time not strictly increasing.
-DataTable read_csv(const std::string& path);
+// no time column, duplicate names, wrong field count, non-numeric or non-finite values, time not
+// strictly increasing, an unknown time unit.
+DataTable read_csv(const std::string& path, const CsvOptions& options = {});
 // The same on text already in memory / a stream; `path` names it in messages.
-DataTable read_csv_text(const std::string& text, const std::string& path);
-DataTable read_csv_stream(std::istream& in, const std::string& path);
+DataTable read_csv_text(const std::string& text, const std::string& path, const CsvOptions& options = {});
+DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options = {});
 // 17 significant digits; atomic.
 void write_csv(const std::string& path, const DataTable& table);
-// The fields of one CSV line, each trimmed of blanks and double quotes ('\r' dropped).
-std::vector<std::string> split_csv_line(const std::string& line);
+// The fields of one CSV line, each trimmed of blanks and double quotes ('\r' dropped); a quoted
+// field keeps its separators ("a,b") and reads "" as one quote.
+std::vector<std::string> split_csv_line(const std::string& line, char separator = ',');
 
 struct ColumnMeta {
   std::string name;

@@ -4,7 +4,8 @@
 // its default written here, and parse errors name the source, the field path and the value.
 //
 // Units are whatever consistent system the scenario uses (SI for the beam cases, slug-ft-s for
-// SCOLE); no conversion happens anywhere in the code.
+// SCOLE), stated by `units:` or not; the model computes in it unconverted. Only measured data are
+// converted, from their columns' units into the sensors' and inputs' (io/units.h).
 //
 //   name, description
 //   structure: beam | scole
@@ -12,6 +13,9 @@
 //   scole:     see ScoleSpec
 //   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
+//   units:     SI | slug-ft-s (optional: the unit system; sensor and input units must agree)
+//   inputs/sensors may name their data column and its unit: column, column_unit
+//   data:      { time_column, time_unit }  (how a measured data file is read)
 //   simulation:{ duration, sample_interval, seed }
 //   identification: { parameterization, estimate, initial, elements, data_elements, method, ...,
 //                      uncertain: {field path: tolerance | alternative switch setting} }
@@ -33,6 +37,7 @@
 
 #include "scoleid/io/signal.h"
 #include "scoleid/io/types.h"
+#include "scoleid/io/units.h"
 
 namespace scoleid::io {
 
@@ -130,6 +135,10 @@ struct InputSpec {
   // missing); "scenario" always uses `signal`. The truth always uses `signal`.
   std::string signal_from = "auto";
   Signal signal;
+  // The data column that drives it (free text, e.g. "Hammer [N]"); "" = the column named `name`.
+  std::string column;
+  // The column's unit when neither the column's header nor its file states one ("" = theirs).
+  std::string column_unit;
 };
 
 // A sensor. kind: displacement | rotation | velocity | acceleration | line_of_sight | strain.
@@ -154,6 +163,11 @@ struct SensorSpec {
   // scenario the identifier reads.
   double bias = 0.0;
   double drift = 0.0;
+  // The data column it reads (free text, e.g. "Acc1 @0.30m [g]"); "" = the column named `name`.
+  // A column's values are converted from the column's unit (its header's bracketed suffix, its
+  // UFF record, or column_unit) into `unit` (or the unit system's) with UDUNITS-2 (io/units.h).
+  std::string column;
+  std::string column_unit;
 };
 
 struct SimulationSpec {
@@ -226,6 +240,13 @@ struct IdentificationSpec {
   double smoothness = 0.0;
 };
 
+// How a data file is read (docs/data.md): the time column by name ("" = the first column), and its
+// unit when the header does not state one ("" = seconds).
+struct DataSpec {
+  std::string time_column;
+  std::string time_unit;
+};
+
 struct TruthModelSpec {
   int segments = 40;
   std::string integrator = "auto";
@@ -249,12 +270,16 @@ struct Scenario {
   std::string description;
   std::string source;       // file path or "built-in scenario 'NAME'", used in messages
   Structure structure = Structure::Beam;
+  // The unit system the numbers are in (`units: SI | slug-ft-s`); None: not stated (sensor and
+  // input units are then checked for their dimension only).
+  units::System units = units::System::None;
   BeamSpec beam;
   ScoleSpec scole;
   std::vector<InputSpec> inputs;
   std::vector<SensorSpec> sensors;
   SimulationSpec simulation;
   IdentificationSpec identification;
+  DataSpec data;
   TruthModelSpec truth;
 };
 

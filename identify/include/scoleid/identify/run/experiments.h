@@ -43,6 +43,7 @@
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/modal_data.h"
+#include "scoleid/io/uff_modes.h"
 #include "scoleid/io/run_directory.h"
 
 namespace scoleid::identify {
@@ -56,6 +57,10 @@ struct ExperimentsSpec {
   std::vector<Run> runs;
   std::optional<std::string> modes_file;
   std::string modes_scenario;  // "" = the first run's
+  // For modes in a Universal File (datasets 55): the standard deviations and stations it does not
+  // state (io/uff_modes.h); given = any of them was written.
+  io::UffModesOptions modes_uff;
+  bool modes_uff_given = false;
   int threads = 0;
 };
 // Throws io::InputError (one line: file, field, value).

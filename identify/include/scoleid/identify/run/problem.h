@@ -51,6 +51,14 @@ struct ColumnUse {
   std::vector<std::string> inputs_from_data;      // inputs driven by their column
   std::vector<std::string> inputs_from_scenario;  // inputs driven by the scenario's signal
   std::vector<std::string> unused;                // columns that matched nothing
+  // Where each sensor's and data-driven input's values came from: its column, the column's unit
+  // and where that was stated (header, file record, column_unit), and the factor into the
+  // sensor's or input's unit (1 when no unit is stated: the values are taken as they are).
+  struct Source {
+    std::string name, column, from_unit, unit_stated_by, to_unit;
+    double scale = 1.0;
+  };
+  std::vector<Source> sources;
   // An input driven by its column that jumps by more than a quarter of its range within one sample:
   // between samples the column is piecewise linear, so each jump (a step, a bang-bang switch) is
   // spread over a sample and its centre moved by up to half a sample, which a ringing structure's

@@ -1,0 +1,184 @@
+#include "scoleid/io/units.h"
+
+#include <udunits2.h>
+
+#include <cctype>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+
+namespace scoleid::io::units {
+namespace {
+
+// UDUNITS-2's unit database, read once (its XML files ship with libudunits2).
+ut_system* unit_system() {
+  static ut_system* system = [] {
+    ut_set_error_message_handler(ut_ignore);
+    return ut_read_xml(nullptr);
+  }();
+  if (!system) throw std::invalid_argument("the UDUNITS-2 unit database could not be read (libudunits2-data)");
+  return system;
+}
+
+struct UnitFree {
+  void operator()(ut_unit* u) const { ut_free(u); }
+};
+using Unit = std::unique_ptr<ut_unit, UnitFree>;
+
+// The SI unit that stands for a quantity's dimension.
+const char* reference(Quantity q) {
+  switch (q) {
+    case Quantity::Length: return "m";
+    case Quantity::Angle: return "rad";
+    case Quantity::Velocity: return "m/s";
+    case Quantity::Acceleration: return "m/s^2";
+    case Quantity::Strain: return "1";
+    case Quantity::Force: return "N";
+    case Quantity::Moment: return "N.m";
+    case Quantity::Time: return "s";
+  }
+  return "1";
+}
+
+bool has_force(Quantity q) { return q == Quantity::Force || q == Quantity::Moment; }
+
+// Replaces each whole-word `word` of text by `by` (words: runs of letters).
+std::string replace_word(const std::string& text, const std::string& word, const std::string& by) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const bool start = i == 0 || !std::isalpha(static_cast<unsigned char>(text[i - 1]));
+    const std::size_t end = i + word.size();
+    if (start && text.compare(i, word.size(), word) == 0 &&
+        (end == text.size() || !std::isalpha(static_cast<unsigned char>(text[end])))) {
+      out += by;
+      i = end;
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
+}
+
+// The unit text as UDUNITS-2 should read it for quantity q (the header's aliases).
+std::string canonical(std::string u, Quantity q) {
+  const auto b = u.find_first_not_of(" \t"), e = u.find_last_not_of(" \t");
+  u = b == std::string::npos ? std::string() : u.substr(b, e - b + 1);
+  if (q == Quantity::Acceleration && (u == "g" || u == "G" || u == "gn" || u == "g_n")) return "standard_free_fall";
+  if (q == Quantity::Strain) {
+    for (const char* micro : {"µε", "με", "ue", "uε", "microstrain", "µstrain", "ustrain"})
+      if (u == micro) return "1e-6";
+    if (u == "ε" || u == "strain" || u == "m/m") return "1";
+  }
+  if (has_force(q)) u = replace_word(u, "lb", "lbf");
+  u = replace_word(replace_word(u, "deg", "degree"), "degrees", "degree");
+  return u;
+}
+
+// UDUNITS-2's parser keeps global state: one caller at a time.
+std::mutex& parser_lock() {
+  static std::mutex m;
+  return m;
+}
+
+Unit parse(const std::string& text) {
+  if (text.empty()) return Unit(nullptr);
+  const std::lock_guard<std::mutex> lock(parser_lock());
+  return Unit(ut_parse(unit_system(), text.c_str(), UT_UTF8));
+}
+
+}  // namespace
+
+const char* quantity_name(Quantity q) {
+  switch (q) {
+    case Quantity::Length: return "length";
+    case Quantity::Angle: return "angle";
+    case Quantity::Velocity: return "velocity";
+    case Quantity::Acceleration: return "acceleration";
+    case Quantity::Strain: return "strain";
+    case Quantity::Force: return "force";
+    case Quantity::Moment: return "moment";
+    case Quantity::Time: return "time";
+  }
+  return "?";
+}
+
+std::optional<Quantity> quantity_of_kind(const std::string& kind) {
+  if (kind == "displacement") return Quantity::Length;
+  if (kind == "rotation" || kind == "line_of_sight") return Quantity::Angle;
+  if (kind == "velocity") return Quantity::Velocity;
+  if (kind == "acceleration") return Quantity::Acceleration;
+  if (kind == "strain") return Quantity::Strain;
+  if (kind == "force") return Quantity::Force;
+  if (kind == "moment") return Quantity::Moment;
+  return std::nullopt;
+}
+
+const char* system_name(System s) {
+  switch (s) {
+    case System::None: return "";
+    case System::SI: return "SI";
+    case System::SlugFtS: return "slug-ft-s";
+  }
+  return "";
+}
+
+std::optional<System> parse_system(const std::string& name) {
+  if (name == "SI") return System::SI;
+  if (name == "slug-ft-s") return System::SlugFtS;
+  return std::nullopt;
+}
+
+std::string system_unit(System s, Quantity q) {
+  if (s != System::SlugFtS) return s == System::SI ? reference(q) : "";
+  switch (q) {
+    case Quantity::Length: return "ft";
+    case Quantity::Velocity: return "ft/s";
+    case Quantity::Acceleration: return "ft/s^2";
+    case Quantity::Force: return "lbf";
+    case Quantity::Moment: return "lbf.ft";
+    default: return reference(q);
+  }
+}
+
+std::optional<std::string> problem_with(const std::string& unit, Quantity q) {
+  const std::string text = canonical(unit, q);
+  const Unit u = parse(text), ref = parse(reference(q));
+  if (!u) return "'" + unit + "' is not a unit UDUNITS-2 knows";
+  if (!ut_are_convertible(u.get(), ref.get())) return "'" + unit + "' is not a unit of " + quantity_name(q);
+  return std::nullopt;
+}
+
+Conversion conversion(const std::string& from, const std::string& to, Quantity q) {
+  for (const auto* u : {&from, &to})
+    if (const auto why = problem_with(*u, q)) throw std::invalid_argument(*why);
+  const Unit a = parse(canonical(from, q)), b = parse(canonical(to, q));
+  cv_converter* cv = ut_get_converter(a.get(), b.get());
+  if (!cv) throw std::invalid_argument("'" + from + "' cannot be converted into '" + to + "'");
+  Conversion c{from, to, 1.0, 0.0};
+  c.offset = cv_convert_double(cv, 0.0);
+  c.scale = cv_convert_double(cv, 1.0) - c.offset;
+  cv_free(cv);
+  // UDUNITS composes factors in floating point: a conversion that is the identity up to rounding
+  // (ft/s^2 into ft/s2, lbf.ft into lb ft) is the identity.
+  if (std::abs(c.scale - 1.0) < 1e-14) c.scale = 1.0;
+  if (std::abs(c.offset) < 1e-300) c.offset = 0.0;
+  return c;
+}
+
+std::string bracketed_unit(const std::string& header) {
+  const auto e = header.find_last_not_of(" \t");
+  if (e == std::string::npos) return "";
+  const char close = header[e];
+  if (close != ']' && close != ')') return "";
+  const auto open = header.rfind(close == ']' ? '[' : '(', e);
+  if (open == std::string::npos) return "";
+  std::string inside = header.substr(open + 1, e - open - 1);
+  const auto b = inside.find_first_not_of(" \t"), ie = inside.find_last_not_of(" \t");
+  inside = b == std::string::npos ? std::string() : inside.substr(b, ie - b + 1);
+  if (close == ')' && !parse(inside) && inside != "g") return "";
+  return inside;
+}
+
+}  // namespace scoleid::io::units

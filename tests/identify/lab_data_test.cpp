@@ -1,0 +1,257 @@
+// Identification from a record as a test lab exports it (docs/data.md): a DAQ CSV with a comment
+// line, a time column named "Time [s]", free-text channel names and accelerations in g, mapped to
+// the scenario's sensors by `column:` and converted with UDUNITS-2; and the same record as a
+// Universal File (dataset 58, ASCII).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "scoleid/identify.h"
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/data_source.h"
+#include "scoleid/io/error.h"
+
+namespace fs = std::filesystem;
+using namespace scoleid;
+
+namespace {
+
+constexpr double kG = 9.80665;  // standard gravity [m/s^2] (CGPM 1901)
+
+// A tap test on a clamped aluminium-like strip: a hammer near the tip, two accelerometers.
+const char* kStrip = R"(
+name: tap-strip
+structure: beam
+units: SI
+beam: {length: 0.6, left: clamped, right: free, rho_A: 0.4, EI: 30, zeta: 0.01}
+inputs:
+  - {name: hammer, column: "Hammer [N]", kind: force, location: 0.55, unit: N,
+     signal: {type: haversine, amplitude: 5, t0: 0.002, width: 0.002}}
+sensors:
+  - {name: acc1, column: "Acc1 @0.30m [g]", kind: acceleration, location: 0.3, unit: m/s^2, noise_std: 0.02}
+  - {name: acc2, column: "Acc2 @tip [g]", kind: acceleration, location: 0.6, unit: m/s^2, noise_std: 0.02}
+simulation: {duration: 0.25, sample_interval: 0.0005, seed: 3}
+identification: {estimate: [EI, rho_A], initial: {EI: 27, rho_A: 0.44}, elements: 8}
+)";
+
+const char* kHeader = "Time [s],Hammer [N],Acc1 @0.30m [g],Acc2 @tip [g]";
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("scoleid-lab-" + std::to_string(::getpid())) / name;
+  fs::create_directories(d);
+  return d;
+}
+
+std::string write(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+// The record in g, as the DAQ writes it (17 digits, so nothing is lost in the file).
+struct Record {
+  std::vector<double> t, hammer;
+  std::vector<std::vector<double>> acc_g;  // per sensor
+};
+
+Record tap_record(const io::Scenario& sc) {
+  const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 2.5e-5, true);
+  Record r;
+  r.t = m.t;
+  r.acc_g.resize(sc.sensors.size());
+  for (std::size_t k = 0; k < m.t.size(); ++k) {
+    r.hammer.push_back(sc.inputs[0].signal(m.t[k]));
+    for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+      r.acc_g[j].push_back(m.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) / kG);
+  }
+  return r;
+}
+
+std::string daq_csv(const Record& r) {
+  std::ostringstream os;
+  os << "# DAQ export, 2 kHz, channels in g\n" << kHeader << "\n";
+  char buf[64];
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g", r.t[k], r.hammer[k]);
+    os << buf;
+    for (const auto& c : r.acc_g) {
+      std::snprintf(buf, sizeof buf, ",%.17g", c[k]);
+      os << buf;
+    }
+    os << "\n";
+  }
+  return os.str();
+}
+
+// The converter a user writes by hand: the DAQ file's values read, times 9.80665, written with the
+// sensors' names as headers.
+io::DataTable hand_converted(const std::string& daq_path) {
+  io::DataTable daq = io::read_csv(daq_path);
+  io::DataTable si;
+  si.t = daq.t;
+  si.names = {"hammer", "acc1", "acc2"};
+  si.columns = {daq.columns[0], daq.columns[1], daq.columns[2]};
+  for (std::size_t j = 1; j < 3; ++j)
+    for (double& x : si.columns[j]) x *= kG;
+  return si;
+}
+
+// One dataset 58 (ASCII, double precision, even abscissa): a time response as test programs write it.
+std::string uff58(const std::string& id1, int node, int spec, const std::string& label, const std::string& unit,
+                  const std::vector<double>& t, const std::vector<double>& y) {
+  char buf[256];
+  std::string s = "    -1\n    58\n";
+  s += id1 + "\nNONE\n01-Dec-26 10:00:00\nNONE\nNONE\n";
+  std::snprintf(buf, sizeof buf, "%5d%10d%5d%10d %-10s%10d%4d %-10s%10d%4d\n", 1, 0, 0, 0, "tap", node, 3, "NONE", 0, 0);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "%10d%10zu%10d%13.5E%13.5E%13.5E\n", 4, t.size(), 1, t.front(), t[1] - t[0], 0.0);
+  s += buf;
+  std::snprintf(buf, sizeof buf, "%10d%5d%5d%5d %-20s %-20s\n", 17, 0, 0, 0, "Time", "s");
+  s += buf;
+  std::snprintf(buf, sizeof buf, "%10d%5d%5d%5d %-20s %-20s\n", spec, 0, 0, 0, label.c_str(), unit.c_str());
+  s += buf;
+  for (int k = 0; k < 2; ++k) {
+    std::snprintf(buf, sizeof buf, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+    s += buf;
+  }
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    std::snprintf(buf, sizeof buf, "%20.12E", y[k]);
+    s += buf;
+    if (k % 4 == 3 || k + 1 == y.size()) s += "\n";
+  }
+  return s + "    -1\n";
+}
+
+io::Scenario without_columns(io::Scenario sc) {
+  for (auto& s : sc.sensors) s.column.clear();
+  for (auto& in : sc.inputs) in.column.clear();
+  return sc;
+}
+
+}  // namespace
+
+TEST(LabData, DaqCsvInGIdentifiesAsTheHandConvertedFileDigitForDigit) {
+  const io::Scenario sc = io::parse_scenario(kStrip, "tap-strip.yaml");
+  const fs::path dir = scratch("daq");
+  const std::string daq = write(dir / "tap.csv", daq_csv(tap_record(sc)));
+  const std::string si = (dir / "tap-si.csv").string();
+  io::write_csv(si, hand_converted(daq));
+
+  const Identification a = identify_parameters(sc, DataSource::file(daq), {});
+  const Identification b = identify_parameters(without_columns(sc), DataSource::file(si), {});
+  ASSERT_EQ(a.names(), b.names());
+  for (Eigen::Index i = 0; i < a.estimate().size(); ++i) EXPECT_EQ(a.estimate()[i], b.estimate()[i]) << a.names()[i];
+  EXPECT_EQ(a.result().summary.iterations_done, b.result().summary.iterations_done);
+  EXPECT_TRUE(a.converged()) << a.verdict();
+  // And its interval holds the strip's EI 30 and rho_A 0.4 (the hammer's column, 4 samples across
+  // its 2 ms pulse, is the record's largest error: the estimates' common scale).
+  const auto params = a.to_json()["parameters"];
+  const double truth[] = {30.0, 0.4};
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_LE(params[i]["interval"]["low"].get<double>(), truth[i]) << params[i]["name"];
+    EXPECT_GE(params[i]["interval"]["high"].get<double>(), truth[i]) << params[i]["name"];
+    EXPECT_NEAR(params[i]["estimate"].get<double>() / truth[i], 1.0, 0.05) << params[i]["name"];
+  }
+  // identify.json says where each sensor's values came from and the factor applied.
+  const auto src = a.to_json()["data_columns"]["sources"];
+  ASSERT_EQ(src.size(), 3u);
+  EXPECT_EQ(src[0]["column"], "Acc1 @0.30m [g]");
+  EXPECT_EQ(src[0]["column_unit"], "g");
+  EXPECT_EQ(src[0]["unit"], "m/s^2");
+  EXPECT_DOUBLE_EQ(src[0]["scale"].get<double>(), kG);
+  EXPECT_EQ(src[2]["name"], "hammer");
+  EXPECT_EQ(src[2]["scale"].get<double>(), 1.0);
+}
+
+TEST(LabData, UnitsThatCannotBeConvertedAreRefusedNamingFileColumnAndBoth) {
+  const io::Scenario base = io::parse_scenario(kStrip, "tap-strip.yaml");
+  const fs::path dir = scratch("refused");
+  const std::string text = daq_csv(tap_record(base));
+  auto error_of = [&](const std::string& from, const std::string& to, io::Scenario sc, const std::string& name) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), to);
+    const std::string p = write(dir / name, t);
+    try {
+      prepare(sc, DataSource::file(p));
+    } catch (const io::InputError& e) {
+      return std::make_pair(p, std::string(e.what()));
+    }
+    return std::make_pair(p, std::string());
+  };
+  // The hammer's column in g: a force cannot be read from an acceleration (nor a gram).
+  io::Scenario sc = base;
+  sc.inputs[0].column = "Hammer [g]";
+  auto [p1, e1] = error_of("Hammer [N]", "Hammer [g]", sc, "force-in-g.csv");
+  EXPECT_EQ(e1, "data file '" + p1 + "': column 'Hammer [g]' (inputs[0], 'hammer'): cannot convert 'g' into 'N': 'g' is not a unit of force");
+  // A unit no one knows.
+  sc = base;
+  sc.sensors[1].column = "Acc2 @tip [gee]";
+  auto [p2, e2] = error_of("Acc2 @tip [g]", "Acc2 @tip [gee]", sc, "unknown.csv");
+  EXPECT_EQ(e2, "data file '" + p2 + "': column 'Acc2 @tip [gee]' (sensors[1], 'acc2'): cannot convert 'gee' into 'm/s^2': 'gee' is not a unit UDUNITS-2 knows");
+  // A column with a unit, a sensor without one in a scenario without a unit system: no silent label.
+  sc = base;
+  sc.units = io::units::System::None;
+  sc.sensors[0].unit.clear();
+  auto [p3, e3] = error_of("# DAQ", "# DAQ", sc, "no-unit.csv");
+  EXPECT_EQ(e3, "data file '" + p3 + "': column 'Acc1 @0.30m [g]' (sensors[0], 'acc1'): is in 'g' but sensors[0] states no unit to convert it into: give sensors[0].unit or the scenario's units");
+  // ... while the unit system alone gives it one.
+  sc.units = io::units::System::SI;
+  EXPECT_NO_THROW(prepare(sc, DataSource::file(p3)));
+}
+
+TEST(LabData, ScenarioUnitsMustAgreeWithTheUnitSystem) {
+  std::string text = kStrip;
+  text.replace(text.find("unit: m/s^2"), 11, "unit: ft/s^2");
+  try {
+    io::parse_scenario(text, "strip.yaml");
+    FAIL();
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "strip.yaml: sensors[0].unit must be the acceleration unit of the scenario's units (SI: m/s^2), got 'ft/s^2'");
+  }
+  text = kStrip;
+  text.replace(text.find("unit: N"), 7, "unit: m");
+  try {
+    io::parse_scenario(text, "strip.yaml");
+    FAIL();
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "strip.yaml: inputs[0].unit must be a unit of force ('m' is not a unit of force), got 'm'");
+  }
+  // The same unit spelled otherwise is the same unit.
+  text = kStrip;
+  text.replace(text.find("unit: m/s^2"), 11, "unit: m s-2");
+  EXPECT_NO_THROW(io::parse_scenario(text, "strip.yaml"));
+}
+
+TEST(LabData, TheSameRecordAsAUniversalFileIdentifiesTheSame) {
+  const io::Scenario sc = io::parse_scenario(kStrip, "tap-strip.yaml");
+  const fs::path dir = scratch("uff");
+  const Record r = tap_record(sc);
+  const std::string daq = write(dir / "tap.csv", daq_csv(r));
+  // The DAQ file's values (as the CSV test reads them) into a UFF file: 13 significant digits.
+  const io::DataTable d = io::read_csv(daq);
+  const std::string uff = write(dir / "tap.uff", uff58("Hammer [N]", 55, 13, "Force", "N", d.t, d.columns[0]) +
+                                                     uff58("Acc1 @0.30m [g]", 30, 12, "Acceleration", "g", d.t, d.columns[1]) +
+                                                     uff58("Acc2 @tip [g]", 60, 12, "Acceleration", "g", d.t, d.columns[2]));
+  const io::DataTable u = io::read_data(uff);
+  EXPECT_EQ(u.names, d.names);
+  EXPECT_EQ(u.units, (std::vector<std::string>{"N", "g", "g"}));
+  ASSERT_EQ(u.t.size(), d.t.size());
+  const Identification a = identify_parameters(sc, DataSource::file(daq), {});
+  const Identification b = identify_parameters(sc, DataSource::file(uff), {});
+  for (Eigen::Index i = 0; i < a.estimate().size(); ++i)
+    EXPECT_NEAR(b.estimate()[i] / a.estimate()[i], 1.0, 1e-6) << a.names()[i];
+  EXPECT_EQ(a.converged(), b.converged());
+  // A spectrum is no record to identify from: refused naming the record and its type.
+  std::string psd = uff58("Acc1 @0.30m [g]", 30, 12, "Acceleration", "g", d.t, d.columns[1]);
+  psd.replace(psd.find("    1         0"), 5, "   12");
+  const std::string p = write(dir / "spectrum.uff", psd);
+  try {
+    prepare(sc, DataSource::file(p));
+    FAIL();
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "UFF file '" + p + "': record 1 (dataset 58 at line 2, 'Acc1 @0.30m [g]'): function type 12 (Spectrum) is not a time response; only time responses (type 1) are data to identify from");
+  }
+}

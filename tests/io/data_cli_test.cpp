@@ -1,0 +1,155 @@
+// scole-data end to end: `info` lists a lab file's channels, `convert` writes the product's CSV
+// and its column description; a record that is no time response, a missing file or an output
+// directory that does not exist exits 2 with one line and writes nothing.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scoleid/io/data_files.h"
+#include "scoleid/io/data_source.h"
+#include "scoleid/io/uff.h"
+
+#ifndef SCOLE_DATA_EXE
+#error "SCOLE_DATA_EXE must be defined to the path of the scole-data executable"
+#endif
+
+namespace fs = std::filesystem;
+using namespace scoleid::io;
+
+namespace {
+
+const fs::path kData = fs::path(SCOLEID_TEST_DATA_DIR) / "uff";
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path scratch() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path d = fs::temp_directory_path() / ("scoleid-data-cli-" + std::to_string(::getpid()) + "-" + info->name());
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+Result run(const std::vector<std::string>& args, const fs::path& dir) {
+  std::string cmd = "cd " + quote(dir.string()) + " && " + quote(SCOLE_DATA_EXE);
+  for (const auto& a : args) cmd += " " + quote(a);
+  cmd += " 2> " + quote((dir / "stderr.txt").string()) + " < /dev/null";
+  Result r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  char buf[4096];
+  std::size_t n = 0;
+  while (pipe && (n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+  const int status = pipe ? ::pclose(pipe) : -1;
+  r.code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+  r.err = slurp(dir / "stderr.txt");
+  return r;
+}
+
+int lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+// Nothing but stderr.txt in the scratch directory.
+void expect_nothing_written(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename(), "stderr.txt") << "left behind: " << e.path();
+}
+
+}  // namespace
+
+TEST(DataCli, InfoListsAUniversalFilesChannels) {
+  const fs::path dir = scratch();
+  const Result r = run({"info", (kData / "binary8byte.uff").string(), "--json"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["format"], "uff");
+  ASSERT_EQ(j["channels"].size(), 1u);
+  const auto& c = j["channels"][0];
+  // What the file's one record 58b says: 250 points from 0 at 0.01 s, an acceleration in g.
+  EXPECT_EQ(c["samples"], 250);
+  EXPECT_DOUBLE_EQ(c["step"].get<double>(), 0.01);
+  EXPECT_EQ(c["unit"], "g");
+  EXPECT_EQ(c["quantity"], "acceleration");
+  EXPECT_EQ(c["function"], "Time Response");
+  EXPECT_TRUE(c["time_response"].get<bool>());
+  // The table lists what the file holds beyond functions: a header, units, nodes.
+  const Result t = run({"info", (kData / "TestLab_161_164_18_15_82.uff").string()}, dir);
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_NE(t.out.find("units (164): code 9 'USER_DEFINED'"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("nodes (15/2411): 36"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("dataset 82"), std::string::npos) << t.out;
+}
+
+TEST(DataCli, ConvertWritesTheTimeResponsesAndTheirDescription) {
+  const fs::path dir = scratch();
+  const Result r = run({"convert", (kData / "binary8byte.uff").string(), "--out", "b8.csv"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const DataTable t = read_data((dir / "b8.csv").string());
+  const uff::File f = uff::read_file((kData / "binary8byte.uff").string());
+  ASSERT_EQ(t.names, std::vector<std::string>{uff::channel_name(f.functions[0])});
+  // The values exactly (17 digits), in the file's unit, which the JSON beside gives back.
+  EXPECT_EQ(t.columns[0], f.functions[0].re);
+  EXPECT_EQ(t.t, f.functions[0].x);
+  EXPECT_EQ(t.units, std::vector<std::string>{"g"});
+  const auto meta = nlohmann::json::parse(slurp(dir / "b8.json"));
+  EXPECT_EQ(meta["columns"][0]["quantity"], "acceleration");
+  EXPECT_EQ(meta["columns"][0]["node"], 1);
+}
+
+TEST(DataCli, ConvertReadsADaqCsvWithDecimalCommas) {
+  const fs::path dir = scratch();
+  std::ofstream(dir / "daq.csv") << "# Messung 3\n\"Zeit [ms]\";\"Kraft [N]\";\"Beschl. Spitze [g]\"\n0;0,5;0\n1;0;-0,125\n2;0;0,25\n";
+  const Result r = run({"convert", "daq.csv", "-o", "si.csv", "-q"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const DataTable t = read_data((dir / "si.csv").string());
+  EXPECT_EQ(t.t, (std::vector<double>{0.0, 0.001, 0.002}));
+  EXPECT_EQ(t.columns[1], (std::vector<double>{0.0, -0.125, 0.25}));
+  EXPECT_EQ(t.units, (std::vector<std::string>{"N", "g"}));
+}
+
+TEST(DataCli, ASpectrumAMissingFileOrAMissingDirectoryExitTwoWritingNothing) {
+  const fs::path dir = scratch();
+  Result r = run({"convert", (kData / "sample_dataset58_psd.uff").string(), "--out", "psd.csv"}, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("record 1 (dataset 58 at line 2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("function type 9 (Power Spectral Density) is not a time response"), std::string::npos) << r.err;
+  expect_nothing_written(dir);
+  r = run({"info", "nowhere.uff"}, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "scole-data: data file 'nowhere.uff': cannot be opened\n");
+  r = run({"convert", (kData / "binary8byte.uff").string(), "--out", "no/such/dir/b8.csv"}, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  expect_nothing_written(dir);
+  r = run({"frobnicate"}, dir);
+  EXPECT_EQ(r.code, 2);
+}
