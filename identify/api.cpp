@@ -1,6 +1,7 @@
 #include "scoleid/identify.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "scoleid/io/error.h"
@@ -50,6 +51,57 @@ std::vector<std::string> Identification::warnings() const {
                 " estimated parameters is identifiable from these data (each row says why); the estimates are not "
                 "determined by the data");
   return w;
+}
+
+namespace {
+
+Eigen::VectorXd coefficients_at(const identify::Problem& p, const Eigen::VectorXd& q) {
+  Eigen::VectorXd c;
+  Eigen::MatrixXd dcdq;
+  p.params->coefficients(q, c, dcdq);
+  return c;
+}
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    std::vector<double> r(static_cast<std::size_t>(m.cols()));
+    for (Eigen::Index j = 0; j < m.cols(); ++j) r[static_cast<std::size_t>(j)] = m(i, j);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+std::vector<double> vector_of(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+}  // namespace
+
+identify::StateSpace Identification::state_space() const {
+  return identify::state_space(problem_->model(), coefficients_at(*problem_, result_.estimate));
+}
+
+identify::ModalModel Identification::modal_model() const {
+  return identify::modal_model(problem_->model(), coefficients_at(*problem_, result_.estimate));
+}
+
+nlohmann::json Identification::model_json() const {
+  const identify::StateSpace s = state_space();
+  const identify::ModalModel m = modal_model();
+  nlohmann::json units_in = nlohmann::json::array(), units_out = nlohmann::json::array();
+  for (const auto& in : problem_->scenario.inputs) units_in.push_back(in.unit);
+  for (const auto& se : problem_->scenario.sensors) units_out.push_back(se.unit);
+  std::vector<double> hz;
+  for (Eigen::Index k = 0; k < m.omega.size(); ++k) hz.push_back(m.omega[k] / (2.0 * M_PI));
+  nlohmann::json zeta = nlohmann::json::array();
+  for (Eigen::Index k = 0; k < m.zeta.size(); ++k) zeta.push_back(std::isfinite(m.zeta[k]) ? nlohmann::json(m.zeta[k]) : nlohmann::json());
+  return {{"scenario", problem_->scenario.name},
+          {"estimate", problem_->params->physical(result_.estimate)},
+          {"converged", converged()},
+          {"state_space", {{"A", matrix_json(s.A)}, {"B", matrix_json(s.B)}, {"C", matrix_json(s.C)}, {"D", matrix_json(s.D)},
+                           {"inputs", s.inputs}, {"outputs", s.outputs}, {"input_units", units_in}, {"output_units", units_out},
+                           {"states", "x = (u, du/dt): the FE model's degrees of freedom, then their rates"}}},
+          {"modal", {{"frequency_hz", hz}, {"omega", vector_of(m.omega)}, {"zeta", zeta}, {"output_shapes", matrix_json(m.output_shapes)},
+                     {"input_shapes", matrix_json(m.input_shapes)}, {"inputs", m.inputs}, {"outputs", m.outputs}}}};
 }
 
 void Identification::write(io::RunDirectory& dir) const { identify::write_outputs(dir, *problem_, result_); }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "scoleid/identify.h"
@@ -113,6 +114,16 @@ void print_problem(const identify::Problem& problem, bool from_file) {
                  st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
 }
 
+// --export-model FILE: a .json whose directory exists (checked before any work).
+void check_export_path(const std::string& path) {
+  if (path.empty()) return;
+  const std::filesystem::path p(path);
+  if (p.extension() != ".json")
+    throw io::InputError("command line: --export-model must name a .json file, got '" + path + "'");
+  if (p.has_parent_path() && !std::filesystem::is_directory(p.parent_path()))
+    throw io::InputError("command line: --export-model '" + path + "': directory '" + p.parent_path().string() + "' does not exist");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -134,7 +145,7 @@ int main(int argc, char** argv) {
       "and per-experiment std, misfit share and residual RMS per experiment), fit-<run>.csv/.gp/.png per run and\n"
       "modes-fit.csv (measured against matched model modes)."};
   std::string scenario = "paper-beam-1";
-  std::string data, out, method;
+  std::string data, out, method, export_model;
   int max_iterations = -1;
   bool list = false, no_std = false, quiet = false;
   app.add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
@@ -152,6 +163,9 @@ int main(int argc, char** argv) {
                "skip the Fisher-information standard deviations and with them the identifiability flags "
                "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
+  app.add_option("--export-model", export_model,
+                 "write the identified linear model to FILE.json: state space A, B, C, D over the scenario's inputs and "
+                 "sensors, and the modal model (frequencies, damping ratios, shapes at sensors and inputs)");
   std::string experiments;
   int threads = -1;
   auto* ex_opt = app.add_option("-e,--experiments", experiments,
@@ -172,7 +186,7 @@ int main(int argc, char** argv) {
   io::install_interrupt_handlers();
   try {
     // A path option given empty is a typo, not a request for the default.
-    for (const char* name : {"--data", "--out", "--experiments", "--scenario", "--print-scenario"})
+    for (const char* name : {"--data", "--out", "--experiments", "--scenario", "--print-scenario", "--export-model"})
       if (app.count(name) > 0 && app.get_option(name)->as<std::string>().empty())
         throw io::InputError(std::string("command line: ") + name + " is empty (give a value, or leave the option out)");
     if (!print_name.empty()) {
@@ -199,6 +213,7 @@ int main(int argc, char** argv) {
     if (out.empty()) out = "run/" + sc.name;
     // The output directory is checked (and its staging area made) before any work.
     io::RunDirectory run_dir(out, Identification::output_files(), "scole-identify");
+    check_export_path(export_model);
     const auto problem = prepare(sc, data.empty() ? DataSource::synthetic() : DataSource::file(data));
     // (Checked again by the run; here so that the refusal is the only line on stderr.)
     if (const auto& w = sc.identification.steepest_weights; !w.empty() && static_cast<int>(w.size()) != problem->params->size())
@@ -208,6 +223,7 @@ int main(int argc, char** argv) {
     print_problem(*problem, !data.empty());
     const Identification id = identify_parameters(problem, options);
     id.write(run_dir);
+    if (!export_model.empty()) io::write_json_atomic(export_model, id.model_json());
     run_dir.commit();
     std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());

@@ -995,3 +995,26 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   EXPECT_EQ(cols[3][0], 1.0);
   EXPECT_EQ(cols[3][1], 2.0);
 }
+
+// --export-model: the identified plant as JSON beside the run (its A has 2 x DOFs rows, its modal
+// frequencies are the eigenvalues of A), a name that is no .json refused before any work.
+TEST(ScoleIdentifyCli, ExportModelWritesThePlant) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const Result r = run({"--scenario", "good.yaml", "--out", "out", "-q", "--export-model", "plant.json"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_file(dir / "plant.json"));
+  const auto& A = j["state_space"]["A"];
+  const std::size_t n = A.size();
+  ASSERT_GT(n, 0u);
+  EXPECT_EQ(n % 2, 0u);
+  EXPECT_EQ(A[0].size(), n);
+  EXPECT_EQ(j["state_space"]["B"].size(), n);
+  EXPECT_EQ(j["state_space"]["outputs"], nlohmann::json::array({"w_tip"}));
+  EXPECT_EQ(j["modal"]["frequency_hz"].size(), n / 2);
+  // The upper half of A is [0 I]: du/dt is the second half of the state.
+  for (std::size_t i = 0; i < n / 2; ++i)
+    for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(A[i][k].get<double>(), k == i + n / 2 ? 1.0 : 0.0);
+  const Result bad = run({"--scenario", "good.yaml", "--out", "out2", "--export-model", "plant.txt"}, dir);
+  expect_input_error(bad, dir / "out2", {"--export-model must name a .json file", "plant.txt"});
+}

@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scoleid/identify/fe/state_space.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/data_files.h"
@@ -75,6 +76,13 @@ public:
   std::string verdict() const;
   // Things the user must know even of a converged run (e.g. no parameter identifiable).
   std::vector<std::string> warnings() const;
+
+  // The identified linear FE model at the estimate (identify/fe/state_space.h): a state-space plant
+  // (A, B, C, D over the scenario's inputs and sensors) and its modal model.
+  identify::StateSpace state_space() const;
+  identify::ModalModel modal_model() const;
+  // Both as JSON (the file scole-identify --export-model writes; docs/theory.md §10.2).
+  nlohmann::json model_json() const;
 
   std::string FullReport() const { return result_.FullReport(); }
   nlohmann::json to_json() const { return result_.to_json(*problem_); }

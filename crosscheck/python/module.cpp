@@ -1,0 +1,249 @@
+// scoleid._core: the library's front doors for Python (README "From Python"). The package
+// scoleid (scoleid/__init__.py) wraps it: scenarios as names, files, YAML text or dicts; data as
+// dicts of numpy arrays, DataFrames or files. Only the public calls are bound — simulate_truth,
+// identify_parameters with its Identification, the cross-check's mode and trajectory comparisons —
+// nothing below them.
+//
+// Errors: io::InputError becomes scoleid.InputError (a ValueError) with the same one-line message;
+// SIGINT during a call ends the solve under way (the library's interrupt checks) and raises
+// KeyboardInterrupt. Long calls release the GIL.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scoleid/crosscheck/modes.h"
+#include "scoleid/crosscheck/trajectories.h"
+#include "scoleid/identify.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
+#include "scoleid/io/scenario.h"
+#include "scoleid/io/validation.h"
+#include "scoleid/truth.h"
+
+namespace py = pybind11;
+using namespace scoleid;
+
+namespace {
+
+// For the duration of one call: the library's SIGINT/SIGTERM recorder in place of Python's
+// handlers (restored after), the GIL released.
+class LibraryCall {
+public:
+  LibraryCall() {
+    io::clear_interrupt();
+    sigaction(SIGINT, nullptr, &old_int_);
+    sigaction(SIGTERM, nullptr, &old_term_);
+    io::install_interrupt_handlers();
+  }
+  ~LibraryCall() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  LibraryCall(const LibraryCall&) = delete;
+  LibraryCall& operator=(const LibraryCall&) = delete;
+
+private:
+  struct sigaction old_int_ {}, old_term_ {};
+  py::gil_scoped_release release_;
+};
+
+// A scenario given as YAML text (source names it in messages), or with source empty as a built-in
+// name or a file path, read as the programs read --scenario.
+io::Scenario scenario_of(const std::string& yaml_text, const std::string& source) {
+  io::Scenario sc = source.empty() ? io::load_scenario(yaml_text) : io::parse_scenario(yaml_text, source);
+  io::validate_scenario(sc);
+  return sc;
+}
+
+// A record as (names, t, values[samples x columns]).
+py::tuple record(const io::DataTable& tab) {
+  py::array_t<double> t(static_cast<py::ssize_t>(tab.t.size()));
+  std::memcpy(t.mutable_data(), tab.t.data(), tab.t.size() * sizeof(double));
+  py::array_t<double> v({static_cast<py::ssize_t>(tab.t.size()), static_cast<py::ssize_t>(tab.names.size())});
+  auto w = v.mutable_unchecked<2>();
+  for (std::size_t j = 0; j < tab.names.size(); ++j)
+    for (std::size_t k = 0; k < tab.t.size(); ++k) w(static_cast<py::ssize_t>(k), static_cast<py::ssize_t>(j)) = tab.columns[j][k];
+  return py::make_tuple(tab.names, t, v);
+}
+
+io::DataTable table_of(const std::vector<std::string>& names, const py::array_t<double, py::array::c_style | py::array::forcecast>& t,
+                       const py::array_t<double, py::array::c_style | py::array::forcecast>& values, const std::string& source) {
+  if (t.ndim() != 1 || values.ndim() != 2 || values.shape(0) != t.shape(0) ||
+      values.shape(1) != static_cast<py::ssize_t>(names.size()))
+    throw io::InputError(source + ": expected t of n samples and n x " + std::to_string(names.size()) + " values");
+  io::DataTable tab;
+  tab.source = source;
+  tab.names = names;
+  tab.t.assign(t.data(), t.data() + t.shape(0));
+  tab.columns.assign(names.size(), std::vector<double>(static_cast<std::size_t>(t.shape(0))));
+  const auto v = values.unchecked<2>();
+  for (py::ssize_t k = 0; k < t.shape(0); ++k)
+    for (std::size_t j = 0; j < names.size(); ++j) tab.columns[j][static_cast<std::size_t>(k)] = v(k, static_cast<py::ssize_t>(j));
+  return tab;
+}
+
+py::tuple truth(const std::string& yaml_text, const std::string& source, bool progress) {
+  const io::Scenario sc = scenario_of(yaml_text, source);
+  TruthOptions o;
+  o.progress = progress;
+  Truth tr;
+  {
+    LibraryCall call;
+    tr = simulate_truth(sc, o);
+  }
+  return py::make_tuple(record(tr.table), io::to_json(tr.meta).dump());
+}
+
+struct IdentifyArgs {
+  std::string data_file;                 // "" = not a file
+  std::optional<std::vector<std::string>> names;
+  std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> t, values;
+  std::string meta_json;                 // truth.json text for an in-memory table ("" = none)
+  std::optional<std::string> method;
+  std::optional<int> max_iterations;
+  bool compute_std = true, verbose = false;
+};
+
+// The identification and the seconds the library call took (scenario parsing to the verdict).
+py::tuple identify_call(const std::string& yaml_text, const std::string& source, const IdentifyArgs& a) {
+  const auto start = std::chrono::steady_clock::now();
+  io::Scenario sc = scenario_of(yaml_text, source);
+  IdentifyOptions o;
+  if (a.method) {
+    const auto m = io::parse<io::Method>(*a.method);
+    if (!m) throw io::InputError("identify: method must be one of " + io::names_joined<io::Method>(", ") + ", got '" + *a.method + "'");
+    o.method = *m;
+  }
+  if (a.max_iterations) {
+    o.max_iterations = *a.max_iterations;
+    sc.identification.max_iterations = *a.max_iterations;
+    io::validate_scenario(sc);
+  }
+  o.compute_std = a.compute_std;
+  o.verbose = a.verbose;
+  DataSource data = DataSource::synthetic();
+  if (!a.data_file.empty()) data = DataSource::file(a.data_file);
+  if (a.names) {
+    std::optional<io::TruthMeta> meta;
+    if (!a.meta_json.empty()) meta = io::truth_meta_from_json(nlohmann::json::parse(a.meta_json), "data (truth metadata)");
+    data = DataSource::in_memory(table_of(*a.names, *a.t, *a.values, "data"), "data", meta);
+  }
+  std::optional<Identification> id;
+  {
+    LibraryCall call;
+    id.emplace(identify_parameters(sc, data, o));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return py::make_tuple(std::move(*id), seconds);
+}
+
+py::dict state_space(const Identification& id) {
+  const identify::StateSpace s = id.state_space();
+  py::dict d;
+  d["A"] = s.A;
+  d["B"] = s.B;
+  d["C"] = s.C;
+  d["D"] = s.D;
+  d["inputs"] = s.inputs;
+  d["outputs"] = s.outputs;
+  return d;
+}
+
+py::dict modal_model(const Identification& id) {
+  const identify::ModalModel m = id.modal_model();
+  py::dict d;
+  d["omega"] = m.omega;
+  d["zeta"] = m.zeta;
+  d["output_shapes"] = m.output_shapes;
+  d["input_shapes"] = m.input_shapes;
+  d["inputs"] = m.inputs;
+  d["outputs"] = m.outputs;
+  return d;
+}
+
+std::string crosscheck_modes(const std::string& yaml_text, const std::string& source, int count, int segments, int elements, int levels) {
+  const io::Scenario sc = scenario_of(yaml_text, source);
+  crosscheck::ModesOptions o;
+  o.count = count;
+  o.segments = segments;
+  o.elements = elements;
+  o.levels = levels;
+  std::string why;
+  if (!o.IsValid(&why)) throw io::InputError("crosscheck_modes: " + why);
+  LibraryCall call;
+  return crosscheck::to_json(crosscheck::compare_modes(sc, o)).dump();
+}
+
+py::tuple crosscheck_trajectories(const std::string& yaml_text, const std::string& source, int segments, int levels, int elements,
+                                  const std::string& truth_root) {
+  const io::Scenario sc = scenario_of(yaml_text, source);
+  crosscheck::TrajectoryOptions o;
+  o.segments = segments;
+  o.levels = levels;
+  o.elements = elements;
+  std::string why;
+  if (!o.IsValid(&why)) throw io::InputError("crosscheck_trajectories: " + why);
+  crosscheck::TrajectoryReport r;
+  {
+    LibraryCall call;
+    r = crosscheck::compare_trajectories(sc, o, truth_root);
+  }
+  py::array_t<double> t(static_cast<py::ssize_t>(r.t.size()));
+  std::memcpy(t.mutable_data(), r.t.data(), r.t.size() * sizeof(double));
+  return py::make_tuple(crosscheck::to_json(r).dump(), t, Eigen::MatrixXd(r.chain), Eigen::MatrixXd(r.fe));
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "scoleid's library calls (use the scoleid package, which wraps them)";
+  static py::exception<io::InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const io::InputError& e) {
+      PyErr_SetString(input_error.ptr(), io::one_line(e.what()).c_str());
+    } catch (const io::Interrupted& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    }
+  });
+  m.def("builtin_scenarios", &io::builtin_scenario_names);
+  m.def("builtin_scenario", &io::builtin_scenario_text);
+  m.def("scenario_json", [](const std::string& text, const std::string& source) { return io::to_json(scenario_of(text, source)).dump(); });
+  m.def("truth", &truth, py::arg("yaml"), py::arg("source"), py::arg("progress") = false);
+  py::class_<IdentifyArgs>(m, "IdentifyArgs")
+      .def(py::init<>())
+      .def_readwrite("data_file", &IdentifyArgs::data_file)
+      .def_readwrite("names", &IdentifyArgs::names)
+      .def_readwrite("t", &IdentifyArgs::t)
+      .def_readwrite("values", &IdentifyArgs::values)
+      .def_readwrite("meta_json", &IdentifyArgs::meta_json)
+      .def_readwrite("method", &IdentifyArgs::method)
+      .def_readwrite("max_iterations", &IdentifyArgs::max_iterations)
+      .def_readwrite("compute_std", &IdentifyArgs::compute_std)
+      .def_readwrite("verbose", &IdentifyArgs::verbose);
+  py::class_<Identification>(m, "Identification")
+      .def_property_readonly("names", &Identification::names)
+      .def_property_readonly("estimate_vector", [](const Identification& id) { return Eigen::VectorXd(id.estimate()); })
+      .def_property_readonly("converged", &Identification::converged)
+      .def_property_readonly("verdict", &Identification::verdict)
+      .def_property_readonly("exit_code", &Identification::exit_code)
+      .def_property_readonly("warnings", &Identification::warnings)
+      .def("to_json", [](const Identification& id) { return id.to_json().dump(); })
+      .def("report", &Identification::FullReport)
+      .def("model_json", [](const Identification& id) { return id.model_json().dump(); })
+      .def("state_space", &state_space)
+      .def("modal_model", &modal_model)
+      .def("write", [](const Identification& id, const std::string& dir) { id.write(dir); });
+  m.def("identify", &identify_call, py::arg("yaml"), py::arg("source"), py::arg("args"));
+  m.def("crosscheck_modes", &crosscheck_modes);
+  m.def("crosscheck_trajectories", &crosscheck_trajectories);
+}

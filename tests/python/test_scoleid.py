@@ -1,0 +1,128 @@
+"""The scoleid Python module against the programs: the same numbers, the plant it exports, its errors.
+
+Run by ctest (label python) with PYTHONPATH=<build>/python and SCOLEID_BUILD_DIR=<build>.
+"""
+import json
+import os
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+import scoleid
+
+BUILD = os.environ.get("SCOLEID_BUILD_DIR", "build")
+TRUTH = os.path.join(BUILD, "model", "scole-truth")
+IDENTIFY = os.path.join(BUILD, "identify", "scole-identify")
+
+
+def run(*args):
+    return subprocess.run(list(args), capture_output=True, text=True, check=False)
+
+
+def read_csv(path):
+    with open(path) as f:
+        names = f.readline().strip().split(",")
+    values = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {n: values[:, j] for j, n in enumerate(names)}
+
+
+def cli_truth_and_identify(tmp_path, name):
+    truth_dir, out = tmp_path / "truth", tmp_path / "identify"
+    r = run(TRUTH, "-s", name, "-o", str(truth_dir), "-q")
+    assert r.returncode == 0, r.stderr
+    r = run(IDENTIFY, "-s", name, "--data", str(truth_dir / "truth.csv"), "-o", str(out), "-q")
+    assert r.returncode in (0, 1), r.stderr
+    with open(out / "identify.json") as f:
+        return read_csv(truth_dir / "truth.csv"), json.load(f)
+
+
+@pytest.mark.parametrize("name,tol", [("paper-beam-1", 1e-12), ("paper-scole-1", 1e-9)])
+def test_truth_and_identify_give_the_programs_numbers(tmp_path, name, tol):
+    csv, cli = cli_truth_and_identify(tmp_path, name)
+    rec = scoleid.truth(name)
+    assert list(rec) == list(csv)
+    for k in csv:
+        scale = max(np.abs(csv[k]).max(), 1e-300)
+        assert np.abs(rec[k] - csv[k]).max() <= 1e-12 * scale, k
+    idn = scoleid.identify(name, data=rec)
+    for p in cli["parameters"]:
+        est = idn.estimates[p["name"]]
+        print("%s %s: CLI %.17g, Python %.17g" % (name, p["name"], p["estimate"], est))
+        assert est == pytest.approx(p["estimate"], rel=tol, abs=0)
+    assert idn.converged == cli["converged"]
+    assert idn.to_json()["iterations"] == cli["iterations"]
+    assert "parameter" in idn.report()
+
+
+def test_state_space_modes_are_the_fe_modes_and_its_step_response_follows_the_truth():
+    sc = "paper-beam-1"
+    idn = scoleid.identify(sc)  # synthetic data: the estimate is the truth to ~1e-5
+    ss, mm = idn.state_space(), idn.modal_model()
+    A, B, C, D = ss["A"], ss["B"], ss["C"], ss["D"]
+    assert ss["inputs"] == ["P"] and ss["outputs"] == ["w_mid"]
+    # The eigenvalues of A are ±iω of the modal model (no damping in this scenario).
+    lam = np.linalg.eigvals(A)
+    w_ss = np.sort(np.abs(lam.imag))[::2]
+    assert np.allclose(w_ss, mm["omega"], rtol=1e-8)
+    # ... and the cross-check's FE modes at the truth (same mesh), scaled by sqrt((EI/rho_A) ratio):
+    # a uniform beam's frequencies scale exactly with it.
+    modes = scoleid.crosscheck_modes(sc, count=10, levels=1)
+    fe = np.array([m["fe_hz"][0] for m in modes["modes"]])
+    phys = idn.physical
+    scale = np.sqrt((phys["EI"] / phys["rho_A"]) / (23000.0 / 67.0))
+    f_ss = w_ss[:10] / (2 * np.pi)
+    print("state-space vs FE modes (first ten), relative:", f_ss / (fe * scale) - 1)
+    assert np.allclose(f_ss, fe * scale, rtol=1e-9)
+    # The plant's step response (P = 10 N at t = 0) against the Simbody truth at the true values.
+    rec = scoleid.truth(sc)
+    t = rec["t"]
+    vals, vecs = np.linalg.eig(A)
+    Vinv_B = np.linalg.solve(vecs, B[:, 0] * 10.0)
+    x = np.real(vecs @ (((np.exp(np.outer(vals, t)) - 1.0) / vals[:, None]) * Vinv_B[:, None]))
+    y = C @ x + D @ (10.0 * np.ones((1, t.size)))
+    rel = np.sqrt(np.mean((y[0] - rec["w_mid"]) ** 2)) / np.sqrt(np.mean(rec["w_mid"] ** 2))
+    print("step response of the exported plant vs the Simbody truth: relative RMS %.3g" % rel)
+    assert rel < 0.02
+
+
+def test_data_as_a_dataframe_and_as_a_file_identify_alike(tmp_path):
+    pd = pytest.importorskip("pandas")
+    rec = scoleid.truth("paper-beam-1")
+    from_dict = scoleid.identify("paper-beam-1", data=rec)
+    df = pd.DataFrame({k: v for k, v in rec.items()})
+    df.attrs["meta"] = rec.meta
+    from_df = scoleid.identify("paper-beam-1", data=df)
+    assert from_df.estimates == from_dict.estimates
+    # The scenario as YAML text and as a dict give what the name gives.
+    text = scoleid.builtin_scenario("paper-beam-1")
+    assert scoleid.identify(text).estimates == scoleid.identify("paper-beam-1").estimates
+    model = from_dict.export_model(tmp_path / "plant.json")
+    assert np.allclose(np.array(model["state_space"]["A"]), from_dict.state_space()["A"], rtol=0, atol=0)
+
+
+def test_errors_are_input_errors_with_the_programs_line():
+    with pytest.raises(scoleid.InputError, match="no-such-scenario"):
+        scoleid.identify("no-such-scenario")
+    with pytest.raises(scoleid.InputError, match=r"beam.EI must be > 0"):
+        scoleid.identify({"name": "x", "structure": "beam", "beam": {"EI": -1}})
+    with pytest.raises(scoleid.InputError, match='needs a "t" entry'):
+        scoleid.identify("paper-beam-1", data={"w_mid": np.zeros(3)})
+    with pytest.raises(scoleid.InputError, match="method must be one of"):
+        scoleid.identify("paper-beam-1", method="newton")
+    assert isinstance(scoleid.InputError("x"), ValueError)
+
+
+def test_python_overhead_over_the_library_is_small(tmp_path):
+    """scoleid.identify against the library call inside it (scenario to verdict) on paper-scole-2."""
+    best = None
+    for _ in range(2):
+        t0 = time.perf_counter()
+        idn = scoleid.identify("paper-scole-2")
+        wall = time.perf_counter() - t0
+        lib = idn.library_seconds
+        ratio = wall / lib - 1.0
+        best = ratio if best is None else min(best, ratio)
+        print("paper-scole-2: Python call %.3f s, library %.3f s, overhead %.2f %%" % (wall, lib, 100 * ratio))
+    assert best <= 0.05
