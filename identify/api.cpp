@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/mat_file.h"
 #include "scoleid/io/validation.h"
 
 namespace scoleid {
@@ -102,6 +104,38 @@ nlohmann::json Identification::model_json() const {
                            {"states", "x = (u, du/dt): the FE model's degrees of freedom, then their rates"}}},
           {"modal", {{"frequency_hz", hz}, {"omega", vector_of(m.omega)}, {"zeta", zeta}, {"output_shapes", matrix_json(m.output_shapes)},
                      {"input_shapes", matrix_json(m.input_shapes)}, {"inputs", m.inputs}, {"outputs", m.outputs}}}};
+}
+
+namespace {
+
+io::MatVariable mat_of(const std::string& name, const Eigen::MatrixXd& m) {
+  io::MatVariable v;
+  v.name = name;
+  v.rows = static_cast<std::size_t>(m.rows());
+  v.cols = static_cast<std::size_t>(m.cols());
+  v.values.assign(m.data(), m.data() + m.size());  // column-major, as MATLAB stores it
+  return v;
+}
+
+io::MatVariable mat_of(const std::string& name, const std::vector<std::string>& s) {
+  io::MatVariable v;
+  v.name = name;
+  v.strings = s;
+  v.is_strings = true;
+  return v;
+}
+
+}  // namespace
+
+void Identification::export_model(const std::string& path) const {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".json") return io::write_json_atomic(path, model_json());
+  if (ext != ".mat") throw io::InputError("export model: '" + path + "' must end in .json or .mat");
+  const identify::StateSpace s = state_space();
+  const identify::ModalModel m = modal_model();
+  io::write_mat_file(path, {mat_of("A", s.A), mat_of("B", s.B), mat_of("C", s.C), mat_of("D", s.D), mat_of("inputs", s.inputs),
+                            mat_of("outputs", s.outputs), mat_of("omega", m.omega), mat_of("zeta", m.zeta),
+                            mat_of("output_shapes", m.output_shapes), mat_of("input_shapes", m.input_shapes)});
 }
 
 void Identification::write(io::RunDirectory& dir) const { identify::write_outputs(dir, *problem_, result_); }

@@ -12,6 +12,7 @@
 #include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/mat_file.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
 
@@ -118,8 +119,10 @@ void print_problem(const identify::Problem& problem, bool from_file) {
 void check_export_path(const std::string& path) {
   if (path.empty()) return;
   const std::filesystem::path p(path);
-  if (p.extension() != ".json")
-    throw io::InputError("command line: --export-model must name a .json file, got '" + path + "'");
+  if (p.extension() != ".json" && p.extension() != ".mat")
+    throw io::InputError("command line: --export-model must name a .json or .mat file, got '" + path + "'");
+  if (p.extension() == ".mat" && !io::mat_files_supported())
+    throw io::InputError("command line: --export-model '" + path + "': this build writes no .mat files (libmatio was not found); use .json");
   if (p.has_parent_path() && !std::filesystem::is_directory(p.parent_path()))
     throw io::InputError("command line: --export-model '" + path + "': directory '" + p.parent_path().string() + "' does not exist");
 }
@@ -164,7 +167,7 @@ int main(int argc, char** argv) {
                "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
   app.add_option("--export-model", export_model,
-                 "write the identified linear model to FILE.json: state space A, B, C, D over the scenario's inputs and "
+                 "write the identified linear model to FILE.json or FILE.mat (MATLAB): state space A, B, C, D over the scenario's inputs and "
                  "sensors, and the modal model (frequencies, damping ratios, shapes at sensors and inputs)");
   std::string experiments;
   int threads = -1;
@@ -223,7 +226,7 @@ int main(int argc, char** argv) {
     print_problem(*problem, !data.empty());
     const Identification id = identify_parameters(problem, options);
     id.write(run_dir);
-    if (!export_model.empty()) io::write_json_atomic(export_model, id.model_json());
+    if (!export_model.empty()) id.export_model(export_model);
     run_dir.commit();
     std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());

@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/validation.h"
@@ -323,47 +324,78 @@ nlohmann::json to_json(const TruthMeta& m) {
           {"true_parameters", m.true_parameters}, {"generator", m.generator}, {"settings", m.settings}};
 }
 
+namespace {
+
+const char* json_kind(const nlohmann::json& v) {
+  return v.is_null() ? "null" : v.is_boolean() ? "a boolean" : v.is_number() ? "a number" : v.is_string() ? "text"
+         : v.is_array() ? "a list" : "an object";
+}
+
+// The member `key` of object `o` as T, or `dflt` when absent; InputError naming the field otherwise.
+template <class T>
+T member(const nlohmann::json& o, const char* key, const T& dflt, const std::string& source, const std::string& field) {
+  const auto it = o.find(key);
+  if (it == o.end()) return dflt;
+  try {
+    return it->get<T>();
+  } catch (const nlohmann::json::exception&) {
+    fail_field(source, field + key, std::is_same<T, std::string>::value ? "must be text" : "must be a number (or a list of numbers)",
+               json_kind(*it));
+  }
+}
+
+ColumnMeta column_meta(const nlohmann::json& c, std::size_t i, const std::string& source) {
+  const std::string at = "columns[" + std::to_string(i) + "].";
+  if (!c.is_object()) fail_field(source, "columns[" + std::to_string(i) + "]", "must be an object", json_kind(c));
+  if (!c.contains("name")) fail_field(source, at + "name", "is required", "none");
+  ColumnMeta cm;
+  cm.name = member<std::string>(c, "name", "", source, at);
+  const std::string f = "columns['" + one_line(cm.name) + "'].";
+  cm.unit = member<std::string>(c, "unit", "", source, f);
+  cm.kind = member<std::string>(c, "kind", "", source, f);
+  if (cm.kind != "input" && cm.kind != "output") fail_field(source, f + "kind", "must be input or output", "'" + cm.kind + "'");
+  cm.quantity = member<std::string>(c, "quantity", "", source, f);
+  cm.at = member<std::string>(c, "at", "", source, f);
+  cm.location = member<double>(c, "location", 0.0, source, f);
+  cm.direction = member<std::vector<double>>(c, "direction", {0, 0, 0}, source, f);
+  cm.noise_std = member<double>(c, "noise_std", 0.0, source, f);
+  if (!std::isfinite(cm.noise_std) || cm.noise_std < 0 || cm.noise_std > limits::kMaxMagnitude)
+    fail_field(source, f + "noise_std", "must be a number in [0, " + format_value(limits::kMaxMagnitude) + "]", format_value(cm.noise_std));
+  if (!std::isfinite(cm.location)) fail_field(source, f + "location", "must be finite", format_value(cm.location));
+  for (double d : cm.direction)
+    if (!std::isfinite(d)) fail_field(source, f + "direction", "must be finite", format_value(d));
+  return cm;
+}
+
+}  // namespace
+
 TruthMeta truth_meta_from_json(const nlohmann::json& j, const std::string& source) {
   TruthMeta m;
-  try {
-    m.scenario = j.value("scenario", "");
-    m.structure = j.value("structure", "");
-    if (j.contains("columns")) {
-      for (const auto& c : j.at("columns")) {
-        ColumnMeta cm;
-        cm.name = c.at("name").get<std::string>();
-        cm.unit = c.value("unit", "");
-        cm.kind = c.value("kind", "");
-        if (cm.kind != "input" && cm.kind != "output")
-          fail_field(source, "columns['" + cm.name + "'].kind", "must be input or output", "'" + cm.kind + "'");
-        cm.quantity = c.value("quantity", "");
-        cm.at = c.value("at", "");
-        cm.location = c.value("location", 0.0);
-        cm.direction = c.value("direction", std::vector<double>{0, 0, 0});
-        cm.noise_std = c.value("noise_std", 0.0);
-        const std::string f = "columns['" + one_line(cm.name) + "']";
-        for (const auto& other : m.columns)
-          if (other.name == cm.name) fail_field(source, f, "must appear once", "a second column of that name");
-        if (!std::isfinite(cm.noise_std) || cm.noise_std < 0 || cm.noise_std > limits::kMaxMagnitude)
-          fail_field(source, f + ".noise_std", "must be a number in [0, " + format_value(limits::kMaxMagnitude) + "]",
-                     format_value(cm.noise_std));
-        if (!std::isfinite(cm.location)) fail_field(source, f + ".location", "must be finite", format_value(cm.location));
-        for (double d : cm.direction)
-          if (!std::isfinite(d)) fail_field(source, f + ".direction", "must be finite", format_value(d));
-        m.columns.push_back(cm);
-      }
+  if (!j.is_object()) fail_field(source, "document", "must be a JSON object", json_kind(j));
+  m.scenario = member<std::string>(j, "scenario", "", source, "");
+  m.structure = member<std::string>(j, "structure", "", source, "");
+  if (j.contains("columns")) {
+    const auto& cols = j.at("columns");
+    if (!cols.is_array()) fail_field(source, "columns", "must be a list", json_kind(cols));
+    for (std::size_t i = 0; i < cols.size(); ++i) {
+      ColumnMeta cm = column_meta(cols[i], i, source);
+      for (const auto& other : m.columns)
+        if (other.name == cm.name) fail_field(source, "columns['" + one_line(cm.name) + "']", "must appear once", "a second column of that name");
+      m.columns.push_back(std::move(cm));
     }
-    if (j.contains("true_parameters")) {
-      m.true_parameters = j.at("true_parameters").get<std::map<std::string, double>>();
-      for (const auto& [k, v] : m.true_parameters)
-        if (!std::isfinite(v) || !(v >= 0))
-          fail_field(source, "true_parameters." + one_line(k), "must be a finite number >= 0", format_value(v));
-    }
-    if (j.contains("generator")) m.generator = j.at("generator");
-    if (j.contains("settings")) m.settings = j.at("settings");
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(source + ": unexpected structure (" + std::string(e.what()) + ")");
   }
+  if (j.contains("true_parameters")) {
+    const auto& tp = j.at("true_parameters");
+    if (!tp.is_object()) fail_field(source, "true_parameters", "must be an object {name: value}", json_kind(tp));
+    for (const auto& [k, v] : tp.items()) {
+      if (!v.is_number()) fail_field(source, "true_parameters." + one_line(k), "must be a number", json_kind(v));
+      const double x = v.get<double>();
+      if (!std::isfinite(x) || !(x >= 0)) fail_field(source, "true_parameters." + one_line(k), "must be a finite number >= 0", format_value(x));
+      m.true_parameters[k] = x;
+    }
+  }
+  if (j.contains("generator")) m.generator = j.at("generator");
+  if (j.contains("settings")) m.settings = j.at("settings");
   return m;
 }
 

@@ -240,6 +240,7 @@ PYBIND11_MODULE(_core, m) {
       .def("to_json", [](const Identification& id) { return id.to_json().dump(); })
       .def("report", &Identification::FullReport)
       .def("model_json", [](const Identification& id) { return id.model_json().dump(); })
+      .def("export_model", &Identification::export_model)
       .def("state_space", &state_space)
       .def("modal_model", &modal_model)
       .def("write", [](const Identification& id, const std::string& dir) { id.write(dir); });

@@ -1016,5 +1016,5 @@ TEST(ScoleIdentifyCli, ExportModelWritesThePlant) {
   for (std::size_t i = 0; i < n / 2; ++i)
     for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(A[i][k].get<double>(), k == i + n / 2 ? 1.0 : 0.0);
   const Result bad = run({"--scenario", "good.yaml", "--out", "out2", "--export-model", "plant.txt"}, dir);
-  expect_input_error(bad, dir / "out2", {"--export-model must name a .json file", "plant.txt"});
+  expect_input_error(bad, dir / "out2", {"--export-model must name a .json or .mat file", "plant.txt"});
 }

@@ -160,3 +160,22 @@ TEST(DataFiles, FreeTextNamesRoundTripThroughWriteCsv) {
   EXPECT_EQ(r.columns, t.columns);
   EXPECT_EQ(r.units, (std::vector<std::string>{"g", "", ""}));
 }
+
+// truth.json of the wrong shape: one line naming the file and the field, never the JSON library's text.
+TEST(DataFiles, TruthJsonTypeErrorsNameTheField) {
+  auto error_of = [](const std::string& text) {
+    try {
+      truth_meta_from_json(nlohmann::json::parse(text), "truth.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of(R"({"columns": [{"name": "w", "kind": "output", "noise_std": "big"}]})"),
+            "truth.json: columns['w'].noise_std must be a number (or a list of numbers), got text");
+  EXPECT_EQ(error_of(R"({"columns": [{"name": 3}]})"), "truth.json: columns[0].name must be text, got a number");
+  EXPECT_EQ(error_of(R"({"columns": {"w": 1}})"), "truth.json: columns must be a list, got an object");
+  EXPECT_EQ(error_of(R"({"true_parameters": {"EI": "23000"}})"), "truth.json: true_parameters.EI must be a number, got text");
+  EXPECT_EQ(error_of(R"([1, 2])"), "truth.json: document must be a JSON object, got a list");
+  EXPECT_EQ(error_of(R"({"scenario": 7})"), "truth.json: scenario must be text, got a number");
+}

@@ -99,7 +99,18 @@ def test_data_as_a_dataframe_and_as_a_file_identify_alike(tmp_path):
     text = scoleid.builtin_scenario("paper-beam-1")
     assert scoleid.identify(text).estimates == scoleid.identify("paper-beam-1").estimates
     model = from_dict.export_model(tmp_path / "plant.json")
+    with open(tmp_path / "plant.json") as f:
+        assert json.load(f) == model
     assert np.allclose(np.array(model["state_space"]["A"]), from_dict.state_space()["A"], rtol=0, atol=0)
+    # The .mat file, read back by scipy.io.loadmat: the same matrices, the names as cells.
+    scipy_io = pytest.importorskip("scipy.io")
+    from_dict.export_model(tmp_path / "plant.mat")
+    mat = scipy_io.loadmat(tmp_path / "plant.mat")
+    ss = from_dict.state_space()
+    for k in ("A", "B", "C", "D"):
+        assert np.array_equal(mat[k], ss[k]), k
+    assert [str(x[0][0]) for x in mat["outputs"]] == ss["outputs"]
+    assert np.array_equal(mat["omega"].ravel(), from_dict.modal_model()["omega"])
 
 
 def test_errors_are_input_errors_with_the_programs_line():

@@ -179,11 +179,11 @@ class Identification:
         return dict(self._core.modal_model())
 
     def export_model(self, path):
-        """The state space and the modal model as JSON (what scole-identify --export-model writes)."""
-        text = self._core.model_json()
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(text)
-        return json.loads(text)
+        """The state space and the modal model to path.json, or path.mat (MATLAB: A, B, C, D, inputs,
+        outputs, omega, zeta, output_shapes, input_shapes), as scole-identify --export-model writes
+        them. Returns the model as a dict."""
+        self._core.export_model(os.fspath(path))
+        return json.loads(self._core.model_json())
 
     def write(self, directory):
         """identify.json, fit.csv, fit.gp (and fit.png with gnuplot) into `directory`."""

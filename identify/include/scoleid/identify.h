@@ -83,6 +83,9 @@ public:
   identify::ModalModel modal_model() const;
   // Both as JSON (the file scole-identify --export-model writes; docs/theory.md §10.2).
   nlohmann::json model_json() const;
+  // Writes them to FILE.json, or FILE.mat (MATLAB; io/mat_file.h, when the build has libmatio).
+  // io::InputError for another extension or a .mat the build cannot write.
+  void export_model(const std::string& path) const;
 
   std::string FullReport() const { return result_.FullReport(); }
   nlohmann::json to_json() const { return result_.to_json(*problem_); }
