@@ -164,3 +164,15 @@ def test_ctrl_c_ends_a_solve_under_way():
     # ... and the handler is Python's again after the call: a second call runs to its end.
     rec = scoleid.identify("paper-beam-1")
     assert rec.converged
+
+
+def test_crosscheck_trajectories_returns_the_records_side_by_side(tmp_path):
+    r = scoleid.crosscheck_trajectories("paper-beam-1", tmp_path / "truths", segments=10, levels=2)
+    assert r["t"].ndim == 1 and r["chain"].shape == r["fe"].shape == (r["t"].size, 1)
+    rms = r["sensors"][0]["relative_rms"]
+    print("paper-beam-1 chain vs FE, relative RMS per level:", rms)
+    # The chain's lumping error falls with n (second order): the finer level is closer.
+    assert len(rms) == 2 and rms[1] < rms[0] < 0.05
+    assert 1.8 < np.log2(rms[0] / rms[1]) < 2.2
+    rel = np.sqrt(np.mean((r["chain"] - r["fe"]) ** 2) / np.mean(r["chain"] ** 2))
+    assert rel == pytest.approx(rms[1], rel=1e-6)
