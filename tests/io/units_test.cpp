@@ -28,6 +28,11 @@ TEST(Units, ConversionsAreTheDefinitions) {
   EXPECT_NEAR(scale("ue", "1", Quantity::Strain), 1e-6, 1e-21);
   EXPECT_NEAR(scale("ms", "s", Quantity::Time), 1e-3, 1e-18);
   EXPECT_NEAR(1.0 / conversion("N", "lbf", Quantity::Force).scale, 4.4482216152605, 1e-12);
+  // The slug as UDUNITS-2 defines it: 14.5939 kg, its database's rounding of lbf s^2/ft
+  // (14.5939029 kg), so that a slug ft/s^2 is 2e-7 short of a pound-force there. No sensor or input
+  // quantity is a mass: no data column is converted through it (docs/data.md §3).
+  EXPECT_NEAR(scale("slug ft/s^2", "N", Quantity::Force), 14.5939 * 0.3048, 1e-12);
+  EXPECT_NEAR(scale("slug ft/s^2", "lbf", Quantity::Force), 14.5939 / 14.593902937206362, 1e-12);
   EXPECT_TRUE(conversion("ft/s^2", "ft/s2", Quantity::Acceleration).identity());
   EXPECT_TRUE(conversion("lb ft", "lbf.ft", Quantity::Moment).identity());
   EXPECT_DOUBLE_EQ(conversion("g", "m/s^2", Quantity::Acceleration).apply(2.0), 2.0 * 9.80665);
