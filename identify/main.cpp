@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
                "skip the Fisher-information standard deviations and with them the identifiability flags "
                "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
-  app.add_option("--export-model", export_model,
+  auto* export_opt = app.add_option("--export-model", export_model,
                  "write the identified linear model to FILE.json or FILE.mat (MATLAB): state space A, B, C, D over the scenario's inputs and "
                  "sensors, and the modal model (frequencies, damping ratios, shapes at sensors and inputs)");
   std::string experiments;
@@ -178,6 +178,7 @@ int main(int argc, char** argv) {
       ->needs(ex_opt);
   ex_opt->excludes(app.get_option("--scenario"));
   ex_opt->excludes(app.get_option("--data"));
+  ex_opt->excludes(export_opt);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -226,8 +227,8 @@ int main(int argc, char** argv) {
     print_problem(*problem, !data.empty());
     const Identification id = identify_parameters(problem, options);
     id.write(run_dir);
-    if (!export_model.empty()) id.export_model(export_model);
     run_dir.commit();
+    if (!export_model.empty()) id.export_model(export_model);
     std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());

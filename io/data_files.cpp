@@ -75,6 +75,8 @@ std::vector<std::string> split_csv_line(const std::string& line, char separator)
         cur.push_back('"');
         ++i;
       } else {
+        // Blanks before an opening quote are outside the field ("t, \"a\"" names a).
+        if (!quoted && !was_quoted && cur.find_first_not_of(" \t") == std::string::npos) cur.clear();
         quoted = !quoted;
         was_quoted = true;
       }
@@ -82,8 +84,8 @@ std::vector<std::string> split_csv_line(const std::string& line, char separator)
       out.push_back(was_quoted ? cur : trim_field(cur, " \t\""));
       cur.clear();
       was_quoted = false;
-    } else if (c != '\r') {
-      cur.push_back(c);
+    } else if (c != '\r' && (quoted || !was_quoted || (c != ' ' && c != '\t'))) {
+      cur.push_back(c);  // (blanks after a closing quote are outside the field too)
     }
   }
   out.push_back(was_quoted ? cur : trim_field(cur, " \t\""));
@@ -202,14 +204,18 @@ DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOp
   std::string line = header_line(in, path, lineno);
   const char sep = separator_of(line);
   const bool decimal_comma = sep != ',';
-  const auto header = split_csv_line(line, sep);
+  auto header = split_csv_line(line, sep);
+  // Exports that end every line with the separator ("t;a;b;") have an empty last field throughout.
+  const bool trailing = header.size() > 2 && header.back().empty();
+  if (trailing) header.pop_back();
   const std::size_t time = read_header(header, options, tab, lineno);
   tab.columns.assign(tab.names.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     if (line[0] == '#') continue;
-    const auto f = split_csv_line(line, sep);
+    auto f = split_csv_line(line, sep);
+    if (trailing && f.size() == header.size() + 1 && f.back().empty()) f.pop_back();
     if (f.size() != header.size())
       throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": expected " +
                        std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));

@@ -74,6 +74,16 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
     throw io::InputError("command line: --out '" + out + "': directory '" + csv.parent_path().string() + "' does not exist");
   std::filesystem::path meta = csv;
   meta.replace_extension(".json");
+  if (std::filesystem::exists(meta)) {  // never over another program's JSON (a truth.json beside truth.csv)
+    nlohmann::json old;
+    try {
+      old = io::read_json(meta.string());
+    } catch (const io::InputError&) {
+    }
+    if (!old.is_object() || !old.contains("format") || old["format"] != io::kColumnsFormat)
+      throw io::InputError("command line: --out '" + out + "': " + meta.string() +
+                           " exists and is not a scole-data column description; choose another --out");
+  }
   const json doc{{"format", io::kColumnsFormat}, {"source", file}, {"time", {{"name", "t"}, {"unit", "s"}}},
                  {"columns", cols}};
   io::write_json_atomic(meta.string(), doc);

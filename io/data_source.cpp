@@ -26,30 +26,56 @@ bool is_uff_file(const std::string& path) {
 
 namespace {
 
-// Units from the column description beside a converted CSV (kColumnsFormat), where the header
-// states none.
-void units_from_sidecar(DataTable& tab, const std::string& path) {
+// The column description beside a converted CSV (kColumnsFormat), or null: a JSON file of the same
+// stem that is not one (truth.json, a lab's own notes, one that does not parse) is not ours.
+nlohmann::json sidecar_of(const std::string& path) {
   std::filesystem::path meta(path);
   meta.replace_extension(".json");
   std::error_code ec;
-  if (meta == std::filesystem::path(path) || !std::filesystem::is_regular_file(meta, ec)) return;
-  const nlohmann::json j = read_json(meta.string());
-  if (!j.is_object() || j.value("format", std::string()) != kColumnsFormat) return;
+  if (meta == std::filesystem::path(path) || !std::filesystem::is_regular_file(meta, ec)) return nullptr;
+  nlohmann::json j;
+  try {
+    j = read_json(meta.string());
+  } catch (const InputError&) {
+    return nullptr;
+  }
+  const auto f = j.is_object() ? j.find("format") : j.end();
+  if (!j.is_object() || f == j.end() || !f->is_string() || f->get<std::string>() != kColumnsFormat) return nullptr;
+  j["__path"] = meta.string();
+  return j;
+}
+
+// Units from the sidecar where the header states none. It must describe exactly the CSV's columns.
+void units_from_sidecar(DataTable& tab, const nlohmann::json& j) {
+  const std::string meta = j["__path"].get<std::string>();
   const auto cols = j.find("columns");
-  if (cols == j.end() || !cols->is_array()) throw InputError(meta.string() + ": columns must be a list");
+  if (cols == j.end() || !cols->is_array()) throw InputError(meta + ": columns must be a list");
+  tab.units.resize(tab.names.size());
+  std::vector<bool> described(tab.names.size(), false);
   for (const auto& c : *cols) {
     if (!c.is_object() || !c.contains("name") || !c["name"].is_string() || (c.contains("unit") && !c["unit"].is_string()))
-      throw InputError(meta.string() + ": columns[]: each needs a name and a unit as text");
+      throw InputError(meta + ": columns[]: each needs a name and a unit as text");
     const int k = tab.find(c["name"].get<std::string>());
-    if (k < 0) continue;
-    tab.units.resize(tab.names.size());
+    if (k < 0)
+      throw InputError(meta + ": describes column '" + one_line(c["name"].get<std::string>()) + "', which '" + tab.source +
+                       "' lacks; the two files are not from the same conversion");
+    described[static_cast<std::size_t>(k)] = true;
     if (tab.units[static_cast<std::size_t>(k)].empty()) tab.units[static_cast<std::size_t>(k)] = c.value("unit", std::string());
   }
+  for (std::size_t k = 0; k < described.size(); ++k)
+    if (!described[k])
+      throw InputError(meta + ": does not describe column '" + one_line(tab.names[k]) + "' of '" + tab.source +
+                       "'; the two files are not from the same conversion");
 }
 
 DataTable read_csv_data(const std::string& path, const CsvOptions& options) {
-  DataTable tab = read_csv(path, options);
-  units_from_sidecar(tab, path);
+  const nlohmann::json sidecar = sidecar_of(path);
+  if (sidecar.is_null()) return read_csv(path, options);
+  // A converted file's t is in seconds, whatever the scenario says of the raw file's time column.
+  CsvOptions own = options;
+  own.time_unit.clear();
+  DataTable tab = read_csv(path, own);
+  units_from_sidecar(tab, sidecar);
   return tab;
 }
 

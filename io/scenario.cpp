@@ -342,6 +342,7 @@ void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, con
       fail_field(source, b.EI.size() == 1 ? r.field("EI") : r.field("EI") + "[" + std::to_string(i) + "]",
                  "must be > 0", format_value(b.EI[i]));
   b.zeta = r.nonneg("zeta", b.zeta);
+  if (b.zeta > 1.0) fail_field(source, r.field("zeta"), "must be at most 1: a damping ratio, and above 1 every mode is overdamped: no ringing structure this models", format_value(b.zeta));
   b.c_kv = r.nonneg("c_kv", b.c_kv);
   b.tip_mass = r.nonneg("tip_mass", b.tip_mass);
   b.tip_inertia = r.nonneg("tip_inertia", b.tip_inertia);
@@ -361,6 +362,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   s.GJ = r.positive("GJ", s.GJ);
   s.rho_I_psi = r.positive("rho_I_psi", s.rho_I_psi);
   s.zeta = r.nonneg("zeta", s.zeta);
+  if (s.zeta > 1.0) fail_field(source, r.field("zeta"), "must be at most 1: a damping ratio, and above 1 every mode is overdamped: no ringing structure this models", format_value(s.zeta));
   s.bending_rotary_inertia = r.boolean("bending_rotary_inertia", s.bending_rotary_inertia);
   if (r.has("shuttle")) parse_rigid(r.child("shuttle"), source, r.field("shuttle"), s.shuttle);
   if (r.has("reflector")) parse_rigid(r.child("reflector"), source, r.field("reflector"), s.reflector);
@@ -507,7 +509,14 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.method = r.choice_of("method", id.method);
   id.max_iterations = r.integer("max_iterations", id.max_iterations, 0, 100000);
   id.gradient_tolerance = r.positive("gradient_tolerance", id.gradient_tolerance);
+  if (!(id.gradient_tolerance < 1.0))
+    fail_field(source, "identification.gradient_tolerance",
+               "must be below 1 (on the scaled gradient: at 1 or more the start already passes it, and \"converged\" would say nothing)",
+               format_value(id.gradient_tolerance));
   id.step_tolerance = r.positive("step_tolerance", id.step_tolerance);
+  if (!(id.step_tolerance < 1.0))
+    fail_field(source, "identification.step_tolerance",
+               "must be below 1 (a relative parameter change: at 1 or more any first step passes it)", format_value(id.step_tolerance));
   id.continuation_misfit = r.nonneg("continuation_misfit", id.continuation_misfit);
   id.steepest_weights = r.numbers("steepest_weights", {});
   for (std::size_t i = 0; i < id.steepest_weights.size(); ++i)
@@ -519,6 +528,11 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.step_rule = r.choice_of("step_rule", id.step_rule);
   id.rtol = r.positive("rtol", id.rtol);
   if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
+  if (id.model_error > 1.0)
+    fail_field(source, "identification.model_error",
+               "must be at most 1 (a fraction of each sensor's RMS signal: above 1 the fit test accepts a model that explains "
+               "nothing)",
+               format_value(id.model_error));
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
   id.start = r.choice_of("start", id.start);
   id.model = r.choice_of("model", id.model);

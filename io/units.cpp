@@ -76,7 +76,16 @@ std::string canonical(std::string u, Quantity q) {
   return u;
 }
 
-// UDUNITS-2's parser keeps global state: one caller at a time.
+// Text that is a number alone ("2", "1e-6") is no unit, though UDUNITS-2 reads it as a
+// dimensionless factor that an angle or a strain would accept: a unit names something (a letter or
+// a symbol such as ° or µ), but for strain's "1" and "%".
+bool names_a_unit(const std::string& text, Quantity q) {
+  for (unsigned char c : text)
+    if (std::isalpha(c) || c >= 0x80) return true;
+  return q == Quantity::Strain && (text == "1" || text == "%");
+}
+
+// UDUNITS-2 keeps global state (the parser, its status): one caller at a time.
 std::mutex& parser_lock() {
   static std::mutex m;
   return m;
@@ -145,8 +154,18 @@ std::string system_unit(System s, Quantity q) {
 std::optional<std::string> problem_with(const std::string& unit, Quantity q) {
   const std::string text = canonical(unit, q);
   const Unit u = parse(text), ref = parse(reference(q));
-  if (!u) return "'" + unit + "' is not a unit UDUNITS-2 knows";
-  if (!ut_are_convertible(u.get(), ref.get())) return "'" + unit + "' is not a unit of " + quantity_name(q);
+  if (!u || !names_a_unit(unit, q)) return "'" + unit + "' is not a unit UDUNITS-2 knows";
+  // Convertible in UDUNITS-2 includes reciprocals (Hz and s, s/m and m/s): a unit of q converts
+  // into q's reference by a finite positive factor.
+  const std::lock_guard<std::mutex> lock(parser_lock());
+  bool ok = ut_are_convertible(u.get(), ref.get()) != 0;
+  if (ok) {
+    cv_converter* cv = ut_get_converter(u.get(), ref.get());
+    const double one = cv ? cv_convert_double(cv, 1.0) - cv_convert_double(cv, 0.0) : 0.0;
+    if (cv) cv_free(cv);
+    ok = std::isfinite(one) && one > 0;
+  }
+  if (!ok) return "'" + unit + "' is not a unit of " + quantity_name(q);
   return std::nullopt;
 }
 
@@ -154,6 +173,7 @@ Conversion conversion(const std::string& from, const std::string& to, Quantity q
   for (const auto* u : {&from, &to})
     if (const auto why = problem_with(*u, q)) throw std::invalid_argument(*why);
   const Unit a = parse(canonical(from, q)), b = parse(canonical(to, q));
+  const std::lock_guard<std::mutex> lock(parser_lock());
   cv_converter* cv = ut_get_converter(a.get(), b.get());
   if (!cv) throw std::invalid_argument("'" + from + "' cannot be converted into '" + to + "'");
   Conversion c{from, to, 1.0, 0.0};
@@ -162,6 +182,8 @@ Conversion conversion(const std::string& from, const std::string& to, Quantity q
   cv_free(cv);
   // UDUNITS composes factors in floating point: a conversion that is the identity up to rounding
   // (ft/s^2 into ft/s2, lbf.ft into lb ft) is the identity.
+  if (!std::isfinite(c.scale) || !std::isfinite(c.offset) || !(c.scale > 0))
+    throw std::invalid_argument("'" + from + "' cannot be converted into '" + to + "'");
   if (std::abs(c.scale - 1.0) < 1e-14) c.scale = 1.0;
   if (std::abs(c.offset) < 1e-300) c.offset = 0.0;
   return c;
@@ -177,7 +199,13 @@ std::string bracketed_unit(const std::string& header) {
   std::string inside = header.substr(open + 1, e - open - 1);
   const auto b = inside.find_first_not_of(" \t"), ie = inside.find_last_not_of(" \t");
   inside = b == std::string::npos ? std::string() : inside.substr(b, ie - b + 1);
-  if (close == ')' && !parse(inside) && inside != "g") return "";
+  if (close == ')') {
+    bool unit = false;
+    for (Quantity q : {Quantity::Length, Quantity::Angle, Quantity::Velocity, Quantity::Acceleration, Quantity::Strain,
+                       Quantity::Force, Quantity::Moment, Quantity::Time})
+      unit = unit || (names_a_unit(inside, q) && parse(canonical(inside, q)));
+    if (!unit) return "";
+  }
   return inside;
 }
 

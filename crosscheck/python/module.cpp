@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <mutex>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -33,8 +34,14 @@ using namespace scoleid;
 
 namespace {
 
-// For the duration of one call: the library's SIGINT/SIGTERM recorder in place of Python's
-// handlers (restored after), the GIL released.
+// For the duration of one call: the GIL released, then one library call at a time (the signal
+// handlers and the interrupt flag are the process's), the library's SIGINT/SIGTERM recorder in
+// place of Python's handlers (restored after).
+std::mutex& call_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 class LibraryCall {
 public:
   LibraryCall() {
@@ -52,7 +59,8 @@ public:
 
 private:
   struct sigaction old_int_ {}, old_term_ {};
-  py::gil_scoped_release release_;
+  py::gil_scoped_release release_;                          // constructed before the lock, released after it
+  std::lock_guard<std::mutex> one_at_a_time_{call_mutex()};
 };
 
 // A scenario given as YAML text (source names it in messages), or with source empty as a built-in

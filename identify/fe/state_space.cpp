@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
@@ -37,6 +38,8 @@ StateSpace state_space(const StructuralModel& model, const VectorXd& c) {
   const Dense d = dense(model, c);
   const Eigen::Index n = model.ndof, m = d.B0.cols(), p = static_cast<Eigen::Index>(model.sensors.size());
   const Eigen::LDLT<MatrixXd> mass(d.M);
+  if (mass.info() != Eigen::Success || !mass.isPositive())
+    throw std::runtime_error("state space: the mass matrix is not positive definite at these parameters");
   const MatrixXd MinvK = mass.solve(d.K), MinvD = mass.solve(d.D), MinvB = mass.solve(d.B0);
   StateSpace s;
   s.A = MatrixXd::Zero(2 * n, 2 * n);

@@ -16,6 +16,7 @@
 
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
+#include "scoleid/io/error.h"
 #include "scoleid/io/uff.h"
 
 #ifndef SCOLE_DATA_EXE
@@ -152,4 +153,32 @@ TEST(DataCli, ASpectrumAMissingFileOrAMissingDirectoryExitTwoWritingNothing) {
   expect_nothing_written(dir);
   r = run({"frobnicate"}, dir);
   EXPECT_EQ(r.code, 2);
+}
+
+// The converted file's JSON: t stays in seconds whatever the raw file's time unit was; a JSON that
+// describes other columns is refused; a same-stem JSON that is not ours (truth.json, notes) is not
+// read, and `convert` never writes over one.
+TEST(DataCli, TheColumnDescriptionBesideAConvertedFile) {
+  const fs::path dir = scratch();
+  std::ofstream(dir / "raw.csv") << "clock,a [g]\n0,1\n2,3\n";
+  ASSERT_EQ(run({"convert", "raw.csv", "-o", "si.csv", "-q", "--time-unit", "ms"}, dir).code, 0);
+  CsvOptions raw_options;
+  raw_options.time_unit = "ms";
+  const DataTable t = read_data((dir / "si.csv").string(), raw_options);
+  EXPECT_EQ(t.t, (std::vector<double>{0.0, 0.002}));
+  EXPECT_EQ(t.units, std::vector<std::string>{"g"});
+  std::ofstream(dir / "si.json") << R"({"format": "scole-data columns 1", "columns": [{"name": "b [g]", "unit": "g"}]})";
+  try {
+    read_data((dir / "si.csv").string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("describes column 'b [g]'"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "si.json") << "{ not json";
+  EXPECT_EQ(read_data((dir / "si.csv").string()).units, std::vector<std::string>{"g"});  // the header's, the JSON ignored
+  std::ofstream(dir / "truth.json") << R"({"scenario": "x", "format": 3})";
+  const Result r = run({"convert", "raw.csv", "-o", "truth.csv"}, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("truth.json exists and is not a scole-data column description"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "truth.csv"));
 }

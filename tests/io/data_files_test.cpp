@@ -179,3 +179,12 @@ TEST(DataFiles, TruthJsonTypeErrorsNameTheField) {
   EXPECT_EQ(error_of(R"([1, 2])"), "truth.json: document must be a JSON object, got a list");
   EXPECT_EQ(error_of(R"({"scenario": 7})"), "truth.json: scenario must be text, got a number");
 }
+
+TEST(DataFiles, BlanksAroundQuotesAndATrailingSeparator) {
+  EXPECT_EQ(split_csv_line("t, \"a b\" ,c"), (std::vector<std::string>{"t", "a b", "c"}));
+  EXPECT_EQ(split_csv_line("\" x \",y"), (std::vector<std::string>{" x ", "y"}));  // inside quotes: kept
+  const auto p = write_file(temp_dir() / "trailing.csv", "Zeit [s];Kraft [N];\n0;1,5;\n0,5;2;\n");
+  const DataTable t = read_csv(p);
+  EXPECT_EQ(t.names, std::vector<std::string>{"Kraft [N]"});
+  EXPECT_EQ(t.columns[0], (std::vector<double>{1.5, 2.0}));
+}

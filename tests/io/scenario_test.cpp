@@ -401,3 +401,18 @@ identification:
   EXPECT_EQ(nonlinear.identification.model, Model::Nonlinear);
   EXPECT_EQ(to_json(nonlinear)["identification"]["model"].get<std::string>(), "nonlinear");
 }
+
+// Values in range that mean nothing are refused with their reason: a damping ratio above 1, a
+// model error larger than the signal, tolerances every start already meets.
+TEST(Scenario, MeaninglessMagnitudesAreRefusedWithTheirReason) {
+  EXPECT_NE(error_of("beam: {zeta: 1.0e20}").find("beam.zeta must be at most 1: a damping ratio"), std::string::npos)
+      << error_of("beam: {zeta: 1.0e20}");
+  EXPECT_NE(error_of("structure: scole\nscole: {zeta: 1000}").find("scole.zeta must be at most 1"), std::string::npos);
+  EXPECT_NE(error_of("identification: {model_error: 1.0e20}").find("identification.model_error must be at most 1"),
+            std::string::npos);
+  EXPECT_NE(error_of("identification: {gradient_tolerance: 1.0e20}").find("identification.gradient_tolerance must be below 1"),
+            std::string::npos);
+  EXPECT_NE(error_of("identification: {step_tolerance: 2}").find("identification.step_tolerance must be below 1"),
+            std::string::npos);
+  EXPECT_EQ(error_of("beam: {zeta: 1}\nidentification: {model_error: 1, gradient_tolerance: 0.5}"), "");
+}

@@ -81,3 +81,18 @@ TEST(Units, HeaderSuffixes) {
   EXPECT_EQ(bracketed_unit("]"), "");
   EXPECT_EQ(bracketed_unit(""), "");
 }
+
+// UDUNITS-2 calls reciprocals convertible (Hz and s); numbers alone parse as dimensionless factors,
+// which an angle would accept. Neither is a unit of the quantity.
+TEST(Units, ReciprocalsAndBareNumbersAreNoUnits) {
+  EXPECT_EQ(*problem_with("Hz", Quantity::Time), "'Hz' is not a unit of time");
+  EXPECT_EQ(*problem_with("s/m", Quantity::Velocity), "'s/m' is not a unit of velocity");
+  EXPECT_THROW(conversion("1/m", "m", Quantity::Length), std::invalid_argument);
+  EXPECT_EQ(*problem_with("2", Quantity::Angle), "'2' is not a unit UDUNITS-2 knows");
+  EXPECT_FALSE(problem_with("1", Quantity::Strain));
+  EXPECT_FALSE(problem_with("%", Quantity::Strain));
+  // Parentheses hold a unit when it is one through the aliases too; a number is none.
+  EXPECT_EQ(bracketed_unit("Rot (deg)"), "deg");
+  EXPECT_EQ(bracketed_unit("Strain (µε)"), "µε");
+  EXPECT_EQ(bracketed_unit("Gyro (2)"), "");
+}

@@ -76,9 +76,10 @@ def truth(scenario, progress=False):
 
 def _table(data):
     """(names, t, values[samples x columns], meta_json) of a dict or DataFrame."""
-    meta = getattr(data, "meta", None)
     if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a pandas DataFrame (truth.json in .attrs["meta"])
-        meta = getattr(data, "attrs", {}).get("meta", meta)
+        meta = getattr(data, "attrs", {}).get("meta")
+    else:
+        meta = data.meta if isinstance(data, TruthRecord) else None
         cols = {str(c): data[c].to_numpy(dtype=float) for c in data.columns}
         if "t" not in cols:
             first = str(data.columns[0])
@@ -94,7 +95,7 @@ def _table(data):
         if v.shape != t.shape:
             raise InputError("data: column '%s' has %d values for %d times" % (n, v.size, t.size))
         values[:, j] = v
-    return names, t, values, json.dumps(meta) if meta else ""
+    return names, t, values, json.dumps(meta) if meta is not None else ""
 
 
 class Identification:

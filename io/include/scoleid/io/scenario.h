@@ -137,7 +137,7 @@ struct InputSpec {
   Signal signal;
   // The data column that drives it (free text, e.g. "Hammer [N]"); "" = the column named `name`.
   std::string column;
-  // The column's unit when neither the column's header nor its file states one ("" = theirs).
+  // The column's unit, in place of what its header or file states ("" = theirs).
   std::string column_unit;
 };
 
