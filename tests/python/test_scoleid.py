@@ -95,6 +95,11 @@ def test_data_as_a_dataframe_and_as_a_file_identify_alike(tmp_path):
     df.attrs["meta"] = rec.meta
     from_df = scoleid.identify("paper-beam-1", data=df)
     assert from_df.estimates == from_dict.estimates
+    # A column that happens to be called "meta" is a column like any other.
+    odd = df.rename(columns={"P": "meta"})
+    odd.attrs["meta"] = rec.meta
+    with pytest.raises(scoleid.InputError, match="does not describe column 'meta'"):
+        scoleid.identify("paper-beam-1", data=odd)
     # The scenario as YAML text and as a dict give what the name gives.
     text = scoleid.builtin_scenario("paper-beam-1")
     assert scoleid.identify(text).estimates == scoleid.identify("paper-beam-1").estimates

@@ -78,13 +78,13 @@ def _table(data):
     """(names, t, values[samples x columns], meta_json) of a dict or DataFrame."""
     if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a pandas DataFrame (truth.json in .attrs["meta"])
         meta = getattr(data, "attrs", {}).get("meta")
-    else:
-        meta = data.meta if isinstance(data, TruthRecord) else None
         cols = {str(c): data[c].to_numpy(dtype=float) for c in data.columns}
         if "t" not in cols:
             first = str(data.columns[0])
             cols = {"t": cols.pop(first), **cols}
         data = cols
+    else:
+        meta = data.meta if isinstance(data, TruthRecord) else None
     if "t" not in data:
         raise InputError('data: a dict of arrays needs a "t" entry (the sample times)')
     t = np.asarray(data["t"], dtype=float)
