@@ -107,12 +107,21 @@ void print_problem(const identify::Problem& problem, bool from_file) {
                    x.from_unit.empty() ? ""
                                        : (" [" + x.from_unit + ", " + x.unit_stated_by + "] x " + io::format_value(x.scale) +
                                           " -> [" + x.to_unit + "]").c_str());
-  for (const auto& st : c.stepped_inputs)
+  for (const auto& st : c.stepped_inputs) {
+    if (st.pulse_samples > 0) {  // an impact: its samples are what was measured; no advice to replace them
+      std::fprintf(stderr,
+                   "scole-identify: note: input '%s' from the data is a pulse over %d samples (largest change %g within one "
+                   "sample, at t = %g): piecewise linear between samples, which keeps its impulse; its content near the "
+                   "sampling rate (%g Hz) is not resolved\n",
+                   st.name.c_str(), st.pulse_samples, st.jump, st.at, 1.0 / st.sample);
+      continue;
+    }
     std::fprintf(stderr,
                  "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g): "
                  "piecewise linear between samples, each jump moves by up to half a sample (%g s)%s\n",
                  st.name.c_str(), st.jump, st.at, 0.5 * st.sample,
                  st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
+  }
 }
 
 // --export-model FILE: a .json whose directory exists (checked before any work).
@@ -230,7 +239,7 @@ int main(int argc, char** argv) {
     run_dir.commit();
     if (!export_model.empty()) id.export_model(export_model);
     std::printf("\n%s", id.FullReport().c_str());
-    std::printf("wrote %s/identify.json, fit.csv, fit.gp (and fit.png with gnuplot)\n", out.c_str());
+    std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with gnuplot)\n", out.c_str());
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
     if (!id.converged())
       std::fprintf(stderr, "scole-identify: %s; outputs written with \"converged\": false\n", id.verdict().c_str());

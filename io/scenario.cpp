@@ -518,6 +518,16 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     fail_field(source, "identification.step_tolerance",
                "must be below 1 (a relative parameter change: at 1 or more any first step passes it)", format_value(id.step_tolerance));
   id.continuation_misfit = r.nonneg("continuation_misfit", id.continuation_misfit);
+  id.band = r.numbers("band", {});
+  if (!id.band.empty()) {
+    if (id.band.size() != 2)
+      fail_field(source, "identification.band", "must be [f_lo, f_hi] in Hz (two numbers)", std::to_string(id.band.size()) + " numbers");
+    if (!(std::isfinite(id.band[0]) && id.band[0] >= 0.0))
+      fail_field(source, "identification.band[0]", "must be a frequency >= 0 Hz (0: low-pass only)", format_value(id.band[0]));
+    if (!(std::isfinite(id.band[1]) && id.band[1] > id.band[0]))
+      fail_field(source, "identification.band[1]", "must be a finite frequency above band[0] = " + format_value(id.band[0]) + " Hz",
+                 format_value(id.band[1]));
+  }
   id.steepest_weights = r.numbers("steepest_weights", {});
   for (std::size_t i = 0; i < id.steepest_weights.size(); ++i)
     if (!(id.steepest_weights[i] > 0))
@@ -536,6 +546,9 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
   id.start = r.choice_of("start", id.start);
   id.model = r.choice_of("model", id.model);
+  if (!id.band.empty() && id.model == Model::Nonlinear)
+    fail_field(source, "identification.band", "needs the linear model (a filter commutes with a linear time-invariant model only)",
+               "model: nonlinear");
   if (r.has("smoothness")) {
     const YAML::Node m = r.child("smoothness");
     if (m.IsScalar() && m.Scalar() == "discrepancy")
@@ -761,7 +774,7 @@ nlohmann::json to_json(const Scenario& s) {
       if (t.width > 0) j["width"] = t.width;
       if (t.type == SignalTerm::Type::Sine) { j["frequency"] = t.f0; j["phase"] = t.phase; j["duration"] = t.duration; }
       if (t.type == SignalTerm::Type::Chirp) { j["f0"] = t.f0; j["f1"] = t.f1; j["duration"] = t.duration; }
-      if (t.type == SignalTerm::Type::Table) { j["times"] = t.times; j["values"] = t.values; }
+      if (t.type == SignalTerm::Type::Table || t.type == SignalTerm::Type::CubicTable) { j["times"] = t.times; j["values"] = t.values; }
       terms.push_back(j);
     }
     return terms;
@@ -836,6 +849,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"method", to_string(id.method)}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
+                         {"band", id.band.empty() ? json(nullptr) : json(id.band)},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"step_rule", to_string(id.step_rule)}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},

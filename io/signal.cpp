@@ -19,6 +19,26 @@ double table_value(const std::vector<double>& ts, const std::vector<double>& vs,
   return (1.0 - a) * vs[k - 1] + a * vs[k];
 }
 
+// The 4-point Lagrange cubic through the samples around t (the stencil shifted inside the range at
+// the ends; linear below four samples), constant beyond the ends.
+double cubic_table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
+  const std::size_t N = ts.size();
+  if (N < 4) return table_value(ts, vs, t);
+  if (t <= ts.front()) return vs.front();
+  if (t >= ts.back()) return vs.back();
+  const auto j = static_cast<std::size_t>(std::upper_bound(ts.begin(), ts.end(), t) - ts.begin());  // ts[j-1] <= t < ts[j]
+  std::size_t s0 = j >= 2 ? j - 2 : 0;
+  if (s0 + 4 > N) s0 = N - 4;
+  double f = 0.0;
+  for (std::size_t a = 0; a < 4; ++a) {
+    double l = 1.0;
+    for (std::size_t b = 0; b < 4; ++b)
+      if (b != a) l *= (t - ts[s0 + b]) / (ts[s0 + a] - ts[s0 + b]);
+    f += l * vs[s0 + a];
+  }
+  return f;
+}
+
 double term_value(const SignalTerm& s, double t) {
   using T = SignalTerm::Type;
   const double tau = t - s.t0;
@@ -39,6 +59,7 @@ double term_value(const SignalTerm& s, double t) {
       if (tau < 0.0 || tau >= s.width) return 0.0;
       return s.amplitude * 0.5 * (1.0 - std::cos(2.0 * kPi * tau / s.width));
     case T::Table: return table_value(s.times, s.values, t);
+    case T::CubicTable: return cubic_table_value(s.times, s.values, t);
   }
   return 0.0;
 }
@@ -51,6 +72,14 @@ Signal Signal::step(double amplitude, double t0) {
   s.type = SignalTerm::Type::Step;
   s.amplitude = amplitude;
   s.t0 = t0;
+  return Signal({s});
+}
+
+Signal Signal::cubic_table(std::vector<double> times, std::vector<double> values) {
+  SignalTerm s;
+  s.type = SignalTerm::Type::CubicTable;
+  s.times = std::move(times);
+  s.values = std::move(values);
   return Signal({s});
 }
 
@@ -84,7 +113,8 @@ std::vector<double> Signal::breakpoints() const {
         if (s.duration > 0.0) b.push_back(s.t0 + s.duration);
         break;
       case T::Chirp: b.push_back(s.t0); b.push_back(s.t0 + s.duration); break;
-      case T::Table: b.insert(b.end(), s.times.begin(), s.times.end()); break;
+      case T::Table:
+      case T::CubicTable: b.insert(b.end(), s.times.begin(), s.times.end()); break;
     }
   }
   std::sort(b.begin(), b.end());
@@ -102,6 +132,7 @@ const char* to_string(SignalTerm::Type t) {
     case T::Chirp: return "chirp";
     case T::Haversine: return "haversine";
     case T::Table: return "table";
+    case T::CubicTable: return "cubic-table";
   }
   return "?";
 }
@@ -113,7 +144,7 @@ std::string Signal::describe() const {
     const auto& s = terms_[i];
     if (i) os << " + ";
     os << to_string(s.type);
-    if (s.type == SignalTerm::Type::Table) {
+    if (s.type == SignalTerm::Type::Table || s.type == SignalTerm::Type::CubicTable) {
       os << " (" << s.times.size() << " points)";
     } else {
       os << ' ' << s.amplitude << " at " << s.t0;

@@ -52,7 +52,8 @@ FitTest fit_test(const FitTestInputs& in) {
     s.noise = std::sqrt(var);
     s.systematic = std::sqrt(std::max(0.0, ms_r - var));
     s.discretisation = disc ? std::sqrt(in.discretisation.col(k).squaredNorm() / static_cast<double>(N)) : std::nan("");
-    const double band2 = 3.0 * var * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(N, 1)));
+    const double independent = std::max(1.0, in.independent_fraction * static_cast<double>(N));
+    const double band2 = 3.0 * var * std::sqrt(2.0 / independent);
     const double strict2 = band2 + (disc ? 4.0 * s.discretisation * s.discretisation : 0.0);
     const double allowed2 = strict2 + std::pow(in.model_error * s.rms_signal, 2);
     s.allowed = std::sqrt(allowed2);

@@ -76,6 +76,8 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
   id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
   id.std = VectorXd::Constant(P, std::nan(""));
   id.resolution = VectorXd::Constant(P, std::nan(""));
+  id.covariance = MatrixXd::Constant(P, P, std::nan(""));
+  id.systematic = systematic;
   id.identifiable.assign(static_cast<std::size_t>(P), true);
   id.reason.assign(static_cast<std::size_t>(P), "");
   // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
@@ -112,6 +114,11 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
       for (Eigen::Index b = 0; b < K; ++b)
         Fk(a, b) = Fr(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]);
     const MatrixXd Ck = Fk.inverse();
+    for (Eigen::Index a = 0; a < K; ++a)
+      for (Eigen::Index b = 0; b < K; ++b) {
+        const int i = keep[static_cast<std::size_t>(a)], j = keep[static_cast<std::size_t>(b)];
+        id.covariance(i, j) = Ck(a, b) * q[i] * q[j];
+      }
     for (Eigen::Index a = 0; a < K; ++a) {
       if (!(Ck(a, a) > 0.0) || !std::isfinite(Ck(a, a))) {  // the restricted matrix is singular too
         const int i = keep[static_cast<std::size_t>(a)];

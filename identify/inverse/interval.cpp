@@ -16,6 +16,8 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
   u.too_wide.assign(static_cast<std::size_t>(P), false);
   u.terms = in.consider;
   const bool refit = in.half_record_estimate.size() == P;
+  if (refit) u.half_record_delta = in.estimate - in.half_record_estimate;
+  if (smoothing) u.smoothing_delta = in.estimate - in.smoothing_estimate;
   if (!refit) u.note = "no half-record refit: interval not assessed";
   else if (!in.half_record_converged) u.note = "the half-record refit did not converge: its shift is where it stopped";
   if (smoothing && !in.smoothing_converged)

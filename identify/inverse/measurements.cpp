@@ -60,10 +60,11 @@ namespace {
 // [t0, T] with the interpolant's stencil there (the products of two stencil weights are
 // polynomials of degree 6 on an interval, which the rule integrates exactly).
 template <class F>
-void for_each_node(const std::vector<double>& t, double t0, double T, F&& f) {
+void for_each_node(const std::vector<double>& t, double t0, double T, F&& f, std::size_t first = 0) {
   static const double gx[5] = {0.04691007703066800, 0.2307653449471585, 0.5, 0.7692346550528415, 0.9530899229693320};
   static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832, 0.1184634425280945};
-  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
+  for (std::size_t i = first; i + 1 < t.size(); ++i) {
+    if (t[i] >= T) break;
     const double a = std::max(t[i], t0), b = std::min(t[i + 1], T);
     if (!(b > a)) continue;
     for (int g = 0; g < 5; ++g) {
@@ -83,6 +84,19 @@ double Measurements::white_noise_integral(double t0, double T) const {
     for (int k = 0; k < m; ++k) sum += wt * w[k] * w[k];
   });
   return sum;
+}
+
+std::vector<double> Measurements::white_noise_integral_profile() const {
+  // The sum of white_noise_integral's interval contributions, interval by interval.
+  std::vector<double> W(t.size(), 0.0);
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    double sum = 0.0;
+    for_each_node(t, t[i - 1], t[i], [&](double wt, std::size_t, const double* w, int m) {
+      for (int k = 0; k < m; ++k) sum += wt * w[k] * w[k];
+    }, i - 1);
+    W[i] = W[i - 1] + sum;
+  }
+  return W;
 }
 
 double Measurements::white_noise_integral_variance(double t0, double T) const {

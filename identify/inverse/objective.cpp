@@ -56,6 +56,7 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   T_ = data_.t.back();
   const double t0 = data_.t.front();
   const int ns = data_.sensors();
+  noise_share();
   if (!options_.weights.empty()) {
     if (static_cast<int>(options_.weights.size()) != ns) throw std::invalid_argument("Objective: one weight per sensor");
     R_ = options_.weights;
@@ -263,25 +264,63 @@ void Objective::forward_windows(const SecondOrderSolver& solver, const Setup& s,
   counters_.quadrature_seconds += inside;
 }
 
-// Running per-sensor sums ∫ r² and ∫ z² from t0, reported as their mean ratio at each sample time
-// they pass (MisfitProfile).
+// Running per-sensor sums ∫ r² and ∫ z² from t0, reported at each sample time t_i they pass as the
+// mean over sensors of m_k = (∫r² − σ_k² B_i)⁺ / (∫z² − σ_k² W_i) (MisfitProfile): with stated noise,
+// what the residual holds beyond the noise's expected share plus two of its standard deviations,
+// against the signal without its noise (docs/theory.md §7.3). A sensor whose record so far is noise
+// alone (∫z² within the noise's share) limits no horizon: it has no phase to lose. Without stated
+// noise (σ_k = 0) m_k = ∫r²/∫z².
 struct Objective::ProfileSums {
-  explicit ProfileSums(const Measurements& d) : data(d), rr(VectorXd::Zero(d.sensors())), zz(VectorXd::Zero(d.sensors())) {}
+  ProfileSums(const Measurements& d, const NoiseShare& n)
+      : data(d), noise(n), rr(VectorXd::Zero(d.sensors())), zz(VectorXd::Zero(d.sensors())) {}
   void report(double t) {
     const auto ns = rr.size();
     while (next < data.t.size() && data.t[next] <= t) {
       double m = 0.0;
-      for (Eigen::Index k = 0; k < ns; ++k) m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
+      for (Eigen::Index k = 0; k < ns; ++k) {
+        if (noise.sigma2.size() == ns && noise.sigma2[k] > 0) {
+          const double signal = zz[k] - noise.sigma2[k] * noise.W[next];
+          const double beyond = std::max(0.0, rr[k] - noise.sigma2[k] * noise.B[next]);
+          m += signal > 0 ? beyond / signal : 0.0;
+        } else {
+          m += zz[k] > 0 ? rr[k] / zz[k] : 0.0;
+        }
+      }
       prof.t.push_back(data.t[next]);
       prof.misfit.push_back(m / static_cast<double>(ns));
       ++next;
     }
   }
   const Measurements& data;
+  const NoiseShare& noise;
   VectorXd rr, zz;
   std::size_t next = 1;  // next sample time to report
   MisfitProfile prof;
 };
+
+void Objective::noise_share() {
+  const int ns = data_.sensors();
+  bool any = false;
+  noise_.sigma2 = VectorXd::Zero(ns);
+  for (int k = 0; k < ns && k < static_cast<int>(options_.noise_std.size()); ++k) {
+    const double sd = options_.noise_std[static_cast<std::size_t>(k)];
+    if (sd > 0 && std::isfinite(sd)) {
+      noise_.sigma2[k] = sd * sd;
+      any = true;
+    }
+  }
+  if (!any) {
+    noise_ = {};
+    return;
+  }
+  noise_.W = data_.white_noise_integral_profile();
+  // Var ∫ñ² over [t0, t_i] taken in proportion to its mean (both grow with the interval count).
+  const double W_all = noise_.W.back();
+  const double V_all = data_.white_noise_integral_variance(data_.t.front(), data_.t.back());
+  noise_.B.resize(noise_.W.size());
+  for (std::size_t i = 0; i < noise_.W.size(); ++i)
+    noise_.B[i] = noise_.W[i] + 2.0 * std::sqrt(W_all > 0 ? V_all * noise_.W[i] / W_all : 0.0);
+}
 
 void Objective::profile_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w,
                                ProfileSums& sums) const {
@@ -339,7 +378,7 @@ double Objective::interpolation_misfit(const VectorXd& q) {
 
 Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondOrderSolver& solver,
                                                   const Trajectory& u) const {
-  ProfileSums sums(data_);
+  ProfileSums sums(data_, noise_);
   profile_window(s, solver, u, sums);
   return std::move(sums.prof);
 }
@@ -962,7 +1001,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   std::unique_ptr<ProfileSums> sums;
   std::unique_ptr<WindowedSink> profile_sink;
   if (profile) {
-    sums = std::make_unique<ProfileSums>(data_);
+    sums = std::make_unique<ProfileSums>(data_, noise_);
     profile_sink = std::make_unique<WindowedSink>(n, kStreamWindow, [&](const Trajectory& w) {
       const auto tp = Clock::now();
       profile_window(s, solver, w, *sums);
@@ -1066,7 +1105,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
 Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  ProfileSums sums(data_);
+  ProfileSums sums(data_, noise_);
   forward_windows(solver, s, data_.t.back(), [&](const Trajectory& w) { profile_window(s, solver, w, sums); });
   return std::move(sums.prof);
 }

@@ -113,6 +113,63 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability
   return terms;
 }
 
+// χ² = Σ r²/σ² of outputs Y against the data, with the Fisher step's noise levels.
+double chi_square(const Problem& p, const RunResult& r, const MatrixXd& Y) {
+  double c = 0.0;
+  for (Eigen::Index i = 0; i < Y.rows(); ++i)
+    for (Eigen::Index k = 0; k < Y.cols(); ++k) {
+      const double sd = static_cast<std::size_t>(k) < r.ident.noise_std.size() ? r.ident.noise_std[static_cast<std::size_t>(k)] : 0.0;
+      if (!(sd > 0.0)) continue;
+      c += std::pow(Y(i, k) - p.data.z(i, k), 2) / (sd * sd);
+    }
+  return c;
+}
+
+// The other-minimum test (docs/theory.md §8.1): every other attempt that converged and explains the
+// data ended at a point the Fisher matrix of the estimate cannot see. If its χ² is within 4 of the
+// estimate's (the likelihood-ratio bound of one degree of freedom at 95 %, as for the mirror), the
+// data cannot tell the two apart, and every parameter whose two values lie more than 2 std apart
+// is flagged. One state solve per such attempt.
+void flag_other_minima(const Problem& p, Objective& obj, RunResult& r, const MatrixXd& Y) {
+  if (r.ident.identifiable.empty()) return;
+  double c0 = -1.0;
+  for (std::size_t a = 0; a < r.attempts.size(); ++a) {
+    const auto& at = r.attempts[a];
+    if (static_cast<int>(a) == r.chosen_attempt || !at.optimizer_converged || !at.explains_data ||
+        at.estimate.size() != r.estimate.size() || !at.estimate.allFinite())
+      continue;
+    std::vector<int> differ;
+    for (Eigen::Index i = 0; i < r.estimate.size(); ++i)
+      if (r.ident.identifiable[static_cast<std::size_t>(i)] && std::abs(at.estimate[i] - r.estimate[i]) > 2.0 * r.ident.std[i])
+        differ.push_back(static_cast<int>(i));
+    if (differ.empty()) continue;
+    MatrixXd Ya;
+    try {
+      Ya = obj.predict(at.estimate);
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (c0 < 0) c0 = chi_square(p, r, Y);
+    const double d = chi_square(p, r, Ya) - c0;
+    r.ident.other_minimum_chi2_difference = std::isfinite(r.ident.other_minimum_chi2_difference)
+                                                ? std::min(r.ident.other_minimum_chi2_difference, d)
+                                                : d;
+    if (!(d < 4.0)) continue;
+    for (int i : differ) {
+      const auto u = static_cast<std::size_t>(i);
+      r.ident.identifiable[u] = false;
+      char buf[300];
+      std::snprintf(buf, sizeof buf,
+                    "the %s start ends at %.6g instead of %.6g and fits the data as well (chi-square difference %.3g, below "
+                    "4): the data cannot tell the two apart",
+                    at.strategy.c_str(), at.estimate[i], r.estimate[i], d);
+      r.ident.reason[u] = buf;
+    }
+  }
+}
+
 // The mirror test (docs/theory.md §8.1): the Fisher matrix sees only the estimate's neighbourhood,
 // so a second profile that explains the data as well is invisible to it. A beam's sections have one
 // such candidate by construction — the profile reversed end for end, which a symmetric support,
@@ -144,15 +201,7 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
   } catch (const std::exception&) {
     return;  // the mirrored profile cannot be solved: no second candidate
   }
-  double c0 = 0.0, c1 = 0.0;
-  for (Eigen::Index i = 0; i < Y.rows(); ++i)
-    for (Eigen::Index k = 0; k < Y.cols(); ++k) {
-      const double sd = static_cast<std::size_t>(k) < r.ident.noise_std.size() ? r.ident.noise_std[static_cast<std::size_t>(k)] : 0.0;
-      if (!(sd > 0.0)) continue;
-      const double w = 1.0 / (sd * sd);
-      c0 += w * std::pow(Y(i, k) - p.data.z(i, k), 2);
-      c1 += w * std::pow(Ym(i, k) - p.data.z(i, k), 2);
-    }
+  const double c0 = chi_square(p, r, Y), c1 = chi_square(p, r, Ym);
   r.ident.mirror_chi2_difference = c1 - c0;
   if (!(c1 - c0 < 4.0)) return;
   for (int i : differ) {
@@ -199,6 +248,17 @@ IntervalInputs refits(const Problem& p, Objective& obj, const OptimizerOptions& 
 
 }  // namespace
 
+FisherInformation band_information(const Problem& p, FisherInformation fi) {
+  if (!(p.band_gain < 1.0) || !fi.stated_noise) return fi;
+  // Formed with the filtered noise level σ√g and the filtered sensitivities, F counts every sample
+  // as independent: the band's information is g F (band_filter.h). Of the N values about g N are
+  // independent: χ²'s band for the noise is N ± 2√(2N/g).
+  fi.F *= p.band_gain;
+  const double Nd = static_cast<double>(fi.data_values);
+  fi.systematic = std::max(0.0, fi.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd / p.band_gain));
+  return fi;
+}
+
 std::vector<io::SensorSpec> sensors_with_noise(const Problem& p) {
   std::vector<io::SensorSpec> sensors = p.scenario.sensors;
   for (std::size_t j = 0; j < sensors.size() && j < p.noise_std.size(); ++j) sensors[j].noise_std = p.noise_std[j];
@@ -217,8 +277,9 @@ void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& o
   // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval.
   const MatrixXd Y = obj.predict(r.estimate);
   const MatrixXd G = obj.output_sensitivities(r.estimate);
-  r.ident = identifiability_from(fisher_information(obj.data(), Y, G, sensors_with_noise(p)), r.estimate);
+  r.ident = identifiability_from(band_information(p, fisher_information(obj.data(), Y, G, sensors_with_noise(p))), r.estimate);
   flag_mirror_ambiguity(p, obj, r, Y);
+  flag_other_minima(p, obj, r, Y);
   r.ident.noise_source = noise_origin(p, r.ident.noise_source);
   IntervalInputs ii = refits(p, obj, oo, r);
   ii.consider = consider_terms(p, r.ident, r.estimate, Y, G, r.fit.discretisation);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scoleid/identify/inverse/spectral_start.h"
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
@@ -212,6 +213,7 @@ RunResult::Attempt attempt_record(AttemptsContext& c, const std::string& strateg
   a.iterations = iterations;
   a.explains_data = f.explains_data;
   a.fit_message = f.message;
+  a.estimate = s.q;
   a.levels = std::move(levels);
   return a;
 }
@@ -251,7 +253,44 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
 }
 
-// One restart from the starting point: "coarse-to-fine", "plain" or "cautious-continuation".
+// The estimate with every sectional family smoothed once by the kernel (¼, ½, ¼) along its sections
+// (the end sections reflected), in log q: a sawtooth about a smooth profile is taken out, the
+// profile's trend kept.
+VectorXd smoothed(const VectorXd& q, const std::vector<std::vector<int>>& families) {
+  VectorXd out = q;
+  for (const auto& f : families) {
+    const std::size_t n = f.size();
+    for (std::size_t j = 0; j < n; ++j) {
+      const double a = std::log(q[f[j > 0 ? j - 1 : std::min<std::size_t>(1, n - 1)]]);
+      const double b = std::log(q[f[j + 1 < n ? j + 1 : (n >= 2 ? n - 2 : 0)]]);
+      out[f[j]] = std::exp(0.25 * a + 0.5 * std::log(q[f[j]]) + 0.25 * b);
+    }
+  }
+  return out;
+}
+
+// The spectral start (spectral_start.h) from q0; q empty when there is none or it is q0 within 1 %.
+SpectralStart spectral_start_of(AttemptsContext& c, const VectorXd& q0) {
+  const Problem& p = c.problem;
+  SpectralStart ss;
+  try {
+    c.objective.set_horizon(c.objective.data_end());
+    ss = spectral_start(p.model(), *p.params, q0, p.data, c.objective.predict(q0));
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    ss.q.resize(0);
+    ss.note = e.what();
+  }
+  if (ss.q.size() == q0.size() && std::abs(std::log(ss.data_hz / ss.model_hz)) < 0.01) {
+    ss.q.resize(0);
+    ss.note = "the model's peak is within 1 % of the record's";
+  }
+  return ss;
+}
+
+// One restart: from the starting point ("coarse-to-fine", "plain", "cautious-continuation") or from
+// the smoothed estimate of the runs so far ("smoothed").
 void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, const std::string& how) {
   AttemptsContext& c = run.c;
   OptimizerSummary s;
@@ -269,6 +308,22 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     label = std::string("plain ") + io::to_string(c.options.method);
     run.header();
     s = run.minimize_from(r.initial, c.options);
+  } else if (how == "smoothed") {
+    Ladder lad = coarse_to_fine(c, families, smoothed(r.summary.q, families));
+    iterations += lad.iterations;
+    label = "smoothed estimate, " + lad.label;
+    levels = std::move(lad.levels);
+    run.header();
+    s = run.minimize_from(lad.q, c.options);
+  } else if (how == "spectral") {
+    const SpectralStart ss = spectral_start_of(c, r.initial);
+    label = "spectral start (" + io::format_value(ss.model_hz) + " Hz -> " + io::format_value(ss.data_hz) + " Hz), " +
+            io::to_string(c.options.method);
+    if (c.verbose)
+      std::printf("spectral start: the record's peak at %.6g Hz, the model's at %.6g Hz from the starting point\n", ss.data_hz,
+                  ss.model_hz);
+    run.header();
+    s = run.minimize_from(ss.q, c.options);
   } else {
     const OptimizerOptions oc = cautious_continuation(c.options, c.problem.scenario.identification);
     label = cautious_continuation_label(oc);
@@ -278,7 +333,8 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
   iterations += s.iterations_done;
   const FitTest f = test_fit(c.problem, c.objective, s.q);
   r.attempts.push_back(attempt_record(c, label, s, f, iterations, std::move(levels)));
-  if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)])) {
+  c.objective.set_horizon(c.objective.data_end());
+  if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)], c.objective.data_points())) {
     r.chosen_attempt = static_cast<int>(r.attempts.size()) - 1;
     r.summary = s;
     r.fit = f;
@@ -293,31 +349,48 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   const auto families = section_families(r.names);
   const bool from_ladder = ladder_first(p.scenario.identification, longest(families), p.scenario.source);
   first_attempt(run, r, families, from_ladder);
-  // The second of the two starts of a sectional family: coarse to fine after a plain run, the plain
-  // run after the ladder (a coarse level can land in a basin the full profile does not leave:
-  // beam-ei8 started coarse to fine stops at J = 0.099 where the plain run reaches 4e-8).
+  // The restarts, each tried when its condition holds, up to identification.restarts of them:
+  //  - the other start of a sectional family (coarse to fine after a plain run, the plain run after
+  //    the ladder: a coarse level can land in a basin the full profile does not leave — beam-ei8
+  //    started coarse to fine stops at J = 0.099 where the plain run reaches 4e-8), when the residual
+  //    exceeds noise and discretisation (a local minimum of a sectional profile may still fit within
+  //    a declared model error) or the run used up its iterations;
+  //  - the smoothed estimate of a sectional family, always: a sectional profile has local minima
+  //    that fit within the noise (beam-ei8 with noise 1e-4 m stops in a sawtooth 7-19 std off whose
+  //    J is 2 % above the minimum near the truth — decisive between the two points, which share the
+  //    noise, but within the noise's own spread of J, so no fit test can see it); coarse to fine
+  //    from the estimate smoothed along its sections reaches the lower one;
+  //  - the spectral start (spectral_start.h), after any failure of the runs so far, when the
+  //    record's dominant spectral peak and the model's at the starting point differ by more than 1 %:
+  //    from the start moved so that the model's frequencies match the record's;
+  //  - the cautious continuation, after any failure of the runs so far: stopped without converging
+  //    (the iteration limit, a stall on a short horizon) or converged where the model does not
+  //    explain the data.
+  // The best attempt is kept (better_attempt); where two converged attempts fit alike but differ,
+  // the assessment flags the parameters they disagree on (assessment.cpp, the other-minimum test).
   std::vector<std::string> strategies;
-  if (!families.empty()) strategies.push_back(from_ladder ? "plain" : "coarse-to-fine");
-  strategies.push_back("cautious-continuation");
-  for (std::size_t k = 0; k < strategies.size() && static_cast<int>(k) < p.scenario.identification.restarts; ++k) {
-    const std::string& how = strategies[k];
-    // Restarts answer a false convergence: the optimiser stopped on a convergence test where the
-    // model does not explain the data. The other start of a sectional family is tried whenever the
-    // residual exceeds noise and discretisation (a local minimum of a sectional profile may still
-    // fit within a declared model error), and also after a run that used up its iterations
-    // (sections the sensors barely see wander through any budget: EI on 64 sections,
-    // docs/theory.md §7.8); the cautious continuation only when a converged fit does not explain
-    // the data.
-    const bool other_start = how == "coarse-to-fine" || how == "plain";
-    const bool out_of_iterations = r.summary.termination == OptimizerSummary::Termination::MaxIterations;
-    if (!r.summary.converged() && !(other_start && out_of_iterations)) break;
-    if (other_start ? r.fit.within_noise_and_discretisation : r.fit.explains_data) continue;
-    if (c.verbose)
-      std::printf("fit test: %s\nrestart %zu (%s) from the starting point\n",
-                  r.fit.explains_data ? "the residual exceeds noise and discretisation" : r.fit.message.c_str(), k + 1,
-                  how.c_str());
+  if (!families.empty()) strategies.insert(strategies.end(), {from_ladder ? "plain" : "coarse-to-fine", "smoothed"});
+  strategies.insert(strategies.end(), {"spectral", "cautious-continuation"});
+  int done = 0;
+  for (const std::string& how : strategies) {
+    if (done >= p.scenario.identification.restarts) break;
+    bool wanted = false;
+    if (how == "smoothed") wanted = r.summary.q.allFinite();
+    else if (how == "spectral") wanted = !r.converged() && spectral_start_of(c, r.initial).q.size() == r.initial.size();
+    else if (how == "cautious-continuation") wanted = !r.converged();
+    else
+      wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
+    if (!wanted) continue;
+    if (c.verbose) {
+      std::printf("fit test: %s\n", r.fit.message.c_str());
+      if (how == "smoothed")
+        std::printf("restart %d (smoothed): from the estimate smoothed along its sections — a sectional minimum may be local\n",
+                    done + 1);
+      else
+        std::printf("restart %d (%s) from the starting point\n", done + 1, how.c_str());
+    }
     restart(run, r, families, how);
-    if (r.converged()) break;
+    ++done;
   }
   r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record
   if (c.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());

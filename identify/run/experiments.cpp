@@ -205,6 +205,9 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     if (sc.identification.start != io::Start::Auto)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           "sets identification.start, which a joint run does not take (it starts plain, without restarts)", r.scenario);
+    if (!sc.identification.band.empty())
+      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+          "sets identification.band, which a joint run does not take (its Fisher sum counts independent samples)", r.scenario);
     if (sc.identification.model != io::Model::Linear)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",

@@ -1,5 +1,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 
+#include <cmath>
+
 #include "scoleid/io/error.h"
 #include "scoleid/io/process.h"
 
@@ -16,23 +18,55 @@ std::string gnuplot_quote(const std::string& text) {
 }
 
 std::string fit_plot_script(const std::vector<std::string>& sensors, const std::vector<std::pair<int, double>>& cost,
-                            const std::string& csv, const std::string& png) {
+                            const std::string& csv, const std::string& png, const FitPlotAnnotations& notes) {
   const std::size_t ns = sensors.size();
+  const bool zoom = notes.zoom_to > notes.zoom_from;
+  const std::size_t cols = zoom ? 2 : 1;
   const std::string data = gnuplot_quote(csv);
-  std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * (ns + 1)) + " noenhanced\nset output " +
-                   gnuplot_quote(png) + "\nset datafile separator ','\nset multiplot layout " + std::to_string(ns + 1) +
-                   ",1\nset grid\nset key top right\n";
-  for (std::size_t k = 0; k < ns; ++k) {
+  std::string gp = "set terminal pngcairo size " + std::to_string(zoom ? 1600 : 1000) + "," + std::to_string(300 * (ns + 1) + 40) +
+                   " noenhanced\nset output " + gnuplot_quote(png) + "\nset datafile separator ','\nset multiplot layout " +
+                   std::to_string(ns + 1) + "," + std::to_string(cols) +
+                   (notes.title.empty() ? std::string() : " title " + gnuplot_quote(notes.title)) + "\nset grid\nset key top right\n";
+  auto panel = [&](std::size_t k, bool window) {
     const std::size_t c = 2 + 3 * k;
-    gp += "set title " + gnuplot_quote(sensors[k]) + "\nset xlabel 't'\nset y2tics\nset ytics nomirror\n";
+    const std::string unit = k < notes.units.size() && !notes.units[k].empty() ? " [" + notes.units[k] + "]" : "";
+    gp += "set title " + gnuplot_quote(sensors[k] + (window ? " (window)" : "")) + "\nset xlabel 't [s]'\nset ylabel " +
+          gnuplot_quote(sensors[k] + unit) + "\nset y2tics\nset ytics nomirror\n";
+    gp += window ? "set xrange [" + io::format_value(notes.zoom_from) + ":" + io::format_value(notes.zoom_to) + "]\n"
+                 : "set autoscale x\n";
     gp += "plot " + data + " every ::1 using 1:" + std::to_string(c) + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
           std::to_string(c + 1) + " with lines dt 2 lw 2 title 'predicted', '' every ::1 using 1:" + std::to_string(c + 2) +
           " axes x1y2 with lines lc rgb 'gray' title 'residual (right axis)'\n";
+  };
+  for (std::size_t k = 0; k < ns; ++k) {
+    panel(k, false);
+    if (zoom) panel(k, true);
   }
-  gp += "unset y2tics\nset ytics mirror\nset title 'cost per iteration'\nset xlabel 'iteration'\nset logscale y\n"
-        "plot '-' using 1:2 with linespoints lw 2 notitle\n";
+  gp += "set autoscale x\nunset y2tics\nset ytics mirror\nset title 'cost per iteration'\nset xlabel 'iteration'\n"
+        "set ylabel 'J'\nset logscale y\nplot '-' using 1:2 with linespoints lw 2 notitle\n";
   for (const auto& [k, c] : cost) gp += std::to_string(k) + "," + io::format_value(c) + "\n";
   gp += "e\nunset multiplot\n";
+  return gp;
+}
+
+std::string spectrum_plot_script(const std::vector<std::string>& sensors, const std::vector<std::string>& units,
+                                 const std::vector<double>& modes_hz, const std::string& title, const std::string& csv,
+                                 const std::string& png) {
+  const std::size_t ns = sensors.size();
+  std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * ns + 40) + " noenhanced\nset output " +
+                   gnuplot_quote(png) + "\nset datafile separator ','\nset multiplot layout " + std::to_string(ns) + ",1" +
+                   (title.empty() ? std::string() : " title " + gnuplot_quote(title)) +
+                   "\nset grid\nset key top right\nset logscale xy\nset xlabel 'frequency [Hz]'\n";
+  for (double f : modes_hz)
+    if (std::isfinite(f) && f > 0) gp += "set arrow from " + io::format_value(f) + ", graph 0 to " + io::format_value(f) + ", graph 1 nohead front lc rgb 'red' dt 2\n";
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::string unit = k < units.size() && !units[k].empty() ? " [(" + units[k] + ")^2/Hz]" : "";
+    gp += "set title " + gnuplot_quote(sensors[k] + " (the model's natural frequencies dashed)") + "\nset ylabel " +
+          gnuplot_quote("PSD" + unit) + "\n";
+    gp += "plot " + gnuplot_quote(csv) + " every ::1 using 1:" + std::to_string(2 + 2 * k) +
+          " with lines lw 2 title 'measured', '' every ::1 using 1:" + std::to_string(3 + 2 * k) + " with lines dt 2 lw 2 title 'predicted'\n";
+  }
+  gp += "unset multiplot\n";
   return gp;
 }
 

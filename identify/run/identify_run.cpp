@@ -3,6 +3,7 @@
 #include "scoleid/identify/run/identify_run.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 
 #include "scoleid/identify/inverse/tied_parameterization.h"
@@ -28,6 +29,7 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
   in.names = p.data.names;
   in.noise_std = p.noise_std;
   in.model_error = model_error(p);
+  in.independent_fraction = p.band_gain;
   if (!q.allFinite()) {
     in.residual = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));
     return fit_test(in);
@@ -69,10 +71,33 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
   return f;
 }
 
-bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b) {
+bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, long data_values) {
   const int ra = (a.optimizer_converged && a.explains_data ? 2 : 0) + (a.explains_data ? 1 : 0);
   const int rb = (b.optimizer_converged && b.explains_data ? 2 : 0) + (b.explains_data ? 1 : 0);
-  return ra != rb ? ra > rb : a.cost < b.cost;
+  if (ra != rb) return ra > rb;
+  // Lower by more than fitting one more free parameter to the noise would gain (J/N): two runs that
+  // ended at the same minimum differ by rounding, and the earlier one is kept.
+  const double margin = data_values > 0 && std::isfinite(b.cost) ? b.cost / static_cast<double>(data_values) : 0.0;
+  return a.cost < b.cost - margin;
+}
+
+void estimate_modes(const Problem& p, RunResult& r) {
+  if (!r.estimate.allFinite()) return;
+  ModalUncertaintyOptions o;
+  // Modes above the data's Nyquist frequency are not seen by the record (its median sample interval).
+  if (p.data.t.size() >= 2) {
+    std::vector<double> dt(p.data.t.size() - 1);
+    for (std::size_t i = 0; i + 1 < p.data.t.size(); ++i) dt[i] = p.data.t[i + 1] - p.data.t[i];
+    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+    if (dt[dt.size() / 2] > 0) o.max_frequency_hz = 0.5 / dt[dt.size() / 2];
+  }
+  try {
+    r.modes = modal_estimates(p.model(), *p.params, r.estimate, r.ident, r.interval, o);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    r.modes.clear();  // a model without a modal decomposition at the estimate: no modes reported
+  }
 }
 
 RunResult start_result(const Problem& p, io::Model model) {
@@ -116,6 +141,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   run_attempts(c, r);
   r.estimate = r.summary.q;
   if (ro.compute_std) assess_estimate(p, obj, c.options, r);
+  estimate_modes(p, r);
   r.counters = obj.counters();
   r.counters.Accumulate(c.extra);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/inverse/band_filter.h"
 #include "scoleid/identify/fe/scole_model.h"
 #include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/io/error.h"
@@ -452,7 +453,13 @@ void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int 
       st.at = tab.t[k];
       st.sample = tab.t[k] - tab.t[k - 1];
     }
-  if (*hi > *lo && st.jump > 0.25 * (*hi - *lo)) p.columns.stepped_inputs.push_back(st);
+  if (!(*hi > *lo && st.jump > 0.25 * (*hi - *lo))) return;
+  if (std::abs(f.back() - f.front()) < 0.25 * (*hi - *lo)) {
+    const double peak = std::max(std::abs(*hi - f.front()), std::abs(*lo - f.front()));
+    st.pulse_samples = static_cast<int>(
+        std::count_if(f.begin(), f.end(), [&](double x) { return std::abs(x - f.front()) > 0.1 * peak; }));
+  }
+  p.columns.stepped_inputs.push_back(st);
 }
 
 // The measurements from the table's sensor columns, the inputs from theirs (signal_from), and
@@ -546,6 +553,43 @@ double measured_data_step(Problem& p, const std::string& csv) {
   return step;
 }
 
+// identification.band (inverse/band_filter.h): the inputs' samples at the data's times and the
+// data filtered alike; the stated noise levels become the filtered data's.
+void apply_band(Problem& p) {
+  const auto& band = p.scenario.identification.band;
+  if (band.empty()) return;
+  const auto& t = p.data.t;
+  const std::string& src = p.scenario.source;
+  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (std::abs((t[i] - t[i - 1]) - dt) > 1e-6 * dt)
+      fail_field(src, "identification.band", "needs uniformly sampled data (the interval at t = " + io::format_value(t[i]) + " is " +
+                 io::format_value(t[i] - t[i - 1]) + " s against the mean " + io::format_value(dt) + " s)", io::format_value(band[1]));
+  if (!(band[1] < 0.5 / dt))
+    fail_field(src, "identification.band[1]", "must lie below the data's Nyquist frequency " + io::format_value(0.5 / dt) + " Hz",
+               io::format_value(band[1]));
+  for (std::size_t k = 0; k < p.noise_std.size(); ++k)
+    if (!(p.noise_std[k] > 0))
+      fail_field(src, "identification.band",
+                 "needs every sensor's noise_std stated (the band's noise level and its chi-square band are drawn from it); sensor '" +
+                     p.scenario.sensors[k].name + "' has none",
+                 io::format_value(band[0]) + " .. " + io::format_value(band[1]) + " Hz");
+  const BandFilter g(band[0], band[1], dt);
+  for (auto& sig : p.signals) {
+    std::vector<double> f(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) f[i] = sig(t[i]);
+    sig = io::Signal::cubic_table(t, g.apply(f));
+  }
+  std::vector<double> col(t.size());
+  for (Eigen::Index k = 0; k < p.data.z.cols(); ++k) {
+    for (std::size_t i = 0; i < t.size(); ++i) col[i] = p.data.z(static_cast<Eigen::Index>(i), k);
+    const auto y = g.apply(col);
+    for (std::size_t i = 0; i < t.size(); ++i) p.data.z(static_cast<Eigen::Index>(i), k) = y[i];
+  }
+  p.band_gain = g.noise_gain(t.size());
+  for (double& sd : p.noise_std) sd *= std::sqrt(p.band_gain);
+}
+
 // The solver's options, once the data are in: a record in which no sensor moves is refused (every
 // parameter fits it the same until the model moves, and then only worse).
 void finish_problem(Problem& p, double step, const std::string* csv) {
@@ -557,8 +601,10 @@ void finish_problem(Problem& p, double step, const std::string* csv) {
                "sensors where the structure cannot move)",
                std::to_string(p.data.sensors()) + " sensor" + (p.data.sensors() == 1 ? "" : "s"));
   }
+  apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
   p.objective_options.solver.step = step;
+  p.objective_options.noise_std = p.noise_std;
   p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                              : SolverOptions::Integrator::Esdirk;

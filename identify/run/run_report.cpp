@@ -1,8 +1,10 @@
 // identify.json, fit.csv / fit.gp / fit.png and the printed summary of one identification run
 // (identify_run.h; the file format: docs/theory.md §10).
 #include <cmath>
+#include <tuple>
 #include <cstdio>
 
+#include "scoleid/identify/inverse/spectral_start.h"
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/data_files.h"
@@ -125,6 +127,17 @@ json integrator_json(const RunResult& r, const Problem& p) {
           {"visible_content_modes", p.content.content_mode}};
 }
 
+json correlation_json(const RunResult& r) {
+  const MatrixXd R = correlation(r.ident);
+  json rows = json::array();
+  for (Eigen::Index i = 0; i < R.rows(); ++i) {
+    json row = json::array();
+    for (Eigen::Index j = 0; j < R.cols(); ++j) row.push_back(finite_or_null(R(i, j)));
+    rows.push_back(row);
+  }
+  return {{"parameters", r.names}, {"matrix", rows}};
+}
+
 json identifiability_json(const RunResult& r) {
   if (r.ident.std.size() == 0)
     return {{"assessed", false}, {"why", "run with --no-std: no standard deviations, no identifiability flags"}};
@@ -142,16 +155,35 @@ json identifiability_json(const RunResult& r) {
           {"chi2", r.ident.chi2},
           {"data_values", r.ident.data_values},
           {"mirror_chi2_difference", finite_or_null(r.ident.mirror_chi2_difference)},
+          {"other_minimum_chi2_difference", finite_or_null(r.ident.other_minimum_chi2_difference)},
+          {"correlation", correlation_json(r)},
           {"half_record_refit_converged", r.half_record_estimate.size() != 0 ? json(r.half_record_converged) : json(nullptr)},
           {"consider", consider},
           {"interval_note", r.interval.note}};
+}
+
+// The identified model's elastic modes (modal_uncertainty.h), lowest first.
+json modes_json(const RunResult& r) {
+  json modes = json::array();
+  for (const auto& m : r.modes) {
+    json e{{"mode", m.mode},
+           {"frequency_hz", m.frequency_hz},
+           {"frequency_std_hz", finite_or_null(m.frequency_std_hz)},
+           {"frequency_interval_hz", finite_or_null(m.frequency_half_width_hz)},
+           {"damping_ratio", finite_or_null(m.damping_ratio)},
+           {"damping_ratio_std", finite_or_null(m.damping_std)},
+           {"damping_ratio_interval", finite_or_null(m.damping_half_width)}};
+    if (!m.note.empty()) e["uncertainty_not_given_because"] = m.note;
+    modes.push_back(e);
+  }
+  return modes;
 }
 
 json data_columns_json(const ColumnUse& c) {
   json stepped = json::array();
   for (const auto& st : c.stepped_inputs)
     stepped.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at}, {"switch_shift_up_to", 0.5 * st.sample},
-                       {"scenario_gives_signal", st.scenario_signal}});
+                       {"scenario_gives_signal", st.scenario_signal}, {"pulse_samples", st.pulse_samples}});
   json sources = json::array();
   for (const auto& x : c.sources)
     sources.push_back({{"name", x.name}, {"column", x.column}, {"column_unit", x.from_unit}, {"unit_stated_by", x.unit_stated_by},
@@ -186,6 +218,56 @@ json counts_json(const RunResult& r, json& out) {
   return out;
 }
 
+// The correlation of the estimates, for two to eight parameters with a covariance.
+std::string correlation_table(const RunResult& r) {
+  const MatrixXd R = correlation(r.ident);
+  const auto P = R.rows();
+  if (P < 2 || P > 8) return "";
+  std::string s = "\ncorrelation of the estimates\n";
+  char cell[64];
+  std::snprintf(cell, sizeof cell, "%-10s", "");
+  s += cell;
+  for (Eigen::Index j = 0; j < P; ++j) {
+    std::snprintf(cell, sizeof cell, " %9.9s", r.names[static_cast<std::size_t>(j)].c_str());
+    s += cell;
+  }
+  s += "\n";
+  for (Eigen::Index i = 0; i < P; ++i) {
+    std::snprintf(cell, sizeof cell, "%-10s", r.names[static_cast<std::size_t>(i)].c_str());
+    s += cell;
+    for (Eigen::Index j = 0; j < P; ++j) {
+      if (std::isfinite(R(i, j))) std::snprintf(cell, sizeof cell, " %9.4f", R(i, j));
+      else std::snprintf(cell, sizeof cell, " %9s", "-");
+      s += cell;
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+// The identified model's modes with std and interval half-width.
+std::string modes_table(const std::vector<ModalEstimate>& modes) {
+  if (modes.empty()) return "";
+  std::string s = "\nmodes of the identified model\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%5s %14s %12s %12s %14s %12s %12s\n", "mode", "frequency_Hz", "std", "± interval",
+                "damping_ratio", "std", "± interval");
+  s += line;
+  auto cell = [](double v, const char* fmt) {
+    char buf[32] = "-";
+    if (std::isfinite(v)) std::snprintf(buf, sizeof buf, fmt, v);
+    return std::string(buf);
+  };
+  for (const auto& m : modes) {
+    std::snprintf(line, sizeof line, "%5d %14s %12s %12s %14s %12s %12s%s%s\n", m.mode, cell(m.frequency_hz, "%.7g").c_str(),
+                  cell(m.frequency_std_hz, "%.3e").c_str(), cell(m.frequency_half_width_hz, "%.3e").c_str(),
+                  cell(m.damping_ratio, "%.5g").c_str(), cell(m.damping_std, "%.3e").c_str(),
+                  cell(m.damping_half_width, "%.3e").c_str(), m.note.empty() ? "" : "  ", m.note.c_str());
+    s += line;
+  }
+  return s;
+}
+
 }  // namespace
 
 nlohmann::json RunResult::to_json(const Problem& p) const {
@@ -216,7 +298,13 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"data_source", p.data_source},
            {"elements", p.structure->elements()},
            {"settings", io::to_json(p.scenario)},
-           {"identifiability", identifiability_json(*this)}};
+           {"identifiability", identifiability_json(*this)},
+           {"modes", modes_json(*this)},
+           {"band", p.scenario.identification.band.empty()
+                        ? json(nullptr)
+                        : json{{"f_lo_hz", p.scenario.identification.band[0]},
+                               {"f_hi_hz", p.scenario.identification.band[1]},
+                               {"noise_gain", p.band_gain}}}};
   counts_json(*this, out);
   if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0) out["data_columns"] = data_columns_json(p.columns);
   return out;
@@ -249,6 +337,8 @@ std::string RunResult::FullReport() const {
                     "-", sd.c_str(), res.c_str(), hw.c_str(), flag);
     s += line;
   }
+  s += correlation_table(*this);
+  s += modes_table(modes);
   std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
                 summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
                 wall_seconds);
@@ -272,6 +362,63 @@ io::DataTable fit_table(const Measurements& data, const MatrixXd& Y) {
   return tab;
 }
 
+namespace {
+
+// The plot's title: the run, its verdict and its first estimates with their intervals.
+std::string plot_title(const RunResult& r) {
+  std::string t = r.scenario + ": ";
+  if (r.converged()) t += "converged";
+  else t += "NOT converged (" + std::string(r.summary.converged() ? "the fit test rejects the fit" : to_string(r.summary.termination)) + ")";
+  for (std::size_t i = 0; i < r.names.size() && i < 4; ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    char buf[96];
+    const double hw = r.interval.half_width.size() > e ? r.interval.half_width[e] : std::nan("");
+    const bool flagged = !r.ident.identifiable.empty() && !r.ident.identifiable[i];
+    if (flagged) std::snprintf(buf, sizeof buf, "; %s %.5g (not identifiable)", r.names[i].c_str(), r.estimate[e]);
+    else if (std::isfinite(hw)) std::snprintf(buf, sizeof buf, "; %s %.5g ± %.2g", r.names[i].c_str(), r.estimate[e], hw);
+    else std::snprintf(buf, sizeof buf, "; %s %.5g", r.names[i].c_str(), r.estimate[e]);
+    t += buf;
+  }
+  if (r.names.size() > 4) t += "; " + std::to_string(r.names.size()) + " parameters in all";
+  return t;
+}
+
+// About ten cycles of the record's dominant frequency from where the response starts (the first
+// sample where a sensor exceeds a tenth of its largest value), when that is under half the record.
+std::pair<double, double> zoom_window(const Measurements& data) {
+  const auto f = dominant_frequency(data.t, data.z);
+  if (!f || data.t.size() < 2) return {0.0, 0.0};
+  const double span = data.t.back() - data.t.front(), width = 10.0 / *f;
+  if (!(width < 0.5 * span)) return {0.0, 0.0};
+  std::size_t first = data.t.size() - 1;
+  for (Eigen::Index k = 0; k < data.z.cols(); ++k) {
+    const double peak = data.z.col(k).cwiseAbs().maxCoeff();
+    for (std::size_t i = 0; i < data.t.size(); ++i)
+      if (std::abs(data.z(static_cast<Eigen::Index>(i), k)) > 0.1 * peak) {
+        first = std::min(first, i);
+        break;
+      }
+  }
+  const double from = std::max(data.t.front(), data.t[first] - 0.1 * width);
+  return {from, std::min(data.t.back(), from + width)};
+}
+
+std::vector<std::string> sensor_units(const Problem& p) {
+  std::vector<std::string> u;
+  for (const auto& s : p.scenario.sensors) u.push_back(s.unit);
+  return u;
+}
+
+void render(const char* png, RenderStatus status) {
+  switch (status) {
+    case RenderStatus::Rendered: break;
+    case RenderStatus::NoGnuplot: std::fprintf(stderr, "scole-identify: note: gnuplot is not installed; no %s\n", png); break;
+    case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s\n", png); break;
+  }
+}
+
+}  // namespace
+
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.csv: measured, predicted and residual per sensor at the sample times.
   MatrixXd predicted = r.predicted;
@@ -284,11 +431,30 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).
   std::vector<std::pair<int, double>> cost;
   for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
-  io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost));
-  switch (render_gnuplot(dir.staging(), "fit.gp")) {
-    case RenderStatus::Rendered: break;
-    case RenderStatus::NoGnuplot: std::fprintf(stderr, "scole-identify: note: gnuplot is not installed; no fit.png\n"); break;
-    case RenderStatus::Failed: std::fprintf(stderr, "scole-identify: note: gnuplot could not render fit.png\n"); break;
+  FitPlotAnnotations notes;
+  notes.title = plot_title(r);
+  notes.units = sensor_units(p);
+  std::tie(notes.zoom_from, notes.zoom_to) = zoom_window(p.data);
+  io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost, "fit.csv", "fit.png", notes));
+  render("fit.png", render_gnuplot(dir.staging(), "fit.gp"));
+  // spectrum.csv / spectrum.gp / spectrum.png: measured and predicted power spectral densities.
+  const Spectrum sm = power_spectrum(p.data.t, p.data.z), sp = power_spectrum(p.data.t, predicted);
+  if (!sm.f.empty() && sm.psd.rows() == sp.psd.rows()) {
+    io::DataTable spec;
+    spec.t = sm.f;
+    spec.time_name = "frequency_hz";
+    for (int k = 0; k < p.data.sensors(); ++k) {
+      const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+      spec.names.insert(spec.names.end(), {n + "_measured_psd", n + "_predicted_psd"});
+      const VectorXd a = sm.psd.col(k), b = sp.psd.col(k);
+      spec.columns.push_back(std::vector<double>(a.data(), a.data() + a.size()));
+      spec.columns.push_back(std::vector<double>(b.data(), b.data() + b.size()));
+    }
+    io::write_csv(dir.path("spectrum.csv"), spec);
+    std::vector<double> modes_hz;
+    for (const auto& m : r.modes) modes_hz.push_back(m.frequency_hz);
+    io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title));
+    render("spectrum.png", render_gnuplot(dir.staging(), "spectrum.gp"));
   }
   io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
 }

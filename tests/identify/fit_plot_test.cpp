@@ -37,10 +37,29 @@ TEST(FitPlot, HostileNamesAreDrawnNotExecuted) {
       for (std::size_t k = 0; k < names.size(); ++k) csv << "," << std::sin(0.1 * i + k) << "," << std::sin(0.1 * i + k) << ",0";
       csv << "\n";
     }
-    std::ofstream(dir / "fit.gp") << fit_plot_script(names, {{0, 1.0}, {1, 0.1}, {2, 0.01}});
+    // With the annotations: a hostile title and units, and a window beside each record.
+    FitPlotAnnotations notes;
+    notes.title = "run'; system \"touch pwned\"";
+    notes.units = {"m'; system \"touch pwned\"", "g", ""};
+    notes.zoom_from = 1.0;
+    notes.zoom_to = 2.0;
+    std::ofstream(dir / "fit.gp") << fit_plot_script(names, {{0, 1.0}, {1, 0.1}, {2, 0.01}}, "fit.csv", "fit.png", notes);
+    std::ofstream spec(dir / "spectrum.csv");
+    spec << "frequency_hz";
+    for (std::size_t k = 0; k < names.size(); ++k) spec << ",m" << k << ",p" << k;
+    spec << "\n";
+    for (int i = 1; i < 50; ++i) {
+      spec << i * 0.5;
+      for (std::size_t k = 0; k < names.size(); ++k) spec << "," << 1.0 / (1.0 + i) << "," << 1.1 / (1.0 + i);
+      spec << "\n";
+    }
+    spec.close();
+    std::ofstream(dir / "spectrum.gp") << spectrum_plot_script(names, notes.units, {2.0, 7.5}, notes.title);
   }
   EXPECT_EQ(render_gnuplot(dir.string(), "fit.gp"), RenderStatus::Rendered);
   EXPECT_TRUE(fs::exists(dir / "fit.png") && fs::file_size(dir / "fit.png") > 1000) << "plot not drawn";
+  EXPECT_EQ(render_gnuplot(dir.string(), "spectrum.gp"), RenderStatus::Rendered);
+  EXPECT_TRUE(fs::exists(dir / "spectrum.png") && fs::file_size(dir / "spectrum.png") > 1000) << "spectrum not drawn";
   EXPECT_FALSE(fs::exists(marker)) << "a sensor name ran a command";
   fs::remove_all(dir.parent_path());
 }

@@ -87,6 +87,26 @@ def test_state_space_modes_are_the_fe_modes_and_its_step_response_follows_the_tr
     assert rel < 0.02
 
 
+def test_modes_and_correlation_follow_the_modal_model_and_the_std():
+    # Paper Case I with 2 % noise: the modes are the modal model's (lowest first, in Hz), and the
+    # first frequency's std is the paper form's closed form: f ∝ √q1, so std(f)/f = std(q1)/(2 q1).
+    sc = scoleid.builtin_scenario("paper-beam-1").replace("location: 5, unit: m}", "location: 5, unit: m, noise_std: 0.00036}")
+    assert "noise_std" in sc
+    idn = scoleid.identify(sc)
+    assert idn.converged
+    modes, mm = idn.modes, idn.modal_model()
+    assert len(modes) == 10 and [m["mode"] for m in modes] == list(range(1, 11))
+    assert np.allclose([m["frequency_hz"] for m in modes], np.asarray(mm["omega"][:10]) / (2 * np.pi), rtol=1e-12)
+    q1, s1 = idn.estimates["q1"], idn.std["q1"]
+    f1 = modes[0]
+    print("f1 %.7f Hz, std %.3e (closed form %.3e)" % (f1["frequency_hz"], f1["frequency_std_hz"], f1["frequency_hz"] * s1 / (2 * q1)))
+    assert f1["frequency_std_hz"] == pytest.approx(f1["frequency_hz"] * s1 / (2 * q1), rel=1e-5)
+    r = idn.correlation
+    assert set(r) == {"q1", "q2"}
+    assert r["q1"]["q1"] == pytest.approx(1.0) and r["q1"]["q2"] == pytest.approx(r["q2"]["q1"])
+    assert -1.0 <= r["q1"]["q2"] <= 1.0
+
+
 def test_data_as_a_dataframe_and_as_a_file_identify_alike(tmp_path):
     pd = pytest.importorskip("pandas")
     rec = scoleid.truth("paper-beam-1")

@@ -158,6 +158,23 @@ class Identification:
         return {p["name"]: p.get("identifiable") for p in self._json["parameters"]}
 
     @property
+    def modes(self):
+        """The identified model's elastic modes, lowest first: dicts with frequency_hz,
+        frequency_std_hz, frequency_interval_hz, damping_ratio, damping_ratio_std,
+        damping_ratio_interval (None where not assessed; docs/theory.md §8.3)."""
+        return [dict(m) for m in self._json.get("modes", [])]
+
+    @property
+    def correlation(self):
+        """The correlation matrix of the estimates as {parameter: {parameter: r}} (None where a
+        parameter has no covariance)."""
+        c = self._json.get("identifiability", {}).get("correlation")
+        if not c:
+            return {}
+        names = c["parameters"]
+        return {a: {b: c["matrix"][i][j] for j, b in enumerate(names)} for i, a in enumerate(names)}
+
+    @property
     def iterations(self):
         """The iteration history, as identify.json's "iterations"."""
         return list(self._json.get("iterations", []))
@@ -187,7 +204,7 @@ class Identification:
         return json.loads(self._core.model_json())
 
     def write(self, directory):
-        """identify.json, fit.csv, fit.gp (and fit.png with gnuplot) into `directory`."""
+        """identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with gnuplot) into `directory`."""
         self._core.write(os.fspath(directory))
 
     def __repr__(self):

@@ -208,6 +208,10 @@ struct IdentificationSpec {
   // (identify/include/scoleid/identify/inverse/optimizers.h); 0 = fit the whole record from the start.
   double continuation_misfit = 0.05;
   std::vector<double> steepest_weights;  // paper's w_i; empty = automatic
+  // The frequency band [f_lo, f_hi] in Hz the fit compares model and data in (empty = the whole
+  // record): inputs and outputs pass the same causal Butterworth band-pass
+  // (identify/include/scoleid/identify/inverse/band_filter.h); f_lo = 0: low-pass only.
+  std::vector<double> band;
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (step_rule)
   // The automatic step's rule (docs/theory.md §5.2): "parameters" resolves flexible modes up to

@@ -11,6 +11,8 @@
 //   chirp     f = A sin(2π (f0 τ + (f1 - f0) τ² / (2 D))), τ = t - t0 in [0, D)  (linear sweep)
 //   haversine f = A (1 - cos(2π (t - t0)/w)) / 2 on [t0, t0+w)   (smooth pulse)
 //   table     piecewise linear through (t_k, f_k), constant beyond the ends
+//   cubic-table  the 4-point Lagrange cubic through the samples around t (a band-limited input's
+//             reading; built in code, not from a scenario), constant beyond the ends
 // Discontinuities (in f or its derivative) are exposed by breakpoints() so integrators can stop
 // there instead of stepping across them.
 #include <string>
@@ -20,7 +22,7 @@
 namespace scoleid::io {
 
 struct SignalTerm {
-  enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table };
+  enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table, CubicTable };
   Type type = Type::Step;
   double amplitude = 0.0;
   double t0 = 0.0;
@@ -38,6 +40,7 @@ public:
   explicit Signal(std::vector<SignalTerm> terms);
   static Signal step(double amplitude, double t0 = 0.0);
   static Signal table(std::vector<double> times, std::vector<double> values);
+  static Signal cubic_table(std::vector<double> times, std::vector<double> values);
 
   double operator()(double t) const;
   // Sorted, unique times where f or f' jumps.

@@ -52,6 +52,9 @@ struct FitTestInputs {
   Eigen::MatrixXd discretisation;  // samples × sensors, refined − identifier outputs at q̂; empty = not estimated
   double model_error = 0.0;        // m, relative to each sensor's RMS signal
   std::vector<std::string> names;  // sensor names, for the message
+  // The share of the samples that are independent (1 for white noise; g = Σh² for data filtered to
+  // a band, inverse/band_filter.h): the noise's χ² band is drawn for that many values.
+  double independent_fraction = 1.0;
 };
 
 struct SensorFit {

@@ -39,11 +39,18 @@ struct Identifiability {
   long data_values = 0;         // N = samples × sensors
   std::vector<bool> identifiable;
   std::vector<std::string> reason;  // why a parameter is flagged ("" when it is not)
+  // The Cramér–Rao covariance of the parameters the Fisher test kept (P × P; NaN in the rows and
+  // columns of the others), and the systematic share of χ² (resolution² = systematic · std²).
+  MatrixXd covariance;
+  double systematic = 0;
   std::vector<double> noise_std;  // σ_k used per sensor
   std::string noise_source;       // "scenario" | "residual" (identify_run refines "scenario" to where each level came from)
   // χ² of the sections' profile reversed end for end minus the estimate's (identify_run's mirror
   // test, docs/theory.md §8.1); NaN when not computed (no sections, or the estimate its own mirror).
   double mirror_chi2_difference = std::nan("");
+  // χ² of the closest other converged attempt minus the estimate's (identify_run's other-minimum
+  // test); NaN when none differs by more than 2 std.
+  double other_minimum_chi2_difference = std::nan("");
 };
 
 // The Fisher information of one experiment at q and what goes with it: F = Gᵀ W G, the χ² of the

@@ -27,6 +27,8 @@ struct Measurements {
   // variance 2 Σ_ab Q_ab² — larger than the 2 Σ_a Q_aa² of independent samples, since
   // neighbouring samples share each interval.
   double white_noise_integral_variance(double t0, double T) const;
+  // white_noise_integral(t.front(), t_i) at every sample time t_i, in one pass.
+  std::vector<double> white_noise_integral_profile() const;
 };
 
 }  // namespace scoleid::identify

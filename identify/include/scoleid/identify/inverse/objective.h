@@ -65,6 +65,9 @@ struct ObjectiveOptions {
   // trajectory_bytes, else the whole state is stored); > 0 = always checkpoint every L points.
   long checkpoint_points = 0;
   std::vector<double> weights;  // R_kk; empty = 1/(T mean z_k²)
+  // Each sensor's stated noise level (<= 0 or absent: unknown). The misfit profile of the horizon
+  // continuation (MisfitProfile) counts only what exceeds the noise's expected share (below).
+  std::vector<double> noise_std;
 };
 
 struct ObjectiveCounters {
@@ -266,6 +269,15 @@ private:
   bool accelerations_ = false;
   std::vector<double> R_;
   std::vector<double> breakpoints_;
+  // The stated noise's share of the misfit profile: per sensor σ_k², and per sample time t_i the
+  // expected ∫ñ² of unit white noise over [t0, t_i] (W_i) and that plus two of its standard
+  // deviations (B_i). Empty without stated noise.
+  struct NoiseShare {
+    VectorXd sigma2;
+    std::vector<double> W, B;
+  };
+  NoiseShare noise_;
+  void noise_share();  // noise_ from options_.noise_std and the sample times
   double T_ = 0.0;  // horizon: end of the cost integral
   ObjectiveCounters counters_;
 };

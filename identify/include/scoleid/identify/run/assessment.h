@@ -1,7 +1,7 @@
 #pragma once
 // The assessment of a linear identification's estimate (docs/theory.md §8): the Fisher information
 // at q̂ (standard deviations, resolution and the identifiability flags, identifiability.h), the
-// mirror test of sectional profiles, the half-record refit, the smoothing shift of a prior, the
+// mirror test of sectional profiles, the other-minimum test of the attempts, the half-record refit, the smoothing shift of a prior, the
 // consider terms of the declared uncertainties and of the identifier's own discretisation, and from
 // them the uncertainty interval (interval.h); a parameter whose interval is too wide is flagged.
 #include "scoleid/identify/run/identify_run.h"
@@ -12,6 +12,10 @@ namespace scoleid::identify {
 // optimiser options (with the prior's chosen weight), for the refits.
 void assess_estimate(const Problem& problem, Objective& objective, const OptimizerOptions& options, RunResult& r);
 
+// The Fisher information of data filtered to identification.band (band_filter.h): scaled by the
+// filter's noise gain g, and the systematic residual counted beyond the noise's χ² band for g N
+// independent values; unchanged without a band.
+FisherInformation band_information(const Problem& problem, FisherInformation fi);
 // The sensors with each one's stated noise level: the scenario's, else truth.json's (make_problem).
 std::vector<io::SensorSpec> sensors_with_noise(const Problem& problem);
 // Where the noise levels came from: "scenario", "truth.json", both, or the identifiability's own word.

@@ -16,10 +16,28 @@ namespace scoleid::identify {
 // characters, which would end the command, shown as spaces.
 std::string gnuplot_quote(const std::string& text);
 
+// What the plot says beyond the curves: a title (the run, its estimates, its verdict), each
+// sensor's unit, and a window [zoom_from, zoom_to] drawn beside each whole record (a record of
+// many cycles is a solid band at full width; the window shows about ten of them where the response
+// starts). No window when zoom_to <= zoom_from.
+struct FitPlotAnnotations {
+  std::string title;
+  std::vector<std::string> units;
+  double zoom_from = 0, zoom_to = 0;
+};
+
 // The script: reads `csv` (t, then measured, predicted, residual per sensor, in `sensors`
 // order) and writes `png`; cost history as (iteration, cost) pairs.
 std::string fit_plot_script(const std::vector<std::string>& sensors, const std::vector<std::pair<int, double>>& cost,
-                            const std::string& csv = "fit.csv", const std::string& png = "fit.png");
+                            const std::string& csv = "fit.csv", const std::string& png = "fit.png",
+                            const FitPlotAnnotations& notes = {});
+
+// spectrum.gp: reads `csv` (frequency in Hz, then measured and predicted power spectral density per
+// sensor) and draws both on logarithmic axes, one panel per sensor, with the identified model's
+// natural frequencies as vertical lines.
+std::string spectrum_plot_script(const std::vector<std::string>& sensors, const std::vector<std::string>& units,
+                                 const std::vector<double>& modes_hz, const std::string& title,
+                                 const std::string& csv = "spectrum.csv", const std::string& png = "spectrum.png");
 
 enum class RenderStatus { Rendered, NoGnuplot, Failed };
 // Runs `gnuplot SCRIPT` in `dir`. Throws io::Interrupted if the program is interrupted meanwhile.

@@ -27,6 +27,7 @@
 #include "scoleid/identify/inverse/fit_test.h"
 #include "scoleid/identify/inverse/identifiability.h"
 #include "scoleid/identify/inverse/interval.h"
+#include "scoleid/identify/inverse/modal_uncertainty.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/data_files.h"
@@ -54,6 +55,9 @@ struct RunResult {
   Identifiability ident;
   UncertaintyInterval interval;
   FitTest fit;  // at the estimate
+  // The identified model's elastic modes, lowest first, with their propagated uncertainty
+  // (inverse/modal_uncertainty.h); empty where the model has none below the data's Nyquist frequency.
+  std::vector<ModalEstimate> modes;
   struct Attempt {
     std::string strategy;
     io::Method method = io::Method::GaussNewton;  // the optimiser of its last stage
@@ -63,6 +67,7 @@ struct RunResult {
     int iterations = 0;
     bool explains_data = false;
     std::string fit_message;
+    VectorXd estimate;  // where it ended
     // The coarse-to-fine levels before the full run (docs/theory.md §7.6), if any: blocks per
     // family, the level's time step, iterations, its cost, and whether its fit was within noise and
     // discretisation on the full model (which ends the ladder).
@@ -110,12 +115,17 @@ struct RunResult {
   // report with the solve counts and the wall time.
   std::string FullReport() const;
 };
+// The modes of the model at r.estimate with the uncertainty of r.ident and r.interval (those below
+// the data's Nyquist frequency, at most ten).
+void estimate_modes(const Problem& problem, RunResult& r);
 // A result with the problem's scenario, names, starting values and truth filled in.
 RunResult start_result(const Problem& problem, io::Model model);
 
 RunResult run_identification(Problem& problem, const RunOptions& options);
 // The rank of two attempts: converged and explaining the data, then explaining it, then the cost.
-bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b);
+// With data_values N > 0 a lower cost must be lower by more than J/N (the same minimum reached twice
+// differs by rounding only).
+bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, long data_values = 0);
 // identification.model: nonlinear (nonlinear_run.cpp; run_identification hands over to it): the
 // optimiser, the fit test, one cautious restart, the Fisher analysis and the uncertainty interval
 // (without declared uncertainties: those it does not propagate, and then gives no interval).
@@ -139,6 +149,6 @@ io::DataTable fit_table(const Measurements& data, const MatrixXd& Y);
 // staging area; the caller commits them as one unit (io/run_directory.h).
 void write_outputs(io::RunDirectory& dir, Problem& problem, const RunResult& r);
 // The file names write_outputs produces (what a RunDirectory for them may replace).
-inline std::vector<std::string> output_files() { return {"identify.json", "fit.csv", "fit.gp", "fit.png"}; }
+inline std::vector<std::string> output_files() { return {"identify.json", "fit.csv", "fit.gp", "fit.png", "spectrum.csv", "spectrum.gp", "spectrum.png"}; }
 
 }  // namespace scoleid::identify

@@ -67,6 +67,9 @@ struct ColumnUse {
     std::string name;
     double jump = 0, at = 0, sample = 0;  // largest jump, the time after it, the interval there
     bool scenario_signal = false;         // the scenario also gives the signal (signal_from: scenario)
+    // A pulse (an impact): the signal ends where it began (within a quarter of its range), and
+    // `pulse_samples` samples hold more than a tenth of its peak. 0 for a step.
+    int pulse_samples = 0;
   };
   std::vector<SteppedInput> stepped_inputs;
 };
@@ -83,6 +86,10 @@ struct Problem {
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
   ColumnUse columns;                          // with a data file
   DataContent content;                        // the modes the step resolves (data_content)
+  // identification.band (inverse/band_filter.h): the filter's noise gain g = Σh² (1 without a band):
+  // the noise_std above are then the filtered data's, σ √g, and about g of the samples are
+  // independent.
+  double band_gain = 1.0;
   const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };

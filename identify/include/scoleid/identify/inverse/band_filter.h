@@ -1,0 +1,58 @@
+#pragma once
+// The band a fit compares model and data in (identification.band; docs/theory.md §6.8).
+//
+// A record from a real structure carries modes no Euler–Bernoulli model follows to the noise
+// level; over a lightly damped record their phase drift is a systematic residual that the fit
+// spreads over every parameter. A modal engineer fits a band. Here the band is a filter G applied
+// to the inputs' samples and to the outputs' samples alike, before the fit:
+//
+//   z_G = G z,   f_G = G f,   and the model is driven by f_G.
+//
+// For a linear time-invariant model at rest before t0, driven by an input read from its samples
+// through a fixed interpolation kernel on their uniform grid (here the 4-point cubic: a filtered
+// input is smooth, and the cubic follows it to O((ω dt)⁴) where the linear interpolant's sinc²
+// loses 0.6 % at a tenth of the sampling rate), the map from input samples to output samples is
+// itself a discrete LTI system H_d. G is discrete LTI too, so H_d (G f) = G (H_d f): the model
+// driven by the filtered input gives, at the sample times, exactly the filtered output of the model
+// driven by the raw samples. Model and data
+// are therefore compared through the same filter, and the cost, its gradient (the costate sees the
+// filtered input and data and nothing else) and the Fisher matrix need no change. Filtering both
+// sides causally keeps each side's phase distortion identical; it is not undone.
+//
+// G: a causal Butterworth band-pass in second-order sections from rest — a low-pass of order 8 at
+// f_hi and, for f_lo > 0, a high-pass of order 4 at f_lo — by the bilinear transform with the
+// edges pre-warped (|G| = 1/√2 at f_lo and f_hi exactly).
+//
+// White noise of variance σ² leaves the filter as coloured noise of variance g σ² per sample, g =
+// Σ h_i² (the impulse response's energy, about the band's share of the Nyquist range): its samples
+// are no longer independent — about g N of them are. The identifier states the noise level of the
+// filtered data as σ √g and counts g N independent values where a χ² band is drawn, and the Fisher
+// matrix, formed with the filtered sensitivities, is scaled by g (equivalently: formed with σ), the
+// information of the band alone.
+#include <complex>
+#include <vector>
+
+namespace scoleid::identify {
+
+class BandFilter {
+public:
+  // Throws std::invalid_argument unless 0 <= f_lo < f_hi < 1/(2 dt).
+  BandFilter(double f_lo, double f_hi, double dt);
+  // The filtered samples, from rest (x on the uniform grid of step dt).
+  std::vector<double> apply(const std::vector<double>& x) const;
+  // G(e^{i 2π f dt}).
+  std::complex<double> response(double f) const;
+  // Σ_{i<n} h_i², the energy of the first n samples of the impulse response.
+  double noise_gain(std::size_t n) const;
+  double f_lo() const { return lo_; }
+  double f_hi() const { return hi_; }
+
+private:
+  struct Section {
+    double b0, b1, b2, a1, a2;  // y = b0 x + b1 x₋₁ + b2 x₋₂ − a1 y₋₁ − a2 y₋₂
+  };
+  std::vector<Section> sections_;
+  double lo_, hi_, dt_;
+};
+
+}  // namespace scoleid::identify
