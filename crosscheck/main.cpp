@@ -145,7 +145,10 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
       if (std::find(families.begin(), families.end(), f.family) == families.end()) families.push_back(f.family);
     for (const auto& fam : families) {
       const fs::path r = fs::path(out) / "results" / (fam + ".json");
-      if (fs::exists(r)) results.push_back(io::read_json(r.string()));
+      if (fs::exists(r)) {
+        results.push_back(io::read_json(r.string()));
+        crosscheck::check_suite_result(results.back(), r.string());
+      }
       else missing.push_back(fam);
     }
     if (!missing.empty()) {

@@ -1,5 +1,7 @@
 #include "scoleid/crosscheck/mismatch_suite.h"
 
+#include "scoleid/crosscheck/json_shape.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -401,6 +403,49 @@ json run_suite_file(const SuiteFile& f, const std::string& out, const SuiteOptio
   return res;
 }
 
+void check_suite_result(const json& f, const std::string& file) {
+  const Shape s(file);
+  if (!f.is_object()) s.fail("(top level)", "an object", &f);
+  for (const char* key : {"family", "mismatch", "size_unit", "reason"}) s.text(f, key, "");
+  s.optional(f, "expectations_met", [&] { s.flag(f, "expectations_met", ""); });
+  s.optional(f, "checks", [&] {
+    const auto& checks = s.objects(f, "checks", "");
+    for (std::size_t i = 0; i < checks.size(); ++i) {
+      const std::string w = "checks[" + std::to_string(i) + "].";
+      s.flag(checks[i], "held", w);
+      s.text(checks[i], "what", w);
+      s.text(checks[i], "measured", w);
+    }
+  });
+  if (!f.value("expectations_met", false) && !f.contains("checks")) s.fail("checks", "present when expectations_met is not true", nullptr);
+  const auto& cases = s.objects(f, "cases", "");
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::string w = "cases[" + std::to_string(k) + "].";
+    const auto& c = cases[k];
+    s.text(c, "label", w);
+    s.number(c, "size", w);
+    if (!c.at("size").is_number()) s.fail(w + "size", "a number", &c.at("size"));
+    s.optional(c, "explains_data", [&] { s.flag(c, "explains_data", w); });
+    s.optional(c, "fit_ratio", [&] { s.number(c, "fit_ratio", w); });
+    s.optional(c, "seeds", [&] {
+      if (!c.at("seeds").is_array()) s.fail(w + "seeds", "an array", &c.at("seeds"));
+    });
+    s.optional(c, "seed_statistics", [&] {
+      const auto& st = s.objects(c, "seed_statistics", w);
+      for (std::size_t i = 0; i < st.size(); ++i) s.text(st[i], "name", w + "seed_statistics[" + std::to_string(i) + "].");
+    });
+    const auto& params = s.objects(c, "parameters", w);
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      const std::string pw = w + "parameters[" + std::to_string(i) + "].";
+      const auto& q = params[i];
+      s.text(q, "name", pw);
+      s.flag(q, "identifiable", pw);
+      s.flag(q, "covered", pw);
+      for (const char* key : {"truth", "estimate", "relative_error", "relative_half_width"}) s.number(q, key, pw);
+    }
+  }
+}
+
 SuiteSummary summarise_suite(const std::vector<json>& families) {
   SuiteSummary s;
   std::vector<double> widths, errors;
@@ -419,7 +464,7 @@ SuiteSummary summarise_suite(const std::vector<json>& families) {
         ++s.cases;
         s.covered += q["covered"].get<bool>() ? 1 : 0;
         widths.push_back(q["relative_half_width"].get<double>());
-        errors.push_back(std::abs(q["relative_error"].get<double>()));
+        errors.push_back(q["relative_error"].is_number() ? std::abs(q["relative_error"].get<double>()) : INFINITY);  // diverged: no bound
       }
   }
   s.coverage = s.cases ? static_cast<double>(s.covered) / s.cases : std::nan("");
@@ -469,7 +514,8 @@ std::map<std::string, std::string> suite_report(const std::vector<json>& familie
         const bool explains = c.value("explains_data", true);
         std::snprintf(buf, sizeof buf, "%s,%s,%.9g,%s,%s,%.12g,%.12g,%.6e,%.6e,%s,%s,%s\n", fam.c_str(),
                       c["label"].get<std::string>().c_str(), c["size"].get<double>(), f["size_unit"].get<std::string>().c_str(),
-                      q["name"].get<std::string>().c_str(), q["truth"].get<double>(), q["estimate"].get<double>(), err, hw,
+                      q["name"].get<std::string>().c_str(), q["truth"].is_number() ? q["truth"].get<double>() : std::nan(""),
+                      q["estimate"].is_number() ? q["estimate"].get<double>() : std::nan(""), err, hw,
                       q["covered"].get<bool>() ? "yes" : "no", ok ? "yes" : "no", explains ? "yes" : "no");
         csv += buf;
         const std::string fit = explains ? "yes" : "no (" + fmt("%.2g", c.value("fit_ratio", 0.0)) + "x)";

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "scoleid/crosscheck/json_shape.h"
 #include "scoleid/crosscheck/table.h"
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
 
 namespace scoleid::crosscheck {
 
@@ -33,15 +35,77 @@ void mode_agreement(const nlohmann::json& m, std::size_t k, double& worst, doubl
 }
 }  // namespace
 
+namespace {
+
+
+void check_modes(const nlohmann::json& m, const std::string& file) {
+  const Shape s(file);
+  if (!m.is_object()) s.fail("(top level)", "an object", &m);
+  s.text(m, "scenario", "");
+  const std::size_t levels = s.array(m, "segments", "", 0, "segment counts", is_count).size();
+  const auto& modes = s.objects(m, "modes", "");
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const std::string w = "modes[" + std::to_string(k) + "].";
+    s.count(modes[k], "index", w);
+    s.array(modes[k], "chain_hz", w, levels, "numbers", is_number_or_null);
+    s.array(modes[k], "fe_hz", w, 0, "numbers", is_number_or_null);
+    for (const char* key : {"chain_extrapolated_hz", "analytic_hz", "extrapolated_vs_fe", "chain_rate", "fe_rate", "mac"})
+      s.number(modes[k], key, w);
+  }
+}
+
+void check_trajectories(const nlohmann::json& t, const std::string& file) {
+  const Shape s(file);
+  if (!t.is_object()) s.fail("(top level)", "an object", &t);
+  const std::size_t levels = s.array(t, "segments", "", 0, "segment counts", is_count).size();
+  s.count(t, "elements", "");
+  const auto& sensors = s.objects(t, "sensors", "");
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const std::string w = "sensors[" + std::to_string(k) + "].";
+    s.text(sensors[k], "name", w);
+    s.text(sensors[k], "kind", w);
+    s.array(sensors[k], "relative_rms", w, levels, "numbers", is_number_or_null);
+    s.number(sensors[k], "rate", w);
+  }
+}
+
+void check_identify(const nlohmann::json& id, const std::string& file) {
+  const Shape s(file);
+  if (!id.is_object()) s.fail("(top level)", "an object", &id);
+  s.text(id, "scenario", "");
+  s.text(id, "data", "");
+  s.flag(id, "all_converged", "");
+  const std::size_t levels = s.array(id, "segments", "", 0, "segment counts", is_count).size();
+  const auto& params = s.objects(id, "parameters", "");
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    const std::string w = "parameters[" + std::to_string(k) + "].";
+    const auto& p = params[k];
+    s.text(p, "name", w);
+    s.number(p, "truth", w);
+    for (const char* key : {"extrapolated_relative_error", "observed_rate", "fe_on_fe_relative_error"}) s.number(p, key, w);
+    s.array(p, "relative_error", w, levels, "numbers", is_number_or_null);
+    s.array(p, "std", w, levels, "numbers", is_number_or_null);
+    s.array(p, "covered_by_2std", w, levels, "true or false", is_flag);
+    if (p.contains("half_width")) s.array(p, "half_width", w, levels, "numbers", is_number_or_null);
+    if (p.contains("half_width") || p.contains("covered_by_interval"))
+      s.array(p, "covered_by_interval", w, levels, "true or false", is_flag);
+  }
+}
+
+}  // namespace
+
 ReportInputs read_report_inputs(const std::string& dir) {
   ReportInputs in;
-  auto get = [&](const std::string& name) {
+  auto get = [&](const std::string& name, void (*check)(const nlohmann::json&, const std::string&)) {
     const fs::path p = fs::path(dir) / name;
-    return fs::exists(p) ? io::read_json(p.string()) : nlohmann::json();
+    if (!fs::exists(p)) return nlohmann::json();
+    nlohmann::json j = io::read_json(p.string());
+    check(j, p.string());
+    return j;
   };
-  in.modes = get("modes.json");
-  in.trajectories = get("trajectories.json");
-  in.identify = get("identify.json");
+  in.modes = get("modes.json", check_modes);
+  in.trajectories = get("trajectories.json", check_trajectories);
+  in.identify = get("identify.json", check_identify);
   return in;
 }
 

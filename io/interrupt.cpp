@@ -26,6 +26,9 @@ void install_interrupt_handlers() {
   sa.sa_flags = 0;  // no SA_RESTART: waitpid() and friends return EINTR
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  // A reader that goes away (`| head`) must not kill the run before its outputs are committed:
+  // writes to the closed pipe fail with EPIPE instead, and the printed table is simply cut short.
+  std::signal(SIGPIPE, SIG_IGN);
 }
 
 int interrupt_signal() { return static_cast<int>(g_signal); }

@@ -75,20 +75,22 @@ Signal Signal::step(double amplitude, double t0) {
   return Signal({s});
 }
 
-Signal Signal::cubic_table(std::vector<double> times, std::vector<double> values) {
+namespace {
+Signal tabulated(SignalTerm::Type type, std::vector<double> times, std::vector<double> values) {
   SignalTerm s;
-  s.type = SignalTerm::Type::CubicTable;
+  s.type = type;
   s.times = std::move(times);
   s.values = std::move(values);
   return Signal({s});
 }
+}  // namespace
+
+Signal Signal::cubic_table(std::vector<double> times, std::vector<double> values) {
+  return tabulated(SignalTerm::Type::CubicTable, std::move(times), std::move(values));
+}
 
 Signal Signal::table(std::vector<double> times, std::vector<double> values) {
-  SignalTerm s;
-  s.type = SignalTerm::Type::Table;
-  s.times = std::move(times);
-  s.values = std::move(values);
-  return Signal({s});
+  return tabulated(SignalTerm::Type::Table, std::move(times), std::move(values));
 }
 
 double Signal::operator()(double t) const {

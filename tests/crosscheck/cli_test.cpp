@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -53,16 +54,24 @@ TEST(CrosscheckCli, BadInputIsOneLineExitTwoNothingWritten) {
             2);
   EXPECT_NE(slurp(d / "err").find("--fe-step 1e-09 gives"), std::string::npos) << slurp(d / "err");
   EXPECT_FALSE(fs::exists(d / "out"));
-  // `report` on a modes.json that is not what `modes` writes: exit 2, the user's directory named
-  // (not the staging copy), the file left as it was.
+  // `report` on a modes.json that is not what `modes` writes: exit 2, the user's file and the field
+  // named (not the staging copy), the file left as it was.
   fs::create_directories(d / "rep");
   { std::ofstream(d / "rep" / "modes.json") << "[1, 2, 3]\n"; }
   EXPECT_EQ(sh(exe + " report --scenario paper-beam-1 --out " + (d / "rep").string() + " 2> " + (d / "err").string()), 2);
   const std::string rep_err = slurp(d / "err");
-  EXPECT_NE(rep_err.find("output directory '" + (d / "rep").string() + "'"), std::string::npos) << rep_err;
+  EXPECT_NE(rep_err.find((d / "rep" / "modes.json").string() + ": field '(top level)'"), std::string::npos) << rep_err;
   EXPECT_EQ(rep_err.find("staging"), std::string::npos) << rep_err;
   EXPECT_EQ(std::count(rep_err.begin(), rep_err.end(), '\n'), 1) << rep_err;
   EXPECT_EQ(slurp(d / "rep" / "modes.json"), "[1, 2, 3]\n");
+  // `modes ... | head -c 1`: the reader goes away; the verb still commits its outputs and exits 0.
+  std::signal(SIGPIPE, SIG_DFL);
+  EXPECT_EQ(sh("bash -c '" + exe + " modes --scenario paper-beam-1 --levels 1 --count 3 --out " + (d / "piped").string() +
+               " 2> /dev/null | head -c 1 > /dev/null; exit ${PIPESTATUS[0]}'"),
+            0);
+  EXPECT_TRUE(fs::exists(d / "piped" / "modes.json"));
+  for (const auto& e : fs::directory_iterator(d))
+    EXPECT_EQ(e.path().filename().string().find("staging"), std::string::npos) << e.path() << " left behind";
   // `suite --collect` before the families have run: exit 2, one line, nothing created.
   fs::create_directories(d / "empty");
   EXPECT_EQ(sh(exe + " suite --collect --out " + (d / "empty").string() + " 2> " + (d / "err").string()), 2);

@@ -227,6 +227,22 @@ std::vector<std::vector<double>> csv_columns(const std::string& text, std::vecto
 
 // ------------------------------------------------------------------------------ bad scenario
 
+// `scole-identify ... | head -c 1`: the reader goes away after one byte; the run still finishes,
+// commits its outputs and exits 0 (before: killed by SIGPIPE, exit 141, the staging left behind).
+TEST(ScoleIdentifyCli, AReaderThatGoesAwayDoesNotLoseTheOutputs) {
+  TempDir dir;
+  std::signal(SIGPIPE, SIG_DFL);  // the default a shell gives a pipeline, whatever this process has
+  const std::string cmd = "cd " + shell_quote(dir.path().string()) + " && bash -c " +
+                          shell_quote(shell_quote(SCOLE_IDENTIFY_EXE) + " -s paper-beam-1 -o out 2> /dev/null | head -c 1 > /dev/null; "
+                                      "exit ${PIPESTATUS[0]}");
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_TRUE(fs::exists(dir / "out" / "identify.json"));
+  for (const auto& e : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename().string().find(".out.staging"), std::string::npos) << e.path() << " left behind";
+}
+
 TEST(ScoleIdentifyCli, UnknownBuiltinScenario) {
   TempDir dir;
   const fs::path out = dir / "out";

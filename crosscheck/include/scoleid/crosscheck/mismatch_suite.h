@@ -83,6 +83,9 @@ struct SuiteSummary {
   std::vector<std::string> failures;  // "family: what did not hold"
 };
 SuiteSummary summarise_suite(const std::vector<nlohmann::json>& families);
+// A family's results file (results/<family>.json) as run_family writes it, or io::InputError naming
+// `file` and the field (json_shape.h): checked before summarise_suite and suite_report read it.
+void check_suite_result(const nlohmann::json& family_result, const std::string& file);
 // report.md, suite.csv (one row per case and parameter), suite.gp (error and interval against the
 // mismatch size, one panel per family) and suite.json: file name → contents.
 std::map<std::string, std::string> suite_report(const std::vector<nlohmann::json>& families, const SuiteSummary& s);

@@ -19,7 +19,8 @@ private:
 };
 
 // Installs the recording handler for SIGINT and SIGTERM (without SA_RESTART, so a blocking wait
-// returns EINTR). Idempotent.
+// returns EINTR), and ignores SIGPIPE: a program whose stdout reader has gone (`| head`) still
+// finishes and commits its outputs, its further printing lost. Idempotent.
 void install_interrupt_handlers();
 // The signal received since installation, or 0.
 int interrupt_signal();
