@@ -60,6 +60,9 @@ json identify_row(std::shared_ptr<identify::Problem> problem) {
 // Gaussian noise of `relative` × each sensor's RMS, seeded; the level is stated to the identifier
 // (it is what a test engineer knows of the instrument).
 void add_noise(identify::Problem& p, double relative, unsigned seed) {
+  if (p.band_gain < 1.0)
+    throw io::InputError(p.scenario.source + ": identification.band: the noise a suite or campaign adds would come after "
+                         "the band's filter; state the sensors' noise_std in the scenario instead");
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   auto& z = p.data.z;
@@ -73,6 +76,7 @@ void add_noise(identify::Problem& p, double relative, unsigned seed) {
     p.noise_std[kk] = sd;
     p.noise_origin[kk] = "scenario";
   }
+  p.objective_options.noise_std = p.noise_std;  // the continuation's noise share (objective.h)
 }
 
 }  // namespace scoleid::crosscheck

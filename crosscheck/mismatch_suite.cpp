@@ -314,12 +314,12 @@ void case_checks(const SuiteFile& f, const json& c, json& checks) {
                            flagged ? q.value("not_identifiable_because", std::string("flagged")) : "identifiable"));
     const auto b = f.expect.max_relative_error.find(n);
     if (b != f.expect.max_relative_error.end() && !flagged) {
-      const double e = std::abs(q["relative_error"].get<double>());
+      const double e = q["relative_error"].is_number() ? std::abs(q["relative_error"].get<double>()) : INFINITY;
       checks.push_back(check(n + " relative error <= " + fmt("%.3g", b->second) + at, e <= b->second, fmt("%.3e", e)));
     }
     if (f.expect.all_covered && !flagged)
       checks.push_back(check(n + " interval covers the truth" + at, q["covered"].get<bool>(),
-                             fmt("error %.3e, half-width %.3e", std::abs(q["relative_error"].get<double>()), val(q["relative_half_width"]))));
+                             fmt("error %.3e, half-width %.3e", std::abs(val(q["relative_error"])), val(q["relative_half_width"]))));
   }
   if (c.contains("seed_statistics"))
     for (const auto& s : c["seed_statistics"]) {
@@ -431,6 +431,7 @@ void check_suite_result(const json& f, const std::string& file) {
       if (!c.at("seeds").is_array()) s.fail(w + "seeds", "an array", &c.at("seeds"));
     });
     s.optional(c, "seed_statistics", [&] {
+      if (!c.contains("seeds")) s.fail(w + "seeds", "present with seed_statistics", nullptr);
       const auto& st = s.objects(c, "seed_statistics", w);
       for (std::size_t i = 0; i < st.size(); ++i) s.text(st[i], "name", w + "seed_statistics[" + std::to_string(i) + "].");
     });
@@ -518,7 +519,7 @@ std::map<std::string, std::string> suite_report(const std::vector<json>& familie
                       q["estimate"].is_number() ? q["estimate"].get<double>() : std::nan(""), err, hw,
                       q["covered"].get<bool>() ? "yes" : "no", ok ? "yes" : "no", explains ? "yes" : "no");
         csv += buf;
-        const std::string fit = explains ? "yes" : "no (" + fmt("%.2g", c.value("fit_ratio", 0.0)) + "x)";
+        const std::string fit = explains ? "yes" : "no (" + fmt("%.2g", c.contains("fit_ratio") && c["fit_ratio"].is_number() ? c["fit_ratio"].get<double>() : std::nan("")) + "x)";
         std::snprintf(buf, sizeof buf, "| %s | %s | %s | %g %s | %s | %+.4f | %s | %s | %s |\n", fam.c_str(),
                       f["mismatch"].get<std::string>().c_str(), c["label"].get<std::string>().c_str(), c["size"].get<double>(),
                       f["size_unit"].get<std::string>().c_str(), q["name"].get<std::string>().c_str(), 100.0 * err,

@@ -57,6 +57,7 @@ void check_modes(const nlohmann::json& m, const std::string& file) {
 void check_trajectories(const nlohmann::json& t, const std::string& file) {
   const Shape s(file);
   if (!t.is_object()) s.fail("(top level)", "an object", &t);
+  s.text(t, "scenario", "");
   const std::size_t levels = s.array(t, "segments", "", 0, "segment counts", is_count).size();
   s.count(t, "elements", "");
   const auto& sensors = s.objects(t, "sensors", "");

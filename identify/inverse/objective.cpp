@@ -313,10 +313,17 @@ void Objective::noise_share() {
     noise_ = {};
     return;
   }
-  noise_.W = data_.white_noise_integral_profile();
+  const double g = options_.noise_independent_fraction;
+  const bool band = g < 1.0 && g > 0.0;
+  if (band) {
+    noise_.W.resize(data_.t.size());
+    for (std::size_t i = 0; i < data_.t.size(); ++i) noise_.W[i] = data_.t[i] - data_.t.front();
+  } else {
+    noise_.W = data_.white_noise_integral_profile();
+  }
   // Var ∫ñ² over [t0, t_i] taken in proportion to its mean (both grow with the interval count).
   const double W_all = noise_.W.back();
-  const double V_all = data_.white_noise_integral_variance(data_.t.front(), data_.t.back());
+  const double V_all = data_.white_noise_integral_variance(data_.t.front(), data_.t.back()) / (band ? g : 1.0);
   noise_.B.resize(noise_.W.size());
   for (std::size_t i = 0; i < noise_.W.size(); ++i)
     noise_.B[i] = noise_.W[i] + 2.0 * std::sqrt(W_all > 0 ? V_all * noise_.W[i] / W_all : 0.0);

@@ -113,7 +113,9 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability
   return terms;
 }
 
-// χ² = Σ r²/σ² of outputs Y against the data, with the Fisher step's noise levels.
+// χ² = Σ r²/σ² of outputs Y against the data, with the Fisher step's noise levels; with a band
+// (band_filter.h) times the noise gain g, since only about g of the filtered values are independent
+// (the likelihood-ratio bounds below are for independent values).
 double chi_square(const Problem& p, const RunResult& r, const MatrixXd& Y) {
   double c = 0.0;
   for (Eigen::Index i = 0; i < Y.rows(); ++i)
@@ -122,7 +124,7 @@ double chi_square(const Problem& p, const RunResult& r, const MatrixXd& Y) {
       if (!(sd > 0.0)) continue;
       c += std::pow(Y(i, k) - p.data.z(i, k), 2) / (sd * sd);
     }
-  return c;
+  return p.band_gain * c;
 }
 
 // The other-minimum test (docs/theory.md §8.1): every other attempt that converged and explains the
@@ -253,9 +255,12 @@ FisherInformation band_information(const Problem& p, FisherInformation fi) {
   // Formed with the filtered noise level σ√g and the filtered sensitivities, F counts every sample
   // as independent: the band's information is g F (band_filter.h). Of the N values about g N are
   // independent: χ²'s band for the noise is N ± 2√(2N/g).
+  // The systematic share is in the same units: χ² over N correlated values counts each independent
+  // one 1/g times, so its share is scaled by g too (resolution = std·√systematic stays the change
+  // of q whose output effect equals the residual beyond the noise).
   fi.F *= p.band_gain;
   const double Nd = static_cast<double>(fi.data_values);
-  fi.systematic = std::max(0.0, fi.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd / p.band_gain));
+  fi.systematic = p.band_gain * std::max(0.0, fi.chi2 - Nd - 2.0 * std::sqrt(2.0 * Nd / p.band_gain));
   return fi;
 }
 

@@ -605,6 +605,7 @@ void finish_problem(Problem& p, double step, const std::string* csv) {
   p.objective_options.solver.rtol = id.rtol;
   p.objective_options.solver.step = step;
   p.objective_options.noise_std = p.noise_std;
+  p.objective_options.noise_independent_fraction = p.band_gain;
   p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                              : SolverOptions::Integrator::Esdirk;

@@ -24,7 +24,7 @@ json modes() {
      "extrapolated_vs_fe": -0.04, "chain_rate": 2.0, "fe_rate": null, "mac": 0.999}]})");
 }
 json trajectories() {
-  return json::parse(R"({"segments": [10, 20], "elements": 8, "sensors": [
+  return json::parse(R"({"scenario": "s", "segments": [10, 20], "elements": 8, "sensors": [
     {"name": "w", "kind": "displacement", "relative_rms": [0.01, 0.003], "rate": 1.9}]})");
 }
 json identify() {

@@ -21,14 +21,15 @@
 //
 // G: a causal Butterworth band-pass in second-order sections from rest — a low-pass of order 8 at
 // f_hi and, for f_lo > 0, a high-pass of order 4 at f_lo — by the bilinear transform with the
-// edges pre-warped (|G| = 1/√2 at f_lo and f_hi exactly).
+// edges pre-warped (|G| = 1/√2 at f_lo and f_hi, up to the other edge's influence, (f_lo/f_hi)^8).
 //
 // White noise of variance σ² leaves the filter as coloured noise of variance g σ² per sample, g =
 // Σ h_i² (the impulse response's energy, about the band's share of the Nyquist range): its samples
 // are no longer independent — about g N of them are. The identifier states the noise level of the
-// filtered data as σ √g and counts g N independent values where a χ² band is drawn, and the Fisher
+// filtered data as σ √g and counts g N independent values where a χ² band is drawn; the Fisher
 // matrix, formed with the filtered sensitivities, is scaled by g (equivalently: formed with σ), the
-// information of the band alone.
+// information of the band alone, and so are the systematic share of χ² and the χ² differences of
+// the mirror and other-minimum tests.
 #include <complex>
 #include <vector>
 

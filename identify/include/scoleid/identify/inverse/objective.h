@@ -68,6 +68,10 @@ struct ObjectiveOptions {
   // Each sensor's stated noise level (<= 0 or absent: unknown). The misfit profile of the horizon
   // continuation (MisfitProfile) counts only what exceeds the noise's expected share (below).
   std::vector<double> noise_std;
+  // The share of the samples that are independent: 1 for white noise; g = Σh² for data filtered
+  // to a band (band_filter.h), whose noise the interpolant follows (E∫ñ² = σ²(t − t0)) and whose
+  // ∫ñ² varies about 1/g times as much.
+  double noise_independent_fraction = 1.0;
 };
 
 struct ObjectiveCounters {
