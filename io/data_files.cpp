@@ -30,7 +30,7 @@ std::string format_value(double v) {
 
 void fail_field(const std::string& source, const std::string& field, const std::string& requirement,
                 const std::string& got) {
-  throw InputError(source + ": " + field + " " + requirement + ", got " + got);
+  throw InputError(source + ": " + field + " " + requirement + ", got " + shorten(got));
 }
 
 int DataTable::find(const std::string& name) const {

@@ -148,7 +148,31 @@ void validate_scenario(const Scenario& sc) {
   }
 }
 
-std::string one_line(const std::string& m) {
+namespace {
+// The largest prefix length <= n that does not end inside a UTF-8 sequence.
+std::size_t utf8_boundary(const std::string& s, std::size_t n) {
+  while (n > 0 && n < s.size() && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+  return n;
+}
+}  // namespace
+
+std::string shorten(const std::string& value, std::size_t keep) {
+  if (value.size() <= keep + 40) return value;
+  return value.substr(0, utf8_boundary(value, keep)) + "... (" + std::to_string(value.size()) + " characters)";
+}
+
+std::string one_line(const std::string& message) {
+  // A message that echoes a huge name or cell is cut in the middle: its head names the file and
+  // the field, its tail the requirement and the value's end.
+  constexpr std::size_t kHead = 400, kTail = 160;
+  std::string cut = message;
+  if (message.size() > kHead + kTail + 80) {
+    const std::size_t head = utf8_boundary(message, kHead);
+    std::size_t tail = message.size() - kTail;
+    while (tail < message.size() && (static_cast<unsigned char>(message[tail]) & 0xC0) == 0x80) ++tail;
+    cut = message.substr(0, head) + " ... (" + std::to_string(tail - head) + " characters left out) ... " + message.substr(tail);
+  }
+  const std::string& m = cut;
   std::string out;
   out.reserve(m.size());
   // Trailing line breaks carry nothing.

@@ -135,6 +135,27 @@ TEST(Counts, OverridesGoThroughTheSameChecks) {
 TEST(OneLine, ControlCharactersAreShownNotPrinted) {
   EXPECT_EQ(one_line("a\nb\tc\x01\n"), "a\\nb\\tc\\x01");
   EXPECT_EQ(one_line("plain"), "plain");
+  // A huge echo is cut in the middle, never inside a UTF-8 sequence; the ends stay.
+  const std::string huge = "file.yaml: field runs[0].name must be at most 64 characters, got '" + std::string(1000000, 'x') +
+                           std::string("\xC3\xA9", 2) + std::string(50000, 'y') + "' (end)";
+  const std::string shown = one_line(huge);
+  EXPECT_LT(shown.size(), 700u);
+  EXPECT_EQ(shown.rfind("file.yaml: field runs[0].name", 0), 0u);
+  EXPECT_EQ(shown.substr(shown.size() - 7), "' (end)");
+  EXPECT_NE(shown.find("characters left out"), std::string::npos);
+  std::string accent(300, 'a');
+  for (int i = 0; i < 200; ++i) accent += "\xC3\xA9";  // é, two bytes each
+  const std::string s = shorten(accent, 301);  // the cut falls inside an é: moved before it
+  EXPECT_EQ(s.substr(0, 303), accent.substr(0, 300) + "...");
+  EXPECT_EQ(s.find("\xC3..."), std::string::npos);
+  EXPECT_NE(s.find("(700 characters)"), std::string::npos) << s;
+  EXPECT_EQ(shorten("short"), "short");
+  try {
+    fail_field("f.yaml", "sensors[0].name", "must be at most 64 characters", std::string(100000, 'n'));
+  } catch (const InputError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 250u);
+    EXPECT_NE(std::string(e.what()).find("(100000 characters)"), std::string::npos);
+  }
 }
 
 TEST(TruthMeta, NegativeNoiseOrTrueValuesAndDuplicateColumnsAreRefused) {

@@ -32,9 +32,13 @@ double sample_count(double duration, double interval);
 // calls it; a program that overrides fields from its command line calls it again.
 void validate_scenario(const Scenario& scenario);
 
-// A message as one line: line breaks and other control characters shown as \n, \t, \xNN.
-// Every program prints its errors through this (a library's multi-line text, a path holding a
-// newline).
+// A message as one line: line breaks and other control characters shown as \n, \t, \xNN, and
+// a message over about 640 characters cut in the middle (its first 400 and last 160 kept, at UTF-8
+// boundaries, with the count left out). Every program prints its errors through this (a library's
+// multi-line text, a path holding a newline, a 50 MB name echoed back).
 std::string one_line(const std::string& message);
+// `value` itself when it is at most keep + 40 characters long, else its first `keep` characters (at
+// a UTF-8 boundary) and "... (N characters)": for echoing a user's value in a message.
+std::string shorten(const std::string& value, std::size_t keep = 80);
 
 }  // namespace scoleid::io
