@@ -16,6 +16,7 @@
 #include "scoleid/crosscheck/table.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 
 namespace scoleid::crosscheck {
 
@@ -168,16 +169,13 @@ void make_cases(Campaign& c) {
 Campaign load_checked(const std::string& path) {
   Campaign c;
   c.path = path;
-  std::ifstream in(path);
-  if (!in) throw io::InputError("campaign file '" + path + "': cannot be read");
-  std::stringstream ss;
-  ss << in.rdbuf();
   YAML::Node root;
   try {
-    root = YAML::Load(ss.str());
+    root = YAML::Load(io::read_text_file(path, "campaign file"));
   } catch (const YAML::Exception& e) {
     throw io::InputError("campaign file '" + path + "': malformed YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }
+  io::check_yaml_document(root, "campaign file '" + path + "'", true);
   if (!root.IsMap()) bad(path, "(top level)", "must be a map", "");
   static const std::vector<std::string> known = {"campaign", "description", "scenarios", "overlay", "grid", "noise"};
   std::vector<std::string> seen;

@@ -20,6 +20,7 @@
 #include "scoleid/crosscheck/truth_levels.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/validation.h"
 
 namespace scoleid::crosscheck {
@@ -38,14 +39,6 @@ std::pair<double, double> range_of(const YAML::Node& n, const std::string& file,
   const double lo = number_of(n[0], file, field + "[0]"), hi = number_of(n[1], file, field + "[1]");
   if (!(lo < hi)) bad(file, field, "needs low < high", text_of(n));
   return {lo, hi};
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw io::InputError("suite file '" + path + "': cannot be read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 double median(std::vector<double> v) {
@@ -97,10 +90,11 @@ static SuiteFile load_suite_file_checked(const std::string& path) {
   f.path = path;
   YAML::Node root;
   try {
-    root = YAML::Load(read_file(path));
+    root = YAML::Load(io::read_text_file(path, "suite file"));
   } catch (const YAML::Exception& e) {
     throw io::InputError("suite file '" + path + "': malformed YAML: " + e.msg);
   }
+  io::check_yaml_document(root, "suite file '" + path + "'", true);
   if (!root.IsMap()) bad(path, "(top level)", "must be a map", "");
   static const std::vector<std::string> known = {"family", "mismatch", "size_unit", "reason", "scenario",
                                                  "overlay", "cases", "noise", "expect"};

@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/validation.h"
 
 #include "scoleid/io/limits.h"
@@ -302,15 +303,7 @@ void write_json_atomic(const std::string& path, const nlohmann::json& j) {
 }
 
 nlohmann::json read_json(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError("JSON file '" + path + "': is a directory");
-  std::ifstream in(path);
-  if (!in) throw InputError("JSON file '" + path + "': cannot be opened");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError("JSON file '" + path + "': malformed at byte " + std::to_string(e.byte));
-  }
+  return parse_json_text(read_text_file(path, "JSON file"), "JSON file '" + path + "'");
 }
 
 void ensure_directory(const std::string& dir) {

@@ -10,6 +10,7 @@
 
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/validation.h"
 
 namespace scoleid::io {
@@ -61,11 +62,7 @@ void check_value(const std::string& column, double v, const Fail& fail) {
 }  // namespace
 
 ModalData read_modal_data(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(one_line("modal data file '" + path + "': cannot be opened"));
-  std::ostringstream os;
-  os << in.rdbuf();
-  return read_modal_data_text(os.str(), path);
+  return read_modal_data_text(read_text_file(path, "modal data file"), path);
 }
 
 ModalData read_modal_data_text(const std::string& text, const std::string& source) {

@@ -27,6 +27,12 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
     throw InputError("output directory '" + target + "': must name a directory below an existing path");
   target_ = t.string();
   const fs::path parent = t.parent_path();
+  // A symbolic link is not followed: the commit renames the staged run onto the path, which would
+  // replace the link (or fail on a dangling one, after all the work).
+  if (fs::is_symlink(fs::symlink_status(t, ec)))
+    throw InputError("output directory '" + target + "': is a symbolic link" +
+                     (fs::exists(t, ec) ? std::string() : std::string(" to nothing")) +
+                     "; give the directory itself");
   const auto st = fs::status(t, ec);
   if (fs::exists(st)) {
     if (!fs::is_directory(st)) throw InputError("output directory '" + target + "': exists and is not a directory");

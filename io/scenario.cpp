@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
 
@@ -188,41 +189,6 @@ private:
   std::set<std::string> seen_;
 };
 
-// One pass over the document before it is read:
-// - a repeated key is refused (yaml-cpp keeps every pair and node[key] answers the first, so the
-//   later value would be dropped silently);
-// - every scalar, key or value, must be UTF-8 after YAML's escapes are decoded ("\N" and "\_"
-//   decode to the single bytes 0x85 and 0xA0, which no JSON writer accepts);
-// - an alias is the node it refers to: each collection is visited once (by its position in the
-//   text), so a self-referencing alias ends and nested aliases cost their size, not their expansion.
-void check_document(const YAML::Node& n, const std::string& source, const std::string& path,
-                    std::set<std::size_t>& seen) {
-  const std::string at = path.empty() ? "document" : path;
-  // A key written without a value (`key:` or `key: ~`) is a slip, not a request for the default.
-  if (n.IsNull() && !path.empty()) fail_field(source, at, "has no value: give one, or leave the key out", "null");
-  if (n.IsScalar()) {
-    if (first_invalid_utf8(n.Scalar()) != std::string::npos)
-      fail_field(source, at, "must be UTF-8 text", "a value with an invalid byte sequence");
-    return;
-  }
-  if (!n.IsMap() && !n.IsSequence()) return;
-  if (!seen.insert(static_cast<std::size_t>(n.Mark().pos)).second) return;
-  if (n.IsMap()) {
-    std::set<std::string> keys;
-    for (const auto& kv : n) {
-      if (!kv.first.IsScalar()) fail_field(source, at, "must have plain keys", "a " + Reader::kind(kv.first) + " as a key");
-      const std::string key = kv.first.Scalar();
-      if (first_invalid_utf8(key) != std::string::npos)
-        fail_field(source, at, "must have UTF-8 keys", "a key with an invalid byte sequence");
-      const std::string f = path.empty() ? key : path + "." + key;
-      if (!keys.insert(key).second) fail_field(source, f, "appears more than once", "a second '" + key + "'");
-      check_document(kv.second, source, f, seen);
-    }
-  } else {
-    for (std::size_t i = 0; i < n.size(); ++i) check_document(n[i], source, path + "[" + std::to_string(i) + "]", seen);
-  }
-}
-
 EndCondition parse_end(Reader& r, const std::string& key, EndCondition dflt) {
   const std::string v = r.choice(key, to_string(dflt), {"pinned", "clamped", "free"});
   if (v == "pinned") return EndCondition::Pinned;
@@ -327,6 +293,37 @@ void parse_rigid(const YAML::Node& n, const std::string& source, const std::stri
 }
 
 // Reads the fields present onto `b` (the defaults, or the scenario's values for truth.overrides);
+// Plausibility of what is attached to a structure, against the structure's own mass m and length L
+// (docs/theory.md §10): beyond 10¹² m (m L² for a rotary inertia) or below 10⁻¹² m, the structure's
+// share of the coupled mass matrix keeps fewer than 4 of double precision's 16 digits, so neither
+// the truth's chain nor the identifier's elements carry it (a body 10⁶–10⁹ times heavier, which
+// grounds the structure in a limiting-case study, is allowed); an offset beyond 10 L is no arm of
+// this structure.
+constexpr double kAttachedRatio = 1e12, kOffsetLengths = 10.0;
+
+void check_attached_mass(const std::string& source, const std::string& field, double v, double m, bool may_be_zero) {
+  if (may_be_zero && v == 0.0) return;
+  if (!(v <= kAttachedRatio * m && v >= m / kAttachedRatio))
+    fail_field(source, field,
+               "must lie within 1e-12 and 1e12 times the structure's own mass " + format_value(m) +
+                   (may_be_zero ? " (or be 0)" : "") + ": beyond, the structure's share of the mass matrix is lost to rounding",
+               format_value(v));
+}
+
+void check_attached_inertia(const std::string& source, const std::string& field, double v, double m, double L) {
+  if (!(v <= kAttachedRatio * m * L * L))
+    fail_field(source, field,
+               "must not exceed 1e12 times the structure's own m L^2 = " + format_value(m * L * L) +
+                   ": beyond, the structure's share of the mass matrix is lost to rounding",
+               format_value(v));
+}
+
+void check_offset(const std::string& source, const std::string& field, double v, double L) {
+  if (!(std::abs(v) <= kOffsetLengths * L))
+    fail_field(source, field, "must lie within 10 structure lengths (" + format_value(kOffsetLengths * L) + ") of the structure",
+               format_value(v));
+}
+
 // `path` is the section's dotted name in messages.
 void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, const std::string& path = "beam") {
   Reader r(n, source, path);
@@ -346,6 +343,8 @@ void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, con
   b.c_kv = r.nonneg("c_kv", b.c_kv);
   b.tip_mass = r.nonneg("tip_mass", b.tip_mass);
   b.tip_inertia = r.nonneg("tip_inertia", b.tip_inertia);
+  check_attached_mass(source, r.field("tip_mass"), b.tip_mass, b.rho_A * b.length, true);
+  check_attached_inertia(source, r.field("tip_inertia"), b.tip_inertia, b.rho_A * b.length, b.length);
   if (b.left == EndCondition::Free && b.right == EndCondition::Free) {
     // free-free is allowed (rigid modes), nothing to check here
   }
@@ -386,6 +385,18 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   s.actuator_stiffness = r.nonneg("actuator_stiffness", s.actuator_stiffness);
   s.actuator_damping = r.nonneg("actuator_damping", s.actuator_damping);
   s.actuator_lag = r.nonneg("actuator_lag", s.actuator_lag);
+  const double m = s.rho_A * s.length, L = s.length;
+  for (const auto& [name, body] : {std::pair<const char*, const RigidBodySpec*>{"shuttle", &s.shuttle}, {"reflector", &s.reflector}}) {
+    const std::string f = r.field(name);
+    check_attached_mass(source, f + ".mass", body->mass, m, false);
+    check_attached_inertia(source, f + ".Ixx", body->Ixx, m, L);
+    check_attached_inertia(source, f + ".Iyy", body->Iyy, m, L);
+    check_attached_inertia(source, f + ".Izz", body->Izz, m, L);
+  }
+  check_attached_mass(source, r.field("actuator_mass"), s.actuator_mass, m, false);
+  check_offset(source, r.field("reflector_rx"), s.reflector_rx, L);
+  check_offset(source, r.field("reflector_ry"), s.reflector_ry, L);
+  for (std::size_t i = 0; i < 3; ++i) check_offset(source, r.field("mast_root") + "[" + std::to_string(i) + "]", s.mast_root[i], L);
 }
 
 double structure_length(const Scenario& sc) {
@@ -585,6 +596,7 @@ void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
   t.accuracy = r.positive("accuracy", t.accuracy);
   if (!(t.accuracy < 1)) fail_field(source, "truth.accuracy", "must be < 1", format_value(t.accuracy));
   t.output_interval = r.nonneg("output_interval", t.output_interval);
+  t.anti_alias_hz = r.nonneg("anti_alias_hz", t.anti_alias_hz);
   t.large_motion = r.boolean("large_motion", t.large_motion);
   if (r.has("overrides")) {
     // Kept as text and applied on demand (truth_scenario), onto whatever the structure section
@@ -657,8 +669,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
   Scenario sc;
   sc.source = source;
   try {
-    std::set<std::size_t> seen;
-    check_document(root, source, "", seen);
+    check_yaml_document(root, source);  // repeated keys, UTF-8, keys without values (input_file.h)
     Reader r(root, source, "");
     sc.name = r.str("name", "unnamed");
     sc.description = r.str("description", "");
@@ -744,9 +755,7 @@ Scenario load_scenario(const std::string& name_or_file) {
   const std::string builtin = builtin_scenario_yaml(name_or_file);
   if (!builtin.empty()) return parse_scenario(builtin, "built-in scenario '" + name_or_file + "'");
   std::error_code ec;
-  if (std::filesystem::is_directory(name_or_file, ec)) throw InputError("scenario file '" + name_or_file + "': is a directory");
-  std::ifstream in(name_or_file);
-  if (!in) {
+  if (!std::filesystem::exists(name_or_file, ec)) {
     const bool looks_like_file = name_or_file.find('/') != std::string::npos ||
                                  name_or_file.find(".yaml") != std::string::npos ||
                                  name_or_file.find(".yml") != std::string::npos;
@@ -756,9 +765,7 @@ Scenario load_scenario(const std::string& name_or_file) {
     throw InputError("scenario '" + name_or_file + "': not a built-in scenario (" + names +
                      ") nor a readable file");
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_scenario(ss.str(), "scenario '" + name_or_file + "'");
+  return parse_scenario(read_text_file(name_or_file, "scenario file"), "scenario '" + name_or_file + "'");
 }
 
 nlohmann::json to_json(const Scenario& s) {
@@ -862,7 +869,7 @@ nlohmann::json to_json(const Scenario& s) {
   }
   j["truth"] = {{"segments", s.truth.segments}, {"integrator", s.truth.integrator},
                 {"accuracy", s.truth.accuracy}, {"output_interval", s.truth.output_interval},
-                {"large_motion", s.truth.large_motion}};
+                {"anti_alias_hz", s.truth.anti_alias_hz}, {"large_motion", s.truth.large_motion}};
   // Sensor overrides: per sensor, its name and the fields in which the truth's sensor differs.
   json sensor_overrides = json::array();
   auto sensor_fields = [](const SensorSpec& se) {

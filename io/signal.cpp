@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace scoleid::io {
@@ -122,6 +123,24 @@ std::vector<double> Signal::breakpoints() const {
   std::sort(b.begin(), b.end());
   b.erase(std::unique(b.begin(), b.end()), b.end());
   return b;
+}
+
+double Signal::highest_frequency() const {
+  using T = SignalTerm::Type;
+  double f = 0.0;
+  for (const auto& s : terms_) {
+    if (s.type == T::Sine) f = std::max(f, std::abs(s.f0));
+    if (s.type == T::Chirp) f = std::max({f, std::abs(s.f0), std::abs(s.f1)});
+  }
+  return f;
+}
+
+double Signal::shortest_width() const {
+  using T = SignalTerm::Type;
+  double w = std::numeric_limits<double>::infinity();
+  for (const auto& s : terms_)
+    if (s.type == T::Pulse || s.type == T::Haversine || s.type == T::BangBang) w = std::min(w, s.width);
+  return w;
 }
 
 const char* to_string(SignalTerm::Type t) {

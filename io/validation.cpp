@@ -123,11 +123,28 @@ void validate_scenario(const Scenario& sc) {
   if (sc.truth.output_interval > sc.simulation.duration)
     fail_field(src, "truth.output_interval", "must not exceed simulation.duration (" + format_value(sc.simulation.duration) + ")",
                format_value(sc.truth.output_interval));
+  if (sc.truth.anti_alias_hz > 0) {
+    const double dt = sc.truth.output_interval > 0 ? sc.truth.output_interval : sc.simulation.sample_interval;
+    if (!(sc.truth.anti_alias_hz < 0.5 / dt))
+      fail_field(src, "truth.anti_alias_hz",
+                 "must lie below the output's Nyquist frequency " + format_value(0.5 / dt) + " Hz (sample interval " +
+                     format_value(dt) + " s)",
+                 format_value(sc.truth.anti_alias_hz));
+    // The filter runs on samples 8 times denser than the output's (model/truth_run.cpp).
+    if (!(sample_count(sc.simulation.duration, dt / 8) <= limits::kMaxSamples))
+      fail_field(src, "truth.anti_alias_hz",
+                 "samples the record 8 times faster inside: more than the limit of " + format_value(limits::kMaxSamples) +
+                     " samples",
+                 format_value(sc.truth.anti_alias_hz));
+  }
   if (sc.truth.segments < 2 || sc.truth.segments > limits::kMaxSegments)
     fail_field(src, "truth.segments", "must be an integer in [2, " + std::to_string(limits::kMaxSegments) + "]",
                std::to_string(sc.truth.segments));
-  if (!(sc.truth.accuracy > 0 && sc.truth.accuracy < 1))
-    fail_field(src, "truth.accuracy", "must be in (0, 1)", format_value(sc.truth.accuracy));
+  // Below 1e-14 no integrator meets a relative error per step in double precision (Simbody's stop
+  // at the first step with "unable to advance time").
+  if (!(sc.truth.accuracy >= 1e-14 && sc.truth.accuracy < 1))
+    fail_field(src, "truth.accuracy", "must be in [1e-14, 1) (a smaller error per step is below double precision)",
+               format_value(sc.truth.accuracy));
   const auto& id = sc.identification;
   if (id.elements < 1 || id.elements > limits::kMaxElements)
     fail_field(src, "identification.elements", "must be an integer in [1, " + std::to_string(limits::kMaxElements) + "]",

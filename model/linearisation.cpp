@@ -4,8 +4,11 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
+
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::model {
 
@@ -54,6 +57,7 @@ Eigen::MatrixXd state_jacobian(const MultibodySystem& system, const State& eq, c
     displace(system, eq, delta, s);
     const Eigen::VectorXd am = generalized_accelerations(system, s);
     A.block(nu, j, nu, 1) = (ap - am) / (2 * h);
+    io::check_interrupt();
   }
   s.updQ() = eq.getQ();
   for (int j = 0; j < nu; ++j) {
@@ -63,6 +67,7 @@ Eigen::MatrixXd state_jacobian(const MultibodySystem& system, const State& eq, c
     s.updU()[j] -= 2 * h;
     const Eigen::VectorXd am = generalized_accelerations(system, s);
     A.block(nu, nu + j, nu, 1) = (ap - am) / (2 * h);
+    io::check_interrupt();
   }
   return A;
 }
@@ -75,10 +80,11 @@ std::vector<Mode> modes_of(const Eigen::MatrixXd& A, double zero_tolerance) {
   double kmax = 0.0;
   for (int j = 0; j < nu; ++j) kmax = std::max(kmax, std::abs(A(nu + j, j)));
   const double floor = std::max(zero_tolerance, 30.0 * std::sqrt(std::numeric_limits<double>::epsilon() * kmax));
-  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
+  const Eigen::VectorXcd lambda =
+      io::interruptible([A]() -> Eigen::VectorXcd { return Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues(); });
   std::vector<Mode> modes;
-  for (int i = 0; i < es.eigenvalues().size(); ++i) {
-    const std::complex<double> l = es.eigenvalues()[i];
+  for (int i = 0; i < lambda.size(); ++i) {
+    const std::complex<double> l = lambda[i];
     const double w = std::abs(l);
     if (l.imag() <= 0.0 || w <= floor) continue;
     modes.push_back({w / (2 * Pi), w, -l.real() / w});
@@ -135,12 +141,16 @@ ModeShapes undamped_modes(const MultibodySystem& system, const State& eq, const 
       for (int j = 0; j < nu; ++j) M(i, j) = Ms(i, j);
     Eigen::MatrixXd Ks = M * K;
     Ks = 0.5 * (Ks + Ks.transpose()).eval();
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Ks, M, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    const auto es = io::interruptible([Ks, M] {
+      return std::make_shared<Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>>(
+          Ks, M, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    });
     for (int i = 0; i < nu; ++i)
-      if (es.eigenvalues()[i] > floor * floor) order.push_back({std::sqrt(es.eigenvalues()[i]), i});
-    vectors = es.eigenvectors();
+      if (es->eigenvalues()[i] > floor * floor) order.push_back({std::sqrt(es->eigenvalues()[i]), i});
+    vectors = es->eigenvectors();
   } else {
-    Eigen::EigenSolver<Eigen::MatrixXd> es(K, true);
+    const auto solver = io::interruptible([K] { return std::make_shared<Eigen::EigenSolver<Eigen::MatrixXd>>(K, true); });
+    const Eigen::EigenSolver<Eigen::MatrixXd>& es = *solver;
     vectors.resize(nu, nu);
     for (int i = 0; i < nu; ++i) {
       const std::complex<double> l = es.eigenvalues()[i];

@@ -84,8 +84,8 @@ int main(int argc, char** argv) {
       sc.truth.segments = segments;
     }
     if (app.count("--accuracy")) {
-      if (!(accuracy > 0 && accuracy < 1))
-        throw io::InputError("command line: --accuracy must be in (0, 1), got " + io::format_value(accuracy));
+      if (!(accuracy >= 1e-14 && accuracy < 1))
+        throw io::InputError("command line: --accuracy must be in [1e-14, 1), got " + io::format_value(accuracy));
       sc.truth.accuracy = accuracy;
     }
     if (!integrator.empty()) sc.truth.integrator = integrator;

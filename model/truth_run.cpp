@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "scoleid/io/band_filter.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
@@ -42,8 +43,9 @@ std::string choose_integrator(const MultibodySystem& system, const State& state)
   if (state.getNU() == 0) return kDefaultIntegrator;
   State eq = state;
   eq.updU() = 0.0;
-  const Eigen::MatrixXd A = state_jacobian(system, eq);
-  const Eigen::VectorXcd lambda = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  Eigen::MatrixXd A = state_jacobian(system, eq);
+  const Eigen::VectorXcd lambda =
+      io::interruptible([A = std::move(A)]() -> Eigen::VectorXcd { return Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues(); });
   std::complex<double> top = 0.0;
   for (int i = 0; i < lambda.size(); ++i)
     if (std::abs(lambda[i]) > std::abs(top)) top = lambda[i];
@@ -199,7 +201,7 @@ void simulate_trapezoidal(const MultibodySystem& system, const State& initial, c
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "step %.4g s, %d Newton corrections, %d Jacobians, %d factorizations; frequency error "
-                "(omega h)^2/12 = %.2g at the fundamental flexible mode (%.4g Hz)",
+                "(omega h)^2/12 = %.2g at %.4g Hz (the fundamental flexible mode, or the fastest input sine above it)",
                 ts.largest_step, ts.newton_iterations, ts.jacobians, ts.factorizations, ts.lowest_mode_frequency_error(),
                 ts.lowest_omega / (2 * Pi));
   sum.message = buf;
@@ -360,6 +362,23 @@ bool TruthOptions::IsValid(std::string* why) const {
 
 std::map<std::string, double> true_parameters(const io::Scenario& sc) { return io::structure_parameters(sc); }
 
+namespace {
+// The acquisition's anti-alias filter (truth.anti_alias_hz): the record, sampled every dt, passes
+// an 8-pole Butterworth low-pass at f_c (io/band_filter.h) channel by channel, inputs and sensors
+// alike, and every m-th sample is kept (k = 0, m, 2m, …: the output's own grid).
+void anti_alias(io::DataTable& tab, double f_c, double dt, int m) {
+  const io::BandFilter lowpass(0.0, f_c, dt);
+  auto keep = [m](const std::vector<double>& x) {
+    std::vector<double> y;
+    y.reserve(x.size() / m + 1);
+    for (std::size_t k = 0; k < x.size(); k += m) y.push_back(x[k]);
+    return y;
+  };
+  tab.t = keep(tab.t);
+  for (auto& c : tab.columns) c = keep(lowpass.apply(c));
+}
+}  // namespace
+
 TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   // The truth simulates the scenario's structure with truth.overrides applied; truth.json
   // reports the values it used and echoes the scenario with its overrides.
@@ -378,6 +397,13 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
     }
     if (!(accuracy < 1)) io::fail_field(sc.source, "truth.accuracy", "must be < 1", io::format_value(accuracy));
   }
+  // A record of nothing is refused: no sensor reads anything, and from rest with no load nothing moves.
+  if (sc.sensors.empty())
+    io::fail_field(sc.source, "sensors", "must list at least one sensor: a truth records what its sensors read", "[]");
+  if (std::all_of(sc.inputs.begin(), sc.inputs.end(), [](const io::InputSpec& in) { return in.signal.is_zero(); }))
+    io::fail_field(sc.source, "inputs",
+                   "must give at least one input a signal: the structure starts at rest, and without a load nothing moves",
+                   sc.inputs.empty() ? "[]" : std::to_string(sc.inputs.size()) + " inputs without a signal");
 
   auto structure = prepare_structure(sc, n);
   const auto sensors = resolve_sensors(sc, *structure);
@@ -397,6 +423,22 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   so.accuracy = accuracy;
   so.final_time = sc.simulation.duration;
   so.sample_interval = sc.truth.output_interval > 0 ? sc.truth.output_interval : sc.simulation.sample_interval;
+  // An acquisition anti-alias filter (truth.anti_alias_hz) runs on samples kOversample times denser.
+  const int oversample = sc.truth.anti_alias_hz > 0 ? kAntiAliasOversample : 1;
+  so.sample_interval /= oversample;
+  // A sine or chirp at or above the samples' Nyquist frequency would alias into the record (and a
+  // step rule tied to the samples cannot follow it); refused, naming it.
+  double f_input = 0.0;
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    const double f = sc.inputs[i].signal.highest_frequency();
+    f_input = std::max(f_input, f);
+    if (f >= 0.5 / so.sample_interval)
+      io::fail_field(sc.source, "inputs[" + std::to_string(i) + "].signal.frequency",
+                     "is at or above " + io::format_value(0.5 / so.sample_interval) +
+                         " Hz, the Nyquist frequency of the truth's samples (every " + io::format_value(so.sample_interval) +
+                         " s): the record would alias it (sample faster, or filter like a DAQ with truth.anti_alias_hz)",
+                     io::format_value(f));
+  }
   so.progress = opt.progress;
   if (so.integrator == "auto") so.integrator = choose_integrator(structure->system(), state);
   if (so.integrator == "trapezoidal") {
@@ -406,6 +448,8 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
     bare->system().realizeTopology();
     const auto modes = natural_modes(bare->system(), bare->system().getDefaultState());
     if (!modes.empty()) so.reference_omega = modes.front().omega;
+    // ... and the fastest sine the inputs drive it with, whose forced response it must follow alike.
+    so.reference_omega = std::max(so.reference_omega, 2 * Pi * f_input);
     // Its step is (12 accuracy)^(1/3) / omega_1 at most (trapezoidal.h): refuse a run that would
     // take more steps than io::limits allows before starting it.
     const double steps = so.final_time * so.reference_omega / std::cbrt(12.0 * accuracy);
@@ -441,6 +485,8 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
     }
   });
 
+  if (oversample > 1) anti_alias(tab, sc.truth.anti_alias_hz, so.sample_interval, oversample);
+
   std::mt19937_64 rng(sc.simulation.seed);
   for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
     const double sd = sc.sensors[i].noise_std;
@@ -462,6 +508,7 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
                  {"integrator", res.summary.integrator},
                  {"accuracy", accuracy},
                  {"seed", sc.simulation.seed},
+                 {"anti_alias_hz", sc.truth.anti_alias_hz},
                  {"lumping", "Hencky bar chain (joint springs from dual-cell compliance)"},
                  {"simbody_version", SCOLEID_SIMBODY_VERSION},
                  {"steps", res.summary.steps_taken},

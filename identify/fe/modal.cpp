@@ -6,9 +6,13 @@
 #include <complex>
 #include <limits>
 
+#include "scoleid/io/interrupt.h"
+
 namespace scoleid::identify {
 
-std::vector<double> natural_frequencies(const SparseMatrix& M, const SparseMatrix& K) {
+namespace {
+
+std::vector<double> natural_frequencies_now(const SparseMatrix& M, const SparseMatrix& K) {
   const MatrixXd Md(M), Kd(K);
   Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> es(Kd, Md, Eigen::EigenvaluesOnly);
   std::vector<double> w;
@@ -16,7 +20,7 @@ std::vector<double> natural_frequencies(const SparseMatrix& M, const SparseMatri
   return w;
 }
 
-NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K) {
+NaturalModes natural_modes_now(const SparseMatrix& M, const SparseMatrix& K) {
   const MatrixXd Md(M), Kd(K);
   double ratio = 0.0;
   for (int i = 0; i < Md.rows(); ++i)
@@ -40,7 +44,7 @@ NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K) {
   return m;
 }
 
-std::vector<DampedMode> damped_modes(const MatrixXd& M, const MatrixXd& D, const MatrixXd& K) {
+std::vector<DampedMode> damped_modes_now(const MatrixXd& M, const MatrixXd& D, const MatrixXd& K) {
   const Eigen::Index n = M.rows();
   std::vector<DampedMode> out;
   if (n == 0) return out;
@@ -95,6 +99,23 @@ std::vector<DampedMode> damped_modes(const MatrixXd& M, const MatrixXd& D, const
   }
   std::sort(out.begin(), out.end(), [](const DampedMode& a, const DampedMode& b) { return a.omega < b.omega; });
   return out;
+}
+
+}  // namespace
+
+// Each dense eigen solve runs through io::interruptible (a fine mesh takes minutes in Eigen, which
+// cannot check for a signal): its body owns copies of its (sparse or small) arguments.
+
+std::vector<double> natural_frequencies(const SparseMatrix& M, const SparseMatrix& K) {
+  return io::interruptible([M, K] { return natural_frequencies_now(M, K); });
+}
+
+NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K) {
+  return io::interruptible([M, K] { return natural_modes_now(M, K); });
+}
+
+std::vector<DampedMode> damped_modes(const MatrixXd& M, const MatrixXd& D, const MatrixXd& K) {
+  return io::interruptible([M, D, K] { return damped_modes_now(M, D, K); });
 }
 
 }  // namespace scoleid::identify

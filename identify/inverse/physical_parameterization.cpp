@@ -39,7 +39,20 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
   std::vector<std::string> allowed, paper_names{"q1", "q2"};
   if (space_.has_q3) paper_names.push_back("q3");
   if (paper_) {
+    // q1, q2 (, q3) and any quantity or group they do not stand for (ζ, ρI_ψ, the masses, ...).
     allowed = paper_names;
+    std::vector<bool> taken(space_.quantities.size(), false);
+    if (space_.rho_A >= 0) taken[static_cast<std::size_t>(space_.rho_A)] = true;
+    if (space_.q3_quantity >= 0) taken[static_cast<std::size_t>(space_.q3_quantity)] = true;
+    if (const auto* ei = group(space_.EI_group))
+      for (int m : ei->members) taken[static_cast<std::size_t>(m)] = true;
+    for (const auto& g : space_.groups) {
+      bool free = true;
+      for (int m : g.members) free = free && !taken[static_cast<std::size_t>(m)];
+      if (free) allowed.push_back(g.name);
+    }
+    for (std::size_t k = 0; k < space_.quantities.size(); ++k)
+      if (!taken[k]) allowed.push_back(space_.quantities[k]);
   } else {
     for (const auto& g : space_.groups) allowed.push_back(g.name);
     allowed.insert(allowed.end(), space_.quantities.begin(), space_.quantities.end());
@@ -147,13 +160,16 @@ std::vector<PhysicalParameterization::Cd> PhysicalParameterization::phi(const st
     const auto* ei = group(space_.EI_group);
     const auto rho0 = start_[static_cast<std::size_t>(space_.rho_A)], EI0 = start_[static_cast<std::size_t>(ei->members[0])];
     Cd q1 = EI0 / rho0, q2 = 1.0 / rho0, q3 = space_.has_q3 ? start_[static_cast<std::size_t>(space_.q3_quantity)] / rho0 : 0.0;
-    for (std::size_t i = 0; i < names_.size(); ++i) (names_[i] == "q1" ? q1 : names_[i] == "q2" ? q2 : q3) = q[i];
+    for (std::size_t i = 0; i < names_.size(); ++i)
+      if (names_[i] == "q1" || names_[i] == "q2" || names_[i] == "q3")
+        (names_[i] == "q1" ? q1 : names_[i] == "q2" ? q2 : q3) = q[i];
     f[static_cast<std::size_t>(space_.rho_A)] = Cd(1.0) / q2;
     for (int m : ei->members) f[static_cast<std::size_t>(m)] = q1 / q2;
     if (space_.has_q3) f[static_cast<std::size_t>(space_.q3_quantity)] = q3 / q2;
-    return f;
   }
+  // Quantities and groups estimated by name (in the paper form: those q1, q2, q3 do not stand for).
   for (std::size_t i = 0; i < names_.size(); ++i) {
+    if (paper_ && (names_[i] == "q1" || names_[i] == "q2" || names_[i] == "q3")) continue;
     if (const auto* g = group(names_[i])) {
       for (int m : g->members) f[static_cast<std::size_t>(m)] = q[i];
     } else {

@@ -293,8 +293,10 @@ SpectralStart spectral_start_of(AttemptsContext& c, const VectorXd& q0) {
 }
 
 // One restart: from the starting point ("coarse-to-fine", "plain", "cautious-continuation") or from
-// the smoothed estimate of the runs so far ("smoothed").
-void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, const std::string& how) {
+// the smoothed estimate of the runs so far ("smoothed"), or from the spectral start `spectral`
+// ("spectral").
+void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, const std::string& how,
+             const SpectralStart& spectral) {
   AttemptsContext& c = run.c;
   OptimizerSummary s;
   int iterations = 0;
@@ -319,7 +321,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     run.header();
     s = run.minimize_from(lad.q, c.options);
   } else if (how == "spectral") {
-    const SpectralStart ss = spectral_start_of(c, r.initial);
+    const SpectralStart& ss = spectral;
     label = "spectral start (" + io::format_value(ss.model_hz) + " Hz -> " + io::format_value(ss.data_hz) + " Hz), " +
             io::to_string(c.options.method);
     if (c.verbose)
@@ -376,11 +378,15 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   if (!families.empty()) strategies.insert(strategies.end(), {from_ladder ? "plain" : "coarse-to-fine", "smoothed"});
   strategies.insert(strategies.end(), {"spectral", "cautious-continuation"});
   int done = 0;
+  SpectralStart spectral;
   for (const std::string& how : strategies) {
     if (done >= p.scenario.identification.restarts) break;
     bool wanted = false;
     if (how == "smoothed") wanted = r.summary.q.allFinite();
-    else if (how == "spectral") wanted = !r.converged() && spectral_start_of(c, r.initial).q.size() == r.initial.size();
+    else if (how == "spectral") {
+      if (!r.converged()) spectral = spectral_start_of(c, r.initial);
+      wanted = !r.converged() && spectral.q.size() == r.initial.size();
+    }
     else if (how == "cautious-continuation") wanted = !r.converged();
     else
       wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
@@ -393,7 +399,7 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
       else
         std::printf("restart %d (%s) from the starting point\n", done + 1, how.c_str());
     }
-    restart(run, r, families, how);
+    restart(run, r, families, how, spectral);
     if (how != "smoothed") ++done;  // a check of every sectional run, not an answer to a failure
   }
   r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record

@@ -17,6 +17,7 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
 #include <stdexcept>
@@ -113,10 +114,11 @@ ExperimentsSpec load_experiments(const std::string& path) {
   if (!fs::is_regular_file(path)) bad(path, "file", "does not exist or is not a file", path);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(io::read_text_file(path, "experiments file"));
   } catch (const YAML::Exception& e) {
     bad(path, "yaml", "is not valid YAML", io::one_line(e.what()));
   }
+  io::check_yaml_document(root, "experiments file '" + path + "'", true);
   if (!root.IsMap()) bad(path, "document", "must be a mapping with experiments, runs and/or modes", YAML::Dump(root));
   for (const auto& kv : root) {
     const std::string key = kv.first.Scalar();

@@ -234,6 +234,25 @@ void check_step(const io::Scenario& sc, const StructuralModel& model, const Para
                      io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
                  io::format_value(h));
   }
+  // A scenario signal the step cannot resolve would be sampled, not integrated: a pulse shorter than
+  // a step is seen whole or not at all (a 1e-9 s pulse of 2e-8 impulse drives a step's worth of
+  // response), a sine at or above 1/(2h) aliases into a slow one. (A data column is read on its own
+  // grid and is exempt.)
+  for (std::size_t i = 0; i < signals.size() && i < sc.inputs.size(); ++i) {
+    const io::Signal& s = signals[i];
+    const std::string f = "inputs[" + std::to_string(i) + "].signal";
+    if (s.shortest_width() < h)
+      fail_field(sc.source, f + ".width",
+                 "is shorter than the identifier's time step " + io::format_value(h) +
+                     " s: a pulse is not resolved by the steps that integrate it (widen it to at least one step, or "
+                     "record it faster)",
+                 io::format_value(s.shortest_width()));
+    if (s.highest_frequency() >= 0.5 / h)
+      fail_field(sc.source, f + ".frequency",
+                 "is at or above " + io::format_value(0.5 / h) + " Hz, the Nyquist frequency of the identifier's time step " +
+                     io::format_value(h) + " s: it would alias into a slower input",
+                 io::format_value(s.highest_frequency()));
+  }
   const double steps = T / h;
   // State and costate, and the sensitivities in blocks of at most kSensitivityBlockBytes (objective.h).
   const double one = (steps + 1.0) * model.ndof * 3.0 * 8.0;

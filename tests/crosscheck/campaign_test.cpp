@@ -191,6 +191,7 @@ TEST(CampaignFile, BadFieldsAreOneLineNamingTheField) {
       {head + "noise: {relative: 0.01, seeds: 100000}\ngrid: {truth.segments: [10, 20, 30, 40, 50, 60, 70, 80, 90, 100, 110]}\n",
        "noise.seeds"},
       {head + "overlay: {sensors: []}\n", "sensors"},
+      {head + "overlay: {truth: {segments: 10, segments: 1000}}\n", "overlay.truth.segments"},
   };
   int k = 0;
   for (const auto& [text, needle] : cases) {

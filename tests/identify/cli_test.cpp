@@ -6,6 +6,7 @@
 // Plus the positive paths: --list-scenarios, --help, and a small identification run without
 // and then with --data (the data being the first run's measured column).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -915,6 +916,34 @@ TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
   expect_input_error(r5, dir / "run5", {"truth.json", "not from the same run"});
 }
 
+TEST(ScoleIdentifyHardening, ATruthJsonWithARepeatedKeyIsRefusedNamingIt) {
+  // {"scenario": "a", ..., "scenario": "b"}: nlohmann would keep the last; refused, naming the key.
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  fs::create_directories(dir / "data");
+  write_file(dir / "data" / "truth.csv", "t,P,w_tip\n0,10,0\n0.01,10,1e-6\n0.02,10,2e-6\n");
+  write_file(dir / "data" / "truth.json",
+             R"({"scenario": "cli-good", "columns": [{"name": "P", "kind": "input", "kind": "output"}], "scenario": "x"})");
+  const Result r = run({"--scenario", (dir / "good.yaml").string(), "--data", (dir / "data" / "truth.csv").string(), "--out",
+                        (dir / "out").string(), "-q"}, dir);
+  expect_input_error(r, dir / "out", {"truth.json", "columns[].kind", "appears more than once"});
+}
+
+TEST(ScoleIdentifyHardening, AnEndlessDeviceIsRefusedAndASignalWhileOpeningAFifoIsAnInterruption) {
+  TempDir dir;
+  // /dev/zero as the scenario: read up to the input-file limit, then one line, exit 2.
+  const Result z = run({"--scenario", "/dev/zero", "--out", (dir / "out").string()}, dir);
+  expect_input_error(z, dir / "out", {"scenario file '/dev/zero'", "limit"});
+  // A FIFO no one writes to: the open blocks; SIGTERM ends the run as an interruption (143).
+  const fs::path fifo = dir / "scenario.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  double after = 0.0;
+  const int code = run_and_signal({"--scenario", fifo.string(), "--out", (dir / "out").string(), "-q"}, dir, 0.5, SIGTERM, &after);
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_LT(after, 1.0);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(ScoleIdentifyCli, PrintScenarioRoundTripsEveryBuiltin) {
   TempDir dir;
   for (const auto& name : scoleid::io::builtin_scenario_names()) {
@@ -986,6 +1015,10 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   write_file(dir / "m.csv", "mode,frequency_hz,frequency_std_hz,shape_std,w_tip,w_mid\n1,0.3,0.001,0.01,1\n");
   expect_input_error(run({"--experiments", (dir / "e3.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
                      {"m.csv", "line 2"});
+  // A key given twice in the experiments file (yaml-cpp would answer the first): refused, naming it.
+  write_file(dir / "e4.yaml", "experiments: two\nruns:\n  - {name: a, scenario: a.yaml, scenario: b.yaml}\n");
+  expect_input_error(run({"--experiments", (dir / "e4.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
+                     {"e4.yaml", "runs[0].scenario", "appears more than once"});
 
   // The cantilever's first two frequencies alone (closed form, f_k = λ_k² √(EI/ρA) / (2π L²)):
   // they fix q1 = EI/ρA and say nothing of q2 = 1/ρA, which the Fisher test flags.

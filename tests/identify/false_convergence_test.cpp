@@ -97,7 +97,9 @@ TEST(FalseConvergence, ShortNoisyRecordsAreNeverCalledConvergedWhenWrong) {
       std::printf("  seed %2u: EI %+.1f %%, rho_A %+.1f %%, %s\n", seed, 100 * (r.estimate[0] / 23000 - 1),
                   100 * (r.estimate[1] / 67 - 1),
                   o == Outcome::Covered ? "converged, covered" : o == Outcome::False ? "CONVERGED AND WRONG" : "not converged");
-    if (seed == 1 || seed == 18) EXPECT_NE(o, Outcome::False) << "seed " << seed;
+    if (seed == 1 || seed == 18) {
+      EXPECT_NE(o, Outcome::False) << "seed " << seed;
+    }
   }
   std::printf("  60 draws: converged and covered %d, not converged %d, converged and wrong %d\n", covered, not_converged, wrong);
   EXPECT_EQ(wrong, 0);
@@ -119,9 +121,11 @@ TEST(FalseConvergence, TheSmoothedRestartLeavesBeamEi8sSawtoothMinimum) {
     std::printf("  seed %u: chosen %s (J %.6e; first attempt %.6e); largest section error %.2f %%\n", seed,
                 chosen.strategy.c_str(), chosen.cost, r.attempts[0].cost, 100 * test_support::max_rel_error(*p, r.estimate));
     EXPECT_LT(test_support::max_rel_error(*p, r.estimate), 0.03) << "seed " << seed;
-    for (int i = 0; i < truth.size(); ++i)
-      if (r.ident.identifiable[static_cast<std::size_t>(i)])
+    for (int i = 0; i < truth.size(); ++i) {
+      if (r.ident.identifiable[static_cast<std::size_t>(i)]) {
         EXPECT_LE(std::abs(r.estimate[i] - truth[i]), r.interval.half_width[i]) << "seed " << seed << " section " << i + 1;
+      }
+    }
   }
 }
 

@@ -11,6 +11,7 @@
 #include "test_support.h"
 #include "scoleid/identify/inverse/cvodes_adjoint.h"
 #include "scoleid/identify/run/problem.h"
+#include "scoleid/io/error.h"
 
 using namespace scoleid::identify;
 using test_support::Case;
@@ -99,6 +100,14 @@ sensors: [{name: w, location: 10}]
 simulation: {duration: 2, sample_interval: 0.01}
 identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
 )";
+// The paper's q1, q2 with ζ estimated beside them by name.
+const char* kPaperZeta = R"(name: grad-paper-zeta
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
+inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
+sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {parameterization: paper, estimate: [q1, q2, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
+)";
 // Both laws on a sectional beam, d_k = 2ζ√(ρA·EI_k) per section; the section boundary at 5 m
 // falls inside an element of the 7-element mesh.
 const char* kBothSections = R"(name: grad-both-sections
@@ -115,6 +124,32 @@ identification: {parameterization: physical, estimate: [EI_1, EI_2, rho_A, zeta,
 TEST(BeamDampingGradient, ChenRussellZeta) { check_kind(kChenRussell); }
 TEST(BeamDampingGradient, PaperQ3IsKelvinVoigtOverRhoA) { check_kind(kPaperQ3); }
 TEST(BeamDampingGradient, BothLawsOnSections) { check_kind(kBothSections); }
+TEST(BeamDampingGradient, PaperFormWithZeta) { check_kind(kPaperZeta); }
+
+TEST(BeamDampingGradient, PaperFormEstimatesZetaByNameAndRefusesWhatTheQsStandFor) {
+  // q = [q1, q2, zeta] maps to EI = q1/q2, ρA = 1/q2, ζ itself; ρA, EI and c_kv beside the q's that
+  // stand for them are refused with the allowed names.
+  Case e = make_case(kPaperZeta, false);
+  VectorXd q(3);
+  q << 400.0, 0.02, 0.03;
+  const auto ph = e.p->params->physical(q);
+  EXPECT_DOUBLE_EQ(ph.at("EI"), 400.0 / 0.02);
+  EXPECT_DOUBLE_EQ(ph.at("rho_A"), 1.0 / 0.02);
+  EXPECT_DOUBLE_EQ(ph.at("zeta"), 0.03);
+  EXPECT_DOUBLE_EQ(e.p->params->initial()[2], 0.08);
+  EXPECT_DOUBLE_EQ(e.p->params->truth()[2], 0.05);
+  for (const char* bad : {"rho_A", "EI", "c_kv"}) {
+    std::string y = kPaperZeta;
+    y.replace(y.find("[q1, q2, zeta]"), 14, std::string("[q1, q2, ") + bad + "]");
+    try {
+      make_case(y.c_str(), false);
+      ADD_FAILURE() << bad << " accepted beside q1, q2";
+    } catch (const scoleid::io::InputError& err) {
+      EXPECT_NE(std::string(err.what()).find("identification.estimate[2]"), std::string::npos) << err.what();
+      EXPECT_NE(std::string(err.what()).find("zeta"), std::string::npos) << err.what();
+    }
+  }
+}
 
 TEST(BeamDampingGradient, TaylorRemainderFallsAtSecondOrder) {
   for (const char* yaml : {kChenRussell, kPaperQ3}) {

@@ -400,6 +400,35 @@ TEST(Identification, StartCoarseToFineNeedsSections) {
   }
 }
 
+TEST(TimeStep, ASignalTheStepCannotResolveIsRefusedNamingIt) {
+  // paper-beam-1 (step 0.01 s at most): a 1e-9 s pulse would be seen as a whole step's load, a
+  // 1 MHz sine would alias; each is refused before any solve, naming the field. A pulse of two
+  // steps is taken.
+  auto with_signal = [](const std::string& signal) {
+    const std::string yaml = R"(name: v
+beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000}
+inputs: [{name: P, location: 5, signal: )" + signal + R"(}]
+sensors: [{name: w, location: 5}]
+simulation: {duration: 2, sample_interval: 0.01}
+identification: {estimate: [EI], elements: 4}
+)";
+    try {
+      make_problem(scoleid::io::parse_scenario(yaml, "s.yaml"), std::nullopt);
+    } catch (const scoleid::io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string e = with_signal("{type: pulse, amplitude: 10, t0: 0.1, width: 1e-9}");
+  EXPECT_NE(e.find("inputs[0].signal.width"), std::string::npos) << e;
+  EXPECT_NE(e.find("1e-09"), std::string::npos) << e;
+  e = with_signal("[{type: step, amplitude: 1}, {type: sine, amplitude: 1, frequency: 1e6}]");
+  EXPECT_NE(e.find("inputs[0].signal.frequency"), std::string::npos) << e;
+  EXPECT_NE(e.find("Nyquist"), std::string::npos) << e;
+  EXPECT_EQ(with_signal("{type: pulse, amplitude: 10, t0: 0.1, width: 0.02}"), "");
+  EXPECT_EQ(with_signal("{type: sine, amplitude: 1, frequency: 5}"), "");
+}
+
 namespace {
 // beam-ei8's loads on a 64-element beam (data on 128) with EI on N equal sections.
 scoleid::io::Scenario sections_scenario(int N) {

@@ -123,6 +123,24 @@ TEST_F(RunDirectoryTest, ForeignFilesAndNonDirectoriesAreRefused) {
   EXPECT_TRUE(leftovers("run").size() == 1u);  // just "file"
 }
 
+TEST_F(RunDirectoryTest, ASymbolicLinkIsRefusedBeforeAnyWorkDanglingOrNot) {
+  // The commit renames onto the path: a dangling link would fail only at the end of the run, a
+  // link to a directory would be replaced by the run. Both refused at once, naming the path.
+  fs::create_symlink(root_ / "nowhere", root_ / "dangling");
+  fs::create_directories(root_ / "real");
+  fs::create_symlink(root_ / "real", root_ / "link");
+  for (const char* name : {"dangling", "link"}) {
+    try {
+      RunDirectory d((root_ / name).string(), owned_, "test");
+      ADD_FAILURE() << name << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("symbolic link"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_symlink(root_ / "link"));
+  EXPECT_FALSE(fs::exists(root_ / "nowhere"));
+}
+
 TEST_F(RunDirectoryTest, QuotesAndSemicolonsInTheNameAreJustCharacters) {
   const fs::path out = root_ / "mast's runs; touch pwned; '";
   {

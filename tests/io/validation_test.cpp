@@ -113,11 +113,34 @@ TEST(Counts, SamplesStepsSegmentsAndElementsAreBounded) {
   EXPECT_TRUE(refused("name: v\nsimulation: {duration: 20, sample_interval: 1e-9}\n",
                       {"simulation.sample_interval", "samples", "1e-09"}));
   EXPECT_TRUE(refused(std::string(kBase) + "truth: {output_interval: 1e-9}\n", {"truth.output_interval"}));
+  // The anti-alias corner must lie below the output's Nyquist frequency (50 Hz at 0.01 s).
+  EXPECT_TRUE(refused(std::string(kBase) + "truth: {anti_alias_hz: 50}\n", {"truth.anti_alias_hz", "Nyquist", "50"}));
+  EXPECT_TRUE(refused(std::string(kBase) + "truth: {anti_alias_hz: -1}\n", {"truth.anti_alias_hz"}));
+  EXPECT_EQ(error_of(std::string(kBase) + "truth: {anti_alias_hz: 49}\n"), "");
   EXPECT_TRUE(refused(std::string(kBase) + "identification: {time_step: 1e-12}\n",
                       {"identification.time_step", "steps", "1e-12"}));
   EXPECT_TRUE(refused(std::string(kBase) + "truth: {segments: 10000000}\n", {"truth.segments", "10000000"}));
   EXPECT_TRUE(refused(std::string(kBase) + "identification: {elements: 100000}\n", {"identification.elements"}));
   EXPECT_EQ(sample_count(2.0, 0.01), 201.0);
+}
+
+TEST(Plausibility, AttachedMassesInertiasAndOffsetsAreBoundedByTheStructuresOwn) {
+  // The beam of kBase weighs 670 kg over 10 m: a tip mass within 1e-12..1e12 times that (or 0), a
+  // tip inertia up to 1e12 m L^2; SCOLE's masses alike and its offsets within 10 mast lengths.
+  const std::string beam = "name: v\nbeam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, ";
+  EXPECT_TRUE(refused(beam + "tip_mass: 1e24}\n", {"beam.tip_mass", "1e+24", "670"}));
+  EXPECT_TRUE(refused(beam + "tip_mass: 1e-15}\n", {"beam.tip_mass", "1e-15"}));
+  EXPECT_TRUE(refused(beam + "tip_inertia: 1e20}\n", {"beam.tip_inertia", "1e+20"}));
+  EXPECT_EQ(error_of(beam + "tip_mass: 0, tip_inertia: 0}\n"), "");
+  EXPECT_EQ(error_of(beam + "tip_mass: 6e14, tip_inertia: 6e16}\n"), "");
+  const std::string scole = "name: v\nstructure: scole\nscole: {";
+  EXPECT_TRUE(refused(scole + "reflector_rx: 1e24}\n", {"scole.reflector_rx", "1e+24", "1300"}));
+  EXPECT_TRUE(refused(scole + "mast_root: [0, 0, -2000]}\n", {"scole.mast_root[2]", "-2000"}));
+  EXPECT_TRUE(refused(scole + "shuttle: {mass: 1e-24, Ixx: 1, Iyy: 1, Izz: 1}}\n", {"scole.shuttle.mass", "1e-24"}));
+  EXPECT_TRUE(refused(scole + "actuator_mass: 1e24}\n", {"scole.actuator_mass", "1e+24"}));
+  EXPECT_TRUE(refused(scole + "reflector: {mass: 12.42, Ixx: 1e20, Iyy: 1e20, Izz: 1e20}}\n", {"scole.reflector.Ixx"}));
+  // truth.overrides pass the same checks.
+  EXPECT_TRUE(refused(scole + "}\ntruth: {overrides: {scole: {reflector_rx: 1e24}}}\n", {"reflector_rx", "1e+24"}));
 }
 
 TEST(Counts, OverridesGoThroughTheSameChecks) {
@@ -127,6 +150,9 @@ TEST(Counts, OverridesGoThroughTheSameChecks) {
   s = parse_scenario(kBase, "s");
   s.truth.accuracy = std::nan("");
   EXPECT_THROW(validate_scenario(s), InputError);
+  s.truth.accuracy = 1e-30;  // below double precision: Simbody stops at its first step
+  EXPECT_THROW(validate_scenario(s), InputError);
+  EXPECT_TRUE(refused(std::string(kBase) + "truth: {accuracy: 1e-20}\n", {"truth.accuracy", "1e-20"}));
   s = parse_scenario(kBase, "s");
   s.identification.max_iterations = -5;
   EXPECT_THROW(validate_scenario(s), InputError);

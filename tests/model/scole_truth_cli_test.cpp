@@ -92,6 +92,8 @@ TEST_F(ScoleTruthCli, EulerBernoulliMastIsRefusedByTheChain) {
   const std::string file = write("eb.yaml", R"(name: cli-eb
 structure: scole
 scole: {bending_rotary_inertia: false}
+inputs:
+  - {name: F, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, width: 1}}
 sensors:
   - {name: tip, at: mast, kind: displacement, location: 130, direction: y}
 simulation: {duration: 1, sample_interval: 0.01}
@@ -194,7 +196,8 @@ std::string with(const std::string& from, const std::string& to) {
 TEST_F(ScoleTruthCli, CommandLineOverridesPassTheScenarioChecks) {
   const std::string file = write("s.yaml", kBeam);
   const fs::path out = dir_ / "out";
-  for (const std::string& opt : {"--segments 10000000", "--segments 1", "--accuracy nan", "--accuracy 2"}) {
+  for (const char* opt_c : {"--segments 10000000", "--segments 1", "--accuracy nan", "--accuracy 2", "--accuracy 1e-30"}) {
+    const std::string opt = opt_c;
     const CliResult r = run("--scenario " + file + " --out " + out.string() + " " + opt);
     EXPECT_EQ(r.code, 2) << opt << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << r.err;

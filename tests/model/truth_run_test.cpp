@@ -1,11 +1,16 @@
 // run_truth (truth.csv / truth.json contents): Gaussian sensor noise with the scenario's std and
 // seed on outputs only, reproducible for a seed; columns and metadata copied from the scenario;
 // the "auto" integrator choice follows the chain's spectrum.
+// The acquisition's anti-alias filter (truth.anti_alias_hz) passes its band and stops what would fold.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <string>
 
+#include "scoleid/io/band_filter.h"
+#include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/truth_run.h"
 
@@ -91,4 +96,87 @@ TEST(TruthRun, AutoIntegratorFollowsTheSpectrum) {
     const auto st = prepare_structure(sc, 20);
     EXPECT_EQ(choose_integrator(st->system(), st->system().getDefaultState()), expect) << name;
   }
+}
+
+TEST(TruthRun, TheAntiAliasFilterPassesTheBandAndStopsWhatWouldFoldIntoIt) {
+  // truth.anti_alias_hz: 200 at 1 kHz output. A moment input of 50 Hz + 900 Hz, both of amplitude
+  // 1: unfiltered, the 900 Hz term samples as a 100 Hz one of amplitude 1. Recorded after the
+  // filter: the 50 Hz term with the filter's own gain and phase (io::BandFilter at the 8-times denser
+  // rate), the 900 Hz one below 1e-4; the output grid k dt; the noise, added after, at its stated
+  // level.
+  auto yaml = [](double noise) {
+    return R"(name: aa-beam
+structure: beam
+beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.01}
+inputs:
+  - {name: M, kind: moment, location: 5, unit: N m,
+     signal: [{type: sine, amplitude: 1, frequency: 50}, {type: sine, amplitude: 1, frequency: 900}]}
+sensors:
+  - {name: w_tip, location: 10, unit: m, noise_std: )" + std::to_string(noise) + R"(}
+simulation: {duration: 1, sample_interval: 0.001, seed: 4}
+truth: {segments: 6, integrator: rk-merson, accuracy: 1e-6, anti_alias_hz: 200}
+)";
+  };
+  const TruthResult r = run_truth(io::parse_scenario(yaml(0.0), "test"));
+  ASSERT_EQ(r.table.t.size(), 1001u);
+  EXPECT_NEAR(r.table.t[500], 0.5, 1e-12);
+  const std::complex<double> G = io::BandFilter(0.0, 200.0, 0.001 / kAntiAliasOversample).response(50.0);
+  EXPECT_NEAR(std::abs(G), 1.0, 1e-3);
+  double worst = 0.0;
+  for (std::size_t k = 300; k < r.table.t.size(); ++k) {  // the filter's transient gone (its poles decay in ~10 ms)
+    const double t = r.table.t[k];
+    worst = std::max(worst, std::abs(r.table.columns[0][k] - std::abs(G) * std::sin(2 * M_PI * 50 * t + std::arg(G))));
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_EQ(r.meta.generator.at("anti_alias_hz"), 200.0);
+  // The noise is white at the stated level after the filter.
+  const double sd = 1e-5;
+  const TruthResult n = run_truth(io::parse_scenario(yaml(sd), "test"));
+  double var = 0.0;
+  for (std::size_t k = 0; k < n.table.t.size(); ++k) var += std::pow(n.table.columns[1][k] - r.table.columns[1][k], 2) / 1001;
+  EXPECT_NEAR(std::sqrt(var) / sd, 1.0, 0.067);
+}
+
+TEST(TruthRun, ASineTheRecordWouldAliasIsRefusedBeforeAnyStep) {
+  // paper-beam-2 driven at 1e20 Hz (the record samples at 100 Hz): refused at once, naming the
+  // input's frequency; below the Nyquist frequency it runs, the trapezoidal step following the sine.
+  io::Scenario sc = io::load_scenario("paper-beam-2");
+  sc.simulation.duration = 0.5;
+  sc.truth.segments = 6;
+  io::SignalTerm sine;
+  sine.type = io::SignalTerm::Type::Sine;
+  sine.amplitude = 1.0;
+  sine.f0 = 1e20;
+  sc.inputs[0].signal = io::Signal({sine});
+  try {
+    run_truth(sc);
+    ADD_FAILURE() << "accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("inputs[0].signal.frequency"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e+20"), std::string::npos) << e.what();
+  }
+  sine.f0 = 40.0;
+  sc.inputs[0].signal = io::Signal({sine});
+  sc.truth.integrator = "trapezoidal";
+  const TruthResult r = run_truth(sc);
+  EXPECT_EQ(r.table.t.size(), 51u);
+  EXPECT_LE(r.summary.max_step, std::cbrt(12.0 * sc.truth.accuracy) / (2 * M_PI * 40.0) * (1 + 1e-12));
+}
+
+TEST(TruthRun, ARecordOfNothingIsRefusedNamingWhatIsMissing) {
+  // No sensors: nothing is recorded; no input with a signal: the structure stays at rest.
+  const std::string base = "name: v\nbeam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000}\n";
+  const std::string load = "inputs: [{name: P, location: 5, signal: {type: step, amplitude: 1}}]\n";
+  const std::string sensor = "sensors: [{name: w, location: 5}]\n";
+  auto error_of = [](const std::string& yaml) {
+    try {
+      run_truth(io::parse_scenario(yaml, "s.yaml"));
+    } catch (const io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of(base + load + "sensors: []\n").find("sensors must list at least one sensor"), std::string::npos);
+  EXPECT_NE(error_of(base + "inputs: []\n" + sensor).find("inputs must give at least one input a signal"), std::string::npos);
+  EXPECT_NE(error_of(base + sensor).find("inputs"), std::string::npos);
 }

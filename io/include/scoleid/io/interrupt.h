@@ -4,7 +4,12 @@
 // check_interrupt(), which throws Interrupted. The program's main catches it, its RunDirectory
 // (run_directory.h) discards the staged outputs, and it exits 128 + signal (130 for SIGINT,
 // 143 for SIGTERM): nothing half-written, nothing from the interrupted run left behind.
+#include <chrono>
+#include <future>
+#include <memory>
 #include <stdexcept>
+#include <thread>
+#include <utility>
 
 namespace scoleid::io {
 
@@ -28,5 +33,20 @@ int interrupt_signal();
 void check_interrupt();
 // Forgets a received signal (a test that raised one; a caller that has dealt with it).
 void clear_interrupt();
+
+// A call that cannot check for a signal itself (a dense eigen solve inside Eigen, seconds to a
+// minute for a fine chain) made interruptible: f runs on a worker thread while the caller waits,
+// checking every 20 ms, and a signal throws Interrupted at once. The worker is then left to finish
+// on its own and its result is dropped, so f must own everything it touches (capture by value).
+// Exceptions of f reach the caller.
+template <class F>
+auto interruptible(F f) -> decltype(f()) {
+  using R = decltype(f());
+  auto task = std::make_shared<std::packaged_task<R()>>(std::move(f));
+  std::future<R> result = task->get_future();
+  std::thread([task] { (*task)(); }).detach();
+  while (result.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) check_interrupt();
+  return result.get();
+}
 
 }  // namespace scoleid::io

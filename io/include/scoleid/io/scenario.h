@@ -258,6 +258,13 @@ struct TruthModelSpec {
   // undamped chain below 1e-6 over 50 periods from here (model/trapezoidal.h).
   double accuracy = 1e-9;
   double output_interval = 0.0;   // 0 = simulation.sample_interval
+  // The acquisition's anti-alias filter (Hz; 0 = none, the default): every channel, inputs and
+  // sensors alike, passes an 8-pole Butterworth low-pass at this corner before it is sampled, as a
+  // DAQ's does; the truth samples 8 times faster inside, filters, keeps every 8th sample, and adds
+  // the sensors' noise after (ADC noise, white at the stated level). Must lie below the output's
+  // Nyquist frequency. The identifier never reads it: a filter applied alike to inputs and outputs
+  // commutes with a linear model (docs/theory.md §9, "Acquisition").
+  double anti_alias_hz = 0.0;
   // truth.overrides as YAML text ("" = none): a partial beam: or scole: section applied on top of
   // the scenario's structure, and `sensors:`, partial sensor entries identified by name (location,
   // direction, bias, drift), applied on top of the scenario's sensors, for the truth only

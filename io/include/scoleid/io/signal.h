@@ -45,6 +45,10 @@ public:
   double operator()(double t) const;
   // Sorted, unique times where f or f' jumps.
   std::vector<double> breakpoints() const;
+  // What a time grid must resolve: the highest frequency of a sine or chirp term (Hz; 0 = none),
+  // and the shortest width of a pulse, haversine or bang-bang term (s; +inf = none).
+  double highest_frequency() const;
+  double shortest_width() const;
   bool is_zero() const { return terms_.empty(); }
   const std::vector<SignalTerm>& terms() const { return terms_; }
   // One-line human description, e.g. "step 10 at 0".

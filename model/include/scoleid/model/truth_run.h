@@ -7,6 +7,9 @@
 // Integration stops at every input breakpoint (io::Signal::breakpoints) and restarts there,
 // so no step straddles a jump in f or f'. Samples are taken at k * dt, k = 0..floor(T/dt),
 // dt = truth.output_interval or simulation.sample_interval, by the integrator's interpolant.
+// With truth.anti_alias_hz the samples are taken 8 times denser (kAntiAliasOversample), every
+// channel passes an 8-pole Butterworth low-pass at that corner (a DAQ's anti-alias filter), and
+// every 8th sample is kept; the noise below is added after (ADC noise).
 // Sensor errors (truth.overrides.sensors): bias + drift·t added to each noise-free read-out.
 // Sensor noise: N(0, noise_std^2), one std::mt19937_64 seeded with simulation.seed, drawn
 // column by column (sensors in scenario order, samples in time order) for sensors with
@@ -104,6 +107,11 @@ public:
 // body relative to ground. At 0.1 rad sin θ = θ to 0.17 % and the second-order terms a linear
 // model drops (1 − cos θ ≈ θ²/2 against θ) are 5 % of the first-order ones (docs/truth-guards.md).
 inline constexpr double kSmallRotationBound = 0.1;
+
+// With truth.anti_alias_hz: how many times denser than the output the truth samples before its
+// anti-alias filter. The corner then lies below 1/16 of the dense rate, and what the filter does not
+// stop folds from above 7/16 of it.
+inline constexpr int kAntiAliasOversample = 8;
 
 struct TruthOptions {
   int segments = 0;            // 0 = scenario truth.segments

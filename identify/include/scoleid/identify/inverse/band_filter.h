@@ -19,7 +19,7 @@
 // filtered input and data and nothing else) and the Fisher matrix need no change. Filtering both
 // sides causally keeps each side's phase distortion identical; it is not undone.
 //
-// G: a causal Butterworth band-pass in second-order sections from rest — a low-pass of order 8 at
+// G (io/band_filter.h): a causal Butterworth band-pass in second-order sections from rest — a low-pass of order 8 at
 // f_hi and, for f_lo > 0, a high-pass of order 4 at f_lo — by the bilinear transform with the
 // edges pre-warped (|G| = 1/√2 at f_lo and f_hi, up to the other edge's influence, (f_lo/f_hi)^8).
 //
@@ -30,30 +30,11 @@
 // matrix, formed with the filtered sensitivities, is scaled by g (equivalently: formed with σ), the
 // information of the band alone, and so are the systematic share of χ² and the χ² differences of
 // the mirror and other-minimum tests.
-#include <complex>
-#include <vector>
+#include "scoleid/io/band_filter.h"
 
 namespace scoleid::identify {
 
-class BandFilter {
-public:
-  // Throws std::invalid_argument unless 0 <= f_lo < f_hi < 1/(2 dt).
-  BandFilter(double f_lo, double f_hi, double dt);
-  // The filtered samples, from rest (x on the uniform grid of step dt).
-  std::vector<double> apply(const std::vector<double>& x) const;
-  // G(e^{i 2π f dt}).
-  std::complex<double> response(double f) const;
-  // Σ_{i<n} h_i², the energy of the first n samples of the impulse response.
-  double noise_gain(std::size_t n) const;
-  double f_lo() const { return lo_; }
-  double f_hi() const { return hi_; }
-
-private:
-  struct Section {
-    double b0, b1, b2, a1, a2;  // y = b0 x + b1 x₋₁ + b2 x₋₂ − a1 y₋₁ − a2 y₋₂
-  };
-  std::vector<Section> sections_;
-  double lo_, hi_, dt_;
-};
+// The filter G itself (one implementation, shared with the truth's acquisition filter).
+using BandFilter = io::BandFilter;
 
 }  // namespace scoleid::identify

@@ -8,6 +8,8 @@
 //   - a group name that sets several quantities to one value (EI: every section, both planes),
 //   - or, in the paper's form (the equation divided by ρA), q1 = EI/ρA, q2 = 1/ρA and, where the
 //     structure has it, q3 = c_kv/ρA (EI the group, c_kv the Kelvin–Voigt coefficient; c_kv = q3/q2).
+//     Beside them the paper form estimates by name any quantity or group they do not stand for
+//     (ζ, ρI_ψ, the masses): identification.estimate [q1, q2, zeta].
 // Quantities not estimated keep their starting values: the scenario's, overridden by
 // identification.initial (keys: quantity, group and q names). ∂c/∂q by complex step: exact to
 // rounding, no step-size choice.

@@ -1,10 +1,10 @@
-#include "scoleid/identify/inverse/band_filter.h"
+#include "scoleid/io/band_filter.h"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace scoleid::identify {
+namespace scoleid::io {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -72,4 +72,4 @@ double BandFilter::noise_gain(std::size_t n) const {
   return e;
 }
 
-}  // namespace scoleid::identify
+}  // namespace scoleid::io

@@ -1,0 +1,37 @@
+#pragma once
+// Reading the files the programs are given, before anything in them is used: one place that
+// bounds the read and checks the document's shape common to every format (docs/theory.md §10).
+//
+// - read_text_file reads a file whole, at most max_bytes: a directory, a file that cannot be
+//   opened and a longer file or device (/dev/zero, a runaway log) are refused with one InputError
+//   line naming the file. Opening a FIFO blocks until a writer comes; a SIGINT/SIGTERM received
+//   meanwhile ends the program as an interruption (io::Interrupted), not as a bad file.
+// - parse_json_text parses JSON and refuses a key repeated within one object (nlohmann keeps the
+//   last, so the first value would be dropped silently), naming the key's path.
+// - check_yaml_document refuses, in a parsed YAML document, a repeated key (yaml-cpp answers
+//   node[key] with the first pair, dropping the later one silently), a non-scalar key, a scalar or
+//   key that is not UTF-8 and (unless allow_null) a key written without a value; each alias's
+//   target is visited once.
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace YAML {
+class Node;
+}
+
+namespace scoleid::io {
+
+// Input files larger than this are refused (scenarios, experiments, campaigns, suite families,
+// modal data, truth.json and the cross-check's own JSON; data records are bounded by their sample
+// count instead).
+inline constexpr std::size_t kMaxInputFileBytes = std::size_t{256} << 20;
+
+// `what` names the kind of file in the message ("scenario file", "JSON file").
+std::string read_text_file(const std::string& path, const std::string& what,
+                           std::size_t max_bytes = kMaxInputFileBytes);
+nlohmann::json parse_json_text(const std::string& text, const std::string& source);
+void check_yaml_document(const YAML::Node& root, const std::string& source, bool allow_null = false);
+
+}  // namespace scoleid::io
