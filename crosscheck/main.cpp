@@ -85,6 +85,65 @@ int guarded(const std::function<int()>& verb) {
   }
 }
 
+// What a suite run leaves in --out when it ends before its result is written (a failure or a
+// signal): the directories it created itself. The family's truth directory is its own and goes
+// whole; the shared ones (--out, results/, truths/: other families may be running into them at the
+// same time, as under ctest) go only when empty.
+class SuiteCleanup {
+public:
+  SuiteCleanup(const fs::path& out, const std::vector<crosscheck::SuiteFile>& files) {
+    for (const fs::path& p : {out, out / "results", out / "truths"}) note(p, false);
+    for (const auto& f : files) note(out / "truths" / f.family, true);
+  }
+  ~SuiteCleanup() {
+    if (done_) return;
+    std::error_code ec;
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) {
+      if (it->second) fs::remove_all(it->first, ec);
+      else fs::remove(it->first, ec);  // fails, as wanted, when not empty
+    }
+  }
+  void dismiss() { done_ = true; }
+  // A family whose result is written: its truths, and the directories holding them, stay.
+  void keep(const fs::path& family_truths) {
+    created_.erase(std::remove_if(created_.begin(), created_.end(),
+                                  [&](const auto& c) { return !c.second || c.first == family_truths; }),
+                   created_.end());
+  }
+
+private:
+  void note(const fs::path& p, bool own) {
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(p, ec))) created_.push_back({p, own});
+  }
+  std::vector<std::pair<fs::path, bool>> created_;
+  bool done_ = false;
+};
+
+// An --out for suite runs holds only what the suite writes there.
+void check_suite_out(const fs::path& out) {
+  std::error_code ec;
+  if (fs::is_symlink(fs::symlink_status(out, ec)))
+    throw io::InputError("output directory '" + out.string() + "': is a symbolic link; give the directory itself");
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec)) throw io::InputError("output directory '" + out.string() + "': exists and is not a directory");
+  static const std::vector<std::string> ours = {"results", "truths", "report.md", "suite.csv", "suite.json", "suite.gp",
+                                                "suite.png"};
+  std::vector<std::string> foreign;
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string n = e.path().filename().string();
+    if (std::find(ours.begin(), ours.end(), n) == ours.end() && n.find(".tmp.") == std::string::npos) foreign.push_back(n);
+  }
+  if (!foreign.empty()) {
+    std::sort(foreign.begin(), foreign.end());
+    std::string list;
+    for (std::size_t i = 0; i < foreign.size() && i < 3; ++i) list += (i ? ", " : "") + foreign[i];
+    if (foreign.size() > 3) list += ", ...";
+    throw io::InputError("output directory '" + out.string() + "': holds files that are not the suite's (" + list +
+                         "); give a new or empty directory, or one holding only earlier suite outputs");
+  }
+}
+
 // scole-crosscheck suite: see --help.
 int run_suite(const std::vector<std::string>& only, const std::string& suite_dir, const std::string& out, bool collect,
               crosscheck::SuiteOptions so, bool quiet) {
@@ -120,11 +179,14 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
         }
       }
     }
+    check_suite_out(out);
+    SuiteCleanup cleanup(out, files);
     if (!files.empty()) fs::create_directories(fs::path(out) / "results");  // (--collect alone writes none)
     bool ok = true;
     for (const auto& f : files) {
       const auto r = crosscheck::run_suite_file(f, out, so);
       io::write_json_atomic((fs::path(out) / "results" / (f.family + ".json")).string(), r);
+      cleanup.keep(fs::path(out) / "truths" / f.family);
       ok = ok && r["expectations_met"].get<bool>();
       if (!quiet)
         for (const auto& c : r["checks"])
@@ -132,6 +194,7 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
             std::fprintf(stderr, "scole-crosscheck suite: %s: expectation failed: %s (measured %s)\n", f.family.c_str(),
                          c["what"].get<std::string>().c_str(), c["measured"].get<std::string>().c_str());
     }
+    cleanup.dismiss();
     if (!only.empty() && !collect) {
       if (!quiet) std::fprintf(stderr, "scole-crosscheck suite: wrote %s/results; %s\n", out.c_str(), ok ? "expectations held" : "NOT every expectation held");
       return ok ? 0 : 1;

@@ -136,6 +136,12 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
                          io::format_value(std::ceil(scenario.simulation.duration / opt.fe_step)) + " steps over the " +
                          io::format_value(scenario.simulation.duration) + " s record; the limit is " +
                          io::format_value(io::limits::kMaxSteps));
+  // The FE response is compared sample by sample: a step longer than the sample interval leaves
+  // the record's own resolution unresolved (and one longer than the record is no integration).
+  if (opt.fe_step > scenario.simulation.sample_interval)
+    throw io::InputError("trajectories: --fe-step " + io::format_value(opt.fe_step) + " exceeds the record's sample interval " +
+                         io::format_value(scenario.simulation.sample_interval) +
+                         " s: the response would not be resolved between samples (leave it 0 for the automatic step)");
   const auto t0 = std::chrono::steady_clock::now();
   TrajectoryReport rep;
   rep.scenario = scenario.name;

@@ -81,6 +81,8 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& sourc
     return json::parse(text, cb);
   } catch (const json::parse_error& e) {
     throw InputError(one_line(source + ": malformed JSON at byte " + std::to_string(e.byte)));
+  } catch (const json::exception& e) {  // a number beyond double's range (out_of_range.406)
+    throw InputError(one_line(source + ": malformed JSON (" + std::string(e.what()) + ")"));
   }
 }
 

@@ -54,6 +54,14 @@ TEST(CrosscheckCli, BadInputIsOneLineExitTwoNothingWritten) {
             2);
   EXPECT_NE(slurp(d / "err").find("--fe-step 1e-09 gives"), std::string::npos) << slurp(d / "err");
   EXPECT_FALSE(fs::exists(d / "out"));
+  // A step longer than the sample interval (0.01 s), here longer than the 10 s record: refused before
+  // any truth is run.
+  EXPECT_EQ(sh(exe + " trajectories --scenario paper-beam-1 --segments 4 --levels 2 --fe-step 100 --out " +
+               (d / "out").string() + " 2> " + (d / "err").string()),
+            2);
+  EXPECT_NE(slurp(d / "err").find("--fe-step 100 exceeds the record's sample interval 0.01"), std::string::npos)
+      << slurp(d / "err");
+  EXPECT_FALSE(fs::exists(d / "out"));
   // `report` on a modes.json that is not what `modes` writes: exit 2, the user's file and the field
   // named (not the staging copy), the file left as it was.
   fs::create_directories(d / "rep");
@@ -162,6 +170,19 @@ TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
                (d / "out").string() + " 2> /dev/null"),
             2);
   EXPECT_EQ(sh(exe + " suite --seeds 1 --only " + (d / "one.yaml").string() + " --out " + (d / "out").string() + " 2> /dev/null"), 2);
+  EXPECT_FALSE(fs::exists(d / "out"));
+  // An --out holding a file of the user's: refused, the file untouched, nothing added.
+  fs::create_directories(d / "mine");
+  write(d / "mine" / "notes.txt", "mine\n");
+  EXPECT_EQ(sh(exe + " suite --only " + (d / "one.yaml").string() + " --out " + (d / "mine").string() + " 2> " +
+               (d / "err").string()),
+            2);
+  EXPECT_NE(slurp(d / "err").find("notes.txt"), std::string::npos) << slurp(d / "err");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d / "mine"), fs::directory_iterator{}), 1);
+  // SIGTERM while the family runs: exit 143 and nothing of it left (its truths were being written).
+  const int code = sh("( " + exe + " suite --only " + (d / "one.yaml").string() + " --out " + (d / "out").string() +
+                      " -q 2> /dev/null & p=$!; sleep 0.5; kill -TERM $p; wait $p )");
+  EXPECT_EQ(code, 143);
   EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);
 }

@@ -47,6 +47,8 @@ TEST(InputFile, ARepeatedJsonKeyIsRefusedWithItsPathAndDistinctKeysAreKept) {
   EXPECT_EQ(j["b"][1]["a"], 3);
   EXPECT_EQ(j["c"][0][0]["a"], 4);
   EXPECT_NE(error_of([] { parse_json_text("{\"a\": ", "s"); }).find("malformed JSON"), std::string::npos);
+  // A number beyond double's range is an error of the file, not of the program.
+  EXPECT_NE(error_of([] { parse_json_text("{\"a\": 1e666666}", "s"); }).find("malformed JSON"), std::string::npos);
 }
 
 TEST(InputFile, ARepeatedYamlKeyIsRefusedWithItsPath) {
