@@ -491,6 +491,18 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
     const double sd = sc.sensors[i].noise_std;
     if (!(sd > 0)) continue;
+    // Noise a thousand times the sensor's own RMS signal leaves a record of noise: over the
+    // 5e6 samples a record may hold, the signal's share of it would still be below the noise of
+    // its own estimate. Refused (a wrong unit, or noise_std: 1e20) rather than written.
+    const auto& col = tab.columns[sc.inputs.size() + i];
+    double ms = 0.0;
+    for (double v : col) ms += v * v;
+    const double rms = col.empty() ? 0.0 : std::sqrt(ms / static_cast<double>(col.size()));
+    if (rms > 0 && sd > 1e3 * rms)
+      io::fail_field(sc.source, "sensors[" + std::to_string(i) + "].noise_std",
+                     "is " + io::format_value(sd / rms) + " times the RMS signal " + io::format_value(rms) + " of sensor '" +
+                         sc.sensors[i].name + "': the record would hold nothing but noise (at most 1000 times)",
+                     io::format_value(sd));
     std::normal_distribution<double> noise(0.0, sd);
     for (double& v : tab.columns[sc.inputs.size() + i]) v += noise(rng);
   }

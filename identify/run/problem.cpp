@@ -620,6 +620,24 @@ void finish_problem(Problem& p, double step, const std::string* csv) {
                "sensors where the structure cannot move)",
                std::to_string(p.data.sensors()) + " sensor" + (p.data.sensors() == 1 ? "" : "s"));
   }
+  // A stated noise level the record contradicts: white noise of std σ added to any signal gives a
+  // record whose mean square is at least about σ² (the signal's share adds to it), and over 30 or
+  // more samples its sample mean square falls below σ²/9 with probability under 1e-12. A level
+  // three times the record's RMS is a wrong unit or a typo (noise_std: 1e20), and a fit test drawn
+  // from it would pass any start.
+  const Eigen::Index N = p.data.z.rows();
+  for (Eigen::Index j = 0; j < p.data.z.cols() && N >= 30; ++j) {
+    const double sd = p.noise_std[static_cast<std::size_t>(j)];
+    const double rms = std::sqrt(p.data.z.col(j).squaredNorm() / static_cast<double>(N));
+    if (!(sd > 3.0 * rms)) continue;
+    const std::string why = "states more noise than the record holds: sensor '" + p.scenario.sensors[static_cast<std::size_t>(j)].name +
+                            "' reads " + io::format_value(rms) + " RMS over " + std::to_string(N) +
+                            " samples, and noise of the stated level alone would read about itself";
+    if (p.noise_origin[static_cast<std::size_t>(j)] == "truth.json" && csv)
+      throw InputError("truth.json beside data file '" + *csv + "': the noise_std of column '" +
+                       p.scenario.sensors[static_cast<std::size_t>(j)].name + "' " + why + ", got " + io::format_value(sd));
+    fail_field(p.scenario.source, "sensors[" + std::to_string(j) + "].noise_std", why, io::format_value(sd));
+  }
   apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
   p.objective_options.solver.step = step;

@@ -429,6 +429,40 @@ identification: {estimate: [EI], elements: 4}
   EXPECT_EQ(with_signal("{type: sine, amplitude: 1, frequency: 5}"), "");
 }
 
+TEST(MeasuredData, AStatedNoiseLevelTheRecordContradictsIsRefused) {
+  // 200 samples of a 1e-3 m sine (RMS 7.1e-4): a stated noise of 1e20 m, or of 3e-3 m, cannot have
+  // been added to it (the record's mean square would be at least the noise's); 1e-5 m can.
+  scoleid::io::DataTable tab;
+  tab.names = {"P", "w"};
+  tab.columns.resize(2);
+  for (int k = 0; k < 200; ++k) {
+    tab.t.push_back(0.01 * k);
+    tab.columns[0].push_back(10.0);
+    tab.columns[1].push_back(1e-3 * std::sin(2 * M_PI * 0.5 * 0.01 * k));
+  }
+  auto with_noise = [&](const std::string& sd) {
+    const auto sc = scoleid::io::parse_scenario(R"(name: v
+beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000}
+inputs: [{name: P, location: 5}]
+sensors: [{name: w, location: 5, noise_std: )" + sd + R"(}]
+simulation: {duration: 1.99, sample_interval: 0.01}
+identification: {estimate: [EI], elements: 4}
+)", "s.yaml");
+    try {
+      make_problem(sc, tab, "w.csv", nullptr, "");
+    } catch (const scoleid::io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  for (const char* sd : {"1e20", "3e-3"}) {
+    const std::string e = with_noise(sd);
+    EXPECT_NE(e.find("sensors[0].noise_std"), std::string::npos) << sd << ": " << e;
+    EXPECT_NE(e.find("more noise than the record holds"), std::string::npos) << e;
+  }
+  EXPECT_EQ(with_noise("1e-5"), "");
+}
+
 namespace {
 // beam-ei8's loads on a 64-element beam (data on 128) with EI on N equal sections.
 scoleid::io::Scenario sections_scenario(int N) {

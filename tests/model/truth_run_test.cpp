@@ -180,3 +180,25 @@ TEST(TruthRun, ARecordOfNothingIsRefusedNamingWhatIsMissing) {
   EXPECT_NE(error_of(base + "inputs: []\n" + sensor).find("inputs must give at least one input a signal"), std::string::npos);
   EXPECT_NE(error_of(base + sensor).find("inputs"), std::string::npos);
 }
+
+TEST(TruthRun, NoiseThatWouldDrownTheRecordIsRefused) {
+  // The midspan of a pinned beam under a 1 N step moves ~1e-3 m (static PL³/48EI = 9e-4 m): noise
+  // of 1e20 m, and of 10 m (1e4 times the signal), is refused naming the field; 1e-5 m is written.
+  auto with_noise = [](const std::string& sd) {
+    return io::parse_scenario("name: v\nbeam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000}\n"
+                              "inputs: [{name: P, location: 5, signal: {type: step, amplitude: 1}}]\n"
+                              "sensors: [{name: w, location: 5, noise_std: " + sd + "}]\n"
+                              "simulation: {duration: 2, sample_interval: 0.01}\ntruth: {segments: 6}\n",
+                              "s.yaml");
+  };
+  for (const char* sd : {"1e20", "10"}) {
+    try {
+      run_truth(with_noise(sd));
+      ADD_FAILURE() << sd << " accepted";
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("sensors[0].noise_std"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("nothing but noise"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(run_truth(with_noise("1e-5")).table.t.size(), 201u);
+}
