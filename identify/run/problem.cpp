@@ -622,7 +622,7 @@ void finish_problem(Problem& p, double step, const std::string* csv) {
   }
   // A stated noise level the record contradicts: white noise of std σ added to any signal gives a
   // record whose mean square is at least about σ² (the signal's share adds to it), and over 30 or
-  // more samples its sample mean square falls below σ²/9 with probability under 1e-12. A level
+  // more samples its sample mean square falls below σ²/9 with probability 3e-10 (χ²₃₀ < 30/9). A level
   // three times the record's RMS is a wrong unit or a typo (noise_std: 1e20), and a fit test drawn
   // from it would pass any start.
   const Eigen::Index N = p.data.z.rows();
