@@ -135,9 +135,11 @@ ExperimentsSpec load_experiments(const std::string& path) {
     try {
       s.threads = root["threads"].as<int>();
     } catch (const YAML::Exception&) {
-      bad(path, "threads", "must be an integer >= 0", scalar(root["threads"], path, "threads"));
+      bad(path, "threads", "must be an integer in [0, 1024]", scalar(root["threads"], path, "threads"));
     }
-    if (s.threads < 0) bad(path, "threads", "must be an integer >= 0", std::to_string(s.threads));
+    // The command line's bound (--threads): more threads than that is no machine's.
+    if (s.threads < 0 || s.threads > 1024)
+      bad(path, "threads", "must be an integer in [0, 1024] (0 = the machine's threads)", std::to_string(s.threads));
   }
   std::set<std::string> names;
   if (root["runs"]) {

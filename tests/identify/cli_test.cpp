@@ -1015,6 +1015,10 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   write_file(dir / "m.csv", "mode,frequency_hz,frequency_std_hz,shape_std,w_tip,w_mid\n1,0.3,0.001,0.01,1\n");
   expect_input_error(run({"--experiments", (dir / "e3.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
                      {"m.csv", "line 2"});
+  // threads beyond the command line's bound of 1024: refused, naming the field.
+  write_file(dir / "e5.yaml", "experiments: two\nthreads: 1000000\nruns:\n  - {name: a, scenario: a.yaml}\n");
+  expect_input_error(run({"--experiments", (dir / "e5.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
+                     {"e5.yaml", "threads", "1000000"});
   // A key given twice in the experiments file (yaml-cpp would answer the first): refused, naming it.
   write_file(dir / "e4.yaml", "experiments: two\nruns:\n  - {name: a, scenario: a.yaml, scenario: b.yaml}\n");
   expect_input_error(run({"--experiments", (dir / "e4.yaml").string(), "--out", out3.string(), "-q"}, dir), out3,
