@@ -126,6 +126,279 @@ ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& p
   rows_per_mode_ = 1 + (data_.has_damping() ? 1 : 0) + static_cast<int>(data_.stations.size());
 }
 
+namespace {
+
+// The model's modes as the matching sees them: the flexible modes, grouped in clusters of
+// (chained) relative eigenvalue difference below the tolerance, each with its mean eigenvalue,
+// frequency, damping ratio and station shapes.
+struct Cluster {
+  std::vector<int> modes;  // mode indices (columns of Φ)
+  double lambda = 0, omega = 0, f = 0, zeta = 0;
+  MatrixXd Y;  // C_s Φ_c (stations × m)
+  Eigen::JacobiSVD<MatrixXd> svd;
+  int rank = 0;
+};
+
+struct Spectrum {
+  const MatrixXd& Phi;  // all n modes, M-orthonormal
+  VectorXd lambda;      // ω²
+  std::vector<int> flex;        // mode index of flexible mode f
+  std::vector<int> cluster_of;  // cluster of flexible mode f
+  std::vector<Cluster> cl;      // the clusters the candidates touch
+  MatrixXd Y;                   // C_s Φ, all modes (for the shape derivatives)
+  int ncand = 0;                // candidates: the first ncand flexible modes
+  const Cluster& of(int f) const { return cl[static_cast<std::size_t>(cluster_of[static_cast<std::size_t>(f)])]; }
+};
+
+Spectrum cluster_spectrum(const NaturalModes& nm, const SparseMatrix& D, const MatrixXd& Cs, int nmeas, bool shapes,
+                          const ModalMisfitOptions& options) {
+  Spectrum s{nm.vectors, nm.omega.array().square(), {}, {}, {}, {}, 0};
+  const MatrixXd& Phi = s.Phi;
+  const int n = static_cast<int>(Phi.rows());
+  for (int k = 0; k < n; ++k)
+    if (nm.omega[k] > nm.floor) s.flex.push_back(k);
+  const int nflex = static_cast<int>(s.flex.size());
+  if (nflex < nmeas)
+    throw std::domain_error("ModalMisfit: the model has " + std::to_string(nflex) + " flexible modes, the data " +
+                            std::to_string(nmeas));
+  s.cluster_of.resize(static_cast<std::size_t>(nflex));
+  std::vector<std::vector<int>> clusters;  // flexible indices of each cluster
+  for (int f = 0; f < nflex; ++f) {
+    const double lk = s.lambda[s.flex[static_cast<std::size_t>(f)]];
+    if (f > 0 && lk - s.lambda[s.flex[static_cast<std::size_t>(f) - 1]] < options.cluster_tolerance * lk) {
+      clusters.back().push_back(f);
+    } else {
+      clusters.push_back({f});
+    }
+    s.cluster_of[static_cast<std::size_t>(f)] = static_cast<int>(clusters.size()) - 1;
+  }
+  s.ncand = std::min(nflex, nmeas + options.extra_candidates);
+  const int ncl = s.cluster_of[static_cast<std::size_t>(s.ncand) - 1] + 1;  // clusters touched by the candidates
+
+  s.cl.resize(static_cast<std::size_t>(ncl));
+  if (shapes) s.Y = Cs * Phi;
+  double shape_scale = 0.0;
+  if (shapes)
+    for (int f = 0; f < s.ncand; ++f)
+      shape_scale = std::max(shape_scale, s.Y.col(s.flex[static_cast<std::size_t>(f)]).norm());
+  const Eigen::Index ns = Cs.rows();
+  for (int j = 0; j < ncl; ++j) {
+    Cluster& C = s.cl[static_cast<std::size_t>(j)];
+    for (int f : clusters[static_cast<std::size_t>(j)]) C.modes.push_back(s.flex[static_cast<std::size_t>(f)]);
+    const int m = static_cast<int>(C.modes.size());
+    double tr_d = 0.0;
+    for (int k : C.modes) {
+      C.lambda += s.lambda[k] / m;
+      tr_d += Phi.col(k).dot(D * Phi.col(k));
+    }
+    C.omega = std::sqrt(C.lambda);
+    C.f = C.omega / kTwoPi;
+    C.zeta = tr_d / (2.0 * m * C.omega);
+    if (shapes) {
+      C.Y.resize(ns, m);
+      for (int i = 0; i < m; ++i) C.Y.col(i) = s.Y.col(C.modes[static_cast<std::size_t>(i)]);
+      C.svd.compute(C.Y, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      const VectorXd& sv = C.svd.singularValues();
+      for (int i = 0; i < sv.size(); ++i)
+        if (sv[i] > kShapeRankTolerance * shape_scale) ++C.rank;
+    }
+  }
+  return s;
+}
+
+// Projection of a measured (unit) shape onto a cluster's station span: the coefficients a and
+// the MAC |P ψ_m|².
+double project(const Cluster& C, const VectorXd& psi, VectorXd* a) {
+  const MatrixXd U = C.svd.matrixU().leftCols(C.rank);
+  const VectorXd ut = U.transpose() * psi;
+  if (a) *a = C.svd.matrixV().leftCols(C.rank) * (C.svd.singularValues().head(C.rank).cwiseInverse().asDiagonal() * ut);
+  return ut.squaredNorm();
+}
+
+// One-to-one matching of least total cost (the assignment problem, solved exactly): cost
+// 1 − MAC with shapes (relative frequency difference × 1e-6 breaks ties), the relative frequency
+// difference without. Candidates a measured shape cannot be matched with (a cluster with no
+// station amplitude) are not allowed. Returns the partner candidate and the MAC of each measured mode.
+std::vector<int> pair_modes(const Spectrum& s, const io::ModalData& data, const std::vector<VectorXd>& measured_shape,
+                            std::vector<double>& mac_of) {
+  const bool shapes = data.has_shapes();
+  const int nmeas = static_cast<int>(data.modes.size());
+  constexpr double kForbidden = 1e30;
+  MatrixXd cost = MatrixXd::Constant(nmeas, s.ncand, kForbidden);
+  MatrixXd macs = MatrixXd::Constant(nmeas, s.ncand, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < nmeas; ++i) {
+    const double fm = data.modes[static_cast<std::size_t>(i)].frequency_hz;
+    for (int f = 0; f < s.ncand; ++f) {
+      const Cluster& C = s.of(f);
+      const double df = std::abs(C.f - fm) / fm;
+      if (!shapes) {
+        cost(i, f) = df;
+        continue;
+      }
+      if (C.rank == 0) continue;
+      macs(i, f) = project(C, measured_shape[static_cast<std::size_t>(i)], nullptr);
+      cost(i, f) = (1.0 - macs(i, f)) + 1e-6 * df;
+    }
+  }
+  const std::vector<int> assigned = least_cost_assignment(cost);
+  std::vector<int> partner(static_cast<std::size_t>(nmeas), -1);
+  mac_of.assign(static_cast<std::size_t>(nmeas), std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < nmeas; ++i) {
+    const int f = assigned[static_cast<std::size_t>(i)];
+    if (f < 0 || !(cost(i, f) < kForbidden)) continue;
+    partner[static_cast<std::size_t>(i)] = f;
+    mac_of[static_cast<std::size_t>(i)] = macs(i, f);
+  }
+  for (int i = 0; i < nmeas; ++i)
+    if (partner[static_cast<std::size_t>(i)] < 0)
+      throw std::domain_error("ModalMisfit: measured mode " + std::to_string(data.modes[static_cast<std::size_t>(i)].label) +
+                              " matches no model mode");
+  return partner;
+}
+
+// A matched model shape at the stations: p = Y_c a, its norm, its unit vector and the sign that
+// aligns it with the measured shape.
+struct ShapeMatch {
+  VectorXd coef, unit;
+  double pnorm = 0.0, sign = 1.0;
+};
+
+// The derivatives of one cluster's mean eigenvalue, frequency, damping ratio and station shapes
+// along one parameter direction (M', K', D'): first-order perturbation theory within the
+// M-orthonormal basis Φ, the cluster's own span taken as the normalisation −½ Φ_cᵀ M' Φ_c.
+struct ClusterDerivative {
+  double dlambda = 0, domega = 0, df = 0, dzeta = 0;
+  MatrixXd dY;  // C_s dΦ_c
+};
+
+ClusterDerivative cluster_derivative(const Spectrum& s, const Cluster& C, const MatrixXd& W, const SparseMatrix& dM,
+                                     const SparseMatrix& dK, const SparseMatrix& dD, bool damping, bool shapes) {
+  const MatrixXd& Phi = s.Phi;
+  const int n = static_cast<int>(Phi.rows());
+  const int m = static_cast<int>(C.modes.size());
+  ClusterDerivative d;
+  // Coefficients of dΦ_c in the basis Φ: E (n × m).
+  MatrixXd Mc(n, m);  // M' Φ_c
+  MatrixXd E = MatrixXd::Zero(n, m);
+  d.dlambda = 0.0;
+  double tr_dD = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const int k = C.modes[static_cast<std::size_t>(i)];
+    const VectorXd phi = Phi.col(k);
+    Mc.col(i) = dM * phi;
+    const VectorXd v = dK * phi - s.lambda[k] * Mc.col(i);
+    d.dlambda += phi.dot(v) / m;
+    if (damping) tr_dD += phi.dot(dD * phi);
+    const VectorXd G = Phi.transpose() * v;
+    for (int j = 0; j < n; ++j) {
+      if (std::find(C.modes.begin(), C.modes.end(), j) != C.modes.end()) continue;
+      E(j, i) = G[j] / (s.lambda[k] - s.lambda[j]);
+    }
+  }
+  // −½ Φ_c (Φ_cᵀ M' Φ_c): the normalisation, within the span.
+  for (int i = 0; i < m; ++i)
+    for (int l = 0; l < m; ++l)
+      E(C.modes[static_cast<std::size_t>(l)], i) -= 0.5 * Phi.col(C.modes[static_cast<std::size_t>(l)]).dot(Mc.col(i));
+  d.domega = d.dlambda / (2.0 * C.omega);
+  d.df = d.domega / kTwoPi;
+  if (damping) {
+    double tr_DdPhi = 0.0;
+    for (int i = 0; i < m; ++i) tr_DdPhi += W.col(i).dot(E.col(i));
+    d.dzeta = (tr_dD + 2.0 * tr_DdPhi) / (2.0 * m * C.omega) - C.zeta * d.domega / C.omega;
+  }
+  if (shapes) d.dY = s.Y * E;
+  return d;
+}
+
+// The weighted residuals of the matched modes (frequency, damping ratio, unit station shape with
+// its sign), the matches, and per measured mode what the shape derivatives need.
+VectorXd modal_residuals(const Spectrum& s, const io::ModalData& data, const std::vector<VectorXd>& measured_shape,
+                         int rows_per_mode, const std::vector<int>& partner, const std::vector<double>& mac_of,
+                         std::vector<ShapeMatch>& shape, std::vector<ModalMisfit::Match>& matches) {
+  const bool damping = data.has_damping(), shapes = data.has_shapes();
+  const int nmeas = static_cast<int>(data.modes.size());
+  const Eigen::Index ns = static_cast<Eigen::Index>(data.stations.size());
+  VectorXd r(static_cast<Eigen::Index>(rows_per_mode) * nmeas);
+  matches.clear();
+  shape.assign(static_cast<std::size_t>(nmeas), {});
+  for (int i = 0; i < nmeas; ++i) {
+    const auto& md = data.modes[static_cast<std::size_t>(i)];
+    const int f = partner[static_cast<std::size_t>(i)];
+    const Cluster& C = s.of(f);
+    const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode;
+    r[row] = (C.f - md.frequency_hz) / md.frequency_std_hz;
+    if (damping) r[row + 1] = (C.zeta - md.damping_ratio) / md.damping_std;
+    if (shapes) {
+      const VectorXd& psim = measured_shape[static_cast<std::size_t>(i)];
+      ShapeMatch& sm = shape[static_cast<std::size_t>(i)];
+      project(C, psim, &sm.coef);
+      const VectorXd p = C.Y * sm.coef;
+      sm.pnorm = p.norm();
+      if (!(sm.pnorm > 0)) throw std::domain_error("ModalMisfit: a matched model shape vanishes at the stations");
+      sm.unit = p / sm.pnorm;
+      sm.sign = psim.dot(sm.unit) < 0 ? -1.0 : 1.0;
+      r.segment(row + (damping ? 2 : 1), ns) = (sm.sign * sm.unit - psim) / md.shape_std;
+    }
+    matches.push_back({i, f, static_cast<int>(C.modes.size()), mac_of[static_cast<std::size_t>(i)], C.f, C.zeta});
+  }
+  return r;
+}
+
+// ∂r/∂q: per parameter direction, the derivative of every matched cluster (cluster_derivative),
+// then of each residual row.
+MatrixXd modal_jacobian(const StructuralModel& model, const Spectrum& s, const SparseMatrix& D, const MatrixXd& dcdq,
+                        const io::ModalData& data, int rows_per_mode, const std::vector<int>& partner,
+                        const std::vector<ShapeMatch>& shape) {
+  const bool damping = data.has_damping(), shapes = data.has_shapes();
+  const int nmeas = static_cast<int>(data.modes.size());
+  const Eigen::Index ns = static_cast<Eigen::Index>(data.stations.size());
+  const int n = model.ndof;
+  const Eigen::Index P = dcdq.cols();
+  MatrixXd jacobian = MatrixXd::Zero(static_cast<Eigen::Index>(rows_per_mode) * nmeas, P);
+  // The clusters that carry a match, with what their derivatives need once per evaluation.
+  std::vector<int> used;
+  for (int i = 0; i < nmeas; ++i) {
+    const int j = s.cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
+    if (std::find(used.begin(), used.end(), j) == used.end()) used.push_back(j);
+  }
+  std::vector<MatrixXd> W(used.size());  // Φᵀ D Φ_c, for tr(Φ_cᵀ D dΦ_c)
+  if (damping)
+    for (std::size_t u = 0; u < used.size(); ++u) {
+      const Cluster& C = s.cl[static_cast<std::size_t>(used[u])];
+      MatrixXd DPc(n, static_cast<Eigen::Index>(C.modes.size()));
+      for (std::size_t i = 0; i < C.modes.size(); ++i) DPc.col(static_cast<Eigen::Index>(i)) = D * s.Phi.col(C.modes[i]);
+      W[u] = s.Phi.transpose() * DPc;
+    }
+  std::vector<ClusterDerivative> cd(used.size());
+  for (Eigen::Index p = 0; p < P; ++p) {
+    const VectorXd dc = dcdq.col(p);
+    if (dc.cwiseAbs().maxCoeff() == 0.0) continue;
+    const SparseMatrix dM = along(model.mass, dc, n);
+    const SparseMatrix dK = along(model.stiffness, dc, n);
+    const SparseMatrix dD = damping ? along(model.damping, dc, n) : SparseMatrix(n, n);
+    for (std::size_t u = 0; u < used.size(); ++u)
+      cd[u] = cluster_derivative(s, s.cl[static_cast<std::size_t>(used[u])], W[u], dM, dK, dD, damping, shapes);
+    for (int i = 0; i < nmeas; ++i) {
+      const auto& md = data.modes[static_cast<std::size_t>(i)];
+      const int j = s.cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
+      const std::size_t u = static_cast<std::size_t>(std::find(used.begin(), used.end(), j) - used.begin());
+      const ClusterDerivative& d = cd[u];
+      const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode;
+      jacobian(row, p) = d.df / md.frequency_std_hz;
+      if (damping) jacobian(row + 1, p) = d.dzeta / md.damping_std;
+      if (shapes) {
+        const ShapeMatch& sm = shape[static_cast<std::size_t>(i)];
+        const VectorXd dp = d.dY * sm.coef;
+        const VectorXd dph = (dp - sm.unit * sm.unit.dot(dp)) / sm.pnorm;
+        jacobian.block(row + (damping ? 2 : 1), p, ns, 1) = sm.sign * dph / md.shape_std;
+      }
+    }
+  }
+  return jacobian;
+}
+
+}  // namespace
+
 const ModalMisfit::Evaluation& ModalMisfit::evaluate(const VectorXd& q, bool derivatives) {
   if (have_last_ && last_.q.size() == q.size() && (last_.q.array() == q.array()).all() &&
       (last_.has_jacobian || !derivatives))
@@ -134,11 +407,7 @@ const ModalMisfit::Evaluation& ModalMisfit::evaluate(const VectorXd& q, bool der
   if (q.size() != params_.size())
     throw std::invalid_argument("ModalMisfit: parameter vector of size " + std::to_string(q.size()) + ", expected " +
                                 std::to_string(params_.size()));
-  const int n = model_.ndof;
-  const int P = params_.size();
-  const bool damping = data_.has_damping(), shapes = data_.has_shapes();
   const int nmeas = static_cast<int>(data_.modes.size());
-  const int ns = static_cast<int>(data_.stations.size());
 
   VectorXd c;
   MatrixXd dcdq;
@@ -151,230 +420,20 @@ const ModalMisfit::Evaluation& ModalMisfit::evaluate(const VectorXd& q, bool der
   ++counters_.evaluations;
   if (!nm.omega.allFinite() || !nm.vectors.allFinite())
     throw std::domain_error("ModalMisfit: the eigenproblem has no finite solution at this q");
-  const MatrixXd& Phi = nm.vectors;
-  const VectorXd lambda = nm.omega.array().square();
+  const Spectrum s = cluster_spectrum(nm, D, Cs_, nmeas, data_.has_shapes(), options_);
+  std::vector<double> mac_of;
+  const std::vector<int> partner = pair_modes(s, data_, measured_shape_, mac_of);
 
-  // Flexible modes and their clusters (chained relative eigenvalue differences below the tolerance).
-  std::vector<int> flex;  // mode index of flexible mode f
-  for (int k = 0; k < n; ++k)
-    if (nm.omega[k] > nm.floor) flex.push_back(k);
-  const int nflex = static_cast<int>(flex.size());
-  if (nflex < nmeas)
-    throw std::domain_error("ModalMisfit: the model has " + std::to_string(nflex) + " flexible modes, the data " +
-                            std::to_string(nmeas));
-  std::vector<int> cluster_of(static_cast<std::size_t>(nflex));
-  std::vector<std::vector<int>> clusters;  // flexible indices of each cluster
-  for (int f = 0; f < nflex; ++f) {
-    const double lk = lambda[flex[static_cast<std::size_t>(f)]];
-    if (f > 0 && lk - lambda[flex[static_cast<std::size_t>(f) - 1]] < options_.cluster_tolerance * lk) {
-      clusters.back().push_back(f);
-    } else {
-      clusters.push_back({f});
-    }
-    cluster_of[static_cast<std::size_t>(f)] = static_cast<int>(clusters.size()) - 1;
-  }
-  const int ncand = std::min(nflex, nmeas + options_.extra_candidates);
-  const int ncl = cluster_of[static_cast<std::size_t>(ncand) - 1] + 1;  // clusters touched by the candidates
-
-  // Per cluster: mean eigenvalue, frequency, damping ratio, member vectors and station shapes.
-  struct Cluster {
-    std::vector<int> modes;  // mode indices (columns of Φ)
-    double lambda = 0, omega = 0, f = 0, zeta = 0;
-    MatrixXd Y;  // C_s Φ_c (stations × m)
-    Eigen::JacobiSVD<MatrixXd> svd;
-    int rank = 0;
-  };
-  std::vector<Cluster> cl(static_cast<std::size_t>(ncl));
-  MatrixXd Y;  // C_s Φ, all modes (for the shape derivatives)
-  if (shapes) Y = Cs_ * Phi;
-  double shape_scale = 0.0;
-  if (shapes)
-    for (int f = 0; f < ncand; ++f)
-      shape_scale = std::max(shape_scale, Y.col(flex[static_cast<std::size_t>(f)]).norm());
-  for (int j = 0; j < ncl; ++j) {
-    Cluster& C = cl[static_cast<std::size_t>(j)];
-    for (int f : clusters[static_cast<std::size_t>(j)]) C.modes.push_back(flex[static_cast<std::size_t>(f)]);
-    const int m = static_cast<int>(C.modes.size());
-    double tr_d = 0.0;
-    for (int k : C.modes) {
-      C.lambda += lambda[k] / m;
-      tr_d += Phi.col(k).dot(D * Phi.col(k));
-    }
-    C.omega = std::sqrt(C.lambda);
-    C.f = C.omega / kTwoPi;
-    C.zeta = tr_d / (2.0 * m * C.omega);
-    if (shapes) {
-      C.Y.resize(ns, m);
-      for (int i = 0; i < m; ++i) C.Y.col(i) = Y.col(C.modes[static_cast<std::size_t>(i)]);
-      C.svd.compute(C.Y, Eigen::ComputeThinU | Eigen::ComputeThinV);
-      const VectorXd& sv = C.svd.singularValues();
-      for (int i = 0; i < sv.size(); ++i)
-        if (sv[i] > kShapeRankTolerance * shape_scale) ++C.rank;
-    }
-  }
-  // Projection of a measured (unit) shape onto a cluster's station span: the coefficients a and
-  // the MAC |P ψ_m|².
-  auto project = [&](const Cluster& C, const VectorXd& psi, VectorXd* a) {
-    const MatrixXd U = C.svd.matrixU().leftCols(C.rank);
-    const VectorXd ut = U.transpose() * psi;
-    if (a)
-      *a = C.svd.matrixV().leftCols(C.rank) * (C.svd.singularValues().head(C.rank).cwiseInverse().asDiagonal() * ut);
-    return ut.squaredNorm();
-  };
-
-  // One-to-one matching of least total cost (the assignment problem, solved exactly): cost
-  // 1 − MAC with shapes (relative frequency difference × 1e-6 breaks ties), the relative frequency
-  // difference without. Candidates a measured shape cannot be matched with (a cluster with no
-  // station amplitude) are not allowed.
-  constexpr double kForbidden = 1e30;
-  MatrixXd cost = MatrixXd::Constant(nmeas, ncand, kForbidden);
-  MatrixXd macs = MatrixXd::Constant(nmeas, ncand, std::numeric_limits<double>::quiet_NaN());
-  for (int i = 0; i < nmeas; ++i) {
-    const double fm = data_.modes[static_cast<std::size_t>(i)].frequency_hz;
-    for (int f = 0; f < ncand; ++f) {
-      const Cluster& C = cl[static_cast<std::size_t>(cluster_of[static_cast<std::size_t>(f)])];
-      const double df = std::abs(C.f - fm) / fm;
-      if (!shapes) {
-        cost(i, f) = df;
-        continue;
-      }
-      if (C.rank == 0) continue;
-      macs(i, f) = project(C, measured_shape_[static_cast<std::size_t>(i)], nullptr);
-      cost(i, f) = (1.0 - macs(i, f)) + 1e-6 * df;
-    }
-  }
-  const std::vector<int> assigned = least_cost_assignment(cost);
-  std::vector<int> partner(static_cast<std::size_t>(nmeas), -1);
-  std::vector<double> mac_of(static_cast<std::size_t>(nmeas), std::numeric_limits<double>::quiet_NaN());
-  for (int i = 0; i < nmeas; ++i) {
-    const int f = assigned[static_cast<std::size_t>(i)];
-    if (f < 0 || !(cost(i, f) < kForbidden)) continue;
-    partner[static_cast<std::size_t>(i)] = f;
-    mac_of[static_cast<std::size_t>(i)] = macs(i, f);
-  }
-  for (int i = 0; i < nmeas; ++i)
-    if (partner[static_cast<std::size_t>(i)] < 0)
-      throw std::domain_error("ModalMisfit: measured mode " +
-                              std::to_string(data_.modes[static_cast<std::size_t>(i)].label) +
-                              " matches no model mode");
-
-  // Residuals.
   Evaluation& e = last_;
   e.q = q;
-  e.r.resize(static_cast<Eigen::Index>(rows_per_mode_) * nmeas);
-  e.matches.clear();
-  std::vector<VectorXd> coef(static_cast<std::size_t>(nmeas));  // a per measured mode
-  std::vector<VectorXd> unit(static_cast<std::size_t>(nmeas));  // ψ̂ per measured mode
-  std::vector<double> pnorm(static_cast<std::size_t>(nmeas), 0.0), sgn(static_cast<std::size_t>(nmeas), 1.0);
-  for (int i = 0; i < nmeas; ++i) {
-    const auto& md = data_.modes[static_cast<std::size_t>(i)];
-    const int f = partner[static_cast<std::size_t>(i)];
-    const Cluster& C = cl[static_cast<std::size_t>(cluster_of[static_cast<std::size_t>(f)])];
-    const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode_;
-    e.r[row] = (C.f - md.frequency_hz) / md.frequency_std_hz;
-    if (damping) e.r[row + 1] = (C.zeta - md.damping_ratio) / md.damping_std;
-    if (shapes) {
-      const VectorXd& psim = measured_shape_[static_cast<std::size_t>(i)];
-      VectorXd a;
-      project(C, psim, &a);
-      const VectorXd p = C.Y * a;
-      const double pn = p.norm();
-      if (!(pn > 0)) throw std::domain_error("ModalMisfit: a matched model shape vanishes at the stations");
-      const VectorXd ph = p / pn;
-      const double s = psim.dot(ph) < 0 ? -1.0 : 1.0;
-      e.r.segment(row + (damping ? 2 : 1), ns) = (s * ph - psim) / md.shape_std;
-      coef[static_cast<std::size_t>(i)] = a;
-      unit[static_cast<std::size_t>(i)] = ph;
-      pnorm[static_cast<std::size_t>(i)] = pn;
-      sgn[static_cast<std::size_t>(i)] = s;
-    }
-    e.matches.push_back({i, f, static_cast<int>(C.modes.size()), mac_of[static_cast<std::size_t>(i)], C.f, C.zeta});
-  }
+  std::vector<ShapeMatch> shape;
+  e.r = modal_residuals(s, data_, measured_shape_, rows_per_mode_, partner, mac_of, shape, e.matches);
   e.J = 0.5 * e.r.squaredNorm();
   e.has_jacobian = false;
   e.jacobian.resize(0, 0);
   if (!std::isfinite(e.J)) throw std::domain_error("ModalMisfit: the misfit is not finite at this q");
-
   if (derivatives) {
-    e.jacobian = MatrixXd::Zero(e.r.size(), P);
-    // The clusters that carry a match, with what their derivatives need once per evaluation.
-    std::vector<int> used;
-    for (int i = 0; i < nmeas; ++i) {
-      const int j = cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
-      if (std::find(used.begin(), used.end(), j) == used.end()) used.push_back(j);
-    }
-    std::vector<MatrixXd> W(used.size());  // Φᵀ D Φ_c, for tr(Φ_cᵀ D dΦ_c)
-    if (damping)
-      for (std::size_t u = 0; u < used.size(); ++u) {
-        const Cluster& C = cl[static_cast<std::size_t>(used[u])];
-        MatrixXd DPc(n, static_cast<Eigen::Index>(C.modes.size()));
-        for (std::size_t i = 0; i < C.modes.size(); ++i)
-          DPc.col(static_cast<Eigen::Index>(i)) = D * Phi.col(C.modes[i]);
-        W[u] = Phi.transpose() * DPc;
-      }
-    struct ClusterDerivative {
-      double dlambda = 0, domega = 0, df = 0, dzeta = 0;
-      MatrixXd dY;  // C_s dΦ_c
-    };
-    std::vector<ClusterDerivative> cd(used.size());
-    for (int p = 0; p < P; ++p) {
-      const VectorXd dc = dcdq.col(p);
-      if (dc.cwiseAbs().maxCoeff() == 0.0) continue;
-      const SparseMatrix dM = along(model_.mass, dc, n);
-      const SparseMatrix dK = along(model_.stiffness, dc, n);
-      const SparseMatrix dD = damping ? along(model_.damping, dc, n) : SparseMatrix(n, n);
-      for (std::size_t u = 0; u < used.size(); ++u) {
-        const Cluster& C = cl[static_cast<std::size_t>(used[u])];
-        const int m = static_cast<int>(C.modes.size());
-        ClusterDerivative& d = cd[u];
-        // Coefficients of dΦ_c in the basis Φ: E (n × m).
-        MatrixXd Mc(n, m);  // M' Φ_c
-        MatrixXd E = MatrixXd::Zero(n, m);
-        d.dlambda = 0.0;
-        double tr_dD = 0.0;
-        for (int i = 0; i < m; ++i) {
-          const int k = C.modes[static_cast<std::size_t>(i)];
-          const VectorXd phi = Phi.col(k);
-          Mc.col(i) = dM * phi;
-          const VectorXd v = dK * phi - lambda[k] * Mc.col(i);
-          d.dlambda += phi.dot(v) / m;
-          if (damping) tr_dD += phi.dot(dD * phi);
-          const VectorXd G = Phi.transpose() * v;
-          for (int j = 0; j < n; ++j) {
-            if (std::find(C.modes.begin(), C.modes.end(), j) != C.modes.end()) continue;
-            E(j, i) = G[j] / (lambda[k] - lambda[j]);
-          }
-        }
-        // −½ Φ_c (Φ_cᵀ M' Φ_c): the normalisation, within the span.
-        for (int i = 0; i < m; ++i)
-          for (int l = 0; l < m; ++l)
-            E(C.modes[static_cast<std::size_t>(l)], i) -=
-                0.5 * Phi.col(C.modes[static_cast<std::size_t>(l)]).dot(Mc.col(i));
-        d.domega = d.dlambda / (2.0 * C.omega);
-        d.df = d.domega / kTwoPi;
-        if (damping) {
-          double tr_DdPhi = 0.0;
-          for (int i = 0; i < m; ++i) tr_DdPhi += W[u].col(i).dot(E.col(i));
-          d.dzeta = (tr_dD + 2.0 * tr_DdPhi) / (2.0 * m * C.omega) - C.zeta * d.domega / C.omega;
-        }
-        if (shapes) d.dY = Y * E;
-      }
-      for (int i = 0; i < nmeas; ++i) {
-        const auto& md = data_.modes[static_cast<std::size_t>(i)];
-        const int j = cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
-        const std::size_t u = static_cast<std::size_t>(std::find(used.begin(), used.end(), j) - used.begin());
-        const ClusterDerivative& d = cd[u];
-        const Eigen::Index row = static_cast<Eigen::Index>(i) * rows_per_mode_;
-        e.jacobian(row, p) = d.df / md.frequency_std_hz;
-        if (damping) e.jacobian(row + 1, p) = d.dzeta / md.damping_std;
-        if (shapes) {
-          const std::size_t ii = static_cast<std::size_t>(i);
-          const VectorXd dp = d.dY * coef[ii];
-          const VectorXd dph = (dp - unit[ii] * unit[ii].dot(dp)) / pnorm[ii];
-          e.jacobian.block(row + (damping ? 2 : 1), p, ns, 1) = sgn[ii] * dph / md.shape_std;
-        }
-      }
-    }
+    e.jacobian = modal_jacobian(model_, s, D, dcdq, data_, rows_per_mode_, partner, shape);
     e.has_jacobian = true;
     if (!e.jacobian.allFinite()) throw std::domain_error("ModalMisfit: the Jacobian is not finite at this q");
   }
