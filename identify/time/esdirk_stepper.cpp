@@ -81,155 +81,87 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
   return res;
 }
 
-StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std::vector<double>& stops_in,
-                                      const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
-                                      double tangent_end, const Start* start, double until) const {
-  if (start) {
-    if (P != 0) throw std::invalid_argument("EsdirkStepper: a resumed run steps the state only");
-    if (h != start->h) throw std::invalid_argument("EsdirkStepper: a resumed run must keep its step");
-    t0 = start->t;
+// One integration's workspace and its steps: column 0 is the state, columns 1..P the tangents
+// (dropped after tangent_end). Stage i of a step solves
+//   (M + g D + g² K) A_i = F(t_i) − D ṽ − K (x̃ + g ṽ),  g = h a_ii,
+// with x̃ = x + h Σ_j a_ij V_j, ṽ = v + h Σ_j a_ij A_j; then V_i = ṽ + g A_i (docs/theory.md §5.1).
+class EsdirkStepper::Sweep {
+public:
+  Sweep(const EsdirkStepper& st, const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
+        double h, StepperCounters& cnt)
+      : st_(st), forcing_(forcing), sink_(sink), tangent_(tangent), P_(P), n_(static_cast<int>(st.M_.rows())),
+        s_(st.tab_.stages), m_(1 + P), h_(h), cnt_(cnt) {
+    const int n = n_, m = m_;
+    x = MatrixXd::Zero(n, m);
+    v = MatrixXd::Zero(n, m);
+    a.resize(n, m);
+    xt.resize(n, m);
+    vt.resize(n, m);
+    w.resize(n, m);
+    Vs.assign(static_cast<std::size_t>(s_), MatrixXd(n, m));
+    As.assign(static_cast<std::size_t>(s_), MatrixXd(n, m));
+    terms.assign(static_cast<std::size_t>(std::max(s_, 4)), {0.0, 0});
+    G.resize(n, std::max(P, 1));
+    F.resize(n);
+    X0.resize(n);
   }
-  if (!(h > 0.0)) throw std::invalid_argument("EsdirkStepper: step must be > 0");
-  if (!(t1 > t0)) throw std::invalid_argument("EsdirkStepper: t1 must exceed t0");
-  if (P < 0 || (P > 0 && !tangent)) throw std::invalid_argument("EsdirkStepper: tangents need their forcing");
-  const int n = static_cast<int>(M_.rows()), s = tab_.stages;
-  std::vector<double> stops;
-  for (double b : stops_in)
-    if (b > t0 && b < t1) stops.push_back(b);
-  std::sort(stops.begin(), stops.end());
-  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
-  stops.push_back(t1);
 
-  int m = 1 + P;
-  MatrixXd x = MatrixXd::Zero(n, m), v = MatrixXd::Zero(n, m), a(n, m), xt(n, m), vt(n, m), w(n, m);
-  std::vector<MatrixXd> Vs(static_cast<std::size_t>(s), MatrixXd(n, m)), As(static_cast<std::size_t>(s), MatrixXd(n, m));
-  // The nonzero coefficients of a stage's (or the step's) sum: (h a_ij or h b_j, j).
-  std::vector<std::pair<double, std::size_t>> terms(static_cast<std::size_t>(std::max(s, 4)), {0.0, 0});
-  MatrixXd G(n, std::max(P, 1));
-  VectorXd F(n), X0(n);
+  bool has_tangents() const { return m_ > 1; }
 
-  StepperCounters cnt;
+  void resume(const Start& start) {
+    x.col(0) = Eigen::Map<const VectorXd>(start.x, n_);
+    v.col(0) = Eigen::Map<const VectorXd>(start.v, n_);
+    a.col(0) = Eigen::Map<const VectorXd>(start.a, n_);
+    origin = start.origin;
+  }
 
-  // Tangent forcing of every tangent column from column 0 at (t, x0, v0, a0), into r's columns 1..P
-  // (less D ṽ + K w, the parts the caller sets up).
-  auto tangent_forcing = [&](double t, const double* x0, const double* v0, const double* a0) {
-    G.setZero();
-    (*tangent)(t, x0, v0, a0, G.data());
-  };
   // Accelerations of every column at the current (x, v), forcing evaluated at tf.
-  auto accelerate = [&](double tf) {
+  void accelerate(double tf) {
     F.setZero();
-    forcing(tf, F.data());
-    ++cnt.stage_forcings;
+    forcing_(tf, F.data());
+    ++cnt_.stage_forcings;
     a.col(0) = F;
-    a.col(0).noalias() -= D_rows_ * v.col(0);
-    a.col(0).noalias() -= K_rows_ * x.col(0);
-    mass_.solve_in_place(a.col(0).data());
-    ++cnt.linear_solves;
-    if (m > 1) {
+    a.col(0).noalias() -= st_.D_rows_ * v.col(0);
+    a.col(0).noalias() -= st_.K_rows_ * x.col(0);
+    st_.mass_.solve_in_place(a.col(0).data());
+    ++cnt_.linear_solves;
+    if (m_ > 1) {
       tangent_forcing(tf, x.col(0).data(), v.col(0).data(), a.col(0).data());
-      a.rightCols(P) = G.leftCols(P);
-      a.rightCols(P).noalias() -= D_rows_ * v.rightCols(P);
-      a.rightCols(P).noalias() -= K_rows_ * x.rightCols(P);
-      mass_.solve_in_place(a.col(1).data(), P, n);
-      cnt.linear_solves += P;
+      a.rightCols(P_) = G.leftCols(P_);
+      a.rightCols(P_).noalias() -= st_.D_rows_ * v.rightCols(P_);
+      a.rightCols(P_).noalias() -= st_.K_rows_ * x.rightCols(P_);
+      st_.mass_.solve_in_place(a.col(1).data(), P_, n_);
+      cnt_.linear_solves += P_;
     }
-  };
-  double origin = t0;
-  auto record = [&](double t, bool resumable) {
+  }
+
+  void record(double t, bool resumable) const {
     Point pt;
     pt.t = t;
-    pt.columns = m;
+    pt.columns = m_;
     pt.x = x.data();
     pt.v = v.data();
     pt.a = a.data();
     pt.origin = origin;
-    pt.h = h;
+    pt.h = h_;
     pt.resumable = resumable;
-    sink(pt);
-  };
-  auto drop_tangents = [&]() {
-    m = 1;
-    for (MatrixXd* A : {&x, &v, &a, &xt, &vt, &w}) A->conservativeResize(n, 1);
-    for (auto& A : Vs) A.conservativeResize(n, 1);
-    for (auto& A : As) A.conservativeResize(n, 1);
-  };
+    sink_(pt);
+  }
 
-  auto step = [&](double tn, double hs) {
-    for (int i = 0; i < s; ++i) {
-      const auto si = static_cast<std::size_t>(i);
-      if (i == 0 && explicit_first_) {
-        Vs[0] = v;
-        As[0] = a;
-        continue;
-      }
-      const double g = hs * tab_.a(i, i);
-      const double ti = tn + tab_.c[si] * hs;
-      const BandedCholesky& S = g > 0.0 ? newton_.factor(g) : mass_;
-      // ṽ = v + h Σ_j a_ij A_j and w = x̃ + g ṽ (x̃ = x + h Σ_j a_ij V_j), each in one pass over all
-      // columns (the sums in the order of the terms, as one accumulation would).
-      std::size_t nt = 0;
-      for (int j = 0; j < i; ++j) {
-        const double c = hs * tab_.a(i, j);
-        if (c != 0.0) terms[nt++] = {c, static_cast<std::size_t>(j)};
-      }
-      const auto& [c0, j0] = terms[0];
-      const auto& [c1, j1] = terms[1];
-      const auto& [c2, j2] = terms[2];
-      switch (nt) {
-        case 0:
-          vt = v;
-          w = x + g * vt;
-          break;
-        case 1:
-          vt = v + c0 * As[j0];
-          w = x + c0 * Vs[j0] + g * vt;
-          break;
-        case 2:
-          vt = v + c0 * As[j0] + c1 * As[j1];
-          w = x + c0 * Vs[j0] + c1 * Vs[j1] + g * vt;
-          break;
-        case 3:
-          vt = v + c0 * As[j0] + c1 * As[j1] + c2 * As[j2];
-          w = x + c0 * Vs[j0] + c1 * Vs[j1] + c2 * Vs[j2] + g * vt;
-          break;
-        default: {
-          xt = x;
-          vt = v;
-          for (std::size_t k = 0; k < nt; ++k) {
-            xt.noalias() += terms[k].first * Vs[terms[k].second];
-            vt.noalias() += terms[k].first * As[terms[k].second];
-          }
-          w = xt + g * vt;
-        }
-      }
-      // (M + g D + g² K) A_i = F − D ṽ − K (x̃ + g ṽ);  V_i = ṽ + g A_i;  X_i = x̃ + g ṽ + g² A_i.
-      // The right-hand side is formed and solved in A_i itself.
-      MatrixXd& Ai = As[si];
-      F.setZero();
-      forcing(ti, F.data());
-      ++cnt.stage_forcings;
-      Ai.col(0) = F;
-      Ai.col(0).noalias() -= D_rows_ * vt.col(0);
-      Ai.col(0).noalias() -= K_rows_ * w.col(0);
-      S.solve_in_place(Ai.col(0).data());
-      ++cnt.linear_solves;
-      Vs[si].col(0) = vt.col(0) + g * Ai.col(0);
-      if (m > 1) {
-        X0 = w.col(0) + (g * g) * Ai.col(0);
-        tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), Ai.col(0).data());
-        Ai.rightCols(P) = G.leftCols(P);
-        Ai.rightCols(P).noalias() -= D_rows_ * vt.rightCols(P);
-        Ai.rightCols(P).noalias() -= K_rows_ * w.rightCols(P);
-        S.solve_in_place(Ai.col(1).data(), P, n);
-        cnt.linear_solves += P;
-        Vs[si].rightCols(P) = vt.rightCols(P) + g * Ai.rightCols(P);
-      }
-    }
+  void drop_tangents() {
+    m_ = 1;
+    for (MatrixXd* A : {&x, &v, &a, &xt, &vt, &w}) A->conservativeResize(n_, 1);
+    for (auto& A : Vs) A.conservativeResize(n_, 1);
+    for (auto& A : As) A.conservativeResize(n_, 1);
+  }
+
+  // One step from tn of length hs.
+  void step(double tn, double hs) {
+    for (int i = 0; i < s_; ++i) stage(i, tn, hs);
     // x += h Σ_j b_j V_j, v += h Σ_j b_j A_j, accumulated term by term in one pass.
     std::size_t nb = 0;
-    for (int j = 0; j < s; ++j) {
-      const double c = hs * tab_.b[static_cast<std::size_t>(j)];
+    for (int j = 0; j < s_; ++j) {
+      const double c = hs * st_.tab_.b[static_cast<std::size_t>(j)];
       if (c != 0.0) terms[nb++] = {c, static_cast<std::size_t>(j)};
     }
     if (nb == 4) {
@@ -245,23 +177,138 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
         v.noalias() += terms[k].first * As[terms[k].second];
       }
     }
-    if (stiffly_accurate_) a = As[static_cast<std::size_t>(s - 1)];
+    if (st_.stiffly_accurate_) a = As[static_cast<std::size_t>(s_ - 1)];
     else accelerate(tn + hs);
-  };
-
-  if (start) {
-    x.col(0) = Eigen::Map<const VectorXd>(start->x, n);
-    v.col(0) = Eigen::Map<const VectorXd>(start->v, n);
-    a.col(0) = Eigen::Map<const VectorXd>(start->a, n);
-    origin = start->origin;
-  } else {
-    accelerate(t0);
   }
-  record(t0, true);
+
+  double origin = 0.0;  // the step grid's origin: the last breakpoint passed, or t0
+
+private:
+  // Tangent forcing of every tangent column from column 0 at (t, x0, v0, a0), into G's columns
+  // (less D ṽ + K w, the parts the caller sets up).
+  void tangent_forcing(double t, const double* x0, const double* v0, const double* a0) {
+    G.setZero();
+    (*tangent_)(t, x0, v0, a0, G.data());
+  }
+
+  // ṽ and w = x̃ + g ṽ of stage i, each in one pass over all columns (the sums in the order of the
+  // terms, as one accumulation would).
+  void stage_predictor(int i, double hs, double g) {
+    std::size_t nt = 0;
+    for (int j = 0; j < i; ++j) {
+      const double c = hs * st_.tab_.a(i, j);
+      if (c != 0.0) terms[nt++] = {c, static_cast<std::size_t>(j)};
+    }
+    const auto& [c0, j0] = terms[0];
+    const auto& [c1, j1] = terms[1];
+    const auto& [c2, j2] = terms[2];
+    switch (nt) {
+      case 0:
+        vt = v;
+        w = x + g * vt;
+        break;
+      case 1:
+        vt = v + c0 * As[j0];
+        w = x + c0 * Vs[j0] + g * vt;
+        break;
+      case 2:
+        vt = v + c0 * As[j0] + c1 * As[j1];
+        w = x + c0 * Vs[j0] + c1 * Vs[j1] + g * vt;
+        break;
+      case 3:
+        vt = v + c0 * As[j0] + c1 * As[j1] + c2 * As[j2];
+        w = x + c0 * Vs[j0] + c1 * Vs[j1] + c2 * Vs[j2] + g * vt;
+        break;
+      default: {
+        xt = x;
+        vt = v;
+        for (std::size_t k = 0; k < nt; ++k) {
+          xt.noalias() += terms[k].first * Vs[terms[k].second];
+          vt.noalias() += terms[k].first * As[terms[k].second];
+        }
+        w = xt + g * vt;
+      }
+    }
+  }
+
+  void stage(int i, double tn, double hs) {
+    const auto si = static_cast<std::size_t>(i);
+    if (i == 0 && st_.explicit_first_) {
+      Vs[0] = v;
+      As[0] = a;
+      return;
+    }
+    const double g = hs * st_.tab_.a(i, i);
+    const double ti = tn + st_.tab_.c[si] * hs;
+    const BandedCholesky& S = g > 0.0 ? st_.newton_.factor(g) : st_.mass_;
+    stage_predictor(i, hs, g);
+    // (M + g D + g² K) A_i = F − D ṽ − K (x̃ + g ṽ);  V_i = ṽ + g A_i;  X_i = x̃ + g ṽ + g² A_i.
+    // The right-hand side is formed and solved in A_i itself.
+    MatrixXd& Ai = As[si];
+    F.setZero();
+    forcing_(ti, F.data());
+    ++cnt_.stage_forcings;
+    Ai.col(0) = F;
+    Ai.col(0).noalias() -= st_.D_rows_ * vt.col(0);
+    Ai.col(0).noalias() -= st_.K_rows_ * w.col(0);
+    S.solve_in_place(Ai.col(0).data());
+    ++cnt_.linear_solves;
+    Vs[si].col(0) = vt.col(0) + g * Ai.col(0);
+    if (m_ > 1) {
+      X0 = w.col(0) + (g * g) * Ai.col(0);
+      tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), Ai.col(0).data());
+      Ai.rightCols(P_) = G.leftCols(P_);
+      Ai.rightCols(P_).noalias() -= st_.D_rows_ * vt.rightCols(P_);
+      Ai.rightCols(P_).noalias() -= st_.K_rows_ * w.rightCols(P_);
+      S.solve_in_place(Ai.col(1).data(), P_, n_);
+      cnt_.linear_solves += P_;
+      Vs[si].rightCols(P_) = vt.rightCols(P_) + g * Ai.rightCols(P_);
+    }
+  }
+
+  const EsdirkStepper& st_;
+  const Forcing& forcing_;
+  const Sink& sink_;
+  const TangentForcing* tangent_;
+  const int P_, n_, s_;
+  int m_;
+  const double h_;
+  StepperCounters& cnt_;
+  MatrixXd x, v, a, xt, vt, w, G;
+  std::vector<MatrixXd> Vs, As;
+  // The nonzero coefficients of a stage's (or the step's) sum: (h a_ij or h b_j, j).
+  std::vector<std::pair<double, std::size_t>> terms;
+  VectorXd F, X0;
+};
+
+StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std::vector<double>& stops_in,
+                                      const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
+                                      double tangent_end, const Start* start, double until) const {
+  if (start) {
+    if (P != 0) throw std::invalid_argument("EsdirkStepper: a resumed run steps the state only");
+    if (h != start->h) throw std::invalid_argument("EsdirkStepper: a resumed run must keep its step");
+    t0 = start->t;
+  }
+  if (!(h > 0.0)) throw std::invalid_argument("EsdirkStepper: step must be > 0");
+  if (!(t1 > t0)) throw std::invalid_argument("EsdirkStepper: t1 must exceed t0");
+  if (P < 0 || (P > 0 && !tangent)) throw std::invalid_argument("EsdirkStepper: tangents need their forcing");
+  std::vector<double> stops;
+  for (double b : stops_in)
+    if (b > t0 && b < t1) stops.push_back(b);
+  std::sort(stops.begin(), stops.end());
+  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
+  stops.push_back(t1);
+
+  StepperCounters cnt;
+  Sweep sw(*this, forcing, sink, P, tangent, h, cnt);
+  sw.origin = t0;
+  if (start) sw.resume(*start);
+  else sw.accelerate(t0);
+  sw.record(t0, true);
   if (t0 >= until) return cnt;
-  bool tangents_on = m > 1;
+  bool tangents_on = sw.has_tangents();
   if (tangents_on && t0 >= tangent_end) {
-    drop_tangents();
+    sw.drop_tangents();
     tangents_on = false;
   }
   double t = t0;
@@ -269,31 +316,31 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
     const double stop = stops[seg];
     const double snap = 1e-12 * std::max(1.0, std::abs(stop));
     // Steps end at origin + k h: a resumed run continues the original run's count.
-    long k = std::max(0L, std::lround((t - origin) / h));
+    long k = std::max(0L, std::lround((t - sw.origin) / h));
     while (t < stop) {
       io::check_interrupt();  // a SIGINT/SIGTERM ends a long solve at the next step (io/interrupt.h)
-      double tnext = origin + static_cast<double>(k + 1) * h;
+      double tnext = sw.origin + static_cast<double>(k + 1) * h;
       if (tnext > stop - snap) tnext = stop;  // land on the stop (no micro-step)
-      step(t, tnext - t);
+      sw.step(t, tnext - t);
       t = tnext;
       ++k;
       ++cnt.steps;
       const bool at_break = t == stop && seg + 1 < stops.size();
-      if (at_break) accelerate(std::nextafter(t, -std::numeric_limits<double>::infinity()));  // left limit
-      record(t, !at_break);
+      if (at_break) sw.accelerate(std::nextafter(t, -std::numeric_limits<double>::infinity()));  // left limit
+      sw.record(t, !at_break);
       if (!at_break && t >= until) return cnt;
       if (tangents_on && t >= tangent_end) {
-        drop_tangents();
+        sw.drop_tangents();
         tangents_on = false;
       }
       if (at_break) {
-        accelerate(t);  // right limit: restart from it
-        origin = t;
-        record(t, true);
+        sw.accelerate(t);  // right limit: restart from it
+        sw.origin = t;
+        sw.record(t, true);
         if (t >= until) return cnt;
       }
     }
-    origin = t;
+    sw.origin = t;
   }
   return cnt;
 }

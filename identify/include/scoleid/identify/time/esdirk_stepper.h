@@ -104,6 +104,8 @@ public:
                          double until = std::numeric_limits<double>::infinity()) const;
 
 private:
+  class Sweep;  // one integration's workspace and steps (esdirk_stepper.cpp)
+
   const SparseMatrix& M_;
   // D and K copied by rows at construction (the Newton factors and `mass` are the caller's and must
   // stay those of the same M, D, K): their products with the stage vectors are then sums per row
