@@ -244,6 +244,31 @@ void compact(const std::vector<const MatrixXd*>& dense, const MatrixXd& Pfull, s
 }
 }  // namespace
 
+namespace {
+// Gauss–Legendre rules on [0, 1]: four points (degree 7) and three (degree 5).
+struct GaussRules {
+  double x4[4], w4[4], x3[3], w3[3];
+  GaussRules() {
+    const double a4 = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2)), b4 = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
+    const double wa = (18.0 + std::sqrt(30.0)) / 36.0, wb = (18.0 - std::sqrt(30.0)) / 36.0;
+    const double x4v[4] = {0.5 * (1 - b4), 0.5 * (1 - a4), 0.5 * (1 + a4), 0.5 * (1 + b4)};
+    const double w4v[4] = {0.5 * wb, 0.5 * wa, 0.5 * wa, 0.5 * wb};
+    const double g3 = 0.5 * std::sqrt(0.6);
+    const double x3v[3] = {0.5 - g3, 0.5, 0.5 + g3}, w3v[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+    std::copy(x4v, x4v + 4, x4);
+    std::copy(w4v, w4v + 4, w4);
+    std::copy(x3v, x3v + 3, x3);
+    std::copy(w3v, w3v + 3, w3);
+  }
+};
+const GaussRules kGauss;
+
+// The mast's point at arc length s from its root (it runs along −z).
+Vector3d mast_point(const io::ScoleSpec& sc, double s) { return Vector3d(vec3(sc.mast_root) - s * Vector3d::UnitZ()); }
+}  // namespace
+
+MatrixXd ScoleNonlinear::on_e(const MatrixXd& rows) const { return MatrixXd(rows.leftCols(ne_)); }
+
 ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs,
                                const std::vector<io::SensorSpec>& sensors) {
   const StructuralModel& m = fe.model;
@@ -254,11 +279,6 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     if (fe.shuttle_dof(i) != ne_ + i) throw std::logic_error("ScoleNonlinear: the shuttle DOFs must come last");
   if (inputs.size() != m.inputs.size() || sensors.size() != m.sensors.size())
     throw std::logic_error("ScoleNonlinear: inputs and sensors must be the linear model's");
-  const io::ScoleSpec& sc = fe.spec;
-  const double L = sc.length, h = L / fe.elements;
-  const Vector3d root = vec3(sc.mast_root);
-  auto point = [&](double s) { return Vector3d(root - s * Vector3d::UnitZ()); };
-  auto on_e = [&](const MatrixXd& rows) { return MatrixXd(rows.leftCols(ne_)); };
 
   G_ = MatrixXd::Zero(n, 6 + ne_);
   for (int k = 0; k < 3; ++k) {
@@ -267,19 +287,28 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
   }
   G_.block(0, 6, ne_, ne_).setIdentity();
 
-  // Mast: ρA at four Gauss points per element (degree 7: exact for products of Hermite cubics),
-  // ρI_ψ at three (degree 5: exact for the slopes' and the linear twist's products).
-  const double a4 = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2)), b4 = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
-  const double wa = (18.0 + std::sqrt(30.0)) / 36.0, wb = (18.0 - std::sqrt(30.0)) / 36.0;
-  const double x4[4] = {0.5 * (1 - b4), 0.5 * (1 - a4), 0.5 * (1 + a4), 0.5 * (1 + b4)};
-  const double w4[4] = {0.5 * wb, 0.5 * wa, 0.5 * wa, 0.5 * wb};
-  const double g3 = 0.5 * std::sqrt(0.6);
-  const double x3[3] = {0.5 - g3, 0.5, 0.5 + g3}, w3[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  add_mast(fe);
+  add_foreshortening(fe);
+  add_reflector(fe);
+  add_shuttle_and_proof_masses(fe);
+  index_points();
+  for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
+  for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
+  add_inputs(fe, inputs);
+  add_sensors(fe, sensors);
+}
+
+// Mast: ρA at four Gauss points per element (degree 7: exact for products of Hermite cubics),
+// ρI_ψ at three (degree 5: exact for the slopes' and the linear twist's products).
+void ScoleNonlinear::add_mast(const ScoleFE& fe) {
+  const io::ScoleSpec& sc = fe.spec;
+  const double h = sc.length / fe.elements;
+  const auto& [x4, w4, x3, w3] = kGauss;
   const double bend = sc.bending_rotary_inertia ? 0.5 : 0.0;
   for (int el = 0; el < fe.elements; ++el) {
     for (int q = 0; q < 4; ++q) {
       const double s = (el + x4[q]) * h;
-      points_.push_back({point(s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA, {}, {}});
+      points_.push_back({mast_point(sc, s), on_e(fe.mast_displacement(s)), w4[q] * h, ScoleFE::kRhoA, {}, {}});
     }
     for (int q = 0; q < 3; ++q) {
       const double s = (el + x3[q]) * h;
@@ -303,84 +332,95 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       coupling_.push_back(std::move(c));
     }
   }
-  // The mast's foreshortening (struct Foreshortening): the slopes' rows at three Gauss points per
-  // element and, per mast mass point, at three on [element start, s_i].
-  {
-    auto node = [&](double s, double weight) {
-      Foreshortening::Node nd;
-      const MatrixXd R = on_e(fe.mast_rotation(s)).topRows(2);
-      for (Eigen::Index j = 0; j < ne_; ++j)
-        if (R.col(j).cwiseAbs().maxCoeff() != 0.0) nd.cols.push_back(static_cast<int>(j));
-      nd.rows.resize(2, static_cast<Eigen::Index>(nd.cols.size()));
-      for (std::size_t k = 0; k < nd.cols.size(); ++k) nd.rows.col(static_cast<Eigen::Index>(k)) = R.col(nd.cols[k]);
-      nd.weight = weight;
-      return nd;
-    };
-    fs_.elements = fe.elements;
-    for (int el = 0; el < fe.elements; ++el)
-      for (int q = 0; q < 3; ++q) fs_.node.push_back(node((el + x3[q]) * h, w3[q] * h));
-    for (int el = 0; el < fe.elements; ++el)
-      for (int q = 0; q < 4; ++q) {
-        const double s0 = el * h, len = x4[q] * h;
-        for (int k = 0; k < 3; ++k) fs_.node.push_back(node(s0 + x3[k] * len, w3[k] * len));
-        fs_.element_of.push_back(el);
-        fs_.point.push_back(static_cast<std::size_t>(4 * el + q));
-      }
-    fs_.t = Vector3d::UnitZ();  // the mast runs along −z from its root
-    for (std::size_t i : fs_.point)  // T_fs leaves M_ee alone only because the rows are lateral
-      if ((fs_.t.transpose() * points_[i].N).cwiseAbs().maxCoeff() != 0.0)
-        throw std::logic_error("ScoleNonlinear: a mast point's rows move it along the mast");
-  }
-  // Reflector: a rigid body on the mast's end, moving exactly with the end section. Every one of
-  // its points is the end's point turned by the section's rotation (turned_arm.h; the linear part
-  // Θ(L) e × a of an arm a is in the point's linear rows) and carried back towards the root by the
-  // end's foreshortening ½ ∫ (u_x'² + u_y'²) ds (an inextensible mast). Its CM carries its mass (its
-  // own coefficient); its inertia about the CM J is carried by pairs of points at ±d on the
-  // principal axes of the second moment S = ½ tr(J) I − J (J = tr(S) I − S), each pair of mass
-  // s_k / d² (s_k an eigenvalue of S: a pair gives s_k u_k u_kᵀ), their mass taken back at the CM
-  // (a constant offset of the CM point's mass).
-  // A rigid body's kinetic energy is fixed by its mass, CM and second moment, so this is the body's
-  // exactly, rotation and all (docs/theory.md §3.8).
-  {
-    const Vector3d r(sc.reflector_rx, sc.reflector_ry, 0.0);
-    const MatrixXd Th = on_e(fe.mast_rotation(L)), U = on_e(fe.mast_displacement(L));
-    // Q = ∫ Θ⊥ᵀ Θ⊥ ds = Pᵀ P: three Gauss points per element (exact: degree 4).
-    MatrixXd Pfull(6 * fe.elements, ne_);
-    for (int el = 0; el < fe.elements; ++el)
-      for (int q = 0; q < 3; ++q)
-        Pfull.middleRows(6 * el + 2 * q, 2) = std::sqrt(w3[q] * h) * on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
-    auto end_point = [&](const Vector3d& arm, double weight, int coefficient) {
-      MassPoint pt{point(L) + arm, MatrixXd(U - skew(arm) * Th), weight, coefficient, {}, {}};
-      compact({&pt.N, &Th}, Pfull, pt.kin.cols, pt.kin.local, {&pt.kin.N, &pt.kin.Theta}, pt.kin.P);
-      pt.kin.arm = arm;
-      pt.kin.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
-      points_.push_back(std::move(pt));
-    };
-    const std::size_t cm = points_.size();
-    end_point(r, 1.0, ScoleFE::kMReflector);
-    const Matrix3d J = inertia_matrix(sc.reflector);
-    const Eigen::SelfAdjointEigenSolver<Matrix3d> S(0.5 * J.trace() * Matrix3d::Identity() - J);
-    // d: the radius of gyration, so that the pairs weigh what the reflector does (any d > 0 is
-    // exact). An inertia whose largest principal moment exceeds the sum of the other two (no rigid
-    // body's: a flat one given products of inertia) has s_k < 0, a pair of negative mass: exact all
-    // the same; M(e) stays positive definite wherever the inertia does (checked at e = 0 below).
-    const double ssum = S.eigenvalues().cwiseAbs().sum();
-    const double d = sc.reflector.mass > 0.0 && ssum > 0.0 ? std::sqrt(ssum / sc.reflector.mass) : 1.0;
-    double taken = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const double sk = S.eigenvalues()[k];
-      if (std::abs(sk) <= 1e-12 * J.trace()) continue;  // a flat body has none along its normal
-      const Vector3d dk = d * S.eigenvectors().col(k);
-      end_point(r + dk, 0.5 * sk / (d * d), -1);
-      end_point(r - dk, 0.5 * sk / (d * d), -1);
-      taken += sk / (d * d);
+}
+
+// The mast's foreshortening (struct Foreshortening): the slopes' rows at three Gauss points per
+// element and, per mast mass point, at three on [element start, s_i].
+void ScoleNonlinear::add_foreshortening(const ScoleFE& fe) {
+  const double h = fe.spec.length / fe.elements;
+  const auto& [x4, w4, x3, w3] = kGauss;
+  auto node = [&](double s, double weight) {
+    Foreshortening::Node nd;
+    const MatrixXd R = on_e(fe.mast_rotation(s)).topRows(2);
+    for (Eigen::Index j = 0; j < ne_; ++j)
+      if (R.col(j).cwiseAbs().maxCoeff() != 0.0) nd.cols.push_back(static_cast<int>(j));
+    nd.rows.resize(2, static_cast<Eigen::Index>(nd.cols.size()));
+    for (std::size_t k = 0; k < nd.cols.size(); ++k) nd.rows.col(static_cast<Eigen::Index>(k)) = R.col(nd.cols[k]);
+    nd.weight = weight;
+    return nd;
+  };
+  fs_.elements = fe.elements;
+  for (int el = 0; el < fe.elements; ++el)
+    for (int q = 0; q < 3; ++q) fs_.node.push_back(node((el + x3[q]) * h, w3[q] * h));
+  for (int el = 0; el < fe.elements; ++el)
+    for (int q = 0; q < 4; ++q) {
+      const double s0 = el * h, len = x4[q] * h;
+      for (int k = 0; k < 3; ++k) fs_.node.push_back(node(s0 + x3[k] * len, w3[k] * len));
+      fs_.element_of.push_back(el);
+      fs_.point.push_back(static_cast<std::size_t>(4 * el + q));
     }
-    points_[cm].offset = -taken;
+  fs_.t = Vector3d::UnitZ();  // the mast runs along −z from its root
+  for (std::size_t i : fs_.point)  // T_fs leaves M_ee alone only because the rows are lateral
+    if ((fs_.t.transpose() * points_[i].N).cwiseAbs().maxCoeff() != 0.0)
+      throw std::logic_error("ScoleNonlinear: a mast point's rows move it along the mast");
+}
+
+// Reflector: a rigid body on the mast's end, moving exactly with the end section. Every one of
+// its points is the end's point turned by the section's rotation (turned_arm.h; the linear part
+// Θ(L) e × a of an arm a is in the point's linear rows) and carried back towards the root by the
+// end's foreshortening ½ ∫ (u_x'² + u_y'²) ds (an inextensible mast). Its CM carries its mass (its
+// own coefficient); its inertia about the CM J is carried by pairs of points at ±d on the
+// principal axes of the second moment S = ½ tr(J) I − J (J = tr(S) I − S), each pair of mass
+// s_k / d² (s_k an eigenvalue of S: a pair gives s_k u_k u_kᵀ), their mass taken back at the CM
+// (a constant offset of the CM point's mass).
+// A rigid body's kinetic energy is fixed by its mass, CM and second moment, so this is the body's
+// exactly, rotation and all (docs/theory.md §3.8).
+void ScoleNonlinear::add_reflector(const ScoleFE& fe) {
+  const io::ScoleSpec& sc = fe.spec;
+  const double L = sc.length, h = L / fe.elements;
+  const auto& [x4, w4, x3, w3] = kGauss;
+  const Vector3d r(sc.reflector_rx, sc.reflector_ry, 0.0);
+  const MatrixXd Th = on_e(fe.mast_rotation(L)), U = on_e(fe.mast_displacement(L));
+  // Q = ∫ Θ⊥ᵀ Θ⊥ ds = Pᵀ P: three Gauss points per element (exact: degree 4).
+  MatrixXd Pfull(6 * fe.elements, ne_);
+  for (int el = 0; el < fe.elements; ++el)
+    for (int q = 0; q < 3; ++q)
+      Pfull.middleRows(6 * el + 2 * q, 2) = std::sqrt(w3[q] * h) * on_e(fe.mast_rotation((el + x3[q]) * h)).topRows(2);
+  auto end_point = [&](const Vector3d& arm, double weight, int coefficient) {
+    MassPoint pt{mast_point(sc, L) + arm, MatrixXd(U - skew(arm) * Th), weight, coefficient, {}, {}};
+    compact({&pt.N, &Th}, Pfull, pt.kin.cols, pt.kin.local, {&pt.kin.N, &pt.kin.Theta}, pt.kin.P);
+    pt.kin.arm = arm;
+    pt.kin.t = Vector3d::UnitZ();  // unit: solve_mass's rank-2 form of the axial part needs |t| = 1
+    points_.push_back(std::move(pt));
+  };
+  const std::size_t cm = points_.size();
+  end_point(r, 1.0, ScoleFE::kMReflector);
+  const Matrix3d J = inertia_matrix(sc.reflector);
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> S(0.5 * J.trace() * Matrix3d::Identity() - J);
+  // d: the radius of gyration, so that the pairs weigh what the reflector does (any d > 0 is
+  // exact). An inertia whose largest principal moment exceeds the sum of the other two (no rigid
+  // body's: a flat one given products of inertia) has s_k < 0, a pair of negative mass: exact all
+  // the same; M(e) stays positive definite wherever the inertia does (checked at e = 0 below).
+  const double ssum = S.eigenvalues().cwiseAbs().sum();
+  const double d = sc.reflector.mass > 0.0 && ssum > 0.0 ? std::sqrt(ssum / sc.reflector.mass) : 1.0;
+  double taken = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double sk = S.eigenvalues()[k];
+    if (std::abs(sk) <= 1e-12 * J.trace()) continue;  // a flat body has none along its normal
+    const Vector3d dk = d * S.eigenvectors().col(k);
+    end_point(r + dk, 0.5 * sk / (d * d), -1);
+    end_point(r - dk, 0.5 * sk / (d * d), -1);
+    taken += sk / (d * d);
   }
-  // Shuttle.
+  points_[cm].offset = -taken;
+}
+
+// The shuttle (a rigid body at S's origin); the proof masses on their own lateral DOFs, axially
+// with the mast.
+void ScoleNonlinear::add_shuttle_and_proof_masses(const ScoleFE& fe) {
+  const io::ScoleSpec& sc = fe.spec;
   points_.push_back({Vector3d::Zero(), MatrixXd::Zero(3, ne_), sc.shuttle.mass, -1, {}, {}});
   rotors_.push_back({inertia_matrix(sc.shuttle), MatrixXd::Zero(3, ne_), -1, {}, {}, {}});
-  // Proof masses: their own lateral DOFs, axially with the mast.
   for (std::size_t k = 0; k < sc.actuator_locations.size(); ++k) {
     MatrixXd N = MatrixXd::Zero(3, ne_);
     N(0, fe.proof_mass_dof(static_cast<int>(k), 0)) = 1.0;
@@ -391,11 +431,15 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     const MatrixXd Th = on_e(fe.mast_rotation(s));
     MatrixXd S = N - on_e(fe.mast_displacement(s));
     S.row(2).setZero();
-    MassPoint pm{point(s), N, sc.actuator_mass, -1, {}, {}};
+    MassPoint pm{mast_point(sc, s), N, sc.actuator_mass, -1, {}, {}};
     compact({&N, &Th, &S}, MatrixXd(), pm.kin.cols, pm.kin.local, {&pm.kin.N, &pm.kin.A, &pm.kin.B}, pm.kin.P);
     points_.push_back(std::move(pm));
   }
+}
 
+// The compact rows of every point and rotor, and the points' axial groups (points sharing the
+// same foreshortening rows share one representative).
+void ScoleNonlinear::index_points() {
   for (auto& p : points_) p.n = Rows3::of(p.N);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     auto& q = points_[i].kin;
@@ -417,9 +461,15 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     r.half.topRows<2>() *= 0.5;
     r.turn = Turning(r.J);
   }
-  for (const auto& t : m.stiffness) stiffness_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
-  for (const auto& t : m.damping) damping_.push_back({SparseMatrix(t.matrix.topLeftCorner(ne_, ne_)), t.coefficient});
+}
 
+// The reflector's CM is the point after the mast's (points_ is complete: addresses are stable).
+const ScoleNonlinear::Kinematics* ScoleNonlinear::reflector_kinematics(const ScoleFE& fe) const {
+  return &points_[static_cast<std::size_t>(4 * fe.elements)].kin;
+}
+
+void ScoleNonlinear::add_inputs(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs) {
+  const StructuralModel& m = fe.model;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& spec = inputs[i];
     Input in;
@@ -429,17 +479,17 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
       in.arm = true;
       in.N = spec.at == "mast" ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
       in.d = vec3(spec.direction);
+      if (spec.at == "reflector") in.kin = reflector_kinematics(fe);
     }
     inputs_.push_back(std::move(in));
   }
-  // The reflector's CM is the point after the mast's (points_ is complete: addresses are stable).
-  const Kinematics* reflector_kin = &points_[static_cast<std::size_t>(4 * fe.elements)].kin;
-  for (std::size_t i = 0; i < inputs.size(); ++i)
-    if (inputs_[i].arm && inputs[i].at == "reflector") inputs_[i].kin = reflector_kin;
+}
 
+void ScoleNonlinear::add_sensors(const ScoleFE& fe, const std::vector<io::SensorSpec>& sensors) {
+  const io::ScoleSpec& sc = fe.spec;
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& spec = sensors[k];
-    const ModelSensor& ms = m.sensors[k];
+    const ModelSensor& ms = fe.model.sensors[k];
     using K = Sensor::Kind;
     Sensor s;
     s.d = vec3(spec.direction);
@@ -451,9 +501,9 @@ ScoleNonlinear::ScoleNonlinear(const ScoleFE& fe, const std::vector<io::InputSpe
     } else if (spec.kind == "acceleration") {
       s.kind = K::PointAcceleration;
       const bool mast = spec.at == "mast";
-      s.p = mast ? point(spec.location) : point(L) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
+      s.p = mast ? mast_point(sc, spec.location) : mast_point(sc, sc.length) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
       s.N = mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
-      if (!mast) s.kin = reflector_kin;
+      if (!mast) s.kin = reflector_kinematics(fe);
     } else {
       // Relative to S: the linear rows restricted to e (they vanish on rigid motion).
       s.kind = ms.order == 1 ? K::RateRow : K::Row;
@@ -1359,21 +1409,54 @@ namespace scoleid::identify {
 // Per rotor: below, at its loop (the inertia turned by θ adds θ- and θ̇-terms). A nonlinear point
 // (struct Kinematics): N(e) for N and the e-derivatives of N(e), at its branch.
 // Elastic: ∂/∂ė = D μ_e, ∂/∂e = K μ_e. A force's arm: ∂/∂e of −f μ_Ω · ((N e) × d) = −f Nᵀ (d × μ_Ω).
+// The state, accelerations and multiplier of residual_vjp split into their rigid and elastic parts.
+struct ScoleNonlinear::Dynamics::VjpFrame {
+  VjpFrame(const StateView& s, const VectorXd& a, const VectorXd& mu)
+      : V(s.V), W(s.Omega), aV(a.head<3>()), aW(a.segment<3>(3)), ae(a.tail(s.e.size())), muV(mu.head<3>()),
+        muW(mu.segment<3>(3)), mue(mu.tail(s.e.size())), e(s.e), edot(s.edot) {}
+  Vector3d V, W, aV, aW;
+  VectorXd ae;
+  Vector3d muV, muW;
+  VectorXd mue, e, edot;
+};
+
 void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu,
                                             const VectorXd& fin, VectorXd& de, VectorXd& du, VectorXd* dc,
                                             const std::vector<Kinematics::At>& kin) const {
   const int ne = g_->ne_;
   const StateView s(y, ne);
-  const Vector3d V = s.V, W = s.Omega;
-  const Vector3d aV = a.head<3>(), aW = a.segment<3>(3);
-  const VectorXd ae = a.tail(ne);
-  const Vector3d muV = mu.head<3>(), muW = mu.segment<3>(3);
-  const VectorXd mue = mu.tail(ne);
-  const VectorXd e = s.e, edot = s.edot;
+  const VjpFrame fr(s, a, mu);
+  const VectorXd& mue = fr.mue;
   de = VectorXd::Zero(ne);
   du = VectorXd::Zero(6 + ne);
   VectorXd due = VectorXd::Zero(ne);  // ∂s/∂ė, gathered apart and added to du at the end
   if (dc) *dc = VectorXd::Zero(g_->ncoef_);
+  add_points_vjp(fr, kin, de, du, due, dc);
+  add_rotors_vjp(fr, de, du, due, dc);
+  de.noalias() += K_ * mue;
+  add_coupling_hessian(fr.e, mue, de);
+  add_foreshortening_vjp(s.u, fr.e, a, mu, de, due, du, dc);
+  due.noalias() += D_ * mue;
+  du.tail(ne) += due;
+  if (dc) {
+    add_coupling_coefficients(fr.e, mue, *dc);
+    for (const auto& t : g_->stiffness_)
+      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * fr.e);
+    for (const auto& t : g_->damping_)
+      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * fr.edot);
+  }
+  add_inputs_vjp(fr, fin, mu, de, dc);
+}
+
+// The mass points' part of residual_vjp (ds/de into de, ds/dė into due, ds/dV and ds/dΩ into du).
+void ScoleNonlinear::Dynamics::add_points_vjp(const VjpFrame& fr, const std::vector<Kinematics::At>& kin, VectorXd& de,
+                                              VectorXd& du, VectorXd& due, VectorXd* dc) const {
+  const Vector3d V = fr.V, W = fr.W;
+  const Vector3d aV = fr.aV, aW = fr.aW;
+  const VectorXd& ae = fr.ae;
+  const Vector3d muV = fr.muV, muW = fr.muW;
+  const VectorXd& mue = fr.mue;
+  const VectorXd &e = fr.e, &edot = fr.edot;
   std::vector<VectorXd> axial_e(g_->axial_rep_.size()), axial_edot(g_->axial_rep_.size());
   for (std::size_t i = 0; i < g_->points_.size(); ++i) {
     const auto& p = g_->points_[i];
@@ -1432,6 +1515,8 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
       q.add_axial(axial_e[g], de);
       q.add_axial(axial_edot[g], due);
     }
+}
+
   // Per rotor (struct Rotor), with θ = Θ e, θ̇ = Θ ė, p = P⊥ θ, ṗ = P⊥ θ̇, q̇ = B ė,
   // ω = Ω + θ̇ + p × q̇, J(θ) = J + ΔJ(θ) (symmetric, second order: struct Turning), h = J(θ) ω, and from μ: z = Θ μ_e,
   // m_A = P⊥ z, m_B = B μ_e, ν = μ_Ω + z + p × m_B (= L(e) μ); α = a_Ω + Θ a_e + p × B a_e,
@@ -1445,6 +1530,10 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
   //   g_ν = J(θ)(α + c) + J'[θ̇] ω,   g_ṗ = m_B × h + q̇ × J(θ) ν,
   //   g_q̇ = m_A × h + J(θ) ν × ṗ + g_ω × p,     g_p = m_B × g_ν + B a_e × J(θ) ν + q̇ × g_ω;
   //   ∂/∂e = Θᵀ (g_θ + P⊥ g_p),  ∂/∂ė = Θᵀ (g_θ̇ + g_ω + P⊥ g_ṗ) + Bᵀ g_q̇,  ∂/∂Ω = h × μ_Ω + g_ω.
+void ScoleNonlinear::Dynamics::add_rotors_vjp(const VjpFrame& fr, VectorXd& de, VectorXd& du, VectorXd& due,
+                                              VectorXd* dc) const {
+  const Vector3d W = fr.W, aW = fr.aW, muW = fr.muW;
+  const VectorXd &ae = fr.ae, &mue = fr.mue, &e = fr.e, &edot = fr.edot;
   for (std::size_t j = 0; j < g_->rotors_.size(); ++j) {
     const auto& rt = g_->rotors_[j];
     const Vector3d yv = muW.cross(W);
@@ -1496,18 +1585,13 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
       due[rt.th.cols[k]] += gd[static_cast<Eigen::Index>(k)];
     }
   }
-  de.noalias() += K_ * mue;
-  add_coupling_hessian(e, mue, de);
-  add_foreshortening_vjp(s.u, e, a, mu, de, due, du, dc);
-  due.noalias() += D_ * mue;
-  du.tail(ne) += due;
-  if (dc) {
-    add_coupling_coefficients(e, mue, *dc);
-    for (const auto& t : g_->stiffness_)
-      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.e);
-    for (const auto& t : g_->damping_)
-      if (t.coefficient >= 0) (*dc)[t.coefficient] += mue.dot(t.matrix * s.edot);
-  }
+}
+
+// The loads' part of residual_vjp: a force's arm and, at a nonlinear point, its own kinematics.
+void ScoleNonlinear::Dynamics::add_inputs_vjp(const VjpFrame& fr, const VectorXd& fin, const VectorXd& mu, VectorXd& de,
+                                              VectorXd* dc) const {
+  const Vector3d muW = fr.muW;
+  const VectorXd &mue = fr.mue, &e = fr.e;
   for (std::size_t i = 0; i < g_->inputs_.size(); ++i) {
     const auto& in = g_->inputs_[i];
     const double fi = fin[static_cast<Eigen::Index>(i)];
@@ -1522,7 +1606,7 @@ void ScoleNonlinear::Dynamics::residual_vjp(const double* y, const VectorXd& a, 
     }
     if (dc && in.coefficient >= 0) {
       double q = mu.dot(in.q0);
-      if (in.arm) q += muW.dot(Vector3d(in.N * s.e).cross(in.d));
+      if (in.arm) q += muW.dot(Vector3d(in.N * fr.e).cross(in.d));
       if (in.kin) {
         const auto k = in.kin->at(e, nullptr, false);
         q += muW.dot(k.offset.cross(in.d)) + in.d.dot(k.rows(mue));

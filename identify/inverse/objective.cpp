@@ -635,67 +635,66 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  VectorXd gc = VectorXd::Zero(model_.ncoef);
+  const std::size_t L = checkpoint_spacing(solver);
+  const double J = L > 0 ? gradient_checkpointed(s, solver, L, gc) : gradient_stored(s, solver, gc);
+  gradient = s.dcdq.transpose() * gc;
+  ++counters_.gradient_evaluations;
+  return J;
+}
+
+double Objective::gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc) {
   const bool rates = C1_.size() != 0;
-  if (const std::size_t L = checkpoint_spacing(solver); L > 0) {
-    // Checkpointed (docs/theory.md §7.9): the forward run keeps its outputs and every L-th point.
-    // With rate sensors the outputs are A₀u and A₁u̇ (each with its derivative, so that their
-    // interpolants are those of the state's), from which the residual needs only f(t) and z(t).
-    const int n = model_.ndof, ns = data_.sensors();
-    RateTerms rt;
-    if (rates) rt = rate_terms(s, solver);
-    const auto tf = Clock::now();
-    CheckpointRecorder ck(n, L);
-    Trajectory out(rates ? 2 * ns : ns);
-    VectorXd y(2 * ns), yd(2 * ns);
-    const VectorXd none = VectorXd::Zero(2 * ns);
-    SolverSummary sum;
-    solver.stream(data_.t.front(), T_, state_forcing(s), breakpoints_,
-                  [&](const SecondOrderSolver::Point& pt) {
-                    ck(pt);
-                    if (!rates) {
-                      push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
-                      return;
-                    }
-                    const Eigen::Map<const VectorXd> x(pt.x, n), v(pt.v, n), a(pt.a, n);
-                    y.head(ns).noalias() = rt.A0 * x;
-                    y.tail(ns).noalias() = rt.A1 * v;
-                    yd.head(ns).noalias() = rt.A0 * v;
-                    yd.tail(ns).noalias() = rt.A1 * a;
-                    out.push(pt.t, y.data(), yd.data(), none.data());
-                  },
-                  &sum);
-    counters_.solver.Accumulate(sum);
-    ++counters_.forward_solves;
-    counters_.forward_seconds += since(tf);
-    VectorXd gc = VectorXd::Zero(model_.ncoef);
-    const double J = rates ? backward_rates_checkpointed(s, solver, rt, out, std::move(ck.checkpoints()), L, gc)
-                           : backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
-    gradient = s.dcdq.transpose() * gc;
-    ++counters_.gradient_evaluations;
-    return J;
-  }
-  const Trajectory u = forward(solver, s, T_);
+  // Checkpointed (docs/theory.md §7.9): the forward run keeps its outputs and every L-th point.
+  // With rate sensors the outputs are A₀u and A₁u̇ (each with its derivative, so that their
+  // interpolants are those of the state's), from which the residual needs only f(t) and z(t).
+  const int n = model_.ndof, ns = data_.sensors();
+  RateTerms rt;
+  if (rates) rt = rate_terms(s, solver);
+  const auto tf = Clock::now();
+  CheckpointRecorder ck(n, L);
+  Trajectory out(rates ? 2 * ns : ns);
+  VectorXd y(2 * ns), yd(2 * ns);
+  const VectorXd none = VectorXd::Zero(2 * ns);
+  SolverSummary sum;
+  solver.stream(data_.t.front(), T_, state_forcing(s), breakpoints_,
+                [&](const SecondOrderSolver::Point& pt) {
+                  ck(pt);
+                  if (!rates) {
+                    push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
+                    return;
+                  }
+                  const Eigen::Map<const VectorXd> x(pt.x, n), v(pt.v, n), a(pt.a, n);
+                  y.head(ns).noalias() = rt.A0 * x;
+                  y.tail(ns).noalias() = rt.A1 * v;
+                  yd.head(ns).noalias() = rt.A0 * v;
+                  yd.tail(ns).noalias() = rt.A1 * a;
+                  out.push(pt.t, y.data(), yd.data(), none.data());
+                },
+                &sum);
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.forward_seconds += since(tf);
+  return rates ? backward_rates_checkpointed(s, solver, rt, out, std::move(ck.checkpoints()), L, gc)
+               : backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
+}
+
+// The backward solves on a stored state u, in reversed time τ = T − t (docs/theory.md §6.2):
+//   P(τ) = p₀(T − τ),  M P'' + D P' + K P = −w₀(T − τ)
+//   Y(τ) = y(T − τ),   M Y'' + D Y' + K Y = −w₁(T − τ)   (velocity and acceleration sensors only)
+// with w₀ = C₀ᵀRr − Kμ, w₁ = C₁ᵀRr − Dμ, μ = M⁻¹C₂ᵀRr (§6.1a; w₀ = CᵀRr without rate sensors).
+void Objective::costates_stored(const SecondOrderSolver& solver, const Trajectory& u, const RateTerms* rt,
+                                Trajectory& P, Trajectory& Y) {
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
-  const SecondOrderSolver::Forcing force = state_forcing(s);
-
   std::vector<double> bp_tau;
   for (double b : breakpoints_)
     if (b < T_) bp_tau.push_back(T_ - b);
   std::sort(bp_tau.begin(), bp_tau.end());
-
-  RateTerms rt;
-  if (rates) rt = rate_terms(s, solver);
-
-  // Backward solves in reversed time τ = T − t (docs/theory.md §6.2):
-  //   P(τ) = p₀(T − τ),  M P'' + D P' + K P = −w₀(T − τ)
-  //   Y(τ) = y(T − τ),   M Y'' + D Y' + K Y = −w₁(T − τ)   (velocity and acceleration sensors only)
-  // with w₀ = C₀ᵀRr − Kμ, w₁ = C₁ᵀRr − Dμ, μ = M⁻¹C₂ᵀRr (§6.1a; w₀ = CᵀRr without rate sensors).
-  auto tc = Clock::now();
-  Trajectory P, Y;
+  const auto tc = Clock::now();
   SolverSummary sum;
-  if (!rates) {
+  if (!rt) {
     VectorXd xb(n), vb(n), zb(ns), rb(ns);
     const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
     SecondOrderSolver::Forcing g = [&](double tau, double* F) {
@@ -710,10 +709,10 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     ++counters_.costate_solves;
   } else {
     VectorXd xb(n), vb(n);
-    RateSources src(*this, rt, [&](double t, VectorXd& y) {
+    RateSources src(*this, *rt, [&](double t, VectorXd& y) {
       u.eval(t, xb.data(), vb.data());
-      y.noalias() = rt.A0 * xb;
-      y.noalias() += rt.A1 * vb;
+      y.noalias() = rt->A0 * xb;
+      y.noalias() += rt->A1 * vb;
     });
     auto weights_at = [&](double tau) { src.at(tau); };
     const VectorXd& w0 = src.w0;
@@ -745,6 +744,20 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
     counters_.costate_solves += 2;
   }
   counters_.costate_seconds += since(tc);
+}
+
+// The gradient on a stored state: forward, costates, then the cost's and the coefficient
+// gradient's quadrature (three Gauss points on every interval of the union of the grids).
+double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solver, VectorXd& gc) {
+  const bool rates = C1_.size() != 0;
+  const Trajectory u = forward(solver, s, T_);
+  const int n = model_.ndof, ns = data_.sensors();
+  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
+  const SecondOrderSolver::Forcing force = state_forcing(s);
+  RateTerms rt;
+  if (rates) rt = rate_terms(s, solver);
+  Trajectory P, Y;
+  costates_stored(solver, u, rates ? &rt : nullptr, P, Y);
 
   // Quadratures: cost and coefficient gradients.
   const auto tq = Clock::now();
@@ -754,7 +767,7 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   if (rates)
     for (double tau : Y.times()) ytimes.push_back(T_ - tau);
   const auto grid = union_grid({&u.times(), &ptimes, &ytimes}, T_);
-  VectorXd x(n), v(n), a(n), F(n), p(n), pd(n), yx(n), yd(n), z(ns), r(ns), gc = VectorXd::Zero(model_.ncoef);
+  VectorXd x(n), v(n), a(n), F(n), p(n), pd(n), yx(n), yd(n), z(ns), r(ns);
   double J = 0.0;
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
@@ -783,11 +796,10 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
       add_coefficient_gradient(t, wt, p, pd, x, v, a, rates, gc);
     }
   }
-  gradient = s.dcdq.transpose() * gc;
-  ++counters_.gradient_evaluations;
   counters_.quadrature_seconds += since(tq);
   return J;
 }
+
 
 void Objective::add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
                                          const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const {

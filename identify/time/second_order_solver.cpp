@@ -343,15 +343,133 @@ void SecondOrderSolver::acceleration(const double* F, const double* x, const dou
   impl_->acceleration(F, x, v, a);
 }
 
+namespace {
+// One SUNDIALS integration of the first-order system y = (x, v) from rest, with the product's
+// own Newton solver (Impl::newton_solve) embedded as the linear solver: CVODES BDF under error
+// control, or ARKODE ARKStep with the DIRK table at a fixed step.
+class SundialsRun {
+public:
+  SundialsRun(SecondOrderSolver::Impl& s, double t0, double h)
+      : s_(s), bdf_(s.opt.integrator == SolverOptions::Integrator::Bdf), h_(h), y_(2 * s.n, ctx_.ctx),
+        ls_(SUNLinSolNewEmpty(ctx_.ctx)) {
+    N_VConst(0.0, y_.v);
+    if (!ls_.ls) throw std::runtime_error("SUNLinSolNewEmpty failed");
+    SUNLinearSolver LS = ls_.ls;
+    LS->content = &s;
+    LS->ops->gettype = ls_type;
+    LS->ops->getid = ls_id;
+    LS->ops->setup = ls_setup;
+    LS->ops->solve = ls_solve;
+    LS->ops->free = ls_free;
+    if (bdf_) {
+      cv_ = std::make_unique<CvodeMem>(ctx_.ctx);
+      s.integrator_mem = cv_->mem;
+      s.get_gamma = CVodeGetCurrentGamma;
+      check(CVodeInit(cv_->mem, cv_rhs, t0, y_.v), "CVodeInit");
+      check(CVodeSetUserData(cv_->mem, &s), "CVodeSetUserData");
+      check(CVodeWFtolerances(cv_->mem, cv_ewt), "CVodeWFtolerances");
+      check(CVodeSetMaxNumSteps(cv_->mem, s.opt.max_steps), "CVodeSetMaxNumSteps");
+      check(CVodeSetMaxOrd(cv_->mem, s.opt.max_order), "CVodeSetMaxOrd");
+      if (s.opt.max_step > 0) check(CVodeSetMaxStep(cv_->mem, s.opt.max_step), "CVodeSetMaxStep");
+      check(CVodeSetLinearSolver(cv_->mem, LS, nullptr), "CVodeSetLinearSolver");
+    } else {
+      ark_.mem = ARKStepCreate(nullptr, ark_rhs, t0, y_.v, ctx_.ctx);
+      if (!ark_.mem) throw std::runtime_error("ARKStepCreate failed");
+      s.integrator_mem = ark_.mem;
+      s.get_gamma = ARKStepGetCurrentGamma;
+      check(ARKStepSetUserData(ark_.mem, &s), "ARKStepSetUserData");
+      const auto table = s.opt.dirk_table < 0 ? ARKODE_ESDIRK324L2SA_4_2_3 : static_cast<ARKODE_DIRKTableID>(s.opt.dirk_table);
+      check(ARKStepSetTableNum(ark_.mem, table, ARKODE_ERK_NONE), "ARKStepSetTableNum");
+      check(ARKStepWFtolerances(ark_.mem, cv_ewt), "ARKStepWFtolerances");
+      check(ARKStepSetLinearSolver(ark_.mem, LS, nullptr), "ARKStepSetLinearSolver");
+      check(ARKStepSetLinear(ark_.mem, 0), "ARKStepSetLinear");
+      check(ARKStepSetDeduceImplicitRhs(ark_.mem, SUNTRUE), "ARKStepSetDeduceImplicitRhs");
+      check(ARKStepSetMaxNumSteps(ark_.mem, s.opt.max_steps), "ARKStepSetMaxNumSteps");
+      check(ARKStepSetFixedStep(ark_.mem, h), "ARKStepSetFixedStep");
+    }
+  }
+
+  double* y() const { return y_.data(); }
+
+  void set_stop(double stop) {
+    if (bdf_) check(CVodeSetStopTime(cv_->mem, stop), "CVodeSetStopTime");
+    else check(ARKStepSetStopTime(ark_.mem, stop), "ARKStepSetStopTime");
+  }
+
+  // One internal step towards `stop`; t is where it ended. A failure throws with the callback's error.
+  void one_step(double stop, double& t) {
+    const int flag = bdf_ ? CVode(cv_->mem, stop, y_.v, &t, CV_ONE_STEP) : ARKStepEvolve(ark_.mem, stop, y_.v, &t, ARK_ONE_STEP);
+    if (flag < 0) {
+      std::string msg = std::string(bdf_ ? "CVODES" : "ARKODE") + " failed at t = " + std::to_string(t) + " with flag " +
+                        std::to_string(flag);
+      if (!s_.callback_error.empty()) msg += ": " + s_.callback_error;
+      throw std::runtime_error(msg);
+    }
+  }
+
+  // Restart past a discontinuity at t. CVodeReInit zeroes the CVODES counters (ARKStepReset keeps
+  // ARKODE's), so they are collected first.
+  void restart(double t) {
+    if (bdf_) {
+      collect();
+      check(CVodeReInit(cv_->mem, t, y_.v), "CVodeReInit");
+    } else {
+      check(ARKStepReset(ark_.mem, t, y_.v), "ARKStepReset");
+      check(ARKStepSetFixedStep(ark_.mem, h_), "ARKStepSetFixedStep");
+    }
+  }
+
+  void collect() {
+    long st = 0, fe = 0, fi = 0, ef = 0, ni = 0;
+    if (bdf_) {
+      CVodeGetNumSteps(cv_->mem, &st);
+      CVodeGetNumRhsEvals(cv_->mem, &fe);
+      CVodeGetNumErrTestFails(cv_->mem, &ef);
+      CVodeGetNumNonlinSolvIters(cv_->mem, &ni);
+    } else {
+      ARKStepGetNumSteps(ark_.mem, &st);
+      ARKStepGetNumRhsEvals(ark_.mem, &fe, &fi);
+      ARKStepGetNumErrTestFails(ark_.mem, &ef);
+      ARKStepGetNumNonlinSolvIters(ark_.mem, &ni);
+    }
+    steps += st;
+    rhs += fe + fi;
+    etf += ef;
+    nni += ni;
+  }
+
+  long steps = 0, rhs = 0, etf = 0, nni = 0;
+
+private:
+  struct LSOwner {
+    explicit LSOwner(SUNLinearSolver l) : ls(l) {}
+    LSOwner(const LSOwner&) = delete;
+    LSOwner& operator=(const LSOwner&) = delete;
+    SUNLinearSolver ls;
+    ~LSOwner() {
+      if (ls) SUNLinSolFree(ls);
+    }
+  };
+  SecondOrderSolver::Impl& s_;
+  const bool bdf_;
+  const double h_;
+  Context ctx_;
+  Vector y_;
+  LSOwner ls_;
+  std::unique_ptr<CvodeMem> cv_;
+  ArkodeMem ark_;
+};
+}  // namespace
+
 Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
                                     SolverSummary* summary) const {
   io::check_interrupt();  // a SIGINT/SIGTERM ends the run between solves (io/interrupt.h)
   const auto wall0 = std::chrono::steady_clock::now();
   Impl& s = *impl_;
   const int n = s.n;
+  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
   if (s.stepper) {
     const long f0 = s.newton->factorizations();
-    const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
     EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing);
     if (summary) {
       *summary = {};
@@ -377,77 +495,8 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
   stops.push_back(t1);
 
-  Context ctx;
-  Vector y(2 * n, ctx.ctx);
-  N_VConst(0.0, y.v);
-  SUNLinearSolver LS = SUNLinSolNewEmpty(ctx.ctx);
-  if (!LS) throw std::runtime_error("SUNLinSolNewEmpty failed");
-  LS->content = &s;
-  LS->ops->gettype = ls_type;
-  LS->ops->getid = ls_id;
-  LS->ops->setup = ls_setup;
-  LS->ops->solve = ls_solve;
-  LS->ops->free = ls_free;
-  struct LSOwner {
-    SUNLinearSolver ls;
-    ~LSOwner() { SUNLinSolFree(ls); }
-  } ls_owner{LS};
-
-  const bool bdf = s.opt.integrator == SolverOptions::Integrator::Bdf;
-  std::unique_ptr<CvodeMem> cv;
-  ArkodeMem ark;
-  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
-  if (bdf) {
-    cv = std::make_unique<CvodeMem>(ctx.ctx);
-    s.integrator_mem = cv->mem;
-    s.get_gamma = CVodeGetCurrentGamma;
-    check(CVodeInit(cv->mem, cv_rhs, t0, y.v), "CVodeInit");
-    check(CVodeSetUserData(cv->mem, &s), "CVodeSetUserData");
-    check(CVodeWFtolerances(cv->mem, cv_ewt), "CVodeWFtolerances");
-    check(CVodeSetMaxNumSteps(cv->mem, s.opt.max_steps), "CVodeSetMaxNumSteps");
-    check(CVodeSetMaxOrd(cv->mem, s.opt.max_order), "CVodeSetMaxOrd");
-    if (s.opt.max_step > 0) check(CVodeSetMaxStep(cv->mem, s.opt.max_step), "CVodeSetMaxStep");
-    check(CVodeSetLinearSolver(cv->mem, LS, nullptr), "CVodeSetLinearSolver");
-  } else {
-    ark.mem = ARKStepCreate(nullptr, ark_rhs, t0, y.v, ctx.ctx);
-    if (!ark.mem) throw std::runtime_error("ARKStepCreate failed");
-    s.integrator_mem = ark.mem;
-    s.get_gamma = ARKStepGetCurrentGamma;
-    check(ARKStepSetUserData(ark.mem, &s), "ARKStepSetUserData");
-    const auto table = s.opt.dirk_table < 0 ? ARKODE_ESDIRK324L2SA_4_2_3 : static_cast<ARKODE_DIRKTableID>(s.opt.dirk_table);
-    check(ARKStepSetTableNum(ark.mem, table, ARKODE_ERK_NONE), "ARKStepSetTableNum");
-    check(ARKStepWFtolerances(ark.mem, cv_ewt), "ARKStepWFtolerances");
-    check(ARKStepSetLinearSolver(ark.mem, LS, nullptr), "ARKStepSetLinearSolver");
-    check(ARKStepSetLinear(ark.mem, 0), "ARKStepSetLinear");
-    check(ARKStepSetDeduceImplicitRhs(ark.mem, SUNTRUE), "ARKStepSetDeduceImplicitRhs");
-    check(ARKStepSetMaxNumSteps(ark.mem, s.opt.max_steps), "ARKStepSetMaxNumSteps");
-    check(ARKStepSetFixedStep(ark.mem, h), "ARKStepSetFixedStep");
-  }
-  auto set_stop = [&](double stop) {
-    if (bdf) check(CVodeSetStopTime(cv->mem, stop), "CVodeSetStopTime");
-    else check(ARKStepSetStopTime(ark.mem, stop), "ARKStepSetStopTime");
-  };
-  auto one_step = [&](double stop, double& t) {
-    return bdf ? CVode(cv->mem, stop, y.v, &t, CV_ONE_STEP) : ARKStepEvolve(ark.mem, stop, y.v, &t, ARK_ONE_STEP);
-  };
-  long steps = 0, rhs = 0, etf = 0, nni = 0;
+  SundialsRun run(s, t0, h);
   const long factorizations0 = s.newton->factorizations();
-  auto collect = [&]() {
-    long st = 0, fe = 0, fi = 0, ef = 0, ni = 0;
-    if (bdf) {
-      CVodeGetNumSteps(cv->mem, &st);
-      CVodeGetNumRhsEvals(cv->mem, &fe);
-      CVodeGetNumErrTestFails(cv->mem, &ef);
-      CVodeGetNumNonlinSolvIters(cv->mem, &ni);
-    } else {
-      ARKStepGetNumSteps(ark.mem, &st);
-      ARKStepGetNumRhsEvals(ark.mem, &fe, &fi);
-      ARKStepGetNumErrTestFails(ark.mem, &ef);
-      ARKStepGetNumNonlinSolvIters(ark.mem, &ni);
-    }
-    steps += st; rhs += fe + fi; etf += ef; nni += ni;
-  };
-
   Trajectory traj(n);
   std::vector<double> a(static_cast<std::size_t>(n));
   auto record = [&](double t, const double* yy, bool left_limit) {
@@ -456,45 +505,31 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
     s.acceleration(s.F.data(), yy, yy + n, a.data());
     traj.push(t, yy, yy + n, a.data());
   };
-  record(t0, y.data(), false);
+  record(t0, run.y(), false);
 
   double t = t0;
   for (std::size_t seg = 0; seg < stops.size(); ++seg) {
     const double stop = stops[seg];
-    set_stop(stop);
+    run.set_stop(stop);
     while (t < stop) {
       io::check_interrupt();  // outside the integrator's callbacks, which turn exceptions into flags
-      const int flag = one_step(stop, t);
-      if (flag < 0) {
-        std::string msg = std::string(bdf ? "CVODES" : "ARKODE") + " failed at t = " + std::to_string(t) +
-                          " with flag " + std::to_string(flag);
-        if (!s.callback_error.empty()) msg += ": " + s.callback_error;
-        throw std::runtime_error(msg);
-      }
+      run.one_step(stop, t);
       if (stop - t <= 1e-12 * std::max(1.0, std::abs(stop))) t = stop;
       const bool at_break = (t >= stop) && seg + 1 < stops.size();
-      record(t, y.data(), at_break);
+      record(t, run.y(), at_break);
     }
     if (seg + 1 < stops.size()) {
-      // Restart past the discontinuity: right limit recorded at the same time. CVodeReInit
-      // zeroes the CVODES counters (ARKStepReset keeps ARKODE's), so collect them first.
-      if (bdf) collect();
-      record(t, y.data(), false);
-      if (bdf) {
-        check(CVodeReInit(cv->mem, t, y.v), "CVodeReInit");
-      } else {
-        check(ARKStepReset(ark.mem, t, y.v), "ARKStepReset");
-        check(ARKStepSetFixedStep(ark.mem, h), "ARKStepSetFixedStep");
-      }
+      record(t, run.y(), false);  // the right limit, at the same time
+      run.restart(t);
     }
   }
-  collect();
+  run.collect();
   if (summary) {
     summary->ok = true;
-    summary->steps = steps;
-    summary->rhs_evaluations = rhs;
-    summary->error_test_failures = etf;
-    summary->nonlinear_iterations = nni;
+    summary->steps = run.steps;
+    summary->rhs_evaluations = run.rhs;
+    summary->error_test_failures = run.etf;
+    summary->nonlinear_iterations = run.nni;
     summary->factorizations = s.newton->factorizations() - factorizations0;
     summary->linear_solves = s.linear_solves;
     summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -173,6 +173,12 @@ public:
     // kin: kinematics(e, true) at the state's e.
     void residual_vjp(const double* y, const VectorXd& a, const VectorXd& mu, const VectorXd& f, VectorXd& de,
                       VectorXd& du, VectorXd* dc, const std::vector<Kinematics::At>& kin) const;
+    // Its parts: the mass points, the rotors, the loads (ds/dė gathered in due).
+    struct VjpFrame;
+    void add_points_vjp(const VjpFrame& fr, const std::vector<Kinematics::At>& kin, VectorXd& de, VectorXd& du,
+                        VectorXd& due, VectorXd* dc) const;
+    void add_rotors_vjp(const VjpFrame& fr, VectorXd& de, VectorXd& du, VectorXd& due, VectorXd* dc) const;
+    void add_inputs_vjp(const VjpFrame& fr, const VectorXd& fin, const VectorXd& mu, VectorXd& de, VectorXd* dc) const;
     const ScoleNonlinear* g_ = nullptr;
     std::vector<double> mass_;            // per mass point
     std::vector<Eigen::Matrix3d> J_;      // per rotor
@@ -360,6 +366,17 @@ private:
     template <class G, class Visit>
     void coefficients(const std::vector<G>& gamma, G zero, Visit&& visit) const;
   };
+
+  // The constructor's parts, in order (scole_nonlinear.cpp).
+  MatrixXd on_e(const MatrixXd& rows) const;  // rows restricted to the elastic DOFs e
+  void add_mast(const ScoleFE& fe);
+  void add_foreshortening(const ScoleFE& fe);
+  void add_reflector(const ScoleFE& fe);
+  void add_shuttle_and_proof_masses(const ScoleFE& fe);
+  void index_points();
+  const Kinematics* reflector_kinematics(const ScoleFE& fe) const;
+  void add_inputs(const ScoleFE& fe, const std::vector<io::InputSpec>& inputs);
+  void add_sensors(const ScoleFE& fe, const std::vector<io::SensorSpec>& sensors);
 
   int ne_ = 0, ncoef_ = 0;
   Foreshortening fs_;

@@ -223,6 +223,13 @@ private:
   // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly.
   double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
                                MatrixXd& H, MisfitProfile* profile);
+  // cost_and_gradient's two ways into gc (the coefficient gradient): the state checkpointed every
+  // L points, or stored whole, with its backward solves (P, and Y with rate sensors: rt given).
+  double gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc);
+  double gradient_stored(const Setup& s, const SecondOrderSolver& solver, VectorXd& gc);
+  struct RateTerms;
+  void costates_stored(const SecondOrderSolver& solver, const Trajectory& u, const RateTerms* rt, Trajectory& P,
+                       Trajectory& Y);
   // The checkpoint spacing for a state over [t0, T] with this solver; 0 = store the whole state.
   std::size_t checkpoint_spacing(const SecondOrderSolver& solver) const;
   // The backward pass on a checkpointed state (docs/theory.md §7.9): the costate with source
