@@ -379,45 +379,30 @@ void anti_alias(io::DataTable& tab, double f_c, double dt, int m) {
 }
 }  // namespace
 
-TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
-  // The truth simulates the scenario's structure with truth.overrides applied; truth.json
-  // reports the values it used and echoes the scenario with its overrides.
-  const io::Scenario sc = io::truth_scenario(scenario);
-  std::string why;
-  if (!opt.IsValid(&why)) throw std::invalid_argument("run_truth: " + why);
-  const int n = opt.segments > 0 ? opt.segments : sc.truth.segments;
-  const std::string integrator = opt.integrator.empty() ? sc.truth.integrator : opt.integrator;
-  const double accuracy = opt.accuracy > 0 ? opt.accuracy : sc.truth.accuracy;
-  {
-    const auto names = integrator_names();
-    if (std::find(names.begin(), names.end(), integrator) == names.end()) {
-      std::string list;
-      for (const auto& x : names) list += (list.empty() ? "" : "|") + x;
-      io::fail_field(sc.source, "truth.integrator", "must be one of " + list, "'" + integrator + "'");
-    }
-    if (!(accuracy < 1)) io::fail_field(sc.source, "truth.accuracy", "must be < 1", io::format_value(accuracy));
+namespace {
+// Refusals before any work: an unknown integrator, an accuracy of 1 or more, a record of
+// nothing (no sensor reads anything; from rest with no load nothing moves).
+void check_truth_request(const io::Scenario& sc, const std::string& integrator, double accuracy) {
+  const auto names = integrator_names();
+  if (std::find(names.begin(), names.end(), integrator) == names.end()) {
+    std::string list;
+    for (const auto& x : names) list += (list.empty() ? "" : "|") + x;
+    io::fail_field(sc.source, "truth.integrator", "must be one of " + list, "'" + integrator + "'");
   }
-  // A record of nothing is refused: no sensor reads anything, and from rest with no load nothing moves.
+  if (!(accuracy < 1)) io::fail_field(sc.source, "truth.accuracy", "must be < 1", io::format_value(accuracy));
   if (sc.sensors.empty())
     io::fail_field(sc.source, "sensors", "must list at least one sensor: a truth records what its sensors read", "[]");
   if (std::all_of(sc.inputs.begin(), sc.inputs.end(), [](const io::InputSpec& in) { return in.signal.is_zero(); }))
     io::fail_field(sc.source, "inputs",
                    "must give at least one input a signal: the structure starts at rest, and without a load nothing moves",
                    sc.inputs.empty() ? "[]" : std::to_string(sc.inputs.size()) + " inputs without a signal");
+}
 
-  auto structure = prepare_structure(sc, n);
-  const auto sensors = resolve_sensors(sc, *structure);
-  std::unique_ptr<Visualizer> viz;
-  if (opt.visualize) {
-    structure->system().setUseUniformBackground(true);
-    viz = std::make_unique<Visualizer>(structure->system(), visualizer_search_path());
-    viz->setMode(Visualizer::RealTime);
-    structure->system().realizeTopology();
-  }
-  const double frame = 1.0 / 30.0;
-  double next_frame = 0.0;
-  State state = structure->system().getDefaultState();
-
+// The integration plan: integrator, accuracy, horizon, sample interval (denser behind an
+// anti-alias filter), breakpoints and, for the trapezoidal rule, the frequency its step follows.
+// Inputs the samples cannot resolve and runs over the step limit are refused here.
+SimulateOptions simulation_plan(const io::Scenario& sc, Structure& structure, State& state,
+                                const std::string& integrator, double accuracy, int n) {
   SimulateOptions so;
   so.integrator = integrator;
   so.accuracy = accuracy;
@@ -439,8 +424,7 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
                          " s): the record would alias it (sample faster, or filter like a DAQ with truth.anti_alias_hz)",
                      io::format_value(f));
   }
-  so.progress = opt.progress;
-  if (so.integrator == "auto") so.integrator = choose_integrator(structure->system(), state);
+  if (so.integrator == "auto") so.integrator = choose_integrator(structure.system(), state);
   if (so.integrator == "trapezoidal") {
     // The trapezoidal rule's step follows the structure's fundamental mode, free of the inputs
     // (a load acting at t = 0 adds slow modes of the accelerated system, e.g. of the proof masses).
@@ -463,6 +447,87 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   }
   for (const auto& in : sc.inputs)
     for (double b : in.signal.breakpoints()) so.breakpoints.push_back(b);
+  return so;
+}
+
+// Each sensor's noise (normal, its noise_std, from the scenario's seed), added after the
+// acquisition filter; noise over 1000 times a sensor's RMS signal is refused.
+void add_sensor_noise(const io::Scenario& sc, io::DataTable& tab) {
+  std::mt19937_64 rng(sc.simulation.seed);
+  for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
+    const double sd = sc.sensors[i].noise_std;
+    if (!(sd > 0)) continue;
+    // Noise a thousand times the sensor's own RMS signal leaves a record of noise: over the
+    // 5e6 samples a record may hold, the signal's share of it would still be below the noise of
+    // its own estimate. Refused (a wrong unit, or noise_std: 1e20) rather than written.
+    const auto& col = tab.columns[sc.inputs.size() + i];
+    double ms = 0.0;
+    for (double v : col) ms += v * v;
+    const double rms = col.empty() ? 0.0 : std::sqrt(ms / static_cast<double>(col.size()));
+    if (rms > 0 && sd > 1e3 * rms)
+      io::fail_field(sc.source, "sensors[" + std::to_string(i) + "].noise_std",
+                     "is " + io::format_value(sd / rms) + " times the RMS signal " + io::format_value(rms) + " of sensor '" +
+                         sc.sensors[i].name + "': the record would hold nothing but noise (at most 1000 times)",
+                     io::format_value(sd));
+    std::normal_distribution<double> noise(0.0, sd);
+    for (double& v : tab.columns[sc.inputs.size() + i]) v += noise(rng);
+  }
+
+}
+
+io::TruthMeta truth_meta(const io::Scenario& scenario, const io::Scenario& sc, const TruthResult& res, int n,
+                         double accuracy) {
+  io::TruthMeta m;
+  m.scenario = sc.name;
+  m.structure = io::to_string(sc.structure);
+  for (const auto& in : sc.inputs)
+    m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
+  for (const auto& se : sc.sensors)
+    m.columns.push_back({se.name, se.unit, "output", se.kind, se.at, se.location, se.direction, se.noise_std});
+  m.true_parameters = true_parameters(sc);
+  m.generator = {{"program", "scole-truth"},
+                 {"segments", n},
+                 {"integrator", res.summary.integrator},
+                 {"accuracy", accuracy},
+                 {"seed", sc.simulation.seed},
+                 {"anti_alias_hz", sc.truth.anti_alias_hz},
+                 {"lumping", "Hencky bar chain (joint springs from dual-cell compliance)"},
+                 {"simbody_version", SCOLEID_SIMBODY_VERSION},
+                 {"steps", res.summary.steps_taken},
+                 {"wall_seconds", res.summary.wall_seconds},
+                 {"real_time_factor", res.summary.real_time_factor()}};
+  m.settings = io::to_json(scenario);
+  return m;
+}
+}  // namespace
+
+TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
+  // The truth simulates the scenario's structure with truth.overrides applied; truth.json
+  // reports the values it used and echoes the scenario with its overrides.
+  const io::Scenario sc = io::truth_scenario(scenario);
+  std::string why;
+  if (!opt.IsValid(&why)) throw std::invalid_argument("run_truth: " + why);
+  const int n = opt.segments > 0 ? opt.segments : sc.truth.segments;
+  const std::string integrator = opt.integrator.empty() ? sc.truth.integrator : opt.integrator;
+  const double accuracy = opt.accuracy > 0 ? opt.accuracy : sc.truth.accuracy;
+  check_truth_request(sc, integrator, accuracy);
+
+  auto structure = prepare_structure(sc, n);
+  const auto sensors = resolve_sensors(sc, *structure);
+  std::unique_ptr<Visualizer> viz;
+  if (opt.visualize) {
+    structure->system().setUseUniformBackground(true);
+    viz = std::make_unique<Visualizer>(structure->system(), visualizer_search_path());
+    viz->setMode(Visualizer::RealTime);
+    structure->system().realizeTopology();
+  }
+  const double frame = 1.0 / 30.0;
+  double next_frame = 0.0;
+  State state = structure->system().getDefaultState();
+
+  SimulateOptions so = simulation_plan(sc, *structure, state, integrator, accuracy, n);
+  so.progress = opt.progress;
+  const int oversample = sc.truth.anti_alias_hz > 0 ? kAntiAliasOversample : 1;
 
   TruthResult res;
   io::DataTable& tab = res.table;
@@ -486,47 +551,8 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
   });
 
   if (oversample > 1) anti_alias(tab, sc.truth.anti_alias_hz, so.sample_interval, oversample);
-
-  std::mt19937_64 rng(sc.simulation.seed);
-  for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
-    const double sd = sc.sensors[i].noise_std;
-    if (!(sd > 0)) continue;
-    // Noise a thousand times the sensor's own RMS signal leaves a record of noise: over the
-    // 5e6 samples a record may hold, the signal's share of it would still be below the noise of
-    // its own estimate. Refused (a wrong unit, or noise_std: 1e20) rather than written.
-    const auto& col = tab.columns[sc.inputs.size() + i];
-    double ms = 0.0;
-    for (double v : col) ms += v * v;
-    const double rms = col.empty() ? 0.0 : std::sqrt(ms / static_cast<double>(col.size()));
-    if (rms > 0 && sd > 1e3 * rms)
-      io::fail_field(sc.source, "sensors[" + std::to_string(i) + "].noise_std",
-                     "is " + io::format_value(sd / rms) + " times the RMS signal " + io::format_value(rms) + " of sensor '" +
-                         sc.sensors[i].name + "': the record would hold nothing but noise (at most 1000 times)",
-                     io::format_value(sd));
-    std::normal_distribution<double> noise(0.0, sd);
-    for (double& v : tab.columns[sc.inputs.size() + i]) v += noise(rng);
-  }
-
-  io::TruthMeta& m = res.meta;
-  m.scenario = sc.name;
-  m.structure = io::to_string(sc.structure);
-  for (const auto& in : sc.inputs)
-    m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
-  for (const auto& se : sc.sensors)
-    m.columns.push_back({se.name, se.unit, "output", se.kind, se.at, se.location, se.direction, se.noise_std});
-  m.true_parameters = true_parameters(sc);
-  m.generator = {{"program", "scole-truth"},
-                 {"segments", n},
-                 {"integrator", res.summary.integrator},
-                 {"accuracy", accuracy},
-                 {"seed", sc.simulation.seed},
-                 {"anti_alias_hz", sc.truth.anti_alias_hz},
-                 {"lumping", "Hencky bar chain (joint springs from dual-cell compliance)"},
-                 {"simbody_version", SCOLEID_SIMBODY_VERSION},
-                 {"steps", res.summary.steps_taken},
-                 {"wall_seconds", res.summary.wall_seconds},
-                 {"real_time_factor", res.summary.real_time_factor()}};
-  m.settings = io::to_json(scenario);
+  add_sensor_noise(sc, tab);
+  res.meta = truth_meta(scenario, sc, res, n, accuracy);
   return res;
 }
 
