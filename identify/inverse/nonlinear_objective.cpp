@@ -15,6 +15,63 @@ constexpr double kDefectTol = 1e-12;
 constexpr double kDefectContraction = 0.3;
 constexpr int kMaxDefect = 12;
 constexpr double kSensitivityStep = 1e-4;
+
+// The transposed stage systems of the costate, (I − hγ J(Y_i))ᵀ Λ_i = rhs, solved by defect
+// correction on a frozen factorisation of (I − hγ J_ref)ᵀ (J_ref = ∂f/∂y at a reference stage, by
+// nonlinear_jacobian), refreshed when the step changes by more than 5 % or the correction stalls.
+class StageAdjointSolver {
+public:
+  StageAdjointSolver(const ScoleNonlinear::Dynamics& dyn, double gamma, VectorXd scale, NonlinearCostateSummary& sum)
+      : dyn_(dyn), gamma_(gamma), scale_(std::move(scale)), sum_(sum) {}
+
+  // The factorisation for step h, refreshed at (y, in) unless it is for a step within 5 % of h.
+  void prepare(const VectorXd& y, const VectorXd& in, double h) {
+    if (!have_ref_ || std::abs(h / h_ref_ - 1.0) > 0.05) refresh(y, in, h);
+  }
+
+  // Λ for rhs at stage (y, in) of step h, JT(x) = J(y)ᵀ x; `t` names the step in an error.
+  template <class Product>
+  VectorXd solve(const VectorXd& rhs, const Product& JT, const VectorXd& y, const VectorXd& in, double h, double t) {
+    VectorXd L = VectorXd::Zero(rhs.size());
+    if (!(rhs.cwiseAbs().maxCoeff() > 0)) return L;
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      L = lu_.solve(rhs);
+      double prev = std::numeric_limits<double>::infinity();
+      for (int m = 0; m < kMaxDefect; ++m) {
+        // The correction, not the residual, is measured: with stiff modes (hγ‖J‖ ≫ 1) the
+        // residual's rounding floor lies far above the solution's.
+        const VectorXd dL = lu_.solve(VectorXd(rhs - L + h * gamma_ * JT(L)));
+        L += dL;
+        ++sum_.defect_iterations;
+        const double size = dL.cwiseAbs().maxCoeff() / std::max(L.cwiseAbs().maxCoeff(), 1e-300);
+        if (size <= kDefectTol) return L;
+        if (m > 0 && size > kDefectContraction * prev) break;
+        prev = size;
+      }
+      refresh(y, in, h);
+    }
+    throw std::runtime_error("nonlinear costate: the stage system does not converge at t = " + std::to_string(t) +
+                             " (a fresh Jacobian did not help)");
+  }
+
+private:
+  void refresh(const VectorXd& y, const VectorXd& in, double h) {
+    const Eigen::Index n = y.size();
+    const MatrixXd Jref = nonlinear_jacobian(dyn_, y, in, scale_);
+    lu_.compute(MatrixXd::Identity(n, n) - h * gamma_ * Jref.transpose());  // (I − hγ J)ᵀ
+    h_ref_ = h;
+    have_ref_ = true;
+    ++sum_.jacobians;
+  }
+
+  const ScoleNonlinear::Dynamics& dyn_;
+  const double gamma_;
+  const VectorXd scale_;
+  NonlinearCostateSummary& sum_;
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  double h_ref_ = 0.0;
+  bool have_ref_ = false;
+};
 }  // namespace
 
 NonlinearObjective::NonlinearObjective(const ScoleNonlinear& model, const Parameterization& params,
@@ -143,20 +200,10 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
   NonlinearCostateSummary sum;
   gc = VectorXd::Zero(model_.coefficients());
 
-  // The frozen transposed Newton matrix of the defect correction, and its scale vector.
+  // The frozen transposed Newton matrix of the defect correction, on the states' scale.
   VectorXd scale = VectorXd::Constant(n, 1e-6);
   for (const auto& y : r.states) scale = scale.cwiseMax(y.cwiseAbs());
-  Eigen::PartialPivLU<MatrixXd> lu;
-  MatrixXd Jref;
-  double h_ref = 0.0;
-  bool have_ref = false;
-  auto refresh = [&](const VectorXd& y, const VectorXd& in, double h) {
-    Jref = nonlinear_jacobian(dyn, y, in, scale);
-    lu.compute(MatrixXd::Identity(n, n) - h * gamma * Jref.transpose());  // (I − hγ J)ᵀ
-    h_ref = h;
-    have_ref = true;
-    ++sum.jacobians;
-  };
+  StageAdjointSolver stages(dyn, gamma, scale, sum);
 
   // A sample's share: ρ = τ R (z − z̃); ∂/∂y directly and through u̇ = f_u(y).
   auto sample_adjoint = [&](int k, VectorXd& ybar) {
@@ -189,8 +236,7 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
       sample_adjoint(st.sample, ybar);
     }
     const double h = st.h;
-    if (!have_ref || std::abs(h / h_ref - 1.0) > 0.05)
-      refresh(st.Y[static_cast<std::size_t>(s - 1)], st.inputs[static_cast<std::size_t>(s - 1)], h);
+    stages.prepare(st.Y[static_cast<std::size_t>(s - 1)], st.inputs[static_cast<std::size_t>(s - 1)], h);
     for (int i = s - 1; i >= 1; --i) {
       const auto iu = static_cast<std::size_t>(i);
       VectorXd S = VectorXd::Zero(n);
@@ -201,33 +247,7 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
       };
       VectorXd rhs = i == s - 1 ? ybar : VectorXd::Zero(n);
       if (S.cwiseAbs().maxCoeff() > 0) rhs += h * JT(S);
-      const double rhs_size = rhs.cwiseAbs().maxCoeff();
-      VectorXd L = VectorXd::Zero(n);
-      if (rhs_size > 0) {
-        bool done = false;
-        for (int attempt = 0; attempt < 2 && !done; ++attempt) {
-          L = lu.solve(rhs);
-          double prev = std::numeric_limits<double>::infinity();
-          for (int m = 0; m < kMaxDefect; ++m) {
-            // The correction, not the residual, is measured: with stiff modes (hγ‖J‖ ≫ 1) the
-            // residual's rounding floor lies far above the solution's.
-            const VectorXd dL = lu.solve(VectorXd(rhs - L + h * gamma * JT(L)));
-            L += dL;
-            ++sum.defect_iterations;
-            const double size = dL.cwiseAbs().maxCoeff() / std::max(L.cwiseAbs().maxCoeff(), 1e-300);
-            if (size <= kDefectTol) {
-              done = true;
-              break;
-            }
-            if (m > 0 && size > kDefectContraction * prev) break;
-            prev = size;
-          }
-          if (!done) refresh(st.Y[iu], st.inputs[iu], h);
-        }
-        if (!done)
-          throw std::runtime_error("nonlinear costate: the stage system does not converge at t = " +
-                                   std::to_string(st.t) + " (a fresh Jacobian did not help)");
-      }
+      const VectorXd L = stages.solve(rhs, JT, st.Y[iu], st.inputs[iu], h, st.t);
       Lam[iu] = L;
       const VectorXd Phi = gamma * L + S;
       if (Phi.cwiseAbs().maxCoeff() > 0) {
