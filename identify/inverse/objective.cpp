@@ -38,6 +38,16 @@ void add_gauss_newton_point(double wt, const Eigen::VectorXd& r, const Eigen::Re
 // 3-point Gauss–Legendre on [0, 1]
 constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
 constexpr double kGw[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
+
+// The quadrature walker: the three-point Gauss–Legendre rule on every interval of `grid`
+// (docs/theory.md §6.4), f(t, weight) at each point in order.
+template <class F>
+void for_each_gauss_point(const std::vector<double>& grid, F&& f) {
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int gq = 0; gq < 3; ++gq) f(grid[k] + kGx[gq] * h, kGw[gq] * h);
+  }
+}
 }  // namespace
 
 Objective::Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
@@ -464,24 +474,20 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   WindowedSink windows(n, spacing, [&](const Trajectory& P) {
     if (!cover_window(P, state, grid, resolve)) return;
     const auto tq = Clock::now();
-    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-      const double h = grid[k + 1] - grid[k];
-      for (int gq = 0; gq < 3; ++gq) {
-        const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
-        state.eval(t, x.data(), xv.data());
-        P.eval(T_ - t, p.data(), pd.data());
-        pd = -pd;  // ṗ(t) = −P'(T − t)
-        if (residual) {
-          data_.eval(t, z.data());
-          r.noalias() = C_ * x;
-          r -= z;
-          double e = 0.0;
-          for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-          J += 0.5 * wt * e;
-        }
-        add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
+    for_each_gauss_point(grid, [&](double t, double wt) {
+      state.eval(t, x.data(), xv.data());
+      P.eval(T_ - t, p.data(), pd.data());
+      pd = -pd;  // ṗ(t) = −P'(T − t)
+      if (residual) {
+        data_.eval(t, z.data());
+        r.noalias() = C_ * x;
+        r -= z;
+        double e = 0.0;
+        for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+        J += 0.5 * wt * e;
       }
-    }
+      add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
+    });
     quadrature += since(tq);
   });
   const auto tc = Clock::now();
@@ -590,30 +596,26 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
   WindowedSink windows(n, spacing, [&](const Trajectory& W) {
     if (!cover_window(W, state, grid, resolve)) return;
     const auto tq = Clock::now();
-    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-      const double h = grid[k + 1] - grid[k];
-      for (int gq = 0; gq < 3; ++gq) {
-        const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
-        state.eval(t, x.data(), xv.data());
-        F.setZero();
-        force(t, F.data());
-        solver.acceleration(F.data(), x.data(), xv.data(), a.data());  // ü from the equation of motion
-        data_.eval(t, z.data());
-        r.noalias() = C_ * x;
-        r.noalias() += C1_ * xv;
-        if (accelerations_) r.noalias() += C2_ * a;
-        r -= z;
-        double e = 0.0;
-        for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-        J += 0.5 * wt * e;
-        // Multiplier of §6.1a: p = p₀ − ẏ − μ with ṗ₀(t) = −P'(T − t), ẏ(t) = −Y'(T − t).
-        W.eval(T_ - t, py.data(), pyd.data());
-        p = py.head(n) + pyd.tail(n);
-        pd = -pyd.head(n);
-        if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
-        add_coefficient_gradient(t, wt, p, pd, x, xv, a, true, gc);
-      }
-    }
+    for_each_gauss_point(grid, [&](double t, double wt) {
+      state.eval(t, x.data(), xv.data());
+      F.setZero();
+      force(t, F.data());
+      solver.acceleration(F.data(), x.data(), xv.data(), a.data());  // ü from the equation of motion
+      data_.eval(t, z.data());
+      r.noalias() = C_ * x;
+      r.noalias() += C1_ * xv;
+      if (accelerations_) r.noalias() += C2_ * a;
+      r -= z;
+      double e = 0.0;
+      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+      J += 0.5 * wt * e;
+      // Multiplier of §6.1a: p = p₀ − ẏ − μ with ṗ₀(t) = −P'(T − t), ẏ(t) = −Y'(T − t).
+      W.eval(T_ - t, py.data(), pyd.data());
+      p = py.head(n) + pyd.tail(n);
+      pd = -pyd.head(n);
+      if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
+      add_coefficient_gradient(t, wt, p, pd, x, xv, a, true, gc);
+    });
     quadrature += since(tq);
   }, 2);
   const auto tc = Clock::now();
@@ -769,33 +771,29 @@ double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solve
   const auto grid = union_grid({&u.times(), &ptimes, &ytimes}, T_);
   VectorXd x(n), v(n), a(n), F(n), p(n), pd(n), yx(n), yd(n), z(ns), r(ns);
   double J = 0.0;
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int gq = 0; gq < 3; ++gq) {
-      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
-      u.eval(t, x.data(), v.data());
-      P.eval(T_ - t, p.data(), pd.data());
-      pd = -pd;  // ṗ(t) = −P'(T − t)
-      data_.eval(t, z.data());
-      if (!rates) {
-        r = C_ * x - z;
-      } else {
-        F.setZero();
-        force(t, F.data());
-        solver.acceleration(F.data(), x.data(), v.data(), a.data());  // ü from the equation of motion
-        r = C_ * x + C1_ * v - z;
-        if (accelerations_) r += C2_ * a;
-        // Multiplier of §6.1a: p = p₀ − ẏ − μ, ẏ(t) = −Y'(T − t).
-        Y.eval(T_ - t, yx.data(), yd.data());
-        p += yd;
-        if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
-      }
-      double e = 0.0;
-      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-      J += 0.5 * wt * e;
-      add_coefficient_gradient(t, wt, p, pd, x, v, a, rates, gc);
+  for_each_gauss_point(grid, [&](double t, double wt) {
+    u.eval(t, x.data(), v.data());
+    P.eval(T_ - t, p.data(), pd.data());
+    pd = -pd;  // ṗ(t) = −P'(T − t)
+    data_.eval(t, z.data());
+    if (!rates) {
+      r = C_ * x - z;
+    } else {
+      F.setZero();
+      force(t, F.data());
+      solver.acceleration(F.data(), x.data(), v.data(), a.data());  // ü from the equation of motion
+      r = C_ * x + C1_ * v - z;
+      if (accelerations_) r += C2_ * a;
+      // Multiplier of §6.1a: p = p₀ − ẏ − μ, ẏ(t) = −Y'(T − t).
+      Y.eval(T_ - t, yx.data(), yd.data());
+      p += yd;
+      if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
     }
-  }
+    double e = 0.0;
+    for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+    J += 0.5 * wt * e;
+    add_coefficient_gradient(t, wt, p, pd, x, v, a, rates, gc);
+  });
   counters_.quadrature_seconds += since(tq);
   return J;
 }
@@ -960,20 +958,17 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
     if (accelerations_)
       for (int i = first; i < first + count; ++i) d.push_back(derivative(s, i));
     Eigen::Index row = 0;
-    for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-      const double h = grid[k + 1] - grid[k];
-      for (int gq = 0; gq < 3; ++gq, row += ns) {
-        const double t = grid[k] + kGx[gq] * h;
-        u.eval(t, x.data(), v.data());
-        if (accelerations_) output_at(s, solver, t, x, v, &a);
-        for (int i = 0; i < count; ++i) {
-          S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
-          CSall.block(row, first + i, ns, 1) = accelerations_
-                                                   ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
-                                                   : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
-        }
+    for_each_gauss_point(grid, [&](double t, double) {
+      u.eval(t, x.data(), v.data());
+      if (accelerations_) output_at(s, solver, t, x, v, &a);
+      for (int i = 0; i < count; ++i) {
+        S[static_cast<std::size_t>(i)].eval(t, si.data(), sv.data());
+        CSall.block(row, first + i, ns, 1) = accelerations_
+                                                 ? tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, sv)
+                                                 : tangent_output_at(solver, Derivative{}, t, x, v, a, si, sv);
       }
-    }
+      row += ns;
+    });
     counters_.quadrature_seconds += since(tq);
   }
 
@@ -984,16 +979,13 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   double J = 0.0;
   Eigen::Index row = 0;
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int gq = 0; gq < 3; ++gq, row += ns) {
-      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
-      u.eval(t, x.data(), v.data());
-      data_.eval(t, z.data());
-      const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-      add_gauss_newton_point(wt, r, CSall.middleRows(row, ns), Rv, J, gradient, H);
-    }
-  }
+  for_each_gauss_point(grid, [&](double t, double wt) {
+    u.eval(t, x.data(), v.data());
+    data_.eval(t, z.data());
+    const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
+    add_gauss_newton_point(wt, r, CSall.middleRows(row, ns), Rv, J, gradient, H);
+    row += ns;
+  });
   if (profile) *profile = misfit_profile(s, solver, u);
   counters_.quadrature_seconds += since(tq);
   return J;
@@ -1301,16 +1293,12 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   for (double tau : P.times()) ptimes.push_back(T_ - tau);
   const auto grid = union_grid({&u.times(), &Sv.times(), &ptimes}, T_);
   VectorXd x(n), xv(n), a(n), p(n), pd(n), gc = VectorXd::Zero(model_.ncoef);
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int gq = 0; gq < 3; ++gq) {
-      const double t = grid[k] + kGx[gq] * h, wt = kGw[gq] * h;
-      u.eval(t, x.data(), xv.data());
-      P.eval(T_ - t, p.data(), pd.data());
-      pd = -pd;
-      add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
-    }
-  }
+  for_each_gauss_point(grid, [&](double t, double wt) {
+    u.eval(t, x.data(), xv.data());
+    P.eval(T_ - t, p.data(), pd.data());
+    pd = -pd;
+    add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
+  });
   counters_.quadrature_seconds += since(tq);
   return s.dcdq.transpose() * gc;
 }

@@ -47,6 +47,16 @@ ButcherTable ButcherTable::arkode_dirk(int id) {
   return t;
 }
 
+std::vector<double> segment_ends(const std::vector<double>& breakpoints, double t0, double t1) {
+  std::vector<double> stops;
+  for (double b : breakpoints)
+    if (b > t0 && b < t1) stops.push_back(b);
+  std::sort(stops.begin(), stops.end());
+  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
+  stops.push_back(t1);
+  return stops;
+}
+
 EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
                              NewtonMatrix& newton, ButcherTable table)
     : M_(M), D_rows_(D), K_rows_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
@@ -292,12 +302,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
   if (!(h > 0.0)) throw std::invalid_argument("EsdirkStepper: step must be > 0");
   if (!(t1 > t0)) throw std::invalid_argument("EsdirkStepper: t1 must exceed t0");
   if (P < 0 || (P > 0 && !tangent)) throw std::invalid_argument("EsdirkStepper: tangents need their forcing");
-  std::vector<double> stops;
-  for (double b : stops_in)
-    if (b > t0 && b < t1) stops.push_back(b);
-  std::sort(stops.begin(), stops.end());
-  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
-  stops.push_back(t1);
+  const std::vector<double> stops = segment_ends(stops_in, t0, t1);
 
   StepperCounters cnt;
   Sweep sw(*this, forcing, sink, P, tangent, h, cnt);

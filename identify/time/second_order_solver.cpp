@@ -264,28 +264,6 @@ int SecondOrderSolver::dim() const { return impl_->n; }
 
 bool SecondOrderSolver::has_tangent_solve() const { return static_cast<bool>(impl_->stepper); }
 
-SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, double t1, const Forcing& forcing, int P,
-                                                                    const TangentForcing& tangent, double tangent_end,
-                                                                    const std::vector<double>& breakpoints,
-                                                                    SolverSummary* summary) const {
-  const Impl& s = *impl_;
-  if (!s.stepper) throw std::logic_error("solve_tangent: only the esdirk integrator steps tangents with the state");
-  const auto wall0 = std::chrono::steady_clock::now();
-  const long f0 = s.newton->factorizations();
-  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
-  EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, P, &tangent, tangent_end);
-  if (summary) {
-    *summary = {};
-    summary->ok = true;
-    summary->steps = r.counters.steps;
-    summary->rhs_evaluations = r.counters.stage_forcings;
-    summary->linear_solves = r.counters.linear_solves;
-    summary->factorizations = s.newton->factorizations() - f0;
-    summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  }
-  return {std::move(r.state), std::move(r.tangents)};
-}
-
 namespace {
 void fill_summary(SolverSummary* summary, const StepperCounters& c, long factorizations,
                   std::chrono::steady_clock::time_point wall0) {
@@ -299,6 +277,22 @@ void fill_summary(SolverSummary* summary, const StepperCounters& c, long factori
   summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 }  // namespace
+
+
+SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, double t1, const Forcing& forcing, int P,
+                                                                    const TangentForcing& tangent, double tangent_end,
+                                                                    const std::vector<double>& breakpoints,
+                                                                    SolverSummary* summary) const {
+  const Impl& s = *impl_;
+  if (!s.stepper) throw std::logic_error("solve_tangent: only the esdirk integrator steps tangents with the state");
+  const auto wall0 = std::chrono::steady_clock::now();
+  const long f0 = s.newton->factorizations();
+  const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
+  EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, P, &tangent, tangent_end);
+  fill_summary(summary, r.counters, s.newton->factorizations() - f0, wall0);
+  return {std::move(r.state), std::move(r.tangents)};
+}
+
 
 void SecondOrderSolver::stream(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
                                const Sink& sink, SolverSummary* summary, const Start* start, double until) const {
@@ -471,15 +465,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   if (s.stepper) {
     const long f0 = s.newton->factorizations();
     EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing);
-    if (summary) {
-      *summary = {};
-      summary->ok = true;
-      summary->steps = r.counters.steps;
-      summary->rhs_evaluations = r.counters.stage_forcings;
-      summary->linear_solves = r.counters.linear_solves;
-      summary->factorizations = s.newton->factorizations() - f0;
-      summary->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    }
+    fill_summary(summary, r.counters, s.newton->factorizations() - f0, wall0);
     return std::move(r.state);
   }
   s.forcing = &forcing;
@@ -488,12 +474,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   s.reference_scales(t0, t1, forcing, breakpoints);
   s.callback_error.clear();
 
-  std::vector<double> stops;
-  for (double b : breakpoints)
-    if (b > t0 && b < t1) stops.push_back(b);
-  std::sort(stops.begin(), stops.end());
-  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
-  stops.push_back(t1);
+  const std::vector<double> stops = segment_ends(breakpoints, t0, t1);
 
   SundialsRun run(s, t0, h);
   const long factorizations0 = s.newton->factorizations();

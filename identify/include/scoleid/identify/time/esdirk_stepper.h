@@ -58,6 +58,10 @@ struct StepperCounters {
   long linear_solves = 0;   // banded triangular solve pairs, all columns
 };
 
+// The ends of the segments a run over [t0, t1] steps: the breakpoints inside (t0, t1), sorted and
+// unique, then t1.
+std::vector<double> segment_ends(const std::vector<double>& breakpoints, double t0, double t1);
+
 class EsdirkStepper {
 public:
   using Forcing = std::function<void(double t, double* F)>;  // F (length n), pre-zeroed
