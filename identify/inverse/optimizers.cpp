@@ -64,6 +64,18 @@ struct Run {
   const std::function<void(const IterationRecord&)>& cb;
   OptimizerSummary sum;
 
+  // A run that cannot go on: the line search (or the cost) failed, with why.
+  void failed(const std::string& why) {
+    sum.termination = OptimizerSummary::Termination::LineSearchFailed;
+    sum.message = why;
+  }
+  // The run's end at iteration k, log-parameters x, cost J (on the last horizon: the whole record
+  // unless stopped early).
+  void conclude(int k, const VectorXd& x, double J) {
+    sum.iterations_done = k;
+    sum.q = x.array().exp();
+    sum.cost = J;
+  }
   void record(int k, double J, const VectorXd& q, const VectorXd& gx) {
     IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0, obj.horizon()};
     sum.iterations.push_back(r);
@@ -181,8 +193,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   auto full = [&]() { return obj.horizon() >= t_end; };
   auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
   auto fail_start = [&]() {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.failed("cost cannot be evaluated at the starting point");
     r.sum.q = x.array().exp();
   };
   obj.set_horizon(t_end);
@@ -256,12 +267,9 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   } catch (const io::Interrupted&) {
     throw;
   } catch (const std::runtime_error& e) {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = e.what();
+    r.failed(e.what());
   }
-  r.sum.iterations_done = k;
-  r.sum.q = x.array().exp();
-  r.sum.cost = cur.J;  // on the last horizon (the whole record unless stopped early)
+  r.conclude(k, x, cur.J);
   r.sum.prior_cost = s.prior_cost(x, cur);
   obj.set_horizon(t_end);
 }
@@ -408,8 +416,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
     }
   }
   if (!start_ok || !r.eval_grad(x, J, gx)) {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = "cost cannot be evaluated at the starting point";
+    r.failed("cost cannot be evaluated at the starting point");
     r.sum.q = x.array().exp();
     obj.set_horizon(t_end);
     return;
@@ -451,8 +458,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
       }
       if (!ok) {
         if (extend(doubled())) continue;
-        r.sum.termination = T::LineSearchFailed;
-        r.sum.message = "no decrease along the search direction";
+        r.failed("no decrease along the search direction");
         break;
       }
       const VectorXd s = a * d, y = gn - gx;
@@ -478,12 +484,9 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   } catch (const io::Interrupted&) {
     throw;
   } catch (const std::runtime_error& e) {
-    r.sum.termination = T::LineSearchFailed;
-    r.sum.message = e.what();
+    r.failed(e.what());
   }
-  r.sum.iterations_done = k;
-  r.sum.q = x.array().exp();
-  r.sum.cost = J;  // on the last horizon (the whole record unless stopped early)
+  r.conclude(k, x, J);
   obj.set_horizon(t_end);
 }
 

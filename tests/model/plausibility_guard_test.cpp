@@ -25,44 +25,17 @@
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/truth_run.h"
 
+#include "cli_fixture.h"
+
 namespace fs = std::filesystem;
 using namespace scoleid;
 
 namespace {
 
-struct CliResult {
-  int code = -1;
-  std::string err;
-};
+using scoleid::model::test::CliResult;
 
-class PlausibilityGuard : public ::testing::Test {
+class PlausibilityGuard : public scoleid::model::test::TruthCliFixture {
 protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("scoleid_guard_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  CliResult run(const std::string& args) {
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(SCOLE_TRUTH_EXE) + " " + args + " 2> " + err.string() + " > /dev/null";
-    const int status = std::system(cmd.c_str());
-    CliResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(err);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    r.err = ss.str();
-    return r;
-  }
   // Nothing but the inputs the test wrote (scenario files, stderr.txt): no output directory, no
   // staging directory left behind.
   void expect_nothing_written() {
@@ -74,7 +47,6 @@ protected:
   }
   static int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
-  fs::path dir_;
 };
 
 // The number after `key` in a message ("t = 0.55 s" -> 0.55), NaN if absent.
