@@ -404,18 +404,67 @@ std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& 
     if (tab.find(n) < 0)
       throw InputError(meta_path + ": describes column '" + n + "', which data file '" + csv +
                        "' lacks; the two files are not from the same run");
+  // The structure, and each column's quantity, site and unit, as the scenario has them: a truth of
+  // another structure, a force read as a moment, a sensor on another body, or values in another
+  // unit would be identified without a word.
+  const std::string structure = io::to_string(sc.structure);
+  if (!meta.structure.empty() && meta.structure != structure)
+    throw InputError(meta_path + ": structure '" + meta.structure + "' but the scenario's is '" + structure +
+                     "'; the data are not of this scenario's structure");
+  for (const auto& c : meta.columns) {
+    const std::string* kind = nullptr;
+    const std::string* at = nullptr;
+    for (const auto& in : sc.inputs)
+      if (in.name == c.name) kind = &in.kind, at = &in.at;
+    for (const auto& se : sc.sensors)
+      if (se.name == c.name) kind = &se.kind, at = &se.at;
+    if (!kind) continue;
+    const std::string what = "column '" + io::one_line(c.name) + "'";
+    if (!c.quantity.empty() && c.quantity != *kind)
+      throw InputError(meta_path + ": " + what + " is a " + c.quantity + " but the scenario's is a " + *kind);
+    if (!c.at.empty() && c.at != *at)
+      throw InputError(meta_path + ": " + what + " is at the " + c.at + " but the scenario's is at the " + *at);
+    const int col = tab.find(c.name);
+    const std::string file_unit = tab.unit(col);
+    if (!c.unit.empty() && !file_unit.empty() && file_unit != c.unit)
+      throw InputError(meta_path + ": " + what + " is in '" + c.unit + "' but data file '" + csv + "' states '" +
+                       file_unit + "'; the two files are not from the same run");
+    if (!c.unit.empty()) p.meta_units[c.name] = c.unit;
+  }
   for (const auto& c : meta.columns)
     for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
       const auto& s = sc.sensors[j];
       if (s.name != c.name) continue;
-      if (c.kind == "output" && !c.quantity.empty() && c.quantity != s.kind)
-        throw InputError(meta_path + ": column '" + c.name + "' is a " + c.quantity + " but the scenario's sensor is a " + s.kind);
       if (p.noise_std[j] <= 0 && c.noise_std > 0) {
         p.noise_std[j] = c.noise_std;
         p.noise_origin[j] = "truth.json";
       }
     }
   return meta.true_parameters;
+}
+
+// A sensor's record with one sample over kLoneSpike times the RMS of all its others: no
+// structure's response does that (a response spreads over the samples its modes last; even a
+// step near the record's end keeps the peak within ten times the RMS), so it is a spike, a
+// corrupted cell or a unit slip in one row (a 1e23 m sample), and a least-squares fit would
+// chase it. Refused, naming the sample.
+constexpr double kLoneSpike = 1e3;
+void check_lone_spike(const std::vector<double>& v, const io::DataTable& tab, int col, const std::string& field,
+                      const std::string& name) {
+  if (v.size() < 30) return;
+  std::size_t peak = 0;
+  for (std::size_t k = 1; k < v.size(); ++k)
+    if (std::abs(v[k]) > std::abs(v[peak])) peak = k;
+  double ms = 0.0;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (k != peak) ms += v[k] * v[k];
+  const double rest = std::sqrt(ms / static_cast<double>(v.size() - 1));
+  if (!(std::abs(v[peak]) > kLoneSpike * rest)) return;
+  throw InputError("data file '" + tab.source + "': column '" + io::one_line(tab.names[static_cast<std::size_t>(col)]) +
+                   "' (" + field + ", sensor '" + name + "'): the sample at t = " + io::format_value(tab.t[peak]) + " s is " +
+                   io::format_value(v[peak]) + ", over " + io::format_value(kLoneSpike) +
+                   " times the RMS of the column's other samples (" + io::format_value(rest) +
+                   "): a spike, a corrupted cell or a unit slip that a least-squares fit would chase; correct or remove it");
 }
 
 // The table column of a sensor or input: its `column`, else its name (-1 when absent).
@@ -435,6 +484,13 @@ std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col,
                         column_unit.empty() ? "file" : field + ".column_unit", unit, 1.0};
   const auto q = io::units::quantity_of_kind(kind);
   if (src.to_unit.empty() && q) src.to_unit = io::units::system_unit(sc.units, *q);
+  // A column its file gives no unit takes the one truth.json beside it states, when the scenario
+  // states a unit to read it in (without one, values are taken as they are, as from any file).
+  if (const auto it = p.meta_units.find(column);
+      src.from_unit.empty() && it != p.meta_units.end() && !src.to_unit.empty() && it->second != src.to_unit) {
+    src.from_unit = it->second;
+    src.unit_stated_by = "truth.json";
+  }
   std::vector<double> v = tab.columns[static_cast<std::size_t>(col)];
   if (src.from_unit.empty() || !q) {
     src.unit_stated_by = src.from_unit.empty() ? "none" : src.unit_stated_by;
@@ -497,6 +553,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
                        (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
                        " (" + field + " of " + sc.source + ")");
     const auto v = column_values(p, tab, col, field, s.name, s.kind, s.unit, s.column_unit);
+    check_lone_spike(v, tab, col, field, s.name);
     for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
     p.data.names.push_back(s.name);
     used[static_cast<std::size_t>(col)] = true;

@@ -23,6 +23,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
 
 #ifndef SCOLE_IDENTIFY_EXE
@@ -914,6 +915,60 @@ TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
   write_file(dir / "data" / "truth.json", meta.dump());
   const Result r5 = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", (dir / "run5").string(), "-q"}, dir);
   expect_input_error(r5, dir / "run5", {"truth.json", "not from the same run"});
+  meta["columns"][2]["name"] = "spare";
+  // 4. A truth.json of another structure, or placing a sensor on another body, is refused naming both.
+  auto refused = [&](nlohmann::json m, const std::string& run_name, const std::vector<std::string>& words) {
+    write_file(dir / "data" / "truth.json", m.dump());
+    const Result r = run({"--scenario", (dir / "good.yaml").string(), "--data", csv, "--out", (dir / run_name).string(), "-q"}, dir);
+    expect_input_error(r, dir / run_name, words);
+  };
+  nlohmann::json other = meta;
+  other["structure"] = "scole";
+  refused(other, "run6", {"truth.json", "structure 'scole'", "'beam'"});
+  other = meta;
+  other["columns"][1]["at"] = "mast";
+  refused(other, "run7", {"truth.json", "column 'w_tip' is at the mast", "at the beam"});
+  other = meta;
+  other["columns"][0]["quantity"] = "moment";
+  refused(other, "run8", {"truth.json", "column 'P' is a moment", "a force"});
+  // 5. The unit truth.json states for a column its file gives none is the column's: values written
+  // in mm are converted into the scenario's m (scale 1e-3 in identify.json), not read as metres.
+  other = meta;
+  other["columns"][1]["unit"] = "mm";
+  write_file(dir / "data" / "truth.json", other.dump());
+  write_file(dir / "in_m.yaml", good_with("kind: displacement, location: 10}", "kind: displacement, location: 10, unit: m}"));
+  const fs::path out9 = dir / "run9";
+  const Result r9 = run({"--scenario", (dir / "in_m.yaml").string(), "--data", csv, "--out", out9.string(), "-q",
+                         "--max-iterations", "0", "--no-std"},
+                        dir);
+  ASSERT_TRUE(r9.code == 0 || r9.code == 1) << r9.err;
+  bool found = false;
+  const auto j9 = read_json_file(out9 / "identify.json");
+  for (const auto& src : j9["data_columns"]["sources"])
+    if (src["name"] == "w_tip") {
+      found = true;
+      EXPECT_EQ(src["column_unit"], "mm");
+      EXPECT_EQ(src["unit_stated_by"], "truth.json");
+      EXPECT_NEAR(src["scale"].get<double>(), 1e-3, 1e-15);
+    }
+  EXPECT_TRUE(found) << j9.dump() << r9.err;
+  // 6. One sample of a sensor's column a thousand times the RMS of the others (a unit slip in one
+  // row): refused, naming the column and the sample's time.
+  fs::remove(dir / "data" / "truth.json");
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "t,P,w_tip\n";
+    for (std::size_t i = 0; i < t.size(); ++i) os << t[i] << ",10," << (i == 57 ? 1e23 : w[i]) << "\n";
+    fs::create_directories(dir / "spike");
+    write_file(dir / "spike" / "m.csv", os.str());
+  }
+  const Result r11 = run({"--scenario", (dir / "good.yaml").string(), "--data", (dir / "spike" / "m.csv").string(),
+                          "--out", (dir / "run11").string(), "-q"},
+                         dir);
+  std::ostringstream at;
+  at << "t = " << scoleid::io::format_value(t[57]) << " s is 1e+23";
+  expect_input_error(r11, dir / "run11", {"column 'w_tip'", at.str(), "1000 times the RMS"});
 }
 
 TEST(ScoleIdentifyHardening, ATruthJsonWithARepeatedKeyIsRefusedNamingIt) {

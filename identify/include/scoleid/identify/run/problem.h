@@ -84,6 +84,8 @@ struct Problem {
   std::map<std::string, double> true_values;  // by parameter name, where known
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
+  // Column units truth.json states (by column name), for columns whose file states none.
+  std::map<std::string, std::string> meta_units;
   ColumnUse columns;                          // with a data file
   DataContent content;                        // the modes the step resolves (data_content)
   // identification.band (inverse/band_filter.h): the filter's noise gain g = Σh² (1 without a band):
