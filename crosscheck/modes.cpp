@@ -32,7 +32,7 @@ io::Scenario shape_scenario(const io::Scenario& truth_sc, int count, std::vector
     io::SensorSpec spec;
     spec.name = name;
     spec.at = at;
-    spec.kind = kind;
+    spec.kind = *io::parse<io::SensorKind>(kind);
     spec.location = s;
     spec.direction = std::move(d);
     sc.sensors.push_back(spec);
@@ -364,7 +364,7 @@ io::ModalData chain_modal_data(const io::Scenario& scenario, int segments, int c
   io::Scenario sc = truth_sc;
   sc.sensors.clear();
   for (const auto& s : truth_sc.sensors)
-    if (s.kind == "displacement" || s.kind == "rotation" || s.kind == "line_of_sight") sc.sensors.push_back(s);
+    if (io::derivative_order(s.kind) == 0 && s.kind != io::SensorKind::Strain) sc.sensors.push_back(s);
   if (sc.sensors.empty())
     io::fail_field(scenario.source, "sensors", "needs a displacement, rotation or line-of-sight sensor for mode shapes", "none");
   if (2 * segments > io::limits::kMaxSegments)

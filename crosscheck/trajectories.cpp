@@ -97,7 +97,7 @@ FeResponse response_of(const AtTruth& a, identify::MatrixXd fe) {
   r.measured = a.p->data.z;
   for (const auto& s : a.p->model().sensors) {
     r.sensors.push_back(s.name);
-    r.kinds.push_back(s.kind);
+    r.kinds.push_back(io::to_string(s.kind));
   }
   return r;
 }

@@ -469,8 +469,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.name = r.str("name", "y" + std::to_string(i + 1));
     if (!names.insert(s.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + s.name + "'");
     s.at = r.choice("at", sc.structure == Structure::Scole ? "mast" : "beam", {"beam", "mast", "reflector", "shuttle"});
-    s.kind = r.choice("kind", "displacement",
-                      {"displacement", "rotation", "velocity", "acceleration", "line_of_sight", "strain"});
+    s.kind = r.choice_of("kind", SensorKind::Displacement);
     s.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), s.at, s.location);
     s.direction = parse_direction(r, "direction");
@@ -478,15 +477,15 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.noise_std = r.nonneg("noise_std", 0.0);
     s.column = r.str("column", "");
     s.column_unit = r.str("column_unit", "");
-    check_units(sc, r, s.kind, s.unit, s.column_unit);
-    if (s.kind == "strain") {
+    check_units(sc, r, to_string(s.kind), s.unit, s.column_unit);
+    if (s.kind == SensorKind::Strain) {
       if (sc.structure != Structure::Beam)
         fail_field(sc.source, r.field("kind"), "is a beam's strain gauge (structure: beam)", "'strain'");
       if (!r.has("offset")) fail_field(sc.source, r.field("offset"), "is required for a strain gauge (its distance from the neutral axis)", "none");
       s.offset = r.num("offset", 0.0);
       if (!(s.offset != 0.0)) fail_field(sc.source, r.field("offset"), "must be nonzero (a gauge on the neutral axis reads nothing)", format_value(s.offset));
     } else if (r.has("offset")) {
-      fail_field(sc.source, r.field("offset"), "belongs to strain gauges (kind: strain)", "'" + s.kind + "' sensor");
+      fail_field(sc.source, r.field("offset"), "belongs to strain gauges (kind: strain)", "'" + std::string(to_string(s.kind)) + "' sensor");
     }
     // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
     // cannot explain, so they belong to the truth's side of a mismatch study only.
@@ -842,9 +841,9 @@ nlohmann::json to_json(const Scenario& s) {
   }
   j["sensors"] = json::array();
   for (const auto& se : s.sensors) {
-    j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", se.kind}, {"location", se.location},
+    j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", to_string(se.kind)}, {"location", se.location},
                             {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
-    if (se.kind == "strain") j["sensors"].back()["offset"] = se.offset;
+    if (se.kind == SensorKind::Strain) j["sensors"].back()["offset"] = se.offset;
     if (!se.column.empty()) j["sensors"].back()["column"] = se.column;
     if (!se.column_unit.empty()) j["sensors"].back()["column_unit"] = se.column_unit;
   }

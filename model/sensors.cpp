@@ -87,11 +87,12 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     const std::string field = "sensors[" + std::to_string(i) + "]";
     ResolvedSensor r;
     using K = ResolvedSensor::Kind;
-    r.kind = se.kind == "rotation" ? K::Rotation
-             : se.kind == "velocity" ? K::Velocity
-             : se.kind == "acceleration" ? K::Acceleration
-             : se.kind == "line_of_sight" ? K::LineOfSight
-             : se.kind == "strain" ? K::Strain : K::Displacement;
+    r.kind = se.kind == io::SensorKind::Rotation       ? K::Rotation
+             : se.kind == io::SensorKind::Velocity     ? K::Velocity
+             : se.kind == io::SensorKind::Acceleration ? K::Acceleration
+             : se.kind == io::SensorKind::LineOfSight  ? K::LineOfSight
+             : se.kind == io::SensorKind::Strain       ? K::Strain
+                                                       : K::Displacement;
     r.reference = st.reference_body();
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);

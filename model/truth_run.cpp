@@ -483,7 +483,7 @@ io::TruthMeta truth_meta(const io::Scenario& scenario, const io::Scenario& sc, c
   for (const auto& in : sc.inputs)
     m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
   for (const auto& se : sc.sensors)
-    m.columns.push_back({se.name, se.unit, "output", se.kind, se.at, se.location, se.direction, se.noise_std});
+    m.columns.push_back({se.name, se.unit, "output", io::to_string(se.kind), se.at, se.location, se.direction, se.noise_std});
   m.true_parameters = true_parameters(sc);
   m.generator = {{"program", "scole-truth"},
                  {"segments", n},

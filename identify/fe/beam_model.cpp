@@ -70,11 +70,10 @@ void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
     if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
-    if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "velocity" && se.kind != "acceleration" &&
-        se.kind != "strain")
+    if (se.kind == io::SensorKind::LineOfSight)
       fail_field(source, f + ".kind",
                  "is not supported by the beam identifier (displacement|rotation|velocity|acceleration|strain)",
-                 "'" + se.kind + "'");
+                 "'" + std::string(io::to_string(se.kind)) + "'");
     if (!(se.location >= 0.0 && se.location <= beam.length))
       fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
                  format_value(se.location));
@@ -82,10 +81,10 @@ void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io
     ms.name = se.name;
     ms.kind = se.kind;
     // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
-    ms.order = se.kind == "velocity" ? 1 : se.kind == "acceleration" ? 2 : 0;
+    ms.order = io::derivative_order(se.kind);
     // strain: ε = −offset · w_ss, the Hermite curvature row (linear in each element).
-    ms.row = se.kind == "rotation" ? fe.rotation_row(se.location)
-             : se.kind == "strain" ? Eigen::RowVectorXd(-se.offset * fe.curvature_row(se.location))
+    ms.row = se.kind == io::SensorKind::Rotation ? fe.rotation_row(se.location)
+             : se.kind == io::SensorKind::Strain ? Eigen::RowVectorXd(-se.offset * fe.curvature_row(se.location))
                                    : fe.displacement_row(se.location);
     m.sensors.push_back(std::move(ms));
   }

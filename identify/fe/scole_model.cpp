@@ -392,18 +392,18 @@ Eigen::RowVectorXd position_sensor_row(const ScoleFE& fe, const FullRows& fr, co
                                        const std::string& f, const std::string& source) {
   const double L = fe.spec.length;
   if (se.at == "shuttle") {
-    if (se.kind == "line_of_sight")
+    if (se.kind == io::SensorKind::LineOfSight)
       fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
-    return d.transpose() * (se.kind == "rotation" ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
+    return d.transpose() * (se.kind == io::SensorKind::Rotation ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
   }
   if (se.at != "mast" && se.at != "reflector")
     fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
   const bool mast = se.at == "mast";
   if (mast) check_station(se.location, L, source, f + ".location");
   const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
-  if (se.kind == "rotation") return d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
+  if (se.kind == io::SensorKind::Rotation) return d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
   const MatrixXd rel = (mast ? fr.displacement(se.location) : fr.reflector()) - fr.shuttle_rigid(p0);
-  if (se.kind == "displacement") return d.transpose() * rel;
+  if (se.kind == io::SensorKind::Displacement) return d.transpose() * rel;
   const Vector3d chord = p0 - vec3(fe.spec.mast_root);
   const double ell = chord.norm();
   if (!(ell > 0.0))
@@ -420,13 +420,13 @@ ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpe
   ms.name = se.name;
   ms.kind = se.kind;
   Eigen::RowVectorXd row;
-  if (se.kind == "velocity" || se.kind == "acceleration") {
-    ms.order = se.kind == "velocity" ? 1 : 2;
+  if (io::derivative_order(se.kind) > 0) {
+    ms.order = io::derivative_order(se.kind);
     row = rate_sensor_row(fr, se, d, ms.order, fe.spec.length, f, source);
-  } else if (se.kind != "displacement" && se.kind != "rotation" && se.kind != "line_of_sight") {
+  } else if (se.kind == io::SensorKind::Strain) {
     fail_field(source, f + ".kind",
                "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
-               "'" + se.kind + "'");
+               "'" + std::string(io::to_string(se.kind)) + "'");
   } else {
     row = position_sensor_row(fe, fr, se, d, f, source);
   }

@@ -494,11 +494,11 @@ void ScoleNonlinear::add_sensors(const ScoleFE& fe, const std::vector<io::Sensor
     Sensor s;
     s.d = vec3(spec.direction);
     if (spec.at == "shuttle") {
-      s.kind = spec.kind == "rotation"       ? K::ShuttleRotation
-               : spec.kind == "velocity"     ? K::ShuttleVelocity
-               : spec.kind == "acceleration" ? K::ShuttleAcceleration
-                                             : K::ShuttleDisplacement;
-    } else if (spec.kind == "acceleration") {
+      s.kind = spec.kind == io::SensorKind::Rotation       ? K::ShuttleRotation
+               : spec.kind == io::SensorKind::Velocity     ? K::ShuttleVelocity
+               : spec.kind == io::SensorKind::Acceleration ? K::ShuttleAcceleration
+                                                           : K::ShuttleDisplacement;
+    } else if (spec.kind == io::SensorKind::Acceleration) {
       s.kind = K::PointAcceleration;
       const bool mast = spec.at == "mast";
       s.p = mast ? mast_point(sc, spec.location) : mast_point(sc, sc.length) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);

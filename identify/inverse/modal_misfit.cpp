@@ -108,7 +108,7 @@ ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& p
     if (!found || found->order != 0)
       io::fail_field(
           src, "column '" + name + "'", "is not a displacement, rotation or line-of-sight sensor of the scenario",
-          "'" + name + "'" + (found ? " (its kind is " + found->kind + ")" : std::string(" (no such sensor)")));
+          "'" + name + "'" + (found ? " (its kind is " + std::string(io::to_string(found->kind)) + ")" : std::string(" (no such sensor)")));
     Cs_.row(static_cast<Eigen::Index>(k)) = found->row;
   }
   if (data_.has_damping() && model_.damping.empty())

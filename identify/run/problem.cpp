@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <filesystem>
+#include <optional>
 #include <random>
 
 #include "scoleid/identify/fe/modal.h"
@@ -412,12 +413,12 @@ std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& 
     throw InputError(meta_path + ": structure '" + meta.structure + "' but the scenario's is '" + structure +
                      "'; the data are not of this scenario's structure");
   for (const auto& c : meta.columns) {
-    const std::string* kind = nullptr;
+    std::optional<std::string> kind;
     const std::string* at = nullptr;
     for (const auto& in : sc.inputs)
-      if (in.name == c.name) kind = &in.kind, at = &in.at;
+      if (in.name == c.name) kind = in.kind, at = &in.at;
     for (const auto& se : sc.sensors)
-      if (se.name == c.name) kind = &se.kind, at = &se.at;
+      if (se.name == c.name) kind = io::to_string(se.kind), at = &se.at;
     if (!kind) continue;
     const std::string what = "column '" + io::one_line(c.name) + "'";
     if (!c.quantity.empty() && c.quantity != *kind)
@@ -552,7 +553,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
       throw InputError("data file '" + csv + "': no column " +
                        (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
                        " (" + field + " of " + sc.source + ")");
-    const auto v = column_values(p, tab, col, field, s.name, s.kind, s.unit, s.column_unit);
+    const auto v = column_values(p, tab, col, field, s.name, io::to_string(s.kind), s.unit, s.column_unit);
     check_lone_spike(v, tab, col, field, s.name);
     for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
     p.data.names.push_back(s.name);

@@ -197,9 +197,9 @@ TEST(Checkpoints, RateSensorGradientOnACheckpointedStateEqualsTheStoredOne) {
   auto sc = scoleid::io::load_scenario("beam-ei8");
   sc.identification.elements = 16;
   sc.simulation.duration = 2.0;
-  sc.sensors[1].kind = "velocity";
+  sc.sensors[1].kind = scoleid::io::SensorKind::Velocity;
   sc.sensors[1].unit = "m/s";
-  sc.sensors[4].kind = "acceleration";
+  sc.sensors[4].kind = scoleid::io::SensorKind::Acceleration;
   sc.sensors[4].unit = "m/s^2";
   const auto p = make_problem(sc, std::nullopt);
   const VectorXd q = p->params->initial() * 1.05;

@@ -656,7 +656,7 @@ TEST(ModalMisfit, DampingDataNeedADampedModel) {
   model.stiffness.push_back({Ks, 0});
   ModelSensor x2;
   x2.name = "x2";
-  x2.kind = "displacement";
+  x2.kind = scoleid::io::SensorKind::Displacement;
   x2.row = Eigen::RowVector2d(0.0, 1.0);
   model.sensors.push_back(x2);
   struct Stiffness final : Parameterization {

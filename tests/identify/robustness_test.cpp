@@ -335,7 +335,7 @@ TEST(Identification, AutoWithAPriorAndARateSensorKeepsTheExplicitMatrix) {
   auto sc = beam_sections(std::vector<double>(17, 30000.0));
   sc.identification.method = scoleid::io::Method::Auto;
   sc.identification.smoothness = 1e-3;
-  sc.sensors[3].kind = "velocity";
+  sc.sensors[3].kind = scoleid::io::SensorKind::Velocity;
   sc.simulation.duration = 1.0;
   auto p = make_problem(sc, std::nullopt);
   RunOptions ro;

@@ -533,7 +533,7 @@ TEST(ScoleNonlinear, TheReflectorsCMIsTheArmTurnedExactlyByTheEndSection) {
     scoleid::io::SensorSpec a;
     a.name = "acc" + std::to_string(k);
     a.at = "reflector";
-    a.kind = "acceleration";
+    a.kind = scoleid::io::SensorKind::Acceleration;
     a.direction = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
     sc.sensors.push_back(a);
   }
@@ -598,7 +598,7 @@ TEST(ScoleNonlinear, UndampedFreeMotionConservesEnergyAndMomenta) {
   sc.inputs.clear();
   sc.sensors = {sc.sensors.front()};
   sc.sensors.front().at = "shuttle";
-  sc.sensors.front().kind = "rotation";
+  sc.sensors.front().kind = scoleid::io::SensorKind::Rotation;
   sc.sensors.front().direction = {1, 0, 0};
   const Model m = make_model(sc, 6);
   const auto dyn = m.nl->at(scole_coefficients(m.fe.spec));

@@ -48,7 +48,7 @@ TEST(StrainSensor, TheHermiteCantileverReadsTheStaticMomentExactly) {
   for (double s : {0.0, 0.13, 0.5, 0.77, 1.0, 1.61, 2.0}) {
     scoleid::io::SensorSpec g;
     g.name = "eps";
-    g.kind = "strain";
+    g.kind = scoleid::io::SensorKind::Strain;
     g.location = s;
     g.offset = c;
     gauges.push_back(g);

@@ -150,7 +150,7 @@ struct InputSpec {
 struct SensorSpec {
   std::string name;
   std::string at = "beam";
-  std::string kind = "displacement";
+  SensorKind kind = SensorKind::Displacement;
   double location = 0.0;
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;

@@ -8,6 +8,7 @@
 //   Start       identification.start                how the first attempt starts (docs/theory.md §7.6)
 //   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
 //   StepRule    identification.step_rule            the automatic time step's rule (§5.2)
+//   SensorKind  sensors[].kind                      what a sensor reads (§3.5, §6.1a)
 //
 // Adding a value: one enumerator and one row of its table, here; the reader, --help and the JSON
 // writers follow, and a switch over the type that misses it is a compiler warning.
@@ -25,6 +26,7 @@ enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent
 enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
+enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain };
 
 // Each type's names, in declaration order (the first is the default where a field has one).
 template <class E>
@@ -55,6 +57,22 @@ struct Names<StepRule> {
   static constexpr std::array<std::pair<StepRule, const char*>, 2> rows{
       {{StepRule::Parameters, "parameters"}, {StepRule::Data, "data"}}};
 };
+
+template <>
+struct Names<SensorKind> {
+  static constexpr std::array<std::pair<SensorKind, const char*>, 6> rows{{{SensorKind::Displacement, "displacement"},
+                                                                          {SensorKind::Rotation, "rotation"},
+                                                                          {SensorKind::Velocity, "velocity"},
+                                                                          {SensorKind::Acceleration, "acceleration"},
+                                                                          {SensorKind::LineOfSight, "line_of_sight"},
+                                                                          {SensorKind::Strain, "strain"}}};
+};
+
+// The time derivative of the structure's motion a sensor of this kind reads: 0 (displacement,
+// rotation, line of sight, strain), 1 (velocity), 2 (acceleration).
+constexpr int derivative_order(SensorKind k) {
+  return k == SensorKind::Velocity ? 1 : k == SensorKind::Acceleration ? 2 : 0;
+}
 
 // The name a scenario, a command line and identify.json use.
 template <class E, class = decltype(Names<E>::rows)>

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "scoleid/io/types.h"
+
 namespace scoleid::identify {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
@@ -35,7 +37,7 @@ struct ModelInput {
 // A sensor is a row on u, u̇ or ü: y_k = C_k u^(order).
 struct ModelSensor {
   std::string name;
-  std::string kind;       // displacement | rotation | line_of_sight (order 0) | velocity (1) | acceleration (2)
+  io::SensorKind kind = io::SensorKind::Displacement;  // order: io::derivative_order(kind)
   int order = 0;          // derivative the row acts on
   Eigen::RowVectorXd row; // C_k
 };
