@@ -27,12 +27,12 @@ io::Scenario shape_scenario(const io::Scenario& truth_sc, int count, std::vector
   sc.sensors.clear();
   scale.clear();
   const int m = 2 * count + 2;
-  auto add = [&](const std::string& name, const std::string& at, const std::string& kind, double s,
-                 std::vector<double> d, double row_scale) {
+  auto add = [&](const std::string& name, io::Site at, io::SensorKind kind, double s, std::vector<double> d,
+                 double row_scale) {
     io::SensorSpec spec;
     spec.name = name;
     spec.at = at;
-    spec.kind = *io::parse<io::SensorKind>(kind);
+    spec.kind = kind;
     spec.location = s;
     spec.direction = std::move(d);
     sc.sensors.push_back(spec);
@@ -43,13 +43,13 @@ io::Scenario shape_scenario(const io::Scenario& truth_sc, int count, std::vector
     for (int k = 1; k <= m; ++k) {
       const double s = L * k / m;
       const std::string tag = "s" + std::to_string(k);
-      add(tag + "_x", "mast", "displacement", s, {1, 0, 0}, 1.0);
-      add(tag + "_y", "mast", "displacement", s, {0, 1, 0}, 1.0);
-      add(tag + "_rz", "mast", "rotation", s, {0, 0, 1}, L);
+      add(tag + "_x", io::Site::Mast, io::SensorKind::Displacement, s, {1, 0, 0}, 1.0);
+      add(tag + "_y", io::Site::Mast, io::SensorKind::Displacement, s, {0, 1, 0}, 1.0);
+      add(tag + "_rz", io::Site::Mast, io::SensorKind::Rotation, s, {0, 0, 1}, L);
     }
   } else {
     const double L = sc.beam.length;
-    for (int k = 1; k <= m; ++k) add("w" + std::to_string(k), "beam", "displacement", L * k / (m + 1), {0, 1, 0}, 1.0);
+    for (int k = 1; k <= m; ++k) add("w" + std::to_string(k), io::Site::Beam, io::SensorKind::Displacement, L * k / (m + 1), {0, 1, 0}, 1.0);
   }
   return sc;
 }

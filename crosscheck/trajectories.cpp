@@ -77,7 +77,7 @@ AtTruth at_truth(const io::Scenario& scenario, const std::string& csv, int eleme
   // Every quantity at the truth's value: the parameters by the truth file's true values (below),
   // the others from the structure, not from the identifier's starting guesses.
   sc.identification.initial.clear();
-  for (auto& in : sc.inputs) in.signal_from = "scenario";
+  for (auto& in : sc.inputs) in.signal_from = io::SignalFrom::Scenario;
   a.p = identify::make_problem(sc, csv);
   const auto& names = a.p->params->names();
   a.q.resize(static_cast<Eigen::Index>(names.size()));
@@ -148,7 +148,7 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
   rep.truth_overrides = io::has_truth_overrides(scenario);
   rep.elements = opt.elements > 0 ? opt.elements : 4 * scenario.identification.elements;
   if (rep.elements > io::limits::kMaxElements) rep.elements = io::limits::kMaxElements;
-  for (const auto& in : scenario.inputs) rep.input_kinds.push_back(in.at + " " + in.kind);
+  for (const auto& in : scenario.inputs) rep.input_kinds.push_back(std::string(io::to_string(in.at)) + " " + io::to_string(in.kind));
   rep.segments = refinement(opt.segments > 0 ? opt.segments : scenario.truth.segments, opt.levels,
                             io::limits::kMaxSegments, "segments");
   rep.truths = run_truth_levels(scenario, rep.segments, truth_root, true, opt.progress);

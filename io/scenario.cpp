@@ -111,6 +111,17 @@ public:
     if (const auto e = parse<E>(v)) return *e;
     fail_field(source_, field(key), "must be one of " + names_joined<E>(), "'" + v + "'");
   }
+  // The same, among some of the type's values only (listed in the message in the order given).
+  template <class E>
+  E choice_among(const std::string& key, E dflt, const std::vector<E>& allowed) {
+    const std::string v = str(key, to_string(dflt));
+    std::string list;
+    for (const E a : allowed) {
+      if (v == to_string(a)) return a;
+      list += (list.empty() ? "" : "|") + std::string(to_string(a));
+    }
+    fail_field(source_, field(key), "must be one of " + list, "'" + v + "'");
+  }
   std::vector<double> numbers(const std::string& key, const std::vector<double>& dflt) {
     if (!has(key)) return dflt;
     const YAML::Node n = node_[key];
@@ -403,13 +414,12 @@ double structure_length(const Scenario& sc) {
   return sc.structure == Structure::Scole ? sc.scole.length : sc.beam.length;
 }
 
-void check_location(const Scenario& sc, const std::string& field, const std::string& at, double loc,
-                    const std::string& source = "") {
-  if (at != "beam" && at != "mast") return;
+void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "") {
+  if (!has_station(at)) return;
   const double L = structure_length(sc);
   if (!(loc >= 0.0 && loc <= L))
-    fail_field(source.empty() ? sc.source : source, field, "must lie on the " + at + " [0, " + format_value(L) + "]",
-               format_value(loc));
+    fail_field(source.empty() ? sc.source : source, field,
+               "must lie on the " + std::string(to_string(at)) + " [0, " + format_value(L) + "]", format_value(loc));
 }
 
 // A sensor's or input's unit and its column's must be units of its quantity, and the unit the
@@ -442,18 +452,17 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     InputSpec in;
     in.name = r.str("name", "u" + std::to_string(i + 1));
     if (!names.insert(in.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + in.name + "'");
-    in.at = r.choice("at", sc.structure == Structure::Scole ? "reflector" : "beam",
-                     {"beam", "mast", "shuttle", "reflector", "actuator1", "actuator2"});
-    in.kind = r.choice("kind", "force", {"force", "moment"});
+    in.at = r.choice_of("at", sc.structure == Structure::Scole ? Site::Reflector : Site::Beam);
+    in.kind = r.choice_of("kind", InputKind::Force);
     in.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), in.at, in.location);
     in.direction = parse_direction(r, "direction");
     in.unit = r.str("unit", "");
-    in.signal_from = r.choice("signal_from", in.signal_from, {"auto", "data", "scenario"});
+    in.signal_from = r.choice_of("signal_from", in.signal_from);
     in.signal = parse_signal(r.child("signal"), sc.source, r.field("signal"));
     in.column = r.str("column", "");
     in.column_unit = r.str("column_unit", "");
-    check_units(sc, r, in.kind, in.unit, in.column_unit);
+    check_units(sc, r, to_string(in.kind), in.unit, in.column_unit);
     sc.inputs.push_back(std::move(in));
   }
 }
@@ -468,7 +477,8 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     SensorSpec s;
     s.name = r.str("name", "y" + std::to_string(i + 1));
     if (!names.insert(s.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + s.name + "'");
-    s.at = r.choice("at", sc.structure == Structure::Scole ? "mast" : "beam", {"beam", "mast", "reflector", "shuttle"});
+    s.at = r.choice_among("at", sc.structure == Structure::Scole ? Site::Mast : Site::Beam,
+                          {Site::Beam, Site::Mast, Site::Reflector, Site::Shuttle});
     s.kind = r.choice_of("kind", SensorKind::Displacement);
     s.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), s.at, s.location);
@@ -630,8 +640,9 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
     if (!names.insert(name).second) fail_field(source, r.field("name"), "must be unique", "'" + name + "'");
     SensorSpec& se = *it;
     if (r.has("location")) {
-      if (se.at != "beam" && se.at != "mast")
-        fail_field(source, r.field("location"), "applies to beam and mast sensors only (sensor '" + name + "' is at " + se.at + ")",
+      if (!has_station(se.at))
+        fail_field(source, r.field("location"),
+                   "applies to beam and mast sensors only (sensor '" + name + "' is at " + to_string(se.at) + ")",
                    format_value(r.num("location", 0.0)));
       se.location = r.num("location", se.location);
       check_location(t, r.field("location"), se.at, se.location, source);
@@ -833,15 +844,15 @@ nlohmann::json to_json(const Scenario& s) {
   }
   j["inputs"] = json::array();
   for (const auto& in : s.inputs) {
-    j["inputs"].push_back({{"name", in.name}, {"at", in.at}, {"kind", in.kind}, {"location", in.location},
-                           {"direction", in.direction}, {"unit", in.unit}, {"signal_from", in.signal_from},
+    j["inputs"].push_back({{"name", in.name}, {"at", to_string(in.at)}, {"kind", to_string(in.kind)}, {"location", in.location},
+                           {"direction", in.direction}, {"unit", in.unit}, {"signal_from", to_string(in.signal_from)},
                            {"signal", signal(in.signal)}});
     if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
     if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;
   }
   j["sensors"] = json::array();
   for (const auto& se : s.sensors) {
-    j["sensors"].push_back({{"name", se.name}, {"at", se.at}, {"kind", to_string(se.kind)}, {"location", se.location},
+    j["sensors"].push_back({{"name", se.name}, {"at", to_string(se.at)}, {"kind", to_string(se.kind)}, {"location", se.location},
                             {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
     if (se.kind == SensorKind::Strain) j["sensors"].back()["offset"] = se.offset;
     if (!se.column.empty()) j["sensors"].back()["column"] = se.column;

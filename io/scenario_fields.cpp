@@ -28,7 +28,7 @@ std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
     }
   }
   for (auto& se : sc.sensors)
-    if (se.at == "beam" || se.at == "mast") v.emplace_back("sensors." + se.name + ".location", &se.location);
+    if (has_station(se.at)) v.emplace_back("sensors." + se.name + ".location", &se.location);
   return v;
 }
 

@@ -128,25 +128,24 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
     const std::string field = "inputs[" + std::to_string(i) + "]";
     AppliedInput a;
     a.signal = in.signal;
-    a.kind = in.kind == "moment" ? AppliedInput::Kind::Moment : AppliedInput::Kind::Force;
+    a.kind = in.kind == io::InputKind::Moment ? AppliedInput::Kind::Moment : AppliedInput::Kind::Force;
     const Vec3 d(in.direction[0], in.direction[1], in.direction[2]);
     if (beam) {
-      if (in.at != "beam")
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", "'" + in.at + "'");
+      if (in.at != io::Site::Beam)
+        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", io::quoted(in.at));
       a.station = st.station_at(in.location);
       a.d_R = a.kind == AppliedInput::Kind::Moment ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
-    } else if (in.at == "beam") {
+    } else if (in.at == io::Site::Beam) {
       io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
-    } else if (in.at.rfind("actuator", 0) == 0) {
-      const int k = in.at == "actuator1" ? 1 : 2;
+    } else if (io::actuator_index(in.at) >= 0) {
+      const int k = io::actuator_index(in.at) + 1;
       a.kind = AppliedInput::Kind::Slider;
       a.slider_x = st.actuator_slider(k, 0);
       a.slider_y = st.actuator_slider(k, 1);
       if (!a.slider_x.isValid())
-        io::fail_field(sc.source, field + ".at", "names an actuator the configuration does not have",
-                       "'" + in.at + "'");
-      if (in.kind != "force")
-        io::fail_field(sc.source, field + ".kind", "must be 'force' for a proof-mass actuator", "'" + in.kind + "'");
+        io::fail_field(sc.source, field + ".at", "names an actuator the configuration does not have", io::quoted(in.at));
+      if (in.kind != io::InputKind::Force)
+        io::fail_field(sc.source, field + ".kind", "must be 'force' for a proof-mass actuator", io::quoted(in.kind));
       if (std::abs(d[2]) > 1e-12 || d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must lie in the actuator plane (x, y)",
                        "[" + io::format_value(d[0]) + ", " + io::format_value(d[1]) + ", " + io::format_value(d[2]) + "]");
@@ -158,9 +157,9 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
       if (d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       a.d_R = d;
-      a.station = in.at == "mast" ? st.station_at(in.location) : st.named_station(in.at);
+      a.station = in.at == io::Site::Mast ? st.station_at(in.location) : st.named_station(in.at);
       if (!a.station.body.isValid())
-        io::fail_field(sc.source, field + ".at", "is not a body of this structure", "'" + in.at + "'");
+        io::fail_field(sc.source, field + ".at", "is not a body of this structure", io::quoted(in.at));
     }
     out.push_back(a);
   }

@@ -103,9 +103,9 @@ ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   Force::Custom(forces_, new JointForces(matter_, std::move(joints), {}, std::move(dampers)));
 }
 
-Station ScoleSystem::named_station(const std::string& at) const {
-  if (at == "shuttle") return {shuttle_, Vec3(0), Vec3(0)};
-  if (at == "reflector") return reflector_station_;
+Station ScoleSystem::named_station(io::Site at) const {
+  if (at == io::Site::Shuttle) return {shuttle_, Vec3(0), Vec3(0)};
+  if (at == io::Site::Reflector) return reflector_station_;
   return {};
 }
 

@@ -97,8 +97,8 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
     if (beam) {
-      if (se.at != "beam")
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
+      if (se.at != io::Site::Beam)
+        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", io::quoted(se.at));
       if (r.kind == K::LineOfSight)
         io::fail_field(sc.source, field + ".kind", "is not defined for a beam", "'line_of_sight'");
       r.station = st.station_at(se.location);
@@ -108,14 +108,14 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     } else {
       if (r.kind == K::Strain)
         io::fail_field(sc.source, field + ".kind", "is a beam's strain gauge (structure: beam)", "'strain'");
-      if (se.at == "beam")
+      if (se.at == io::Site::Beam)
         io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
       if (d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       r.d_R = d;
-      r.station = se.at == "mast" ? st.station_at(se.location) : st.named_station(se.at);
-      if (se.at == "mast" && r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
-      if (se.at == "shuttle") r.reference = GroundIndex;
+      r.station = se.at == io::Site::Mast ? st.station_at(se.location) : st.named_station(se.at);
+      if (se.at == io::Site::Mast && r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
+      if (se.at == io::Site::Shuttle) r.reference = GroundIndex;
     }
     out.push_back(r);
   }

@@ -16,7 +16,7 @@ Station Structure::station_at(double s) const {
   return st;
 }
 
-Station Structure::named_station(const std::string&) const { return {}; }
+Station Structure::named_station(io::Site) const { return {}; }
 
 SimTK::MobilizedBodyIndex Structure::actuator_slider(int, int) const { return {}; }
 

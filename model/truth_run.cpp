@@ -481,9 +481,9 @@ io::TruthMeta truth_meta(const io::Scenario& scenario, const io::Scenario& sc, c
   m.scenario = sc.name;
   m.structure = io::to_string(sc.structure);
   for (const auto& in : sc.inputs)
-    m.columns.push_back({in.name, in.unit, "input", in.kind, in.at, in.location, in.direction, 0.0});
+    m.columns.push_back({in.name, in.unit, "input", io::to_string(in.kind), io::to_string(in.at), in.location, in.direction, 0.0});
   for (const auto& se : sc.sensors)
-    m.columns.push_back({se.name, se.unit, "output", io::to_string(se.kind), se.at, se.location, se.direction, se.noise_std});
+    m.columns.push_back({se.name, se.unit, "output", io::to_string(se.kind), io::to_string(se.at), se.location, se.direction, se.noise_std});
   m.true_parameters = true_parameters(sc);
   m.generator = {{"program", "scole-truth"},
                  {"segments", n},

@@ -52,13 +52,13 @@ void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io:
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& in = inputs[i];
     const std::string f = "inputs[" + std::to_string(i) + "]";
-    if (in.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + in.at + "'");
+    if (in.at != io::Site::Beam) fail_field(source, f + ".at", "must be 'beam' for a beam structure", io::quoted(in.at));
     if (!(in.location >= 0.0 && in.location <= beam.length))
       fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
                  format_value(in.location));
     ModelInput mi;
     mi.name = in.name;
-    mi.vector = (in.kind == "moment" ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
+    mi.vector = (in.kind == io::InputKind::Moment ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
     m.inputs.push_back(std::move(mi));
   }
 }
@@ -69,7 +69,7 @@ void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
-    if (se.at != "beam") fail_field(source, f + ".at", "must be 'beam' for a beam structure", "'" + se.at + "'");
+    if (se.at != io::Site::Beam) fail_field(source, f + ".at", "must be 'beam' for a beam structure", io::quoted(se.at));
     if (se.kind == io::SensorKind::LineOfSight)
       fail_field(source, f + ".kind",
                  "is not supported by the beam identifier (displacement|rotation|velocity|acceleration|strain)",

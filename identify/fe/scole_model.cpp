@@ -346,17 +346,16 @@ MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& 
   const io::ScoleSpec& sc = fe.spec;
   const int nact = static_cast<int>(sc.actuator_locations.size());
   const double L = sc.length;
-  const bool moment = in.kind == "moment";
-  if (in.at == "shuttle") return moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
-  if (in.at == "reflector") return moment ? fr.rotation(L) : fr.reflector();
-  if (in.at == "mast") {
+  const bool moment = in.kind == io::InputKind::Moment;
+  if (in.at == io::Site::Shuttle) return moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
+  if (in.at == io::Site::Reflector) return moment ? fr.rotation(L) : fr.reflector();
+  if (in.at == io::Site::Mast) {
     check_station(in.location, L, source, f + ".location");
     return moment ? fr.rotation(in.location) : fr.displacement(in.location);
   }
-  if (in.at == "actuator1" || in.at == "actuator2") {
-    const int k = in.at == "actuator1" ? 0 : 1;
-    if (k >= nact) fail_field(source, f + ".at", "names an actuator the configuration does not have", "'" + in.at + "'");
-    if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", "'" + in.kind + "'");
+  if (const int k = io::actuator_index(in.at); k >= 0) {
+    if (k >= nact) fail_field(source, f + ".at", "names an actuator the configuration does not have", io::quoted(in.at));
+    if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", io::quoted(in.kind));
     if (std::abs(d[2]) > 1e-12)
       fail_field(source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
     // Slider force: +f on the proof mass, −f on the mast at s_k.
@@ -367,7 +366,7 @@ MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& 
     return rows;
   }
   fail_field(source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
-             "'" + in.at + "'");
+             io::quoted(in.at));
 }
 
 // A rate sensor's row: velocity, d/dt of the displacement sensor's quantity (relative to the
@@ -375,15 +374,15 @@ MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& 
 // acceleration of the point along d (an accelerometer), the absolute displacement's row on ü.
 Eigen::RowVectorXd rate_sensor_row(const FullRows& fr, const io::SensorSpec& se, const Vector3d& d, int order, double L,
                                    const std::string& f, const std::string& source) {
-  if (se.at != "shuttle" && se.at != "mast" && se.at != "reflector")
-    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
-  const bool mast = se.at == "mast";
+  if (se.at != io::Site::Shuttle && se.at != io::Site::Mast && se.at != io::Site::Reflector)
+    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", io::quoted(se.at));
+  const bool mast = se.at == io::Site::Mast;
   if (mast) check_station(se.location, L, source, f + ".location");
-  const MatrixXd absolute = se.at == "shuttle" ? fr.shuttle_rigid(Vector3d::Zero())
+  const MatrixXd absolute = se.at == io::Site::Shuttle ? fr.shuttle_rigid(Vector3d::Zero())
                             : mast           ? fr.displacement(se.location)
                                              : fr.reflector();
   const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
-  return d.transpose() * (order == 2 || se.at == "shuttle" ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
+  return d.transpose() * (order == 2 || se.at == io::Site::Shuttle ? absolute : MatrixXd(absolute - fr.shuttle_rigid(p0)));
 }
 
 // A displacement, rotation or line-of-sight sensor's row on u: the shuttle's against ground, the
@@ -391,14 +390,14 @@ Eigen::RowVectorXd rate_sensor_row(const FullRows& fr, const io::SensorSpec& se,
 Eigen::RowVectorXd position_sensor_row(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const Vector3d& d,
                                        const std::string& f, const std::string& source) {
   const double L = fe.spec.length;
-  if (se.at == "shuttle") {
+  if (se.at == io::Site::Shuttle) {
     if (se.kind == io::SensorKind::LineOfSight)
       fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
     return d.transpose() * (se.kind == io::SensorKind::Rotation ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
   }
-  if (se.at != "mast" && se.at != "reflector")
-    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", "'" + se.at + "'");
-  const bool mast = se.at == "mast";
+  if (se.at != io::Site::Mast && se.at != io::Site::Reflector)
+    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", io::quoted(se.at));
+  const bool mast = se.at == io::Site::Mast;
   if (mast) check_station(se.location, L, source, f + ".location");
   const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
   if (se.kind == io::SensorKind::Rotation) return d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());

@@ -475,11 +475,11 @@ void ScoleNonlinear::add_inputs(const ScoleFE& fe, const std::vector<io::InputSp
     Input in;
     in.q0 = G_.transpose() * m.inputs[i].vector;
     in.coefficient = m.inputs[i].coefficient;
-    if (spec.kind == "force" && (spec.at == "mast" || spec.at == "reflector")) {
+    if (spec.kind == io::InputKind::Force && (spec.at == io::Site::Mast || spec.at == io::Site::Reflector)) {
       in.arm = true;
-      in.N = spec.at == "mast" ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
+      in.N = spec.at == io::Site::Mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
       in.d = vec3(spec.direction);
-      if (spec.at == "reflector") in.kin = reflector_kinematics(fe);
+      if (spec.at == io::Site::Reflector) in.kin = reflector_kinematics(fe);
     }
     inputs_.push_back(std::move(in));
   }
@@ -493,14 +493,14 @@ void ScoleNonlinear::add_sensors(const ScoleFE& fe, const std::vector<io::Sensor
     using K = Sensor::Kind;
     Sensor s;
     s.d = vec3(spec.direction);
-    if (spec.at == "shuttle") {
+    if (spec.at == io::Site::Shuttle) {
       s.kind = spec.kind == io::SensorKind::Rotation       ? K::ShuttleRotation
                : spec.kind == io::SensorKind::Velocity     ? K::ShuttleVelocity
                : spec.kind == io::SensorKind::Acceleration ? K::ShuttleAcceleration
                                                            : K::ShuttleDisplacement;
     } else if (spec.kind == io::SensorKind::Acceleration) {
       s.kind = K::PointAcceleration;
-      const bool mast = spec.at == "mast";
+      const bool mast = spec.at == io::Site::Mast;
       s.p = mast ? mast_point(sc, spec.location) : mast_point(sc, sc.length) + Vector3d(sc.reflector_rx, sc.reflector_ry, 0.0);
       s.N = mast ? on_e(fe.mast_displacement(spec.location)) : on_e(fe.reflector_displacement());
       if (!mast) s.kin = reflector_kinematics(fe);

@@ -414,17 +414,17 @@ std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& 
                      "'; the data are not of this scenario's structure");
   for (const auto& c : meta.columns) {
     std::optional<std::string> kind;
-    const std::string* at = nullptr;
+    std::string at;
     for (const auto& in : sc.inputs)
-      if (in.name == c.name) kind = in.kind, at = &in.at;
+      if (in.name == c.name) kind = io::to_string(in.kind), at = io::to_string(in.at);
     for (const auto& se : sc.sensors)
-      if (se.name == c.name) kind = io::to_string(se.kind), at = &se.at;
+      if (se.name == c.name) kind = io::to_string(se.kind), at = io::to_string(se.at);
     if (!kind) continue;
     const std::string what = "column '" + io::one_line(c.name) + "'";
     if (!c.quantity.empty() && c.quantity != *kind)
       throw InputError(meta_path + ": " + what + " is a " + c.quantity + " but the scenario's is a " + *kind);
-    if (!c.at.empty() && c.at != *at)
-      throw InputError(meta_path + ": " + what + " is at the " + c.at + " but the scenario's is at the " + *at);
+    if (!c.at.empty() && c.at != at)
+      throw InputError(meta_path + ": " + what + " is at the " + c.at + " but the scenario's is at the " + at);
     const int col = tab.find(c.name);
     const std::string file_unit = tab.unit(col);
     if (!c.unit.empty() && !file_unit.empty() && file_unit != c.unit)
@@ -518,7 +518,7 @@ std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col,
 // An input driven by its column (piecewise linear), with its largest jump within one sample.
 void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
   const auto& in = p.scenario.inputs[i];
-  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, in.kind, in.unit, in.column_unit);
+  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, io::to_string(in.kind), in.unit, in.column_unit);
   p.signals[i] = io::Signal::table(tab.t, f);
   p.columns.inputs_from_data.push_back(in.name);
   const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
@@ -564,11 +564,11 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
     const auto& in = sc.inputs[i];
     const int col = column_of(tab, in.name, in.column);
     const std::string field = "inputs[" + std::to_string(i) + "]";
-    if ((in.signal_from == "data" || !in.column.empty()) && col < 0)
+    if ((in.signal_from == io::SignalFrom::Data || !in.column.empty()) && col < 0)
       throw InputError("data file '" + csv + "': no column " +
                        (in.column.empty() ? "for input '" + in.name + "'" : "'" + io::one_line(in.column) + "' (" + field + ".column)") +
                        " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + ")");
-    if (in.signal_from != "scenario" && col >= 0) {
+    if (in.signal_from != io::SignalFrom::Scenario && col >= 0) {
       input_from_column(p, i, tab, col);
       used[static_cast<std::size_t>(col)] = true;
     } else {

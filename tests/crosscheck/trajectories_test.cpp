@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 TEST(Trajectories, EveryInputAndSensorKindAgreesAndImprovesWithSegments) {
   const io::Scenario sc = io::load_scenario(COVERAGE_SCENARIO);
   std::set<std::string> inputs, sensors;
-  for (const auto& in : sc.inputs) inputs.insert(in.at.rfind("actuator", 0) == 0 ? "actuator " + in.kind : in.at + " " + in.kind);
+  for (const auto& in : sc.inputs)
+    inputs.insert((io::actuator_index(in.at) >= 0 ? std::string("actuator") : io::to_string(in.at)) + " " + io::to_string(in.kind));
   for (const auto& s : sc.sensors) sensors.insert(io::to_string(s.kind));
   EXPECT_EQ(inputs, (std::set<std::string>{"shuttle force", "shuttle moment", "reflector force", "reflector moment",
                                            "mast force", "actuator force"}));

@@ -102,8 +102,8 @@ TEST(ScoleDamping, ActuatorOnAFixedBaseIsASingleDofOscillator) {
   const ScoleSpec s = heavy_base(k, c);
   scoleid::io::InputSpec in;
   in.name = "a1x";
-  in.at = "actuator1";
-  in.kind = "force";
+  in.at = scoleid::io::Site::Actuator1;
+  in.kind = scoleid::io::InputKind::Force;
   in.direction = {1.0, 0.0, 0.0};
   const ScoleFE fe = build_scole(s, 10, {in}, {}, "test");
   const AssembledModel a = assemble(fe.model, scole_coefficients(s));

@@ -532,7 +532,7 @@ TEST(ScoleNonlinear, TheReflectorsCMIsTheArmTurnedExactlyByTheEndSection) {
   for (int k = 0; k < 3; ++k) {
     scoleid::io::SensorSpec a;
     a.name = "acc" + std::to_string(k);
-    a.at = "reflector";
+    a.at = scoleid::io::Site::Reflector;
     a.kind = scoleid::io::SensorKind::Acceleration;
     a.direction = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
     sc.sensors.push_back(a);
@@ -597,7 +597,7 @@ TEST(ScoleNonlinear, UndampedFreeMotionConservesEnergyAndMomenta) {
   sc.scole.actuator_damping = 0.0;
   sc.inputs.clear();
   sc.sensors = {sc.sensors.front()};
-  sc.sensors.front().at = "shuttle";
+  sc.sensors.front().at = scoleid::io::Site::Shuttle;
   sc.sensors.front().kind = scoleid::io::SensorKind::Rotation;
   sc.sensors.front().direction = {1, 0, 0};
   const Model m = make_model(sc, 6);

@@ -125,15 +125,15 @@ struct ScoleSpec {
 // transversally and ignore it.
 struct InputSpec {
   std::string name;
-  std::string at = "beam";
-  std::string kind = "force";  // force | moment
+  Site at = Site::Beam;
+  InputKind kind = InputKind::Force;
   double location = 0.0;
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;
   // With a data file (scole-identify --data): "auto" drives the input by the file's column of the
   // same name when there is one, else by `signal`; "data" requires the column (an error if it is
   // missing); "scenario" always uses `signal`. The truth always uses `signal`.
-  std::string signal_from = "auto";
+  SignalFrom signal_from = SignalFrom::Auto;
   Signal signal;
   // The data column that drives it (free text, e.g. "Hammer [N]"); "" = the column named `name`.
   std::string column;
@@ -149,7 +149,7 @@ struct InputSpec {
 // reflector), measured in the shuttle frame along `direction`.
 struct SensorSpec {
   std::string name;
-  std::string at = "beam";
+  Site at = Site::Beam;
   SensorKind kind = SensorKind::Displacement;
   double location = 0.0;
   std::vector<double> direction = {0.0, 0.0, 0.0};

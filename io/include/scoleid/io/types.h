@@ -9,6 +9,9 @@
 //   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
 //   StepRule    identification.step_rule            the automatic time step's rule (§5.2)
 //   SensorKind  sensors[].kind                      what a sensor reads (§3.5, §6.1a)
+//   Site        inputs[].at, sensors[].at            the body a sensor or input is on (§3.5, §4)
+//   InputKind   inputs[].kind                        what an input applies: a force or a moment
+//   SignalFrom  inputs[].signal_from                 what drives an input with a data file (§9)
 //
 // Adding a value: one enumerator and one row of its table, here; the reader, --help and the JSON
 // writers follow, and a switch over the type that misses it is a compiler warning.
@@ -27,6 +30,9 @@ enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
 enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain };
+enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
+enum class InputKind { Force, Moment };
+enum class SignalFrom { Auto, Data, Scenario };
 
 // Each type's names, in declaration order (the first is the default where a field has one).
 template <class E>
@@ -68,6 +74,31 @@ struct Names<SensorKind> {
                                                                           {SensorKind::Strain, "strain"}}};
 };
 
+template <>
+struct Names<Site> {
+  static constexpr std::array<std::pair<Site, const char*>, 6> rows{{{Site::Beam, "beam"},
+                                                                    {Site::Mast, "mast"},
+                                                                    {Site::Shuttle, "shuttle"},
+                                                                    {Site::Reflector, "reflector"},
+                                                                    {Site::Actuator1, "actuator1"},
+                                                                    {Site::Actuator2, "actuator2"}}};
+};
+template <>
+struct Names<InputKind> {
+  static constexpr std::array<std::pair<InputKind, const char*>, 2> rows{
+      {{InputKind::Force, "force"}, {InputKind::Moment, "moment"}}};
+};
+template <>
+struct Names<SignalFrom> {
+  static constexpr std::array<std::pair<SignalFrom, const char*>, 3> rows{
+      {{SignalFrom::Auto, "auto"}, {SignalFrom::Data, "data"}, {SignalFrom::Scenario, "scenario"}}};
+};
+
+// A site along which a location is measured: the beam or the mast (a station s ∈ [0, L]).
+constexpr bool has_station(Site s) { return s == Site::Beam || s == Site::Mast; }
+// The proof-mass actuator a site names (0, 1), or -1.
+constexpr int actuator_index(Site s) { return s == Site::Actuator1 ? 0 : s == Site::Actuator2 ? 1 : -1; }
+
 // The time derivative of the structure's motion a sensor of this kind reads: 0 (displacement,
 // rotation, line of sight, strain), 1 (velocity), 2 (acceleration).
 constexpr int derivative_order(SensorKind k) {
@@ -80,6 +111,12 @@ const char* to_string(E v) {
   for (const auto& [value, name] : Names<E>::rows)
     if (value == v) return name;
   return "?";
+}
+
+// The name in single quotes, as a message shows a field's value: 'moment'.
+template <class E, class = decltype(Names<E>::rows)>
+std::string quoted(E v) {
+  return "'" + std::string(to_string(v)) + "'";
 }
 
 // The value of a name (nullopt if it names none): parse<Method>(name).

@@ -29,7 +29,7 @@ public:
   ScoleSystem(const io::ScoleSpec& scole, int segments);
   io::Structure kind() const override { return io::Structure::Scole; }
   SimTK::MobilizedBodyIndex reference_body() const override { return shuttle_; }
-  Station named_station(const std::string& at) const override;
+  Station named_station(io::Site at) const override;
   SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const override;
 
   SimTK::MobilizedBodyIndex shuttle() const { return shuttle_; }

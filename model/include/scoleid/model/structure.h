@@ -49,8 +49,8 @@ public:
   virtual SimTK::MobilizedBodyIndex reference_body() const = 0;
   // The point at arc position s on the rigid segment that contains it.
   Station station_at(double s) const;
-  // Named rigid bodies: "shuttle", "reflector"; an invalid index if absent.
-  virtual Station named_station(const std::string& at) const;
+  // Named rigid bodies: the shuttle, the reflector; an invalid index if absent.
+  virtual Station named_station(io::Site at) const;
   // Slider mobilizers of actuator K (1-based) along reference x and y, or invalid.
   virtual SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const;
 
