@@ -22,6 +22,7 @@
 #include <iostream>
 
 #include "campaign_mpi.h"
+#include "scoleid/io/program.h"
 #include "scoleid/crosscheck/campaign_runner.h"
 #include "scoleid/crosscheck/identify_study.h"
 #include "scoleid/crosscheck/mismatch_suite.h"
@@ -68,22 +69,8 @@ void write_report(io::RunDirectory& dir, const crosscheck::ReportInputs& in, boo
   if (missing && !quiet)
     std::fprintf(stderr, "scole-crosscheck: gnuplot is not installed: plots not drawn (the .gp scripts are written)\n");
 }
-// Runs a verb; what escapes it becomes the exit code of the footer (2 bad input, 130/143
-// interrupted, 1 a failed run), with one line on stderr.
-int guarded(const std::function<int()>& verb) {
-  try {
-    return verb();
-  } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-crosscheck: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "\nscole-crosscheck: %s\n", e.what());
-    return e.exit_code();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-crosscheck: run failed: %s\n", io::one_line(e.what()).c_str());
-    return 1;
-  }
-}
+// Runs a verb; what escapes it becomes the exit code of the footer (io/program.h).
+int guarded(const std::function<int()>& verb) { return io::guarded_main("scole-crosscheck", verb); }
 
 // What a suite run leaves in --out when it ends before its result is written (a failure or a
 // signal): the directories it created itself. The family's truth directory is its own and goes
@@ -476,15 +463,7 @@ int main(int argc, char** argv) {
       "files in the output directory, all at once.");
   Cli c;
   add_verbs(app, c);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "scole-crosscheck: %s (see --help)\n", io::one_line(e.what()).c_str());
-    return 2;
-  }
+  if (const auto code = io::parse_command_line(app, argc, argv, "scole-crosscheck")) return *code;
   io::install_interrupt_handlers();
   if (c.camp->parsed()) {
     c.co.progress = !c.quiet;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "scoleid/io/program.h"
 #include "scoleid/identify.h"
 #include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
@@ -188,28 +189,14 @@ int main(int argc, char** argv) {
   ex_opt->excludes(app.get_option("--scenario"));
   ex_opt->excludes(app.get_option("--data"));
   ex_opt->excludes(export_opt);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "scole-identify: %s (see --help)\n", io::one_line(e.what()).c_str());
-    return 2;
-  }
+  if (const auto code = io::parse_command_line(app, argc, argv, "scole-identify")) return *code;
   io::install_interrupt_handlers();
-  try {
+  return io::guarded_main("scole-identify", [&] {
     // A path option given empty is a typo, not a request for the default.
     for (const char* name : {"--data", "--out", "--experiments", "--scenario", "--print-scenario", "--export-model"})
       if (app.count(name) > 0 && app.get_option(name)->as<std::string>().empty())
         throw io::InputError(std::string("command line: ") + name + " is empty (give a value, or leave the option out)");
-    if (!print_name.empty()) {
-      std::fputs(io::builtin_scenario_text(print_name).c_str(), stdout);
-      return 0;
-    }
-    if (list) {
-      std::fputs(io::builtin_scenario_listing().c_str(), stdout);
-      return 0;
-    }
+    if (io::print_builtin_scenarios(print_name, list)) return 0;
     const std::optional<io::Method> method_given = method.empty() ? std::nullopt : io::parse<io::Method>(method);
     if (!experiments.empty())
       return run_experiments_command(experiments, out, method_given, threads, max_iterations, !no_std, !quiet);
@@ -244,14 +231,5 @@ int main(int argc, char** argv) {
     if (!id.converged())
       std::fprintf(stderr, "scole-identify: %s; outputs written with \"converged\": false\n", id.verdict().c_str());
     return id.exit_code();
-  } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-identify: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "scole-identify: %s\n", e.what());
-    return e.exit_code();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-identify: run failed: %s\n", io::one_line(e.what()).c_str());
-    return 1;
-  }
+  });
 }

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scoleid/io/program.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
@@ -122,15 +123,9 @@ int main(int argc, char** argv) {
   }
   app.footer("Exit codes: 0 success; 2 bad usage or bad input (one line naming the file, record or line, field and "
              "value; nothing written); 130/143 interrupted.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "scole-data: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  }
+  if (const auto code = io::parse_command_line(app, argc, argv, "scole-data")) return *code;
   io::install_interrupt_handlers();
-  try {
+  return io::guarded_main("scole-data", [&] {
     const io::CsvOptions options{time_column, time_unit};
     if (*info) {
       const io::DataFileInfo d = io::describe_data(file, options);
@@ -145,14 +140,5 @@ int main(int argc, char** argv) {
       convert(file, out, options, quiet);
     }
     return 0;
-  } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-data: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "\nscole-data: %s\n", e.what());
-    return e.exit_code();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-data: %s\n", io::one_line(e.what()).c_str());
-    return 1;
-  }
+  });
 }

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <string>
 
+#include "scoleid/io/program.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
@@ -58,23 +59,10 @@ int main(int argc, char** argv) {
       "2 bad usage or bad input; 130/143 interrupted by SIGINT/SIGTERM. "
       "On any failure nothing is written: truth.csv and truth.json are staged beside --out and moved into place "
       "together at the end.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "scole-truth: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  }
+  if (const auto code = io::parse_command_line(app, argc, argv, "scole-truth")) return *code;
   io::install_interrupt_handlers();
-  try {
-    if (!print_name.empty()) {
-      std::fputs(io::builtin_scenario_text(print_name).c_str(), stdout);
-      return 0;
-    }
-    if (list) {
-      std::fputs(io::builtin_scenario_listing().c_str(), stdout);
-      return 0;
-    }
+  return io::guarded_main("scole-truth", [&] {
+    if (io::print_builtin_scenarios(print_name, list)) return 0;
     io::Scenario sc = io::load_scenario(scenario);
     // Command-line overrides go into the scenario and through the same checks as the file.
     if (app.count("--segments")) {
@@ -109,14 +97,5 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "scole-truth: %s: %s -> %s/truth.csv\n", sc.name.c_str(),
                    res.summary.BriefReport().c_str(), out.c_str());
     return 0;
-  } catch (const io::InputError& e) {
-    std::fprintf(stderr, "scole-truth: %s\n", io::one_line(e.what()).c_str());
-    return 2;
-  } catch (const io::Interrupted& e) {
-    std::fprintf(stderr, "\nscole-truth: %s\n", e.what());
-    return e.exit_code();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "scole-truth: run failed: %s\n", io::one_line(e.what()).c_str());
-    return 1;
-  }
+  });
 }

@@ -23,6 +23,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "common/cli_support.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
 
@@ -34,34 +35,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) {
-    if (c == '\'')
-      q += "'\\''";
-    else
-      q += c;
-  }
-  return q + "'";
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  ASSERT_TRUE(out.good()) << "cannot write " << p;
-}
+using Result = scoleid::test::CommandResult;
+using scoleid::test::shell_quote;
+using scoleid::test::slurp;
+using scoleid::test::write_file;
 
 // Non-empty-terminated lines of a stream's text ("a\nb\n" -> {a, b}; "a\nb" -> {a, b}).
 std::vector<std::string> lines_of(const std::string& text) {
@@ -103,26 +80,9 @@ private:
   fs::path path_;
 };
 
-// Runs scole-identify with `args`; stdout through the pipe, stderr through a file in `dir`.
+// Runs scole-identify with `args` from inside `dir`.
 Result run(const std::vector<std::string>& args, const TempDir& dir) {
-  const fs::path err_file = dir / "stderr.txt";
-  // From inside `dir`: a command smuggled through a name would leave its marker file there.
-  std::string cmd = "cd " + shell_quote(dir.path().string()) + " && " + shell_quote(SCOLE_IDENTIFY_EXE);
-  for (const auto& a : args) cmd += " " + shell_quote(a);
-  cmd += " 2> " + shell_quote(err_file.string()) + " < /dev/null";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) {
-    r.err = "popen failed for: " + cmd;
-    return r;
-  }
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-  r.err = read_file(err_file);
-  return r;
+  return scoleid::test::run_command(SCOLE_IDENTIFY_EXE, args, dir.path());
 }
 
 // The --out directory may exist, but must hold no identify.json, no fit.csv, no *.tmp.* file.
@@ -325,7 +285,7 @@ identification:
 )");
   const Result r = run({"--scenario", (dir / "acc.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_file(dir / "out" / "identify.json"));
+  const auto j = nlohmann::json::parse(slurp(dir / "out" / "identify.json"));
   for (const auto& p : j["parameters"]) {
     EXPECT_LT(std::abs(p["relative_error"].get<double>()), 2e-3) << p.dump();
     EXPECT_EQ(p["identifiable"], true) << p.dump();
@@ -356,7 +316,7 @@ identification:
   const Result r = run({"--scenario", (dir / "slew.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("nonlinear model"), std::string::npos) << r.err;
-  const auto j = nlohmann::json::parse(read_file(dir / "out" / "identify.json"));
+  const auto j = nlohmann::json::parse(slurp(dir / "out" / "identify.json"));
   EXPECT_EQ(j["model"], "nonlinear");
   EXPECT_EQ(j["settings"]["identification"]["model"], "nonlinear");
   const auto& p = j["parameters"][0];
@@ -515,7 +475,7 @@ TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
   for (const auto& e : fs::directory_iterator(out1))
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
   nlohmann::json j1;
-  ASSERT_NO_THROW(j1 = nlohmann::json::parse(read_file(out1 / "identify.json")));
+  ASSERT_NO_THROW(j1 = nlohmann::json::parse(slurp(out1 / "identify.json")));
   for (const char* k : {"parameters", "iterations", "termination", "gradient_evaluations", "forward_solves", "wall_seconds"})
     EXPECT_TRUE(j1.contains(k)) << "identify.json lacks '" << k << "'";
   ASSERT_TRUE(j1["parameters"].is_array());
@@ -535,7 +495,7 @@ TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
 
   // 2. The measured column of fit.csv as a data file t,w_tip; no truth.json beside it.
   std::vector<std::string> header;
-  const auto cols = csv_columns(read_file(out1 / "fit.csv"), header);
+  const auto cols = csv_columns(slurp(out1 / "fit.csv"), header);
   int jt = -1, jm = -1;
   for (std::size_t k = 0; k < header.size(); ++k) {
     if (header[k] == "t") jt = static_cast<int>(k);
@@ -557,7 +517,7 @@ TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
   const Result r2 = run({"--scenario", yaml.string(), "--data", csv.string(), "--out", out2.string(), "-q"}, dir);
   ASSERT_EQ(r2.code, 0) << "stderr:\n" << r2.err << "stdout:\n" << r2.out;
   nlohmann::json j2;
-  ASSERT_NO_THROW(j2 = nlohmann::json::parse(read_file(out2 / "identify.json")));
+  ASSERT_NO_THROW(j2 = nlohmann::json::parse(slurp(out2 / "identify.json")));
   ASSERT_TRUE(j2.contains("parameters"));
   ASSERT_EQ(j2["parameters"].size(), 2u);
   for (const auto& p : j2["parameters"]) {
@@ -574,7 +534,7 @@ TEST(ScoleIdentifyCli, GoodRunSyntheticThenWithData) {
 namespace {
 bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
-nlohmann::json read_json_file(const fs::path& p) { return nlohmann::json::parse(read_file(p)); }
+nlohmann::json read_json_file(const fs::path& p) { return nlohmann::json::parse(slurp(p)); }
 
 // Starts scole-identify with `args` in `dir`, sends `sig` after `delay` seconds, returns the
 // exit code (or -1); `after`, if given, receives the seconds from the signal to the exit.
@@ -738,7 +698,7 @@ TEST(ScoleIdentifyHardening, ForeignFilesInOutAreNeitherReplacedNorMixed) {
   write_file(out / "notes.txt", "mine");
   const Result r = run({"--scenario", "paper-beam-1", "--out", out.string()}, dir);
   expect_input_error(r, out, {"output directory", "notes.txt"});
-  EXPECT_EQ(read_file(out / "notes.txt"), "mine");
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
 }
 
 TEST(ScoleIdentifyHardening, EarlierRunIsReplacedWholeOrKept) {
@@ -746,13 +706,13 @@ TEST(ScoleIdentifyHardening, EarlierRunIsReplacedWholeOrKept) {
   write_file(dir / "good.yaml", kGood);
   const fs::path out = dir / "out";
   ASSERT_EQ(run({"--scenario", (dir / "good.yaml").string(), "--out", out.string(), "-q"}, dir).code, 0);
-  const std::string first = read_file(out / "identify.json");
+  const std::string first = slurp(out / "identify.json");
   // A failing run (bad data) leaves the earlier run exactly as it was.
   write_file(dir / "bad.csv", "t,w_tip\n0,0\n0.01,nan\n");
   const Result bad = run({"--scenario", (dir / "good.yaml").string(), "--data", (dir / "bad.csv").string(), "--out",
                           out.string(), "-q"}, dir);
   EXPECT_EQ(bad.code, 2);
-  EXPECT_EQ(read_file(out / "identify.json"), first);
+  EXPECT_EQ(slurp(out / "identify.json"), first);
   expect_only(dir.path(), {"good.yaml", "bad.csv", "out", "stderr.txt"});
 }
 
@@ -834,7 +794,7 @@ TEST(ScoleIdentifyHardening, DataColumnsNoiseAndStaleMetadata) {
   const fs::path out1 = dir / "run1";
   ASSERT_EQ(run({"--scenario", (dir / "good.yaml").string(), "--out", out1.string(), "-q"}, dir).code, 0);
   std::vector<std::string> header;
-  const auto cols = csv_columns(read_file(out1 / "fit.csv"), header);
+  const auto cols = csv_columns(slurp(out1 / "fit.csv"), header);
   const auto col = [&](const std::string& n) {
     const auto it = std::find(header.begin(), header.end(), n);
     return cols[static_cast<std::size_t>(it - header.begin())];
@@ -1024,7 +984,7 @@ TEST(ScoleIdentifyCli, TruthOverridesShapeTheSyntheticDataAndTheReportedTruth) {
   write_file(dir / "o.yaml", std::string(kGood) + "truth:\n  overrides:\n    beam: {EI: 25000}\n");
   const Result r = run({"--scenario", (dir / "o.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_file(dir / "out" / "identify.json"));
+  const auto j = nlohmann::json::parse(slurp(dir / "out" / "identify.json"));
   const auto& q1 = j["parameters"][0];
   EXPECT_NEAR(q1["truth"].get<double>(), 25000.0 / 67.0, 1e-9 * 25000.0 / 67.0);
   EXPECT_LT(std::abs(q1["relative_error"].get<double>()), 1e-3) << q1.dump();
@@ -1046,7 +1006,7 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   const Result r = run({"--experiments", (dir / "e.yaml").string(), "--out", out.string(), "-q", "--threads", "2"}, dir);
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   for (const char* f : {"identify.json", "fit-a.csv", "fit-b.csv", "fit-a.gp", "fit-b.gp"}) EXPECT_TRUE(fs::exists(out / f)) << f;
-  const auto j = nlohmann::json::parse(read_file(out / "identify.json"));
+  const auto j = nlohmann::json::parse(slurp(out / "identify.json"));
   EXPECT_TRUE(j["converged"].get<bool>());
   ASSERT_EQ(j["per_experiment"].size(), 2u);
   double share = 0;
@@ -1090,13 +1050,13 @@ TEST(ScoleIdentifyExperiments, TwoRunsAndModesThenBadInput) {
   const fs::path out4 = dir / "out4";
   const Result rm = run({"--experiments", (dir / "e3.yaml").string(), "--out", out4.string(), "-q"}, dir);
   ASSERT_EQ(rm.code, 0) << rm.err << rm.out;
-  const auto jm = nlohmann::json::parse(read_file(out4 / "identify.json"));
+  const auto jm = nlohmann::json::parse(slurp(out4 / "identify.json"));
   EXPECT_EQ(jm["per_experiment"][0]["kind"], "modal");
   EXPECT_NEAR(jm["estimate"]["q1"].get<double>() / q1, 1.0, 1e-4);
   EXPECT_TRUE(jm["identifiability"]["identifiable"]["q1"].is_boolean());
   EXPECT_TRUE(jm["identifiability"]["identifiable"]["q2"].is_string()) << jm["identifiability"].dump();
   std::vector<std::string> header;
-  const auto cols = csv_columns(read_file(out4 / "modes-fit.csv"), header);
+  const auto cols = csv_columns(slurp(out4 / "modes-fit.csv"), header);
   ASSERT_GE(header.size(), 4u);
   EXPECT_EQ(header[3], "model_mode");
   ASSERT_EQ(cols[3].size(), 2u);
@@ -1111,7 +1071,7 @@ TEST(ScoleIdentifyCli, ExportModelWritesThePlant) {
   write_file(dir / "good.yaml", kGood);
   const Result r = run({"--scenario", "good.yaml", "--out", "out", "-q", "--export-model", "plant.json"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_file(dir / "plant.json"));
+  const auto j = nlohmann::json::parse(slurp(dir / "plant.json"));
   const auto& A = j["state_space"]["A"];
   const std::size_t n = A.size();
   ASSERT_GT(n, 0u);

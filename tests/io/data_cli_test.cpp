@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/cli_support.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
@@ -30,23 +31,8 @@ namespace {
 
 const fs::path kData = fs::path(SCOLEID_TEST_DATA_DIR) / "uff";
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using Result = scoleid::test::CommandResult;
+using scoleid::test::slurp;
 
 fs::path scratch() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
@@ -57,18 +43,7 @@ fs::path scratch() {
 }
 
 Result run(const std::vector<std::string>& args, const fs::path& dir) {
-  std::string cmd = "cd " + quote(dir.string()) + " && " + quote(SCOLE_DATA_EXE);
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " 2> " + quote((dir / "stderr.txt").string()) + " < /dev/null";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  char buf[4096];
-  std::size_t n = 0;
-  while (pipe && (n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = pipe ? ::pclose(pipe) : -1;
-  r.code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(dir / "stderr.txt");
-  return r;
+  return scoleid::test::run_command(SCOLE_DATA_EXE, args, dir);
 }
 
 int lines(const std::string& s) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/cli_support.h"
 #include "scoleid/io/error.h"
 
 using namespace scoleid::io;
@@ -17,10 +18,7 @@ fs::path temp_dir() {
   fs::create_directories(d);
   return d;
 }
-std::string write_file(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-  return p.string();
-}
+using scoleid::test::write_file;
 std::string error_of_csv(const std::string& text) {
   const auto p = write_file(temp_dir() / "d.csv", text);
   try {

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "common/cli_support.h"
 #include "scoleid/io/error.h"
 
 #ifndef SCOLEID_TEST_DATA_DIR
@@ -27,10 +28,7 @@ namespace {
 
 std::string data_path(const std::string& name) { return std::string(SCOLEID_TEST_DATA_DIR) + "/uff/" + name; }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using scoleid::test::slurp;
 
 // The message of the InputError parsing `bytes` throws; "" when it parses. Anything else fails.
 std::string error_of(const std::string& bytes, const std::string& source = "t.uff") {

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "common/cli_support.h"
+
 namespace scoleid::model::test {
 
 struct CliResult {
@@ -30,22 +32,14 @@ protected:
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  std::string write(const std::string& name, const std::string& text) {
-    const std::filesystem::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
+  std::string write(const std::string& name, const std::string& text) { return scoleid::test::write_file(dir_ / name, text); }
   // scole-truth with `args` (stdout discarded).
   CliResult run(const std::string& args) {
     const std::filesystem::path err = dir_ / "stderr.txt";
     const std::string cmd = std::string(SCOLE_TRUTH_EXE) + " " + args + " 2> " + err.string() + " > /dev/null";
-    const int status = std::system(cmd.c_str());
     CliResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(err);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    r.err = ss.str();
+    r.code = scoleid::test::sh(cmd);
+    r.err = scoleid::test::slurp(err);
     return r;
   }
 
