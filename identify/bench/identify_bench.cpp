@@ -77,6 +77,11 @@ int main() {
     const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
     const double tfd = 2.0 * N * tf;  // 2N forward solves
     std::printf("%6d %12.4f %12.4f %10.2f %12.4f %10.1f\n", N, tf, tg, tg / tf, tfd, tfd / tf);
+    obj.reset_counters();
+    obj.cost_and_gradient(q, g);
+    const auto& c = obj.counters();
+    std::printf("%6s gradient's split: forward %.4f, costate %.4f, quadrature %.4f s (%s)\n", "", c.forward_seconds,
+                c.costate_seconds, c.quadrature_seconds, c.checkpointed_passes ? "checkpointed" : "stored");
     (N == 2 ? ratio_n2 : ratio_n64) = tg / tf;
     (N == 2 ? grad_n2 : grad_n64) = tg;
   }
@@ -136,6 +141,11 @@ int main() {
     const double tf = best_of(3, [&] { obj.cost(q); });
     const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
     scole_ratio = tg / tf;
+    obj.reset_counters();
+    obj.cost_and_gradient(q, g);
+    const auto& c = obj.counters();
+    std::printf("   gradient's split: forward %.4f, costate %.4f, quadrature %.4f s (%s)\n", c.forward_seconds,
+                c.costate_seconds, c.quadrature_seconds, c.checkpointed_passes ? "checkpointed" : "stored");
     std::printf("   %d DOFs, step %.2e s: forward %.4f s, adjoint gradient %.4f s, ratio %.2f\n", p->model().ndof,
                 p->objective_options.solver.step, tf, tg, scole_ratio);
   }

@@ -48,6 +48,15 @@ void for_each_gauss_point(const std::vector<double>& grid, F&& f) {
     for (int gq = 0; gq < 3; ++gq) f(grid[k] + kGx[gq] * h, kGw[gq] * h);
   }
 }
+
+// A quadrature grid sorted, with points closer than rounding (1e-12 relative) merged into the
+// first: the state's and the costate's grids mirror each other (t = T − τ) and meet again only up
+// to rounding, and a sliver of 1e-16 s between them would cost three Gauss points for nothing.
+void sort_grid(std::vector<double>& g) {
+  std::sort(g.begin(), g.end());
+  g.erase(std::unique(g.begin(), g.end(), [](double a, double b) { return b - a <= 1e-12 * std::max(1.0, std::abs(a)); }),
+          g.end());
+}
 }  // namespace
 
 Objective::Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
@@ -205,8 +214,7 @@ std::vector<double> Objective::union_grid(const std::vector<const std::vector<do
   for (const auto* s : sets) g.insert(g.end(), s->begin(), s->end());
   g.insert(g.end(), data_.t.begin(), data_.t.end());
   g.push_back(t_end);
-  std::sort(g.begin(), g.end());
-  g.erase(std::unique(g.begin(), g.end()), g.end());
+  sort_grid(g);
   const double t0 = data_.t.front();
   g.erase(std::remove_if(g.begin(), g.end(), [&](double t) { return t < t0 || t > t_end; }), g.end());
   return g;
@@ -224,8 +232,7 @@ void Objective::window_grid(const Trajectory& w, double t_end, std::vector<doubl
     grid.push_back(*it);
   grid.push_back(lo);
   grid.push_back(hi);
-  std::sort(grid.begin(), grid.end());
-  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  sort_grid(grid);
 }
 
 double Objective::misfit_window(const Setup& s, const SecondOrderSolver& solver, const Trajectory& w,
@@ -435,8 +442,7 @@ bool Objective::cover_window(const Trajectory& W, CheckpointedState& state, std:
     if (t >= ta && t <= tb) grid.push_back(t);
   grid.push_back(ta);
   grid.push_back(tb);
-  std::sort(grid.begin(), grid.end());
-  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  sort_grid(grid);
   grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
   return true;
 }
