@@ -73,8 +73,8 @@ int main() {
     Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
     VectorXd g;
-    const double tf = best_of(3, [&] { obj.cost(q); });
-    const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
+    const double tf = best_of(5, [&] { obj.cost(q); });
+    const double tg = best_of(5, [&] { obj.cost_and_gradient(q, g); });
     const double tfd = 2.0 * N * tf;  // 2N forward solves
     std::printf("%6d %12.4f %12.4f %10.2f %12.4f %10.1f\n", N, tf, tg, tg / tf, tfd, tfd / tf);
     obj.reset_counters();
@@ -138,8 +138,8 @@ int main() {
     Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
     VectorXd g;
-    const double tf = best_of(3, [&] { obj.cost(q); });
-    const double tg = best_of(3, [&] { obj.cost_and_gradient(q, g); });
+    const double tf = best_of(5, [&] { obj.cost(q); });
+    const double tg = best_of(5, [&] { obj.cost_and_gradient(q, g); });
     scole_ratio = tg / tf;
     obj.reset_counters();
     obj.cost_and_gradient(q, g);

@@ -209,6 +209,15 @@ Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s, d
   return u;
 }
 
+// The breakpoints in reversed time τ = T − t (the costates' runs), sorted.
+std::vector<double> Objective::reversed_breakpoints() const {
+  std::vector<double> out;
+  for (double b : breakpoints_)
+    if (b < T_) out.push_back(T_ - b);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const {
   std::vector<double> g;
   for (const auto* s : sets) g.insert(g.end(), s->begin(), s->end());
@@ -456,10 +465,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
   const SecondOrderSolver::Forcing force = state_forcing(s);
   CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
-  std::vector<double> bp_tau;
-  for (double b : breakpoints_)
-    if (b < T_) bp_tau.push_back(T_ - b);
-  std::sort(bp_tau.begin(), bp_tau.end());
+  const std::vector<double> bp_tau = reversed_breakpoints();
   // Costate source from the recorded outputs: C x(t) is the Hermite interpolant of (C x_k, C v_k),
   // the same numbers as C times the state's interpolant.
   VectorXd yb(ns), ydb(ns), zb(ns);
@@ -498,7 +504,8 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   });
   const auto tc = Clock::now();
   SolverSummary sum;
-  solver.stream(0.0, T_ - t0, g, bp_tau, [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum);
+  solver.stream(0.0, T_ - t0, g, bp_tau, [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, nullptr,
+                std::numeric_limits<double>::infinity(), StepAnchor::End);
   windows.finish();
   counters_.solver.Accumulate(sum);
   counters_.solver.Accumulate(state.summary());
@@ -576,10 +583,7 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   const SecondOrderSolver::Forcing force = state_forcing(s);
   CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
-  std::vector<double> bp_tau;
-  for (double b : breakpoints_)
-    if (b < T_) bp_tau.push_back(T_ - b);
-  std::sort(bp_tau.begin(), bp_tau.end());
+  const std::vector<double> bp_tau = reversed_breakpoints();
   // The sources from the recorded (A₀u, A₁u̇): the same numbers as A₀, A₁ times the state's interpolant.
   VectorXd yo(2 * ns), ydo(2 * ns);
   RateSources src(*this, rt, [&](double t, VectorXd& y) {
@@ -627,7 +631,7 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
   const auto tc = Clock::now();
   SolverSummary sum;
   solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau,
-                        [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum);
+                        [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, StepAnchor::End);
   windows.finish();
   counters_.solver.Accumulate(sum);
   counters_.solver.Accumulate(state.summary());
@@ -696,10 +700,7 @@ void Objective::costates_stored(const SecondOrderSolver& solver, const Trajector
   const int n = model_.ndof, ns = data_.sensors();
   const double t0 = data_.t.front();
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
-  std::vector<double> bp_tau;
-  for (double b : breakpoints_)
-    if (b < T_) bp_tau.push_back(T_ - b);
-  std::sort(bp_tau.begin(), bp_tau.end());
+  const std::vector<double> bp_tau = reversed_breakpoints();
   const auto tc = Clock::now();
   SolverSummary sum;
   if (!rt) {
@@ -712,7 +713,7 @@ void Objective::costates_stored(const SecondOrderSolver& solver, const Trajector
       rb = C_ * xb - zb;
       Eigen::Map<VectorXd>(F, n) = -CtR * rb;
     };
-    P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
+    P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum, StepAnchor::End);
     counters_.solver.Accumulate(sum);
     ++counters_.costate_solves;
   } else {
@@ -735,7 +736,7 @@ void Objective::costates_stored(const SecondOrderSolver& solver, const Trajector
         weights_at(tau);
         Eigen::Map<VectorXd>(F, n) = -w1;
       };
-      auto sol = solver.solve_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, &sum);
+      auto sol = solver.solve_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, &sum, StepAnchor::End);
       counters_.solver.Accumulate(sum);
       P = std::move(sol.state);
       Y = std::move(sol.tangents.front());
@@ -744,9 +745,9 @@ void Objective::costates_stored(const SecondOrderSolver& solver, const Trajector
         weights_at(tau);
         Eigen::Map<VectorXd>(F, n) = -w1;
       };
-      P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum);
+      P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum, StepAnchor::End);
       counters_.solver.Accumulate(sum);
-      Y = solver.solve(0.0, T_ - t0, g1, bp_tau, &sum);
+      Y = solver.solve(0.0, T_ - t0, g1, bp_tau, &sum, StepAnchor::End);
       counters_.solver.Accumulate(sum);
     }
     counters_.costate_solves += 2;
@@ -1276,10 +1277,7 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   const std::vector<Trajectory> S = solve_tangents(solver, s, T_, T_, u, {derivative_along(s.dcdq * v)});
   const Trajectory& Sv = S.front();
   // Costate with the tangent's output in place of the residual: M P'' + D P' + K P = −Cᵀ R C S(T − τ).
-  std::vector<double> bp_tau;
-  for (double b : breakpoints_)
-    if (b < T_) bp_tau.push_back(T_ - b);
-  std::sort(bp_tau.begin(), bp_tau.end());
+  const std::vector<double> bp_tau = reversed_breakpoints();
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   const MatrixXd CtRC = C_.transpose() * Rv.asDiagonal() * C_;
   auto tc = Clock::now();
@@ -1289,7 +1287,7 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
     Eigen::Map<VectorXd>(F, n).noalias() = -CtRC * sx;
   };
   SolverSummary sum;
-  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum);
+  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum, StepAnchor::End);
   counters_.solver.Accumulate(sum);
   ++counters_.costate_solves;
   counters_.costate_seconds += since(tc);

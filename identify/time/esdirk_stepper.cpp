@@ -68,7 +68,7 @@ EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const
 
 EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const std::vector<double>& stops_in,
                                          const Forcing& forcing, int P, const TangentForcing* tangent,
-                                         double tangent_end) const {
+                                         double tangent_end, StepAnchor anchor) const {
   const int n = static_cast<int>(M_.rows());
   Result res;
   res.state = Trajectory(n);
@@ -87,7 +87,8 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
     for (int i = 1; i < pt.columns; ++i)
       res.tangents[static_cast<std::size_t>(i - 1)].push(pt.t, pt.x + i * stride, pt.v + i * stride, pt.a + i * stride);
   };
-  res.counters = stream(t0, t1, h, stops_in, forcing, record, P, tangent, tangent_end);
+  res.counters = stream(t0, t1, h, stops_in, forcing, record, P, tangent, tangent_end, nullptr,
+                        std::numeric_limits<double>::infinity(), anchor);
   return res;
 }
 
@@ -293,7 +294,7 @@ private:
 
 StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std::vector<double>& stops_in,
                                       const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
-                                      double tangent_end, const Start* start, double until) const {
+                                      double tangent_end, const Start* start, double until, StepAnchor anchor) const {
   if (start) {
     if (P != 0) throw std::invalid_argument("EsdirkStepper: a resumed run steps the state only");
     if (h != start->h) throw std::invalid_argument("EsdirkStepper: a resumed run must keep its step");
@@ -325,6 +326,12 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
     while (t < stop) {
       io::check_interrupt();  // a SIGINT/SIGTERM ends a long solve at the next step (io/interrupt.h)
       double tnext = sw.origin + static_cast<double>(k + 1) * h;
+      if (anchor == StepAnchor::End) {
+        // Steps end at stop − j h: the first step of the segment takes the remainder (no
+        // micro-step: a remainder within `snap` joins the next full step, as it does above).
+        const double j = std::ceil((stop - t - snap) / h) - 1.0;
+        tnext = j > 0.0 ? stop - j * h : stop;
+      }
       if (tnext > stop - snap) tnext = stop;  // land on the stop (no micro-step)
       sw.step(t, tnext - t);
       t = tnext;

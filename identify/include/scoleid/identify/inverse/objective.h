@@ -190,6 +190,7 @@ private:
   VectorXd tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
                              const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const;
   // Union of the given time sets and the sample times, restricted to [t0, t_end].
+  std::vector<double> reversed_breakpoints() const;
   std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const;
   SecondOrderSolver::Forcing state_forcing(const Setup& s) const;
   // ∂_i M, ∂_i D, ∂_i K and ∂_i b per input, for the sensitivity forcing.

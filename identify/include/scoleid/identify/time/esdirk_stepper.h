@@ -62,6 +62,13 @@ struct StepperCounters {
 // unique, then t1.
 std::vector<double> segment_ends(const std::vector<double>& breakpoints, double t0, double t1);
 
+// Where a run's steps are anchored within each segment between its stops: at its start (steps end
+// at start + k h, the last one shortened to land on the segment's end) or at its end (steps end at
+// end − k h, the first one taking the remainder). A reversed-time run (τ = T − t, the costates)
+// anchored at the end steps on the forward run's grid mirrored, so that the two solutions share
+// their nodes and the quadratures over both need one grid, not the union of two.
+enum class StepAnchor { Start, End };
+
 class EsdirkStepper {
 public:
   using Forcing = std::function<void(double t, double* F)>;  // F (length n), pre-zeroed
@@ -80,7 +87,8 @@ public:
   // Integrates from rest over [t0, t1] with step h; `stops` are the forcing breakpoints (any order,
   // those outside (t0, t1) ignored). P tangents (0 = state only) up to tangent_end.
   Result run(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing, int P = 0,
-             const TangentForcing* tangent = nullptr, double tangent_end = 0.0) const;
+             const TangentForcing* tangent = nullptr, double tangent_end = 0.0,
+             StepAnchor anchor = StepAnchor::Start) const;
 
   // Streaming: every recorded point goes to `sink` instead of into trajectories, so a solve needs
   // memory for one step whatever its length. The point carries what a restart needs: the step
@@ -104,8 +112,8 @@ public:
   // resumable point at or beyond `until` (the grid is still that of [t0, t1]).
   StepperCounters stream(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing,
                          const Sink& sink, int P = 0, const TangentForcing* tangent = nullptr, double tangent_end = 0.0,
-                         const Start* start = nullptr,
-                         double until = std::numeric_limits<double>::infinity()) const;
+                         const Start* start = nullptr, double until = std::numeric_limits<double>::infinity(),
+                         StepAnchor anchor = StepAnchor::Start) const;
 
 private:
   class Sweep;  // one integration's workspace and steps (esdirk_stepper.cpp)
