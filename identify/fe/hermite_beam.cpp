@@ -24,37 +24,30 @@ constexpr std::array<double, 4> kX = {0.0694318442029737, 0.3300094782075719, 0.
                                       0.9305681557970263};
 constexpr std::array<double, 4> kW = {0.1739274225687269, 0.3260725774312731, 0.3260725774312731,
                                       0.1739274225687269};
+
+// ∫_a^b f fᵀ ds of a basis f(s) by the 4-point Gauss rule: exact to degree 7.
+template <class Basis>
+Mat4 gram(double a, double b, Basis f) {
+  Mat4 m = Mat4::Zero();
+  for (int g = 0; g < 4; ++g) {
+    const Vec4 v = f(a + (b - a) * kX[g]);
+    m += (b - a) * kW[g] * v * v.transpose();
+  }
+  return m;
+}
 }  // namespace
 
 Mat4 mass(double h, double a, double b) {
-  Mat4 m = Mat4::Zero();
-  for (int g = 0; g < 4; ++g) {
-    const double s = a + (b - a) * kX[g];
-    const Vec4 n = shape(s / h, h);
-    m += (b - a) * kW[g] * n * n.transpose();
-  }
-  return m;
+  return gram(a, b, [h](double s) { return shape(s / h, h); });
 }
 
 Mat4 stiffness(double h, double a, double b) {
-  Mat4 k = Mat4::Zero();
-  for (int g = 0; g < 4; ++g) {
-    const double s = a + (b - a) * kX[g];
-    const Vec4 c = curvature(s / h, h);
-    k += (b - a) * kW[g] * c * c.transpose();
-  }
-  return k;
+  return gram(a, b, [h](double s) { return curvature(s / h, h); });
 }
 
+// N' N'ᵀ is of degree 4: the 4-point rule is exact.
 Mat4 slope_product(double h, double a, double b) {
-  // N' N'ᵀ is of degree 4: the 4-point rule is exact.
-  Mat4 m = Mat4::Zero();
-  for (int g = 0; g < 4; ++g) {
-    const double s = a + (b - a) * kX[g];
-    const Vec4 d = slope(s / h, h);
-    m += (b - a) * kW[g] * d * d.transpose();
-  }
-  return m;
+  return gram(a, b, [h](double s) { return slope(s / h, h); });
 }
 
 }  // namespace scoleid::identify::hermite

@@ -456,6 +456,22 @@ bool Objective::cover_window(const Trajectory& W, CheckpointedState& state, std:
   return true;
 }
 
+namespace {
+// A checkpointed backward pass's counts: `costates` solves in `seconds`, of which `quadrature` in
+// the quadrature and `resolve` re-solving the state's segments from checkpoints (a forward cost).
+void count_checkpointed_pass(ObjectiveCounters& c, const SolverSummary& sum, const CheckpointedState& state, int costates,
+                             double seconds, double quadrature, double resolve) {
+  c.solver.Accumulate(sum);
+  c.solver.Accumulate(state.summary());
+  c.costate_solves += costates;
+  ++c.checkpointed_passes;
+  c.checkpoint_resolves += state.resolves();
+  c.costate_seconds += seconds - quadrature - resolve;
+  c.forward_seconds += resolve;
+  c.quadrature_seconds += quadrature;
+}
+}  // namespace
+
 double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out,
                                         bool residual, std::vector<Checkpoint> ckpts, std::size_t spacing,
                                         VectorXd& gc) {
@@ -507,14 +523,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   solver.stream(0.0, T_ - t0, g, bp_tau, [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, nullptr,
                 std::numeric_limits<double>::infinity(), StepAnchor::End);
   windows.finish();
-  counters_.solver.Accumulate(sum);
-  counters_.solver.Accumulate(state.summary());
-  ++counters_.costate_solves;
-  ++counters_.checkpointed_passes;
-  counters_.checkpoint_resolves += state.resolves();
-  counters_.costate_seconds += since(tc) - quadrature - resolve;
-  counters_.forward_seconds += resolve;  // the state's segments re-solved from checkpoints
-  counters_.quadrature_seconds += quadrature;
+  count_checkpointed_pass(counters_, sum, state, 1, since(tc), quadrature, resolve);
   return J;
 }
 
@@ -633,14 +642,7 @@ double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderS
   solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau,
                         [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, StepAnchor::End);
   windows.finish();
-  counters_.solver.Accumulate(sum);
-  counters_.solver.Accumulate(state.summary());
-  counters_.costate_solves += 2;
-  ++counters_.checkpointed_passes;
-  counters_.checkpoint_resolves += state.resolves();
-  counters_.costate_seconds += since(tc) - quadrature - resolve;
-  counters_.forward_seconds += resolve;
-  counters_.quadrature_seconds += quadrature;
+  count_checkpointed_pass(counters_, sum, state, 2, since(tc), quadrature, resolve);
   return J;
 }
 
