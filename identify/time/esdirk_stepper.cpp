@@ -328,7 +328,7 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
       double tnext = sw.origin + static_cast<double>(k + 1) * h;
       if (anchor == StepAnchor::End) {
         // Steps end at stop − j h: the first step of the segment takes the remainder (no
-        // micro-step: a remainder within `snap` joins the next full step, as it does above).
+        // micro-step: a remainder within `snap` joins the next full step, as the line below does).
         const double j = std::ceil((stop - t - snap) / h) - 1.0;
         tnext = j > 0.0 ? stop - j * h : stop;
       }
