@@ -7,17 +7,9 @@
 
 namespace scoleid::io {
 
-namespace {
-std::vector<BuiltinScenario> all_builtins() {
-  auto all = beam_builtin_scenarios();
-  for (auto& s : scole_builtin_scenarios()) all.push_back(std::move(s));
-  return all;
-}
-}  // namespace
-
 std::vector<std::string> builtin_scenario_names() {
   std::vector<std::string> names;
-  for (const auto& s : all_builtins()) names.push_back(s.name);
+  for (const auto& s : builtin_scenario_texts()) names.push_back(s.name);
   return names;
 }
 
@@ -40,15 +32,16 @@ std::string builtin_scenario_text(const std::string& name) {
 }
 
 std::string builtin_scenario_yaml(const std::string& name) {
-  for (const auto& s : all_builtins())
+  for (const auto& s : builtin_scenario_texts())
     if (s.name == name) return s.yaml;
   return {};
 }
 
+// The file's first line without its "# ".
 std::string builtin_scenario_description(const std::string& name) {
-  for (const auto& s : all_builtins())
-    if (s.name == name) return s.description;
-  return {};
+  const std::string yaml = builtin_scenario_yaml(name);
+  if (yaml.rfind("# ", 0) != 0) return {};
+  return yaml.substr(2, yaml.find('\n') - 2);
 }
 
 }  // namespace scoleid::io

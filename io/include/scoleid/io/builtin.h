@@ -1,18 +1,18 @@
 #pragma once
-// Registry of built-in scenarios. Each is YAML text parsed by the same parser as a user's file,
-// so the built-ins exercise the schema exactly as files do.
+// Registry of built-in scenarios: the YAML files of io/scenarios/, compiled in as text. Each is
+// parsed by the same parser as a user's file, so the built-ins exercise the schema exactly as
+// files do. A file's first line, a comment, is the one-line summary --list-scenarios prints.
 #include <string>
 #include <vector>
 
 namespace scoleid::io {
 
-struct BuiltinScenario {
-  std::string name;
-  std::string description;
-  std::string yaml;
+struct BuiltinScenarioText {
+  std::string name;  // the file's stem
+  std::string yaml;  // the file, as written
 };
 
-std::vector<BuiltinScenario> beam_builtin_scenarios();   // builtin_beam.cpp
-std::vector<BuiltinScenario> scole_builtin_scenarios();  // builtin_scole.cpp
+// In the order --list-scenarios shows them (builtin_scenarios.cpp, written by CMake).
+const std::vector<BuiltinScenarioText>& builtin_scenario_texts();
 
 }  // namespace scoleid::io
