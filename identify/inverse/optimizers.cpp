@@ -17,8 +17,6 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   };
   if (method == io::Method::Auto) return bad("method auto must be resolved before the optimiser (run/strategy.h)");
   if (!(smoothness_weight >= 0)) return bad("smoothness_weight must be >= 0");
-  if (smoothness_weight > 0 && method != io::Method::GaussNewtonKrylov && method != io::Method::GaussNewton)
-    return bad("the smoothness prior needs method gauss-newton or gauss-newton-krylov");
   if (!(max_krylov_iterations >= 1)) return bad("max_krylov_iterations must be >= 1");
   if (max_iterations < 0) return bad("max_iterations must be >= 0");
   if (!(gradient_tolerance > 0) || !(step_tolerance > 0)) return bad("tolerances must be > 0");
@@ -58,11 +56,50 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using T = OptimizerSummary::Termination;
 
+// The smoothness prior ½ β Σ_chains Σ_j (x_{j+1} − x_j)² on x = log q: value, gradient, product.
+struct Smoothness {
+  double beta = 0.0;
+  std::vector<std::vector<int>> chains;
+  double value(const VectorXd& x) const {
+    double v = 0.0;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) v += std::pow(x[c[j + 1]] - x[c[j]], 2);
+    return 0.5 * beta * v;
+  }
+  // β LᵀL (P × P), for the explicit Gauss–Newton matrix
+  MatrixXd matrix(Eigen::Index P) const {
+    MatrixXd A = MatrixXd::Zero(P, P);
+    if (beta == 0.0) return A;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
+        const int a = c[j], b = c[j + 1];
+        A(a, a) += beta;
+        A(b, b) += beta;
+        A(a, b) -= beta;
+        A(b, a) -= beta;
+      }
+    return A;
+  }
+  // β LᵀL y
+  VectorXd apply(const VectorXd& y) const {
+    VectorXd out = VectorXd::Zero(y.size());
+    if (beta == 0.0) return out;
+    for (const auto& c : chains)
+      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
+        const double d = y[c[j + 1]] - y[c[j]];
+        out[c[j + 1]] += beta * d;
+        out[c[j]] -= beta * d;
+      }
+    return out;
+  }
+};
+
 struct Run {
   Misfit& obj;
   const OptimizerOptions& opt;
   const std::function<void(const IterationRecord&)>& cb;
   OptimizerSummary sum;
+  const Smoothness prior{opt.smoothness_weight, opt.smoothness_chains};
 
   // A run that cannot go on: the line search (or the cost) failed, with why.
   void failed(const std::string& why) {
@@ -103,13 +140,18 @@ struct Run {
   bool small_gradient(const VectorXd& gx, double J) const {
     return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
   }
-  // Evaluate J and ∂J/∂x at x, or return false if the point is outside the model's domain.
+  // Evaluate J and ∂J/∂x at x (with the smoothness prior's value and gradient, if any), or return
+  // false if the point is outside the model's domain.
   bool eval_grad(const VectorXd& x, double& J, VectorXd& gx) {
     try {
       const VectorXd q = x.array().exp();
       VectorXd gq;
       J = obj.cost_and_gradient(q, gq);
       gx = q.cwiseProduct(gq);
+      if (prior.beta > 0) {
+        J += prior.value(x);
+        gx += prior.apply(x);
+      }
       return std::isfinite(J);
     } catch (const std::domain_error&) {
       return false;
@@ -118,44 +160,6 @@ struct Run {
     } catch (const std::runtime_error&) {
       return false;  // integrator failure at an extreme trial point: treat as infeasible
     }
-  }
-};
-
-// The smoothness prior ½ β Σ_chains Σ_j (x_{j+1} − x_j)² on x = log q: value, gradient, product.
-struct Smoothness {
-  double beta = 0.0;
-  std::vector<std::vector<int>> chains;
-  double value(const VectorXd& x) const {
-    double v = 0.0;
-    for (const auto& c : chains)
-      for (std::size_t j = 0; j + 1 < c.size(); ++j) v += std::pow(x[c[j + 1]] - x[c[j]], 2);
-    return 0.5 * beta * v;
-  }
-  // β LᵀL (P × P), for the explicit Gauss–Newton matrix
-  MatrixXd matrix(Eigen::Index P) const {
-    MatrixXd A = MatrixXd::Zero(P, P);
-    if (beta == 0.0) return A;
-    for (const auto& c : chains)
-      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
-        const int a = c[j], b = c[j + 1];
-        A(a, a) += beta;
-        A(b, b) += beta;
-        A(a, b) -= beta;
-        A(b, a) -= beta;
-      }
-    return A;
-  }
-  // β LᵀL y
-  VectorXd apply(const VectorXd& y) const {
-    VectorXd out = VectorXd::Zero(y.size());
-    if (beta == 0.0) return out;
-    for (const auto& c : chains)
-      for (std::size_t j = 0; j + 1 < c.size(); ++j) {
-        const double d = y[c[j + 1]] - y[c[j]];
-        out[c[j + 1]] += beta * d;
-        out[c[j]] -= beta * d;
-      }
-    return out;
   }
 };
 
@@ -281,7 +285,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
 class ExplicitStep final : public StepStrategy {
 public:
   ExplicitStep(Run& r, Eigen::Index P)
-      : r_(r), prior_{r.opt.smoothness_weight, r.opt.smoothness_chains}, prior_matrix_(prior_.matrix(P)) {}
+      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)) {}
   bool evaluate(const VectorXd& xx, Point& p, bool with_profile) override {
     try {
       const VectorXd q = xx.array().exp();
@@ -337,7 +341,7 @@ public:
 
 private:
   Run& r_;
-  const Smoothness prior_;
+  const Smoothness& prior_;
   const MatrixXd prior_matrix_;
   Misfit::MisfitProfile prof_;
 };
@@ -487,6 +491,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
     r.failed(e.what());
   }
   r.conclude(k, x, J);
+  r.sum.prior_cost = r.prior.value(x);
   obj.set_horizon(t_end);
 }
 
@@ -498,7 +503,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
 // gradient methods (one extra state solve per accepted step while the horizon is short).
 class KrylovStep final : public StepStrategy {
 public:
-  explicit KrylovStep(Run& r) : r_(r), prior_{r.opt.smoothness_weight, r.opt.smoothness_chains} {
+  explicit KrylovStep(Run& r) : r_(r), prior_(r.prior) {
     if (!r.obj.has_matrix_free_products())
       throw std::invalid_argument(std::string(io::to_string(io::Method::GaussNewtonKrylov)) +
                                   ": velocity and acceleration sensors are not supported (use " +
@@ -520,7 +525,7 @@ public:
 
 private:
   Run& r_;
-  const Smoothness prior_;
+  const Smoothness& prior_;
   double g0_ = 0.0;
 };
 

@@ -112,12 +112,9 @@ RunResult start_result(const Problem& p, io::Model model) {
 
 namespace {
 // The smoothness prior's chains (identification.smoothness, docs/theory.md §7.8): the sectional
-// families, refused for a method that does not take a prior or a run without sections.
-std::vector<std::vector<int>> smoothness_chains(const Problem& p, const std::vector<std::string>& names, io::Method method) {
+// families, refused for a run without sections.
+std::vector<std::vector<int>> smoothness_chains(const Problem& p, const std::vector<std::string>& names) {
   if (p.scenario.identification.smoothness == 0.0) return {};
-  if (method != io::Method::GaussNewtonKrylov && method != io::Method::GaussNewton)
-    io::fail_field(p.scenario.source, "identification.smoothness", "needs method gauss-newton or gauss-newton-krylov (or auto)",
-                   io::to_string(method));
   auto chains = section_families(names);
   if (chains.empty())
     io::fail_field(p.scenario.source, "identification.smoothness",
@@ -134,7 +131,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   r.method = resolve_method(ro.method.value_or(id.method), p.params->size(), id.smoothness != 0.0,
                             obj.has_matrix_free_products());
-  const auto chains = smoothness_chains(p, r.names, r.method);
+  const auto chains = smoothness_chains(p, r.names);
   AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source),
                     ro.verbose};
   c.options.smoothness_chains = chains;

@@ -8,16 +8,18 @@
 //                     weights, w_i = α q_i² (steepest descent in log q) with α from backtracking.
 //   lbfgs             limited-memory BFGS (m = 8) on x with an Armijo backtracking line search;
 //                     one costate gradient per trial point.
+//   Every method takes the optional smoothness prior (OptimizerOptions::smoothness_weight): its
+//   value and gradient in x are added to the data's (gradient methods), and its constant matrix
+//   too (gauss-newton; gauss-newton-krylov adds its product).
 //   gauss-newton      trust-region Gauss–Newton (Levenberg) on x from forward sensitivities;
 //                     see gauss_newton_step.h for the step and the radius, and below for the
-//                     horizon continuation. Takes the optional smoothness prior (its matrix
-//                     added to the data's).
+//                     horizon continuation.
 //   gauss-newton-krylov  inexact trust-region Gauss–Newton: the step from truncated conjugate
 //                     gradients (Steihaug) on matrix-free products H v (objective.h,
 //                     gauss_newton_product: one tangent and one costate solve each), stopped by the
 //                     Eisenstat–Walker forcing η = min(½, √(‖g‖/‖g₀‖)); the cost of a step follows
-//                     the number of directions the data inform, not P. Takes the optional
-//                     smoothness prior. Displacement sensors only. docs/theory.md §7.7–7.8.
+//                     the number of directions the data inform, not P. Displacement sensors
+//                     only. docs/theory.md §7.7–7.8.
 //
 // Horizon continuation (every method, `continuation`; described for Gauss–Newton, the gradient
 // methods do the same with a misfit-profile state solve after each accepted step while the
@@ -82,7 +84,7 @@ struct OptimizerOptions {
   double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
   // gauss-newton-krylov: CG iterations per step (each one matrix-free product: two solves)
   int max_krylov_iterations = 50;
-  // Smoothness prior on x = log q (gauss-newton and gauss-newton-krylov; docs/theory.md §7.8):
+  // Smoothness prior on x = log q (every method; docs/theory.md §7.8):
   //   ½ β Σ_chains Σ_j (x_{c_{j+1}} − x_{c_j})²
   // over chains of neighbouring sections (e.g. the indices of EI_1 … EI_N). β = 0: off.
   double smoothness_weight = 0.0;
