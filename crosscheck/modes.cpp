@@ -26,30 +26,9 @@ io::Scenario shape_scenario(const io::Scenario& truth_sc, int count, std::vector
   io::Scenario sc = truth_sc;
   sc.sensors.clear();
   scale.clear();
-  const int m = 2 * count + 2;
-  auto add = [&](const std::string& name, io::Site at, io::SensorKind kind, double s, std::vector<double> d,
-                 double row_scale) {
-    io::SensorSpec spec;
-    spec.name = name;
-    spec.at = at;
-    spec.kind = kind;
-    spec.location = s;
-    spec.direction = std::move(d);
-    sc.sensors.push_back(spec);
-    scale.push_back(row_scale);
-  };
-  if (sc.structure == io::Structure::Scole) {
-    const double L = sc.scole.length;
-    for (int k = 1; k <= m; ++k) {
-      const double s = L * k / m;
-      const std::string tag = "s" + std::to_string(k);
-      add(tag + "_x", io::Site::Mast, io::SensorKind::Displacement, s, {1, 0, 0}, 1.0);
-      add(tag + "_y", io::Site::Mast, io::SensorKind::Displacement, s, {0, 1, 0}, 1.0);
-      add(tag + "_rz", io::Site::Mast, io::SensorKind::Rotation, s, {0, 0, 1}, L);
-    }
-  } else {
-    const double L = sc.beam.length;
-    for (int k = 1; k <= m; ++k) add("w" + std::to_string(k), io::Site::Beam, io::SensorKind::Displacement, L * k / (m + 1), {0, 1, 0}, 1.0);
+  for (const auto& s : io::shape_sensors(truth_sc, count)) {
+    sc.sensors.push_back(s.spec);
+    scale.push_back(s.scale);
   }
   return sc;
 }

@@ -122,7 +122,8 @@ double LaggedSignal::operator()(double t) const {
 
 std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure& st) {
   std::vector<AppliedInput> out;
-  const bool beam = st.kind() == io::Structure::Beam;
+  const bool planar = st.planar();
+  const std::string kind = io::to_string(st.kind());
   for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
     const io::InputSpec& in = sc.inputs[i];
     const std::string field = "inputs[" + std::to_string(i) + "]";
@@ -130,13 +131,13 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
     a.signal = in.signal;
     a.kind = in.kind == io::InputKind::Moment ? AppliedInput::Kind::Moment : AppliedInput::Kind::Force;
     const Vec3 d(in.direction[0], in.direction[1], in.direction[2]);
-    if (beam) {
+    if (planar) {
       if (in.at != io::Site::Beam)
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", io::quoted(in.at));
+        io::fail_field(sc.source, field + ".at", "must be 'beam' for a " + kind + " structure", io::quoted(in.at));
       a.station = st.station_at(in.location);
       a.d_R = a.kind == AppliedInput::Kind::Moment ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
     } else if (in.at == io::Site::Beam) {
-      io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
+      io::fail_field(sc.source, field + ".at", "must not be 'beam' for a " + kind + " structure", "'beam'");
     } else if (io::actuator_index(in.at) >= 0) {
       const int k = io::actuator_index(in.at) + 1;
       a.kind = AppliedInput::Kind::Slider;
@@ -150,8 +151,8 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
         io::fail_field(sc.source, field + ".direction", "must lie in the actuator plane (x, y)",
                        "[" + io::format_value(d[0]) + ", " + io::format_value(d[1]) + ", " + io::format_value(d[2]) + "]");
       a.d_R = d;
-      if (st.kind() == io::Structure::Scole && sc.scole.actuator_lag > 0)
-        a.lagged = std::make_shared<const LaggedSignal>(in.signal, sc.scole.actuator_lag, sc.simulation.duration,
+      if (st.actuator_lag() > 0)
+        a.lagged = std::make_shared<const LaggedSignal>(in.signal, st.actuator_lag(), sc.simulation.duration,
                                                         sc.source, field + ".signal");
     } else {
       if (d.norm() == 0)

@@ -18,6 +18,7 @@ Inertia inertia_of(const io::RigidBodySpec& b) {
 
 ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   length_ = sc.length;
+  actuator_lag_ = sc.actuator_lag;
   root_R_ = Vec3(sc.mast_root[0], sc.mast_root[1], sc.mast_root[2]);
   axis_B_ = axis_R_ = Vec3(0, 0, -1);
 

@@ -81,7 +81,8 @@ double joint_moment(const SimbodyMatterSubsystem& matter, const State& state, co
 
 std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Structure& st) {
   std::vector<ResolvedSensor> out;
-  const bool beam = st.kind() == io::Structure::Beam;
+  const bool planar = st.planar();
+  const std::string kind = io::to_string(st.kind());
   for (std::size_t i = 0; i < sc.sensors.size(); ++i) {
     const io::SensorSpec& se = sc.sensors[i];
     const std::string field = "sensors[" + std::to_string(i) + "]";
@@ -96,11 +97,11 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     r.reference = st.reference_body();
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
-    if (beam) {
+    if (planar) {
       if (se.at != io::Site::Beam)
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a beam structure", io::quoted(se.at));
+        io::fail_field(sc.source, field + ".at", "must be 'beam' for a " + kind + " structure", io::quoted(se.at));
       if (r.kind == K::LineOfSight)
-        io::fail_field(sc.source, field + ".kind", "is not defined for a beam", "'line_of_sight'");
+        io::fail_field(sc.source, field + ".kind", "is not defined for a " + kind + " structure", "'line_of_sight'");
       r.station = st.station_at(se.location);
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
       if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
@@ -109,7 +110,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
       if (r.kind == K::Strain)
         io::fail_field(sc.source, field + ".kind", "is a beam's strain gauge (structure: beam)", "'strain'");
       if (se.at == io::Site::Beam)
-        io::fail_field(sc.source, field + ".at", "must not be 'beam' for a scole structure", "'beam'");
+        io::fail_field(sc.source, field + ".at", "must not be 'beam' for a " + kind + " structure", "'beam'");
       if (d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       r.d_R = d;

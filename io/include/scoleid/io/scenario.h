@@ -300,6 +300,15 @@ Scenario truth_scenario(const Scenario& scenario);
 // Whether truth.overrides changes any structure or sensor field.
 bool has_truth_overrides(const Scenario& scenario);
 
+// Sensors that sample the structure's mode shapes at 2·count + 2 stations along its length (the
+// cross-check's MAC, crosscheck/modes.h): a beam's deflection; the mast's two deflections and its
+// torsion, the rotation's row scaled by the length so that it weighs like a deflection.
+struct ShapeSensor {
+  SensorSpec spec;
+  double scale = 1.0;
+};
+std::vector<ShapeSensor> shape_sensors(const Scenario& sc, int count);
+
 // NAME (a built-in) or a path to a YAML file. Throws InputError.
 Scenario load_scenario(const std::string& name_or_file);
 // Parses YAML text; `source` names it in error messages. Throws InputError.

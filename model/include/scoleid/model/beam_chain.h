@@ -31,6 +31,7 @@ class BeamChain : public Structure {
 public:
   BeamChain(const io::BeamSpec& beam, int segments);
   io::Structure kind() const override { return io::Structure::Beam; }
+  bool planar() const override { return true; }
   SimTK::MobilizedBodyIndex reference_body() const override { return SimTK::GroundIndex; }
   const HenckyLumping& lumping() const { return lumping_; }
 

@@ -28,6 +28,8 @@ class ScoleSystem : public Structure {
 public:
   ScoleSystem(const io::ScoleSpec& scole, int segments);
   io::Structure kind() const override { return io::Structure::Scole; }
+  bool planar() const override { return false; }
+  double actuator_lag() const override { return actuator_lag_; }
   SimTK::MobilizedBodyIndex reference_body() const override { return shuttle_; }
   Station named_station(io::Site at) const override;
   SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const override;
@@ -39,6 +41,7 @@ private:
   SimTK::MobilizedBodyIndex shuttle_, reflector_;
   Station reflector_station_;
   std::vector<SimTK::MobilizedBodyIndex> sliders_;  // [2 (k-1) + axis]
+  double actuator_lag_ = 0.0;
 };
 
 }  // namespace scoleid::model

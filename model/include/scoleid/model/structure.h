@@ -45,6 +45,12 @@ public:
 
   // "beam" or "scole".
   virtual io::Structure kind() const = 0;
+  // A planar chain (a beam): every load and sensor is at site 'beam', at an arc position, and acts
+  // in the chain's plane (its direction implied). Otherwise an assembly in space, where each load
+  // and sensor names its site and direction (inputs.h, sensors.h).
+  virtual bool planar() const = 0;
+  // The time constant of the proof-mass actuators' force lag (inputs.h); 0: none, or no actuators.
+  virtual double actuator_lag() const { return 0.0; }
   // The body in which displacements are measured (ground or shuttle).
   virtual SimTK::MobilizedBodyIndex reference_body() const = 0;
   // The point at arc position s on the rigid segment that contains it.
