@@ -140,15 +140,15 @@ struct Run {
   bool small_gradient(const VectorXd& gx, double J) const {
     return gx.cwiseAbs().maxCoeff() <= opt.gradient_tolerance * std::max(J, 1e-300);
   }
-  // Evaluate J and ∂J/∂x at x (with the smoothness prior's value and gradient, if any), or return
-  // false if the point is outside the model's domain.
-  bool eval_grad(const VectorXd& x, double& J, VectorXd& gx) {
+  // Evaluate J and ∂J/∂x at x (with the smoothness prior's value and gradient if `with_prior` and
+  // there is one), or return false if the point is outside the model's domain.
+  bool eval_grad(const VectorXd& x, double& J, VectorXd& gx, bool with_prior = true) {
     try {
       const VectorXd q = x.array().exp();
       VectorXd gq;
       J = obj.cost_and_gradient(q, gq);
       gx = q.cwiseProduct(gq);
-      if (prior.beta > 0) {
+      if (with_prior && prior.beta > 0) {
         J += prior.value(x);
         gx += prior.apply(x);
       }
@@ -510,7 +510,7 @@ public:
                                   io::to_string(io::Method::GaussNewton) + ")");
   }
   bool evaluate(const VectorXd& xx, Point& p, bool) override {
-    if (!r_.eval_grad(xx, p.Jd, p.g)) return false;
+    if (!r_.eval_grad(xx, p.Jd, p.g, false)) return false;  // the data's share; the prior's added here
     p.J = p.Jd + prior_.value(xx);
     p.g += prior_.apply(xx);
     return true;

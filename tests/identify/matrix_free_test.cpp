@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <map>
 #include <random>
+#include <tuple>
 
 #include "scoleid/identify/run/identify_run.h"
 
@@ -168,19 +169,21 @@ TEST(SmoothnessPrior, DiscrepancyWeightIsTheLargestWithinTheNoiseAndHalvesTheSec
   EXPECT_LT(rms_error(b), 0.7 * rms_error(a));
 }
 
-TEST(SmoothnessPrior, ExplicitAndMatrixFreeGaussNewtonReachTheSameMinimiser) {
-  // The prior enters the explicit Gauss–Newton matrix as β LᵀL and the matrix-free product as
-  // β LᵀL v: on the same cost (EI on 8 sections, 4 sensors, 1 % noise, β = 10⁻²) both optimisers
-  // must stop at the same minimiser, with the same split of the cost into data and prior.
+TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {
+  // The prior enters the explicit Gauss–Newton matrix as β LᵀL, the matrix-free product as β LᵀL v
+  // and the gradient methods' cost and gradient as its value and β LᵀL x: on the same cost (EI on 8
+  // sections, 4 sensors, 1 % noise, β = 10⁻²) every optimiser must stop at the same minimiser, with
+  // the same split of the cost into data and prior.
   RunOptions ro;
   ro.verbose = false;
   ro.compute_std = false;
   std::map<std::string, RunResult> out;
   Eigen::Index points = 1;
-  for (const std::string method : {"gauss-newton", "gauss-newton-krylov"}) {
+  for (const std::string method : {"gauss-newton", "gauss-newton-krylov", "lbfgs"}) {
     auto sc = sections_scenario("1e-2", 8, 4, 0.01);
     sc.identification.method = *scoleid::io::parse<scoleid::io::Method>(method);
     sc.identification.restarts = 0;
+    sc.identification.max_iterations = 200;
     auto p = make_problem(sc, std::nullopt);
     points = p->data.z.size();
     out[method] = run_identification(*p, ro);
@@ -190,53 +193,22 @@ TEST(SmoothnessPrior, ExplicitAndMatrixFreeGaussNewtonReachTheSameMinimiser) {
     EXPECT_TRUE(r.summary.converged()) << method;
     EXPECT_GT(r.summary.prior_cost, 0.0) << method;
   }
-  const auto& a = out["gauss-newton"];
-  const auto& b = out["gauss-newton-krylov"];
-  const double dq = (a.estimate.array() / b.estimate.array() - 1.0).abs().maxCoeff();
-  std::printf("largest relative difference of the estimates %.3e; prior shares %.6e and %.6e\n", dq, a.summary.prior_cost,
-              b.summary.prior_cost);
-  // Both stop when an accepted step lowers J by less than J / (data points) (optimizers.h): they
-  // agree to that, and the sections to 1e-3 (their std at 1 % noise is tens of percent).
+  // Gauss–Newton stops once an accepted step lowers J by less than J / (data points) (optimizers.h).
+  // The matrix-free run agrees with it to that, and the sections to 1e-3 (their std at 1 % noise is
+  // tens of percent). L-BFGS goes on past it (measured: 1.3e-3 lower, about two such gains, the
+  // sections 1.2e-3 apart).
   const double stall = 1.0 / static_cast<double>(points);
-  EXPECT_LT(dq, 1e-3);
-  EXPECT_NEAR(a.summary.cost, b.summary.cost, stall * b.summary.cost);
-  EXPECT_NEAR(a.summary.prior_cost, b.summary.prior_cost, 2e-3 * b.summary.prior_cost);
-}
-
-TEST(SmoothnessPrior, LbfgsTakesThePriorAndReachesTheGaussNewtonMinimiser) {
-  // The gradient methods add the prior's value and gradient in x = log q to the data's: on the
-  // cost of the test above L-BFGS must stop near the explicit Gauss–Newton minimiser, with the
-  // prior's share of the cost reported.
-  RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = false;
-  std::map<std::string, RunResult> out;
-  Eigen::Index points = 1;
-  for (const std::string method : {"gauss-newton", "lbfgs"}) {
-    auto sc = sections_scenario("1e-2", 8, 4, 0.01);
-    sc.identification.method = *scoleid::io::parse<scoleid::io::Method>(method);
-    sc.identification.restarts = 0;
-    sc.identification.max_iterations = 200;
-    auto p = make_problem(sc, std::nullopt);
-    points = p->data.z.size();
-    out[method] = run_identification(*p, ro);
-    const auto& r = out[method];
-    std::printf("%-14s %s; cost %.8e (prior %.6e), RMS error %.3e\n", method.c_str(), r.summary.BriefReport().c_str(),
-                r.summary.cost, r.summary.prior_cost, rms_error(r));
-    EXPECT_TRUE(r.summary.converged()) << method;
-    EXPECT_GT(r.summary.prior_cost, 0.0) << method;
+  const auto& a = out["gauss-newton"];
+  for (const auto& [method, tol, cost_gains, prior_tol] :
+       {std::tuple<std::string, double, double, double>{"gauss-newton-krylov", 1e-3, 1.0, 2e-3}, {"lbfgs", 1e-2, 5.0, 2e-2}}) {
+    const auto& b = out[method];
+    const double dq = (a.estimate.array() / b.estimate.array() - 1.0).abs().maxCoeff();
+    std::printf("%s: largest relative difference of the estimates %.3e; prior shares %.6e and %.6e\n", method.c_str(), dq,
+                a.summary.prior_cost, b.summary.prior_cost);
+    EXPECT_LT(dq, tol) << method;
+    EXPECT_NEAR(a.summary.cost, b.summary.cost, cost_gains * stall * b.summary.cost) << method;
+    EXPECT_NEAR(a.summary.prior_cost, b.summary.prior_cost, prior_tol * b.summary.prior_cost) << method;
   }
-  const auto& a = out["gauss-newton"];
-  const auto& b = out["lbfgs"];
-  const double dq = (a.estimate.array() / b.estimate.array() - 1.0).abs().maxCoeff();
-  std::printf("largest relative difference of the estimates %.3e; prior shares %.6e and %.6e\n", dq, a.summary.prior_cost,
-              b.summary.prior_cost);
-  // Gauss–Newton stops once a step gains less than J / (data points); the gain still left is a few
-  // times that (measured: L-BFGS ends 1.3e-3 lower, 2 such gains, the sections 1.2e-3 apart).
-  const double stall = 1.0 / static_cast<double>(points);
-  EXPECT_LT(dq, 1e-2);
-  EXPECT_NEAR(a.summary.cost, b.summary.cost, 5 * stall * a.summary.cost);
-  EXPECT_NEAR(a.summary.prior_cost, b.summary.prior_cost, 2e-2 * a.summary.prior_cost);
 }
 
 // The noise's share of the cost (docs/theory.md §7.8): for unit white noise n at the samples, ∫ñ²
