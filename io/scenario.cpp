@@ -16,6 +16,7 @@
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
+#include "structure_kinds.h"
 
 namespace scoleid::io {
 
@@ -410,9 +411,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   for (std::size_t i = 0; i < 3; ++i) check_offset(source, r.field("mast_root") + "[" + std::to_string(i) + "]", s.mast_root[i], L);
 }
 
-double structure_length(const Scenario& sc) {
-  return sc.structure == Structure::Scole ? sc.scole.length : sc.beam.length;
-}
+double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
 
 void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "") {
   if (!has_station(at)) return;
@@ -660,34 +659,6 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
 
 }  // namespace
 
-std::vector<ShapeSensor> shape_sensors(const Scenario& sc, int count) {
-  std::vector<ShapeSensor> out;
-  const int m = 2 * count + 2;
-  auto add = [&](const std::string& name, Site at, SensorKind kind, double s, std::vector<double> d, double scale) {
-    ShapeSensor e;
-    e.spec.name = name;
-    e.spec.at = at;
-    e.spec.kind = kind;
-    e.spec.location = s;
-    e.spec.direction = std::move(d);
-    e.scale = scale;
-    out.push_back(std::move(e));
-  };
-  const double L = structure_length(sc);
-  if (sc.structure == Structure::Scole) {
-    for (int k = 1; k <= m; ++k) {
-      const double s = L * k / m;
-      const std::string tag = "s" + std::to_string(k);
-      add(tag + "_x", Site::Mast, SensorKind::Displacement, s, {1, 0, 0}, 1.0);
-      add(tag + "_y", Site::Mast, SensorKind::Displacement, s, {0, 1, 0}, 1.0);
-      add(tag + "_rz", Site::Mast, SensorKind::Rotation, s, {0, 0, 1}, L);
-    }
-  } else {
-    for (int k = 1; k <= m; ++k)
-      add("w" + std::to_string(k), Site::Beam, SensorKind::Displacement, L * k / (m + 1), {0, 1, 0}, 1.0);
-  }
-  return out;
-}
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source) {
   check_utf8(yaml_text, source);

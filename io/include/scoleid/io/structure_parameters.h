@@ -1,7 +1,8 @@
 #pragma once
 // The physical parameters of a scenario's structure, by name: one table per structure kind that
 // the truth (truth.json's true_parameters), the identifier (true values read back from a
-// truth.json) and the reports read. A new physical parameter is one row here.
+// truth.json) and the reports read. A new physical parameter is one row of its kind's table
+// (io/structure_kinds.h).
 #include <map>
 #include <string>
 #include <vector>
