@@ -9,6 +9,7 @@
 #include "scoleid/crosscheck/trajectories.h"
 #include "scoleid/identify.h"
 #include "scoleid/truth.h"
+#include "common/test_data.h"
 
 using namespace scoleid;
 
@@ -17,16 +18,7 @@ namespace {
 // A clamped aluminium strip (0.6 m, EI 30 N·m², ρA 0.4 kg/m, 3 mm thick: gauges 1.5 mm from the
 // neutral axis on either face), tapped near the tip with a 4 ms haversine, sampled at 2 kHz.
 io::Scenario strip() {
-  return io::parse_scenario(R"(name: strain-strip
-beam: {length: 0.6, left: clamped, right: free, rho_A: 0.4, EI: 30, zeta: 0.01}
-inputs: [{name: F, location: 0.55, signal: {type: haversine, amplitude: 2, t0: 0.001, width: 0.004}}]
-sensors:
-  - {name: eps_root, kind: strain, location: 0.04, offset: 0.0015}
-  - {name: eps_mid, kind: strain, location: 0.27, offset: -0.0015}
-simulation: {duration: 0.4, sample_interval: 0.0005}
-identification: {parameterization: physical, estimate: [EI, rho_A, zeta], initial: {EI: 26, rho_A: 0.45, zeta: 0.012}, elements: 12}
-truth: {segments: 80}
-)",
+  return io::parse_scenario(scoleid::test::test_scenario("strain_gauge_test/strain-strip"),
                             "strain strip");
 }
 

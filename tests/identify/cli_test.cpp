@@ -26,6 +26,7 @@
 #include "common/cli_support.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
+#include "common/test_data.h"
 
 #ifndef SCOLE_IDENTIFY_EXE
 #error "SCOLE_IDENTIFY_EXE must be defined to the path of the scole-identify executable"
@@ -116,19 +117,7 @@ void expect_input_error(const Result& r, const fs::path& out, const std::vector<
 // A short cantilever case: step tip load, tip sensor, q1 = EI/rho_A and q2 = 1/rho_A. Ten
 // elements keep the discretisation error against the (twice as fine) synthetic data well under
 // 1e-3 (four elements give ~4e-3 on q1) while the whole run stays well under a second.
-const char* kGood = R"(name: cli-good
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0}
-inputs:
-  - {name: P, at: beam, kind: force, location: 10, signal: {type: step, amplitude: 10, t0: 0}}
-sensors:
-  - {name: w_tip, at: beam, kind: displacement, location: 10}
-simulation: {duration: 2, sample_interval: 0.01, seed: 1}
-identification:
-  parameterization: paper
-  estimate: [q1, q2]
-  initial: {rho_A: 63, EI: 19000}
-  elements: 10
-)";
+const std::string kGood = scoleid::test::test_scenario("cli_test/cli-good");
 
 // kGood with the first occurrence of `from` replaced by `to`.
 std::string good_with(const std::string& from, const std::string& to) {
@@ -253,13 +242,7 @@ TEST(ScoleIdentifyCli, UnsupportedSensorKind) {
 
 TEST(ScoleIdentifyCli, UnsupportedScoleSensorKind) {
   // A line of sight is defined from the mast root to a mast or reflector point, not for the shuttle.
-  expect_yaml_error(R"(name: scole-los
-structure: scole
-inputs: [{name: F_y, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, width: 1.5}}]
-sensors: [{name: los, at: shuttle, kind: line_of_sight, direction: y}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI], elements: 4}
-)",
+  expect_yaml_error(scoleid::test::test_scenario("cli_test/scole-los"),
                     {"sensors[0].kind", "'line_of_sight'"});
 }
 
@@ -269,20 +252,7 @@ TEST(ScoleIdentifyCli, AccelerometerAndVelocitySensorsRecoverStiffnessMassAndDam
   // against 40. (At 10 elements c_kv's bias is 2.6e-3 with the damping-aware step of 2.1 ms; the
   // sample-interval step, 5 ms, hid it under a time error of the opposite sign: 8.2e-4.)
   TempDir dir;
-  write_file(dir / "acc.yaml", R"(name: acc-beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 49.65480843}
-inputs:
-  - {name: P, at: beam, kind: force, location: 10, signal: {type: haversine, amplitude: 10, t0: 0, width: 0.2}}
-sensors:
-  - {name: a_tip, at: beam, kind: acceleration, location: 10}
-  - {name: v_mid, at: beam, kind: velocity, location: 5}
-simulation: {duration: 4, sample_interval: 0.005, seed: 1}
-identification:
-  parameterization: physical
-  estimate: [EI, rho_A, c_kv]
-  initial: {rho_A: 63, EI: 20000, c_kv: 67.34983296}
-  elements: 20
-)");
+  write_file(dir / "acc.yaml", scoleid::test::test_scenario("cli_test/acc-beam"));
   const Result r = run({"--scenario", (dir / "acc.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir / "out" / "identify.json"));
@@ -297,22 +267,7 @@ TEST(ScoleIdentifyCli, TheNonlinearModelIsUsedAndSaid) {
   // used on stderr and in identify.json, recovers EI from its own nonlinear data, and gives std
   // from its Fisher matrix and an uncertainty interval that holds the error.
   TempDir dir;
-  write_file(dir / "slew.yaml", R"(name: short-slew
-structure: scole
-scole: {actuator_stroke: 100}
-inputs:
-  - {name: M_roll, at: shuttle, kind: moment, direction: x, signal: {type: bangbang, amplitude: 100000, t0: 0, width: 2}}
-sensors:
-  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y}
-  - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
-simulation: {duration: 2, sample_interval: 0.02, seed: 1}
-identification:
-  parameterization: physical
-  estimate: [EI]
-  initial: {EI: 3.8e7}
-  elements: 4
-  model: nonlinear
-)");
+  write_file(dir / "slew.yaml", scoleid::test::test_scenario("cli_test/short-slew"));
   const Result r = run({"--scenario", (dir / "slew.yaml").string(), "--out", (dir / "out").string(), "-q"}, dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("nonlinear model"), std::string::npos) << r.err;
@@ -390,14 +345,7 @@ TEST(ScoleIdentifyCli, SteepestWeightsOfTheWrongCountAreTheOnlyLine) {
 }
 
 TEST(ScoleIdentifyCli, AnInertiaNoRigidBodyHasIsRefused) {
-  expect_yaml_error(R"(name: bad-shuttle
-structure: scole
-scole: {shuttle: {mass: 6366, Ixx: 1, Iyy: 1, Izz: 100}}
-inputs: [{name: F, at: reflector, kind: force, direction: [1, 0, 0], signal: {type: step, amplitude: 1}}]
-sensors: [{name: s, at: mast, location: 130, direction: [0, 1, 0]}]
-simulation: {duration: 2, sample_interval: 0.02}
-identification: {parameterization: physical, estimate: [EI], initial: {EI: 3.8e7}, elements: 4}
-)",
+  expect_yaml_error(scoleid::test::test_scenario("cli_test/bad-shuttle"),
                     {"scole.shuttle", "triangle inequality", "Izz 100"});
 }
 
@@ -606,25 +554,7 @@ TEST(ScoleIdentifyHardening, NotConvergedExitsOneWithOutputsMarked) {
 // data misfit of this noise draw lies above the noise band; docs/theory.md §7.8).
 TEST(ScoleIdentifyHardening, AnUnmetDiscrepancyPrincipleExitsOne) {
   TempDir dir;
-  write_file(dir / "band.yaml", R"(name: discrepancy-not-met
-structure: beam
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 26000, 30000, 34000, 38000, 33000, 28000, 25000]}
-inputs:
-  - {name: P1, at: beam, kind: force, location: 3.1, unit: N, signal: {type: step, amplitude: 10, t0: 0}}
-  - {name: P2, at: beam, kind: force, location: 6.7, unit: N, signal: {type: haversine, amplitude: 20, t0: 0.5, width: 0.2}}
-sensors:
-  - {name: w1, location: 0.625, unit: m, noise_std: 1.0e-4}
-  - {name: w3, location: 3.125, unit: m, noise_std: 1.0e-4}
-  - {name: w5, location: 5.625, unit: m, noise_std: 1.0e-4}
-  - {name: w7, location: 8.125, unit: m, noise_std: 1.0e-4}
-simulation: {duration: 10, sample_interval: 0.01, seed: 1}
-identification:
-  parameterization: physical
-  estimate: [EI_1, EI_2, EI_3, EI_4, EI_5, EI_6, EI_7, EI_8]
-  initial: {EI: 30000}
-  elements: 16
-  smoothness: discrepancy
-)");
+  write_file(dir / "band.yaml", scoleid::test::test_scenario("cli_test/discrepancy-not-met"));
   const fs::path out = dir / "out";
   const Result r = run({"--scenario", (dir / "band.yaml").string(), "--out", out.string(), "-q"}, dir);
   ASSERT_TRUE(fs::exists(out / "identify.json")) << r.err;
@@ -642,14 +572,7 @@ identification:
 // sensor on a pinned support records noise alone.
 TEST(ScoleIdentifyHardening, ARunWithNoIdentifiableParameterSaysSo) {
   TempDir dir;
-  write_file(dir / "support.yaml", R"(name: sensor-on-support
-structure: beam
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000}
-inputs: [{name: P, location: 5, signal: {type: step, amplitude: 10, t0: 0}}]
-sensors: [{name: w0, location: 0, noise_std: 1.0e-5}]
-simulation: {duration: 10, sample_interval: 0.01, seed: 1}
-identification: {parameterization: physical, estimate: [EI, rho_A], initial: {EI: 19000, rho_A: 63}, elements: 10}
-)");
+  write_file(dir / "support.yaml", scoleid::test::test_scenario("cli_test/sensor-on-support"));
   const fs::path out = dir / "out";
   const Result r = run({"--scenario", (dir / "support.yaml").string(), "--out", out.string(), "-q"}, dir);
   ASSERT_TRUE(fs::exists(out / "identify.json")) << r.err;
@@ -755,18 +678,7 @@ TEST(ScoleIdentifyHardening, FlaggedParametersHaveNoStdAndNoStdMeansNotAssessed)
   const fs::path out = dir / "out", out2 = dir / "out2";
   // Dampers of 1e-6 lb s/ft on the free proof masses change the tip response by far less than
   // the identifier's own discretisation residual (at 1e-2 lb s/ft they are resolved to 3e-4).
-  write_file(dir / "unseen.yaml", R"(name: unseen-actuator-damper
-structure: scole
-scole: {actuator_damping: 1.0e-6, actuator_stroke: 5}
-inputs:
-  - {name: F_x, at: reflector, kind: force, direction: x, signal: {type: haversine, amplitude: 10, t0: 0, width: 1.5}}
-  - {name: F_y, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, t0: 0.5, width: 1.5}}
-sensors:
-  - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y}
-  - {name: pitch_tip, at: mast, kind: displacement, location: 130, direction: x}
-simulation: {duration: 6, sample_interval: 0.02}
-identification: {parameterization: physical, estimate: [EI, c_actuator], initial: {EI: 3.8e7, c_actuator: 1.2e-6}, elements: 6}
-)");
+  write_file(dir / "unseen.yaml", scoleid::test::test_scenario("cli_test/unseen-actuator-damper"));
   const Result r = run({"--scenario", (dir / "unseen.yaml").string(), "--out", out.string(), "-q"}, dir);
   ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
   int flagged = 0;

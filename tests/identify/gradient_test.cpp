@@ -12,6 +12,7 @@
 #include "scoleid/identify/inverse/cvodes_adjoint.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/error.h"
+#include "common/test_data.h"
 
 using namespace scoleid::identify;
 using test_support::Case;
@@ -20,60 +21,18 @@ using test_support::max_rel;
 
 namespace {
 
-// ∂J/∂q by central differences in log q with one Richardson step (error O(η⁴)).
-VectorXd central_gradient(Objective& obj, const VectorXd& q) {
-  VectorXd g(q.size());
-  for (int i = 0; i < q.size(); ++i) {
-    auto D = [&](double eta) {
-      VectorXd qp = q, qm = q;
-      qp[i] *= std::exp(eta);
-      qm[i] *= std::exp(-eta);
-      return (obj.cost(qp) - obj.cost(qm)) / (2.0 * eta * q[i]);
-    };
-    g[i] = (4.0 * D(5e-3) - D(1e-2)) / 3.0;
-  }
-  return g;
-}
-
 // Small meshes and a 2 s horizon keep the dense CVODES reference cheap.
-const char* kPaper = R"(name: grad-paper
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
-const char* kPhysical = R"(name: grad-physical
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211}
-inputs: [{name: P, location: 6.3, signal: {type: step, amplitude: 10, t0: 0}}]
-sensors: [{name: w, location: 10}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
-const char* kSections = R"(name: grad-sections
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 30000, 26000, 35000], c_kv: 49.65480843}
-inputs: [{name: P, location: 3.3, signal: {type: pulse, amplitude: 50, t0: 0.1, width: 0.2}}]
-sensors: [{name: a, location: 2.5}, {name: b, location: 7.5}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI_1, EI_2, EI_3, EI_4, rho_A, c_kv], initial: {EI: 28000, rho_A: 70, c_kv: 84}, elements: 8}
-)";
+const std::string kPaper = scoleid::test::test_scenario("gradient_test/grad-paper");
+const std::string kPhysical = scoleid::test::test_scenario("gradient_test/grad-physical");
+const std::string kSections = scoleid::test::test_scenario("gradient_test/grad-sections");
 
-void check_kind(const char* yaml) {
+void check_kind(const std::string& yaml) {
   // (1) Same integrator (ESDIRK, fixed step): costate vs central FD vs Gauss–Newton gradient.
   Case e = make_case(yaml, false);
   const VectorXd q = e.p->params->initial();
   const VectorXd g_fd = test_support::expect_gradients_match_differences(*e.obj, q);
   // (2) Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint (CVodeF/CVodeB) and FD.
-  Case b = make_case(yaml, true);
-  VectorXd g_b;
-  const double Jb = b.obj->cost_and_gradient(q, g_b);
-  const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
-  std::printf("  bdf: costate vs CVODES adjoint %.2e (J %.10e vs %.10e)\n", max_rel(g_b, ref.gradient), Jb, ref.cost);
-  for (int i = 0; i < q.size(); ++i)
-    std::printf("    %-6s costate %+.10e  cvodes %+.10e  fd(esdirk) %+.10e\n", e.p->params->names()[static_cast<std::size_t>(i)].c_str(),
-                g_b[i], ref.gradient[i], g_fd[i]);
-  EXPECT_LT(max_rel(g_b, ref.gradient), 1e-5);
-  EXPECT_NEAR(Jb, ref.cost, 1e-6 * ref.cost);
+  test_support::expect_costate_matches_cvodes(yaml, q, g_fd);
 }
 
 }  // namespace
@@ -85,39 +44,14 @@ TEST(Gradient, SectionalStiffnessMassAndDamping) { check_kind(kSections); }
 // The beam's two damping laws (docs/theory.md §2.2): square-root ζ and Kelvin–Voigt c_kv.
 namespace {
 // Chen–Russell ζ estimated with ρA and EI (cantilever with a tip body).
-const char* kChenRussell = R"(name: grad-chen-russell
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
-)";
+const std::string kChenRussell = scoleid::test::test_scenario("gradient_test/grad-chen-russell");
 // The paper's q1, q2, q3 = c_kv/ρA, with Chen–Russell damping present (held at its ζ).
-const char* kPaperQ3 = R"(name: grad-paper-q3
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.02, c_kv: 124.1370211}
-inputs: [{name: P, location: 6.3, signal: {type: step, amplitude: 10, t0: 0}}]
-sensors: [{name: w, location: 10}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: paper, estimate: [q1, q2, q3], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
+const std::string kPaperQ3 = scoleid::test::test_scenario("gradient_test/grad-paper-q3");
 // The paper's q1, q2 with ζ estimated beside them by name.
-const char* kPaperZeta = R"(name: grad-paper-zeta
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0.05, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: w, location: 10}, {name: r, kind: rotation, location: 7}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: paper, estimate: [q1, q2, zeta], initial: {rho_A: 60, EI: 20000, zeta: 0.08}, elements: 4}
-)";
+const std::string kPaperZeta = scoleid::test::test_scenario("gradient_test/grad-paper-zeta");
 // Both laws on a sectional beam, d_k = 2ζ√(ρA·EI_k) per section; the section boundary at 5 m
 // falls inside an element of the 7-element mesh.
-const char* kBothSections = R"(name: grad-both-sections
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: [23000, 35000], zeta: 0.03, c_kv: 50}
-inputs: [{name: P, location: 3.3, signal: {type: pulse, amplitude: 50, t0: 0.1, width: 0.2}}]
-sensors: [{name: a, location: 2.5}, {name: b, location: 7.5}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI_1, EI_2, rho_A, zeta, c_kv],
-  initial: {EI: 28000, rho_A: 70, zeta: 0.04, c_kv: 80}, elements: 7}
-)";
+const std::string kBothSections = scoleid::test::test_scenario("gradient_test/grad-both-sections");
 
 }  // namespace
 
@@ -152,13 +86,10 @@ TEST(BeamDampingGradient, PaperFormEstimatesZetaByNameAndRefusesWhatTheQsStandFo
 }
 
 TEST(BeamDampingGradient, TaylorRemainderFallsAtSecondOrder) {
-  for (const char* yaml : {kChenRussell, kPaperQ3}) {
+  for (const std::string& yaml : {kChenRussell, kPaperQ3}) {
     Case e = make_case(yaml, false);
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
-    for (std::size_t k = 1; k < 5; ++k) {
-      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
-    }
+    test_support::expect_second_order(R, 1, 5);
   }
 }
 
@@ -176,14 +107,11 @@ TEST(BeamDampingGradient, PaperQ3MapsToKelvinVoigt) {
 
 TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
   // R(ε) = |J(q ∘ exp(ε d)) − J(q) − ε ∇J·(q ∘ d)| for a random direction d in log q.
-  for (const char* yaml : {kPaper, kSections}) {
+  for (const std::string& yaml : {kPaper, kSections}) {
     Case e = make_case(yaml, false);
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 7);
     // Second order: the remainder quarters at each halving (ratio 4; first order would give 2).
-    for (std::size_t k = 1; k < 5; ++k) {
-      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
-    }
+    test_support::expect_second_order(R, 1, 5);
   }
 }
 
@@ -195,36 +123,10 @@ TEST(Gradient, TaylorRemainderFallsAtSecondOrder) {
 // error, like the displacement-only costate above; with BDF at rtol 1e-10 it must agree with the
 // CVODES adjoint, whose outputs on v and a = ẍ are just more rows of g(t, y, q).
 namespace {
-const char* kRatesBeam = R"(name: grad-rates-beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: a_tip, kind: acceleration, location: 10}, {name: v_mid, kind: velocity, location: 6}, {name: w, location: 8}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
-const char* kRatesScole = R"(name: grad-rates-scole
-structure: scole
-scole: {zeta: 0.01}
-inputs:
-  - {name: F_y, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, t0: 0, width: 0.5}}
-  - {name: M_z, at: reflector, kind: moment, direction: z, signal: {type: haversine, amplitude: 200, t0: 0.2, width: 0.5}}
-sensors:
-  - {name: acc_tip_y, at: mast, kind: acceleration, location: 130, direction: y}
-  - {name: acc_refl_x, at: reflector, kind: acceleration, direction: x}
-  - {name: vel_mid_y, at: mast, kind: velocity, location: 65, direction: y}
-  - {name: acc_shuttle_y, at: shuttle, kind: acceleration, direction: y}
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [EI, rho_A, GJ, m_reflector],
-  initial: {EI: 3.8e7, rho_A: 0.09, GJ: 3.6e7, m_reflector: 11.5}, elements: 4}
-)";
+const std::string kRatesBeam = scoleid::test::test_scenario("gradient_test/grad-rates-beam");
+const std::string kRatesScole = scoleid::test::test_scenario("gradient_test/grad-rates-scole");
 // A pulse input: the acceleration outputs jump at its two breakpoints, and so do r and the costate forcing.
-const char* kRatesPulse = R"(name: grad-rates-pulse
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211}
-inputs: [{name: P, location: 6.3, signal: {type: pulse, amplitude: 10, t0: 0.3, width: 0.4}}]
-sensors: [{name: a_tip, kind: acceleration, location: 10}, {name: v_tip, kind: velocity, location: 10}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
+const std::string kRatesPulse = scoleid::test::test_scenario("gradient_test/grad-rates-pulse");
 
 struct RateBounds {
   double costate_fd;          // ESDIRK: costate vs central differences and vs Gauss–Newton
@@ -232,7 +134,7 @@ struct RateBounds {
   bool taylor;                // the Taylor test (needs the gradient consistent with the discrete cost)
 };
 
-void check_rates(const char* yaml, const RateBounds& bound) {
+void check_rates(const std::string& yaml, const RateBounds& bound) {
   // (1) Same integrator (ESDIRK, fixed step): Gauss–Newton and costate gradients vs central FD.
   Case e = make_case(yaml, false);
   const VectorXd q = e.p->params->initial();
@@ -240,7 +142,7 @@ void check_rates(const char* yaml, const RateBounds& bound) {
   MatrixXd H;
   e.obj->gauss_newton(q, g_gn, H);
   e.obj->cost_and_gradient(q, g_cg);
-  const VectorXd g_fd = central_gradient(*e.obj, q);
+  const VectorXd g_fd = test_support::richardson_gradient(*e.obj, q);
   std::printf("  esdirk: Gauss-Newton vs FD %.2e, costate vs FD %.2e, costate vs Gauss-Newton %.2e\n",
               max_rel(g_gn, g_fd), max_rel(g_cg, g_fd), max_rel(g_cg, g_gn));
   for (int i = 0; i < q.size(); ++i)
@@ -252,10 +154,7 @@ void check_rates(const char* yaml, const RateBounds& bound) {
   // (2) The costate gradient passes the Taylor test (the remainder falls at second order).
   if (bound.taylor) {
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, q, 5);
-    for (std::size_t k = 1; k < 5; ++k) {
-      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
-    }
+    test_support::expect_second_order(R, 1, 5);
   }
   // (3) Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint (CVodeF/CVodeB).
   Case b = make_case(yaml, true);
@@ -281,13 +180,7 @@ void check_rates(const char* yaml, const RateBounds& bound) {
 // Hermite interpolants are linear in the points), which must leave g the exact derivative of the
 // discrete cost.
 TEST(Gradient, VelocitySensorsGaussNewtonIsTheGradientOfTheDiscreteCost) {
-  const char* yaml = R"(name: grad-velocity-beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 124.1370211, tip_mass: 30, tip_inertia: 5}
-inputs: [{name: P, location: 10, signal: {type: haversine, amplitude: 10, t0: 0.05, width: 0.3}}]
-sensors: [{name: v_tip, kind: velocity, location: 10}, {name: v_mid, kind: velocity, location: 6}, {name: w, location: 8}]
-simulation: {duration: 2, sample_interval: 0.01}
-identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initial: {rho_A: 60, EI: 20000, c_kv: 175.2712184}, elements: 4}
-)";
+  const std::string yaml = scoleid::test::test_scenario("gradient_test/grad-velocity-beam");
   Case e = make_case(yaml, false);
   const VectorXd q = e.p->params->initial();
   VectorXd g_gn;
@@ -297,7 +190,7 @@ identification: {parameterization: physical, estimate: [rho_A, EI, c_kv], initia
   const double J = e.obj->cost(q);
   std::printf("  velocity sensors: J %.15e (Gauss-Newton pass) vs %.15e (forward)\n", J_gn, J);
   EXPECT_NEAR(J_gn, J, 1e-12 * J);
-  const VectorXd g_fd = central_gradient(*e.obj, q);
+  const VectorXd g_fd = test_support::richardson_gradient(*e.obj, q);
   std::printf("  velocity sensors: Gauss-Newton vs FD %.2e\n", max_rel(g_gn, g_fd));
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-5);
   // H is symmetric positive definite (three parameters the data see).

@@ -12,25 +12,13 @@
 #include "scoleid/identify/inverse/modal_uncertainty.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "test_support.h"
+#include "common/test_data.h"
 
 using namespace scoleid::identify;
 
 namespace {
 
-const char* kUniformBeam = R"(name: modal-beam
-structure: beam
-beam: {length: 2, left: pinned, right: pinned, rho_A: 3.0, EI: 150.0, zeta: 0.02}
-inputs:
-  - {name: P, at: beam, kind: force, location: 0.7, unit: N, signal: {type: step, amplitude: 1, t0: 0}}
-sensors:
-  - {name: w, at: beam, kind: displacement, location: 0.9, unit: m}
-simulation: {duration: 1, sample_interval: 0.002, seed: 1}
-identification:
-  parameterization: physical
-  estimate: [EI, rho_A, zeta]
-  initial: {EI: 150.0, rho_A: 3.0, zeta: 0.02}
-  elements: 12
-)";
+const std::string kUniformBeam = scoleid::test::test_scenario("modal_uncertainty_test/modal-beam");
 
 // An assessment with a given covariance, systematic share and interval terms.
 struct Assessment {

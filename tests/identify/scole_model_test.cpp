@@ -333,24 +333,9 @@ const char* kPhysicalId =
     "identification: {parameterization: physical, estimate: [EI_roll, EI_pitch, rho_A, rho_I_psi, GJ, zeta],\n"
     "  initial: {EI_roll: 3.6e7, EI_pitch: 4.3e7, rho_A: 0.085, rho_I_psi: 1.1, GJ: 3.5e7, zeta: 0.015}, elements: 4}\n";
 
-// ∂J/∂q_i by central differences in log q_i with one Richardson step:
-// D(η) = (J(q_i e^η) − J(q_i e^−η)) / (2η q_i),  ∂J/∂q_i ≈ (4 D(η/2) − D(η)) / 3  (error O(η⁴)).
-// A relative step of 1e-2 keeps rounding small for parameters that move J only slightly (ζ over a
-// 2 s horizon changes J by 1e-5 relative per unit relative change).
-VectorXd richardson_gradient(Objective& obj, const VectorXd& q, double eta = 1e-2) {
-  VectorXd g(q.size());
-  for (int i = 0; i < q.size(); ++i) {
-    auto D = [&](double e) {
-      VectorXd qp = q, qm = q;
-      qp[i] *= std::exp(e);
-      qm[i] *= std::exp(-e);
-      return (obj.cost(qp) - obj.cost(qm)) / (2.0 * e * q[i]);
-    };
-    g[i] = (4.0 * D(0.5 * eta) - D(eta)) / 3.0;
-  }
-  return g;
-}
-
+// richardson_gradient (test_support.h) at its relative step 1e-2 keeps rounding small for
+// parameters that move J only slightly (ζ over a 2 s horizon changes J by 1e-5 relative per unit
+// relative change).
 void check_gradient(const std::string& yaml, double refine = 4.0) {
   // The costate and sensitivity gradients are optimise-then-discretise: they differ from the
   // derivative of the discrete cost by the time error, O(h³). At the automatic step that gap is
@@ -371,7 +356,7 @@ void check_gradient(const std::string& yaml, double refine = 4.0) {
   MatrixXd H;
   e.obj->cost_and_gradient(q, g_adj);
   e.obj->gauss_newton(q, g_gn, H);
-  const VectorXd g_fd = richardson_gradient(*e.obj, q);
+  const VectorXd g_fd = test_support::richardson_gradient(*e.obj, q);
   std::printf("  esdirk, step %.3e: costate vs FD %.2e, Gauss-Newton vs FD %.2e, costate vs Gauss-Newton %.2e\n",
               h / refine, max_rel(g_adj, g_fd), max_rel(g_gn, g_fd), max_rel(g_adj, g_gn));
   for (int i = 0; i < q.size(); ++i)
@@ -380,16 +365,7 @@ void check_gradient(const std::string& yaml, double refine = 4.0) {
   EXPECT_LT(max_rel(g_adj, g_fd), 1e-5);
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-5);
   // Adaptive BDF at rtol 1e-10: costate vs the CVODES adjoint (CVodeF/CVodeB).
-  Case b = make_case(yaml, true);
-  VectorXd g_b;
-  const double Jb = b.obj->cost_and_gradient(q, g_b);
-  const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
-  std::printf("  bdf: costate vs CVODES adjoint %.2e (J %.10e vs %.10e)\n", max_rel(g_b, ref.gradient), Jb, ref.cost);
-  for (int i = 0; i < q.size(); ++i)
-    std::printf("    %-9s costate %+.10e  cvodes %+.10e\n", b.p->params->names()[static_cast<std::size_t>(i)].c_str(),
-                g_b[i], ref.gradient[i]);
-  EXPECT_LT(max_rel(g_b, ref.gradient), 1e-5);
-  EXPECT_NEAR(Jb, ref.cost, 1e-6 * ref.cost);
+  test_support::expect_costate_matches_cvodes(yaml, q);
 }
 
 }  // namespace
@@ -423,10 +399,7 @@ TEST(ScoleGradient, TaylorRemainderFallsAtSecondOrder) {
   for (const char* id : {kPaperId, kPhysicalId, kReflectorId}) {
     Case e = make_case(scole_yaml("taylor", id), false);
     const std::vector<double> R = test_support::taylor_remainders(*e.obj, e.p->params->initial(), 11);
-    for (std::size_t k = 1; k < R.size(); ++k) {
-      EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
-      EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
-    }
+    test_support::expect_second_order(R);
   }
 }
 

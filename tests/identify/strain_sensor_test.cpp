@@ -10,6 +10,7 @@
 #include "test_support.h"
 #include "scoleid/identify/fe/beam_model.h"
 #include "scoleid/io/error.h"
+#include "common/test_data.h"
 
 using namespace scoleid::identify;
 using test_support::Case;
@@ -19,15 +20,7 @@ namespace {
 
 // A clamped aluminium strip (0.6 m, 3 mm thick: gauges 1.5 mm from the neutral axis), tapped near
 // the tip; one displacement sensor beside two strain gauges.
-const char* kStrip = R"(name: strain-strip
-beam: {length: 0.6, left: clamped, right: free, rho_A: 0.4, EI: 30, zeta: 0.01}
-inputs: [{name: F, location: 0.55, signal: {type: haversine, amplitude: 2, t0: 0.001, width: 0.004}}]
-sensors:
-  - {name: eps_root, kind: strain, location: 0.04, offset: 0.0015}
-  - {name: eps_mid, kind: strain, location: 0.27, offset: -0.0015}
-simulation: {duration: 0.3, sample_interval: 0.0005}
-identification: {parameterization: physical, estimate: [EI, rho_A, zeta], initial: {EI: 26, rho_A: 0.45, zeta: 0.012}, elements: 6}
-)";
+const std::string kStrip = scoleid::test::test_scenario("strain_sensor_test/strain-strip");
 
 }  // namespace
 

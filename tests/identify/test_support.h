@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "scoleid/identify/inverse/cvodes_adjoint.h"
 #include "scoleid/identify/run/identify_run.h"
 
 namespace scoleid::identify::test_support {
@@ -34,6 +35,32 @@ inline std::vector<double> taylor_remainders(Objective& obj, const VectorXd& q, 
     std::printf("  %12.4e %14.6e %8.3f\n", eps, R.back(), k ? R[static_cast<std::size_t>(k) - 1] / R.back() : 0.0);
   }
   return R;
+}
+
+// Second order: successive remainders R[k-1]/R[k] of taylor_remainders within (3.5, 4.5) for k in
+// [first, last) (first order would give 2).
+inline void expect_second_order(const std::vector<double>& R, std::size_t first = 1, std::size_t last = 0) {
+  if (last == 0) last = R.size();
+  for (std::size_t k = first; k < last; ++k) {
+    EXPECT_GT(R[k - 1] / R[k], 3.5) << "halving " << k;
+    EXPECT_LT(R[k - 1] / R[k], 4.5) << "halving " << k;
+  }
+}
+
+// ∂J/∂q_i by central differences in log q_i with one Richardson step:
+// D(η) = (J(q_i e^η) − J(q_i e^−η)) / (2η q_i),  ∂J/∂q_i ≈ (4 D(η/2) − D(η)) / 3  (error O(η⁴)).
+inline VectorXd richardson_gradient(Objective& obj, const VectorXd& q, double eta = 1e-2) {
+  VectorXd g(q.size());
+  for (int i = 0; i < q.size(); ++i) {
+    auto D = [&](double e) {
+      VectorXd qp = q, qm = q;
+      qp[i] *= std::exp(e);
+      qm[i] *= std::exp(-e);
+      return (obj.cost(qp) - obj.cost(qm)) / (2.0 * e * q[i]);
+    };
+    g[i] = (4.0 * D(0.5 * eta) - D(eta)) / 3.0;
+  }
+  return g;
 }
 
 // A problem and its objective built from scenario YAML text. `bdf` switches to CVODES BDF at
@@ -88,6 +115,24 @@ inline VectorXd expect_gradients_match_differences(Objective& obj, const VectorX
   EXPECT_LT(max_rel(g_adj, g_fd), 1e-4);
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-4);
   return g_fd;
+}
+
+// Adaptive BDF at rtol 1e-10: the costate gradient of `yaml` at q against the CVODES adjoint
+// (CVodeF/CVodeB), to 1e-5 in the gradient and 1e-6 in J; `fd`, if given, printed beside them.
+inline void expect_costate_matches_cvodes(const std::string& yaml, const VectorXd& q, const VectorXd& fd = VectorXd()) {
+  Case b = make_case(yaml, true);
+  VectorXd g_b;
+  const double Jb = b.obj->cost_and_gradient(q, g_b);
+  const CvodesAdjointResult ref = cvodes_adjoint_gradient(*b.obj, q, 1e-10);
+  std::printf("  bdf: costate vs CVODES adjoint %.2e (J %.10e vs %.10e)\n", max_rel(g_b, ref.gradient), Jb, ref.cost);
+  for (int i = 0; i < q.size(); ++i) {
+    std::printf("    %-9s costate %+.10e  cvodes %+.10e", b.p->params->names()[static_cast<std::size_t>(i)].c_str(), g_b[i],
+                ref.gradient[i]);
+    if (fd.size() == q.size()) std::printf("  fd(esdirk) %+.10e", fd[i]);
+    std::printf("\n");
+  }
+  EXPECT_LT(max_rel(g_b, ref.gradient), 1e-5);
+  EXPECT_NEAR(Jb, ref.cost, 1e-6 * ref.cost);
 }
 
 }  // namespace scoleid::identify::test_support

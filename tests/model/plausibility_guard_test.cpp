@@ -26,6 +26,7 @@
 #include "scoleid/model/truth_run.h"
 
 #include "cli_fixture.h"
+#include "common/test_data.h"
 
 namespace fs = std::filesystem;
 using namespace scoleid;
@@ -59,10 +60,7 @@ double number_after(const std::string& msg, const std::string& key) {
 // SCOLE driven by actuator 1 along y only (the default actuators at L/3 and 2L/3, the default
 // stroke), cheap: 4 segments, 2 s.
 std::string actuator_scenario(const std::string& signal, const std::string& extra = "") {
-  return R"(name: guard-actuator
-structure: scole
-inputs:
-  - {name: F_a1, at: actuator1, kind: force, direction: y, unit: lb, signal: )" +
+  return scoleid::test::test_scenario("plausibility_guard_test/guard-actuator") +
          signal + R"(}
 sensors:
   - {name: roll_tip, at: mast, kind: displacement, location: 130, direction: y, unit: ft}
@@ -144,15 +142,7 @@ namespace {
 // attitude is the rotation that crosses the bound; the passive proof masses get the room the
 // mast sweeps past them (s theta < 14 ft).
 std::string roll_scenario(bool large_motion) {
-  return std::string(R"(name: guard-roll
-structure: scole
-scole: {EI: 4.0e9, GJ: 4.0e9, actuator_stroke: 1000}
-inputs:
-  - {name: M_roll, at: shuttle, kind: moment, direction: x, unit: lb ft, signal: {type: step, amplitude: 60000, t0: 0}}
-sensors:
-  - {name: roll, at: shuttle, kind: rotation, direction: x, unit: rad}
-simulation: {duration: 2.5, sample_interval: 0.01, seed: 1}
-truth: {segments: 2, accuracy: 1e-7)") +
+  return std::string(scoleid::test::test_scenario("plausibility_guard_test/guard-roll")) +
          (large_motion ? ", large_motion: true" : "") + "}\n";
 }
 }  // namespace
@@ -189,15 +179,7 @@ TEST_F(PlausibilityGuard, RotationBeyondTheBoundIsRefusedUnlessLargeMotion) {
 TEST_F(PlausibilityGuard, BeamSegmentRotationRelativeToGroundIsBounded) {
   // Cantilever under a suddenly applied tip load: static tip slope P L^2 / (2 EI) = 0.22 rad.
   auto beam = [](const std::string& truth_extra) {
-    return io::parse_scenario(R"(name: guard-beam
-structure: beam
-beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000, c_kv: 248.2740421}
-inputs:
-  - {name: P, at: beam, kind: force, location: 10, unit: N, signal: {type: step, amplitude: 100, t0: 0}}
-sensors:
-  - {name: w_tip, at: beam, kind: displacement, location: 10, unit: m}
-simulation: {duration: 3, sample_interval: 0.01, seed: 1}
-truth: {segments: 4, integrator: rk-merson, accuracy: 1e-6)" + truth_extra + "}\n",
+    return io::parse_scenario(scoleid::test::test_scenario("plausibility_guard_test/guard-beam") + truth_extra + "}\n",
                               "scenario 'beam.yaml'");
   };
   try {

@@ -18,6 +18,7 @@
 #include "scoleid/io/data_files.h"
 
 #include "cli_fixture.h"
+#include "common/test_data.h"
 
 namespace fs = std::filesystem;
 
@@ -30,16 +31,7 @@ protected:
   static int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 };
 
-const char* kBeam = R"(name: cli-beam
-structure: beam
-beam: {length: 10, left: pinned, right: pinned, rho_A: 67, EI: 23000, zeta: 0}
-inputs:
-  - {name: P, at: beam, kind: force, location: 5, unit: N, signal: {type: step, amplitude: 10, t0: 0}}
-sensors:
-  - {name: w_mid, at: beam, kind: displacement, location: 5, unit: m}
-simulation: {duration: 4, sample_interval: 0.01, seed: 1}
-truth: {segments: 20, integrator: rk-merson, accuracy: 1e-6}
-)";
+const std::string kBeam = scoleid::test::test_scenario("scole_truth_cli_test/cli-beam");
 
 }  // namespace
 
@@ -60,16 +52,7 @@ TEST_F(ScoleTruthCli, BadFieldValueExits2WithOneLineAndNoOutput) {
 
 TEST_F(ScoleTruthCli, EulerBernoulliMastIsRefusedByTheChain) {
   // Rigid segments always carry the section's bending rotary inertia (docs/theory.md §3.3).
-  const std::string file = write("eb.yaml", R"(name: cli-eb
-structure: scole
-scole: {bending_rotary_inertia: false}
-inputs:
-  - {name: F, at: reflector, kind: force, direction: y, signal: {type: haversine, amplitude: 10, width: 1}}
-sensors:
-  - {name: tip, at: mast, kind: displacement, location: 130, direction: y}
-simulation: {duration: 1, sample_interval: 0.01}
-truth: {segments: 10}
-)");
+  const std::string file = write("eb.yaml", scoleid::test::test_scenario("scole_truth_cli_test/cli-eb"));
   const fs::path out = dir_ / "out";
   const CliResult r = run("--scenario " + file + " --out " + out.string());
   EXPECT_EQ(r.code, 2);
