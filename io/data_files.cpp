@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/signal.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/validation.h"
 
@@ -41,14 +42,7 @@ int DataTable::find(const std::string& name) const {
 }
 
 double DataTable::interpolate(int j, double tt) const {
-  const auto& v = columns.at(static_cast<std::size_t>(j));
-  if (t.empty()) return 0.0;
-  if (tt <= t.front()) return v.front();
-  if (tt >= t.back()) return v.back();
-  const auto it = std::upper_bound(t.begin(), t.end(), tt);
-  const std::size_t k = static_cast<std::size_t>(it - t.begin());
-  const double a = (tt - t[k - 1]) / (t[k] - t[k - 1]);
-  return (1.0 - a) * v[k - 1] + a * v[k];
+  return linear_table_value(t, columns.at(static_cast<std::size_t>(j)), tt);
 }
 
 std::string DataTable::unit(int j) const {

@@ -10,21 +10,11 @@ namespace scoleid::io {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-double table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
-  if (ts.empty()) return 0.0;
-  if (t <= ts.front()) return vs.front();
-  if (t >= ts.back()) return vs.back();
-  const auto it = std::upper_bound(ts.begin(), ts.end(), t);
-  const std::size_t k = static_cast<std::size_t>(it - ts.begin());
-  const double a = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
-  return (1.0 - a) * vs[k - 1] + a * vs[k];
-}
-
 // The 4-point Lagrange cubic through the samples around t (the stencil shifted inside the range at
 // the ends; linear below four samples), constant beyond the ends.
 double cubic_table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
   const std::size_t N = ts.size();
-  if (N < 4) return table_value(ts, vs, t);
+  if (N < 4) return linear_table_value(ts, vs, t);
   if (t <= ts.front()) return vs.front();
   if (t >= ts.back()) return vs.back();
   const auto j = static_cast<std::size_t>(std::upper_bound(ts.begin(), ts.end(), t) - ts.begin());  // ts[j-1] <= t < ts[j]
@@ -59,12 +49,22 @@ double term_value(const SignalTerm& s, double t) {
     case T::Haversine:
       if (tau < 0.0 || tau >= s.width) return 0.0;
       return s.amplitude * 0.5 * (1.0 - std::cos(2.0 * kPi * tau / s.width));
-    case T::Table: return table_value(s.times, s.values, t);
+    case T::Table: return linear_table_value(s.times, s.values, t);
     case T::CubicTable: return cubic_table_value(s.times, s.values, t);
   }
   return 0.0;
 }
 }  // namespace
+
+double linear_table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
+  if (ts.empty()) return 0.0;
+  if (t <= ts.front()) return vs.front();
+  if (t >= ts.back()) return vs.back();
+  const auto it = std::upper_bound(ts.begin(), ts.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - ts.begin());
+  const double a = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+  return (1.0 - a) * vs[k - 1] + a * vs[k];
+}
 
 Signal::Signal(std::vector<SignalTerm> terms) : terms_(std::move(terms)) {}
 

@@ -489,19 +489,7 @@ scoleid::io::Scenario part2_scenario(const std::map<std::string, double>& initia
 }
 
 // The closed-form modal series (2000 terms) at the scenario's sample times: no FE in the data.
-Measurements series_data(const scoleid::io::Scenario& sc) {
-  Measurements m;
-  m.names = {sc.sensors[0].name};
-  const double dt = sc.simulation.sample_interval;
-  const int n = static_cast<int>(std::lround(sc.simulation.duration / dt));
-  m.z.resize(n + 1, 1);
-  for (int k = 0; k <= n; ++k) {
-    m.t.push_back(k * dt);
-    m.z(k, 0) = analytic::ss_step_response(sc.sensors[0].location, k * dt, sc.inputs[0].location,
-                                          sc.inputs[0].signal(1.0), sc.beam.length, sc.beam.EI[0], sc.beam.rho_A, 2000);
-  }
-  return m;
-}
+Measurements series_data(const scoleid::io::Scenario& sc) { return synthesize_series(sc, 2000); }
 
 json part2() {
   std::printf("Part 2. EI_1..EI_4 + rho_A from the modal series (paper-beam-1: midspan step load and sensor, 20 elements),\n"

@@ -82,4 +82,11 @@ double ss_step_response(double x, double t, double a, double P, double L, double
   return w;
 }
 
+std::vector<double> ss_step_samples(double x, double dt, int n, double a, double P, double L, double EI, double rhoA,
+                                    int terms) {
+  std::vector<double> w;
+  for (int k = 0; k <= n; ++k) w.push_back(ss_step_response(x, k * dt, a, P, L, EI, rhoA, terms));
+  return w;
+}
+
 }  // namespace scoleid::identify::analytic

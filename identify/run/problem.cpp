@@ -1,4 +1,6 @@
 #include "scoleid/identify/run/problem.h"
+
+#include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/time/checkpoints.h"
 
 #include <algorithm>
@@ -299,6 +301,22 @@ void add_sensor_errors(const io::Scenario& sc, bool add_noise, Measurements& m) 
   }
 }
 }  // namespace
+
+Measurements synthesize_series(const io::Scenario& sc, int terms) {
+  using io::EndCondition;
+  if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1 || sc.beam.left != EndCondition::Pinned ||
+      sc.beam.right != EndCondition::Pinned || sc.inputs.empty() || sc.sensors.empty())
+    throw std::invalid_argument("synthesize_series: a uniform simply supported beam with an input and a sensor");
+  Measurements m;
+  m.names = {sc.sensors[0].name};
+  const double dt = sc.simulation.sample_interval;
+  const int n = static_cast<int>(std::lround(sc.simulation.duration / dt));
+  const auto w = analytic::ss_step_samples(sc.sensors[0].location, dt, n, sc.inputs[0].location, sc.inputs[0].signal(1.0),
+                                           sc.beam.length, sc.beam.EI[0], sc.beam.rho_A, terms);
+  m.z = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
+  for (int k = 0; k <= n; ++k) m.t.push_back(k * dt);
+  return m;
+}
 
 Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
   const auto [model, coefficients] = true_model(sc, elements);

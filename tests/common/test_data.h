@@ -1,9 +1,13 @@
 #pragma once
 // The tests' data files (tests/data): scenarios the tests start from, exported lab files.
+#include <gtest/gtest.h>
+
 #include <stdexcept>
 #include <string>
 
 #include "common/cli_support.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/scenario.h"
 
 namespace scoleid::test {
 
@@ -15,6 +19,24 @@ inline std::string test_scenario(const std::string& name) {
   const std::string text = slurp(test_data_path("scenarios/" + name + ".yaml"));
   if (text.empty()) throw std::runtime_error("no test scenario " + name);
   return text;
+}
+
+// `text` with its first `from` replaced by `to`; a test failure if `from` is not there.
+inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// The message of the InputError that parsing scenario `yaml` (named `source`) throws; "" if it parses.
+inline std::string scenario_error(const std::string& yaml, const std::string& source) {
+  try {
+    io::parse_scenario(yaml, source);
+  } catch (const io::InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace scoleid::test

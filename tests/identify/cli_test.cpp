@@ -120,13 +120,7 @@ void expect_input_error(const Result& r, const fs::path& out, const std::vector<
 const std::string kGood = scoleid::test::test_scenario("cli_test/cli-good");
 
 // kGood with the first occurrence of `from` replaced by `to`.
-std::string good_with(const std::string& from, const std::string& to) {
-  std::string s = kGood;
-  const auto at = s.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) s.replace(at, from.size(), to);
-  return s;
-}
+std::string good_with(const std::string& from, const std::string& to) { return scoleid::test::replaced(kGood, from, to); }
 
 // Writes `yaml` to DIR/s.yaml, runs it with --out DIR/out, checks the input-error contract.
 void expect_yaml_error(const std::string& yaml, const std::vector<std::string>& needles_after_source) {

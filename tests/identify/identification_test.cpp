@@ -29,19 +29,7 @@ RunResult identify_builtin(Problem& p, const std::string& method = "", int max_i
 
 
 // Case I data from the closed-form modal series (no FE anywhere in the data).
-Measurements series_data(const scoleid::io::Scenario& sc) {
-  Measurements m;
-  m.names = {sc.sensors[0].name};
-  const double dt = sc.simulation.sample_interval;
-  const int n = static_cast<int>(std::lround(sc.simulation.duration / dt));
-  m.z.resize(n + 1, 1);
-  for (int k = 0; k <= n; ++k) {
-    m.t.push_back(k * dt);
-    m.z(k, 0) = analytic::ss_step_response(sc.sensors[0].location, k * dt, sc.inputs[0].location,
-                                          sc.inputs[0].signal(1.0), sc.beam.length, sc.beam.EI[0], sc.beam.rho_A);
-  }
-  return m;
-}
+Measurements series_data(const scoleid::io::Scenario& sc) { return synthesize_series(sc); }
 
 }  // namespace
 

@@ -236,6 +236,22 @@ void check_jacobian(ModalMisfit& mis, const VectorXd& q, const char* what, bool 
     }
 }
 
+// The frequency, frequency + shape and frequency + shape + damping misfits of the first six modes:
+// each gradient, and the last one's Jacobian, against central differences at q.
+void check_misfit_levels(const FeSetup& s, const Modes& m, const std::vector<std::string>& stations, const VectorXd& q) {
+  {
+    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), {}, 1e-3, 0, 0));
+    check_gradient(mis, q, "frequencies");
+  }
+  {
+    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), stations, 1e-3, 1e-2, 0));
+    check_gradient(mis, q, "frequencies + shapes");
+  }
+  ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), stations, 1e-3, 1e-2, 0.1));
+  check_gradient(mis, q, "frequencies + shapes + damping");
+  check_jacobian(mis, q, "frequencies + shapes + damping");
+}
+
 }  // namespace
 
 TEST(ModalMisfit, GradientMatchesCentralDifferencesOnScole) {
@@ -252,18 +268,9 @@ TEST(ModalMisfit, GradientMatchesCentralDifferencesOnScole) {
   for (int k = 0; k < 6; ++k)
     std::printf("  mode %d: f = %.6f Hz, zeta = %.3e\n", k + 1, m.f[static_cast<std::size_t>(k)],
                 m.zeta[static_cast<std::size_t>(k)]);
-  {
-    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), {}, 1e-3, 0, 0));
-    check_gradient(mis, qt, "frequencies");
-  }
-  {
-    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), kScoleStations, 1e-3, 1e-2, 0));
-    check_gradient(mis, qt, "frequencies + shapes");
-  }
+  check_misfit_levels(s, m, kScoleStations, qt);
   {
     ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), kScoleStations, 1e-3, 1e-2, 0.1));
-    check_gradient(mis, qt, "frequencies + shapes + damping");
-    check_jacobian(mis, qt, "frequencies + shapes + damping");
     // One eigensolve per evaluation point: J, g and H at the same q share it.
     mis.reset_counters();
     const VectorXd q1 = qt * 1.01;
@@ -295,19 +302,7 @@ TEST(ModalMisfit, GradientMatchesCentralDifferencesOnABeam) {
   const Modes m = flexible_modes(s, qd, stations);
   std::printf("pinned-pinned beam (16 elements, EI on 4 sections, n = %d), %zu flexible modes, first %.4f Hz\n",
               s.model().ndof, m.f.size(), m.f[0]);
-  {
-    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), {}, 1e-3, 0, 0));
-    check_gradient(mis, qt, "frequencies");
-  }
-  {
-    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), stations, 1e-3, 1e-2, 0));
-    check_gradient(mis, qt, "frequencies + shapes");
-  }
-  {
-    ModalMisfit mis(s.model(), *s.params, modal_data(m, first(6), stations, 1e-3, 1e-2, 0.1));
-    check_gradient(mis, qt, "frequencies + shapes + damping");
-    check_jacobian(mis, qt, "frequencies + shapes + damping");
-  }
+  check_misfit_levels(s, m, stations, qt);
 }
 
 TEST(ModalMisfit, TaylorRemainderFallsAtSecondOrder) {

@@ -1,3 +1,4 @@
+#include "common/test_data.h"
 #include "scoleid/io/scenario.h"
 
 #include <gtest/gtest.h>
@@ -12,14 +13,7 @@
 using namespace scoleid::io;
 
 namespace {
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_scenario(yaml, "scenario 'x.yaml'");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::string& yaml) { return scoleid::test::scenario_error(yaml, "scenario 'x.yaml'"); }
 }  // namespace
 
 TEST(Scenario, EveryBuiltinParsesAndHasInputsAndSensors) {

@@ -1,6 +1,7 @@
 // The validation pass (io/validation.h) and the scenario loader's document checks: each finding
 // of a hostile-input review is reproduced here and must be refused with an InputError that
 // names the field and the value (never another exception, a crash, a hang or a silent default).
+#include "common/test_data.h"
 #include "scoleid/io/validation.h"
 
 #include <gtest/gtest.h>
@@ -23,14 +24,7 @@ beam: {length: 10, left: clamped, right: free, rho_A: 67, EI: 23000}
 simulation: {duration: 2, sample_interval: 0.01}
 )";
 
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_scenario(yaml, "scenario 's.yaml'");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::string& yaml) { return scoleid::test::scenario_error(yaml, "scenario 's.yaml'"); }
 
 ::testing::AssertionResult refused(const std::string& yaml, const std::vector<std::string>& needles) {
   const std::string e = error_of(yaml);

@@ -138,13 +138,7 @@ TEST_F(ScoleTruthCli, StepLoadPeaksAtTwiceTheStaticDeflection) {
 // ------------------------------------------------------------------------------- hardening
 
 namespace {
-std::string with(const std::string& from, const std::string& to) {
-  std::string s = kBeam;
-  const auto at = s.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) s.replace(at, from.size(), to);
-  return s;
-}
+std::string with(const std::string& from, const std::string& to) { return scoleid::test::replaced(kBeam, from, to); }
 }  // namespace
 
 TEST_F(ScoleTruthCli, CommandLineOverridesPassTheScenarioChecks) {

@@ -60,4 +60,8 @@ private:
 
 const char* to_string(SignalTerm::Type t);
 
+// Piecewise-linear interpolation of the samples (ts, vs) at t (ts increasing), constant beyond the
+// ends; 0 without samples. A `table` signal's law and DataTable::interpolate.
+double linear_table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t);
+
 }  // namespace scoleid::io

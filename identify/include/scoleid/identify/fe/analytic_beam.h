@@ -33,5 +33,8 @@ double cantilever_static_tip_load(double x, double P, double L, double EI);
 // Modal series with `terms` modes (the neglected tail is bounded by Σ k⁻⁴, below 1e-11 relative at 4000).
 double ss_step_response(double x, double t, double a, double P, double L, double EI, double rhoA,
                         int terms = 4000);
+// The same at t_k = k·dt, k = 0..n.
+std::vector<double> ss_step_samples(double x, double dt, int n, double a, double P, double L, double EI, double rhoA,
+                                    int terms = 4000);
 
 }  // namespace scoleid::identify::analytic

@@ -105,6 +105,10 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const io::Da
 
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
+// The closed-form modal series (`terms` modes) of a uniform simply supported beam under the step
+// load of the scenario's first input, at its first sensor and its sample times: data with no
+// finite elements in them (std::invalid_argument for any other structure).
+Measurements synthesize_series(const io::Scenario& scenario, int terms = 4000);
 // The same from the nonlinear SCOLE model (identification.model: nonlinear) at a step of at most `step`.
 Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, double step, bool add_noise);
 // The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for a beam or
