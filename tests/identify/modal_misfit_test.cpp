@@ -236,6 +236,17 @@ void check_jacobian(ModalMisfit& mis, const VectorXd& q, const char* what, bool 
     }
 }
 
+// Where the SCOLE modal data are taken: q_true * (1.03, 0.98, 1.05, 1.5) for EI, rho_A,
+// rho_I_psi, zeta.
+VectorXd scole_data_point(const VectorXd& qt) {
+  VectorXd qd = qt;
+  qd[0] *= 1.03;
+  qd[1] *= 0.98;
+  qd[2] *= 1.05;
+  qd[3] *= 1.5;
+  return qd;
+}
+
 // The frequency, frequency + shape and frequency + shape + damping misfits of the first six modes:
 // each gradient, and the last one's Jacobian, against central differences at q.
 void check_misfit_levels(const FeSetup& s, const Modes& m, const std::vector<std::string>& stations, const VectorXd& q) {
@@ -257,11 +268,7 @@ void check_misfit_levels(const FeSetup& s, const Modes& m, const std::vector<std
 TEST(ModalMisfit, GradientMatchesCentralDifferencesOnScole) {
   const FeSetup s = setup(scole({"EI", "rho_A", "rho_I_psi", "zeta"}), 20);
   const VectorXd qt = s.params->truth();
-  VectorXd qd = qt;
-  qd[0] *= 1.03;
-  qd[1] *= 0.98;
-  qd[2] *= 1.05;
-  qd[3] *= 1.5;
+  const VectorXd qd = scole_data_point(qt);
   const Modes m = flexible_modes(s, qd, kScoleStations);
   std::printf("SCOLE (20 elements, n = %d): data at q_true * (1.03, 0.98, 1.05, 1.5), first 6 flexible modes:\n",
               s.model().ndof);
@@ -308,11 +315,7 @@ TEST(ModalMisfit, GradientMatchesCentralDifferencesOnABeam) {
 TEST(ModalMisfit, TaylorRemainderFallsAtSecondOrder) {
   const FeSetup s = setup(scole({"EI", "rho_A", "rho_I_psi", "zeta"}), 20);
   const VectorXd qt = s.params->truth();
-  VectorXd qd = qt;
-  qd[0] *= 1.03;
-  qd[1] *= 0.98;
-  qd[2] *= 1.05;
-  qd[3] *= 1.5;
+  const VectorXd qd = scole_data_point(qt);
   ModalMisfit mis(s.model(), *s.params,
                   modal_data(flexible_modes(s, qd, kScoleStations), first(6), kScoleStations, 1e-3, 1e-2, 0.1));
   std::mt19937_64 rng(7);

@@ -14,6 +14,21 @@ using namespace scoleid::io;
 
 namespace {
 std::string error_of(const std::string& yaml) { return scoleid::test::scenario_error(yaml, "scenario 'x.yaml'"); }
+
+// The message of the InputError loading the built-in or file `name` throws; "" if it loads.
+std::string load_error(const std::string& name) {
+  try {
+    load_scenario(name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Each `head + tail` is refused with exactly `message`.
+void expect_errors(const std::string& head, std::initializer_list<std::pair<std::string, std::string>> cases) {
+  for (const auto& [tail, message] : cases) EXPECT_EQ(error_of(head + tail), message) << tail;
+}
 }  // namespace
 
 TEST(Scenario, EveryBuiltinParsesAndHasInputsAndSensors) {
@@ -44,22 +59,14 @@ TEST(Scenario, JsonEchoRoundTripsKeyFields) {
 }
 
 TEST(Scenario, UnknownBuiltinNamesTheChoices) {
-  try {
-    load_scenario("paper-beam-9");
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("paper-beam-9"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("paper-beam-1"), std::string::npos);
-  }
+  const std::string e = load_error("paper-beam-9");
+  EXPECT_NE(e.find("paper-beam-9"), std::string::npos) << e;
+  EXPECT_NE(e.find("paper-beam-1"), std::string::npos) << e;
 }
 
 TEST(Scenario, MissingFileIsNamed) {
-  try {
-    load_scenario("/nonexistent/s.yaml");
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/s.yaml"), std::string::npos);
-  }
+  const std::string e = load_error("/nonexistent/s.yaml");
+  EXPECT_NE(e.find("/nonexistent/s.yaml"), std::string::npos) << e;
 }
 
 TEST(Scenario, MalformedYamlGivesLine) {
@@ -154,20 +161,23 @@ TEST(TruthOverrides, UnknownFieldsOrTheOtherStructureAreRefused) {
   EXPECT_NE(error_of("name: m\ntruth: {overrides: {plate: {}}}\n").find("truth.overrides.plate"), std::string::npos);
 }
 
-// truth.overrides.sensors: partial entries named after the scenario's sensors (location,
-// direction, bias, drift) for the truth alone; echoed as overrides.sensors = [{name, fields that
-// differ}], which alone make has_truth_overrides true.
-TEST(TruthOverrides, SensorEntriesChangeTheTruthsSensorsOnlyAndAreEchoed) {
-  const std::string head = R"(name: sensors
+// A SCOLE scenario with two sensors, open at truth.overrides.sensors for entries.
+const std::string kSensorOverridesHead = R"(name: sensors
 structure: scole
 sensors:
   - {name: roll_tip, at: mast, location: 130, direction: y}
   - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
-  - {name: roll_mid, at: mast, location: 65, direction: y}
 truth:
   overrides:
     sensors:
 )";
+
+// truth.overrides.sensors: partial entries named after the scenario's sensors (location,
+// direction, bias, drift) for the truth alone; echoed as overrides.sensors = [{name, fields that
+// differ}], which alone make has_truth_overrides true.
+TEST(TruthOverrides, SensorEntriesChangeTheTruthsSensorsOnlyAndAreEchoed) {
+  const std::string head = scoleid::test::replaced(
+      kSensorOverridesHead, "truth:\n", "  - {name: roll_mid, at: mast, location: 65, direction: y}\ntruth:\n");
   const Scenario s = parse_scenario(head + R"(      - {name: roll_tip, direction: [0, 0.99985, 0.01745], bias: 1.0e-3}
       - {name: roll_mid, location: 80, drift: -2.0e-4}
 )", "scenario 'm.yaml'");
@@ -194,37 +204,30 @@ truth:
 }
 
 TEST(TruthOverrides, SensorEntryErrorsNameTheField) {
-  const std::string head = R"(name: sensors
-structure: scole
-sensors:
-  - {name: roll_tip, at: mast, location: 130, direction: y}
-  - {name: yaw_tip, at: reflector, kind: rotation, direction: z}
-truth:
-  overrides:
-    sensors:
-)";
-  EXPECT_EQ(error_of(head + "      - {name: roll_tpi, bias: 1}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario (roll_tip, yaw_tip), "
-            "got 'roll_tpi'");
-  EXPECT_EQ(error_of(head + "      - {bias: 1}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario, got none");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, bias: 1}\n      - {name: roll_tip, drift: 1}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[1].name must be unique, got 'roll_tip'");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, drift: .nan}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].drift must be a finite number, got '.nan'");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, bias: -.inf}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].bias must be a finite number, got '-.inf'");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, location: 131}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].location must lie on the mast [0, 130], got 131");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, direction: [0, 0, 0]}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].direction must be non-zero, got [0, 0, 0]");
-  EXPECT_EQ(error_of(head + "      - {name: yaw_tip, location: 100}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].location applies to beam and mast sensors only (sensor "
-            "'yaw_tip' is at reflector), got 100");
-  EXPECT_EQ(error_of(head + "      - {name: roll_tip, noise_std: 1}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors[0].noise_std is not a known field, got 'noise_std'");
-  EXPECT_EQ(error_of(head + "      {name: roll_tip}\n"),
-            "scenario 'x.yaml': truth.overrides.sensors must be a list, got map");
+  const std::string head = kSensorOverridesHead;
+  expect_errors(
+      head,
+      {{"      - {name: roll_tpi, bias: 1}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario (roll_tip, yaw_tip), "
+        "got 'roll_tpi'"},
+       {"      - {bias: 1}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].name must name a sensor of the scenario, got none"},
+       {"      - {name: roll_tip, bias: 1}\n      - {name: roll_tip, drift: 1}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[1].name must be unique, got 'roll_tip'"},
+       {"      - {name: roll_tip, drift: .nan}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].drift must be a finite number, got '.nan'"},
+       {"      - {name: roll_tip, bias: -.inf}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].bias must be a finite number, got '-.inf'"},
+       {"      - {name: roll_tip, location: 131}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].location must lie on the mast [0, 130], got 131"},
+       {"      - {name: roll_tip, direction: [0, 0, 0]}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].direction must be non-zero, got [0, 0, 0]"},
+       {"      - {name: yaw_tip, location: 100}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].location applies to beam and mast sensors only (sensor "
+        "'yaw_tip' is at reflector), got 100"},
+       {"      - {name: roll_tip, noise_std: 1}\n",
+        "scenario 'x.yaml': truth.overrides.sensors[0].noise_std is not a known field, got 'noise_std'"},
+       {"      {name: roll_tip}\n", "scenario 'x.yaml': truth.overrides.sensors must be a list, got map"}});
   // The main section refuses them: the identifier models an ideal sensor plus noise.
   EXPECT_EQ(error_of("name: b\nsensors:\n  - {name: w, location: 5, bias: 0.001}\n"),
             "scenario 'x.yaml': sensors[0].bias is refused here: bias and drift describe the truth's sensor errors: "
@@ -328,11 +331,12 @@ identification:
   EXPECT_NE(error_of(head + "{scole.reflector.weight: 1}\n").find("identification.uncertain.scole.reflector.weight names no number"),
             std::string::npos);
   EXPECT_NE(error_of(head + "{sensors.nobody.location: 1}\n").find("names no number"), std::string::npos);
-  EXPECT_EQ(error_of(head + "{scole.GJ: -1}\n"),
-            "scenario 'x.yaml': identification.uncertain.scole.GJ must be a tolerance > 0, got -1");
-  EXPECT_EQ(error_of(head + "{scole.bending_rotary_inertia: true}\n"),
-            "scenario 'x.yaml': identification.uncertain.scole.bending_rotary_inertia must name the alternative to the "
-            "model's setting, got true");
+  expect_errors(
+      head,
+      {{"{scole.GJ: -1}\n", "scenario 'x.yaml': identification.uncertain.scole.GJ must be a tolerance > 0, got -1"},
+       {"{scole.bending_rotary_inertia: true}\n",
+        "scenario 'x.yaml': identification.uncertain.scole.bending_rotary_inertia must name the alternative to the "
+        "model's setting, got true"}});
   EXPECT_NE(error_of(head + "[1, 2]\n").find("identification.uncertain must be a map"), std::string::npos);
 }
 
