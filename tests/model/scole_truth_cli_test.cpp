@@ -29,6 +29,19 @@ using scoleid::model::test::CliResult;
 class ScoleTruthCli : public scoleid::model::test::TruthCliFixture {
 protected:
   static int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+  // Runs the truth on scenario text `yaml` (written to bad.yaml) into out/: exit 2 and one line on
+  // stderr holding the file's path and each of `needles`; no truth.csv or truth.json written.
+  void expect_refused(const std::string& yaml, std::initializer_list<std::string> needles) {
+    const std::string file = write("bad.yaml", yaml);
+    const fs::path out = dir_ / "out";
+    const CliResult r = run("--scenario " + file + " --out " + out.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+    for (const auto& n : needles) EXPECT_NE(r.err.find(n), std::string::npos) << n << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out / "truth.csv"));
+    EXPECT_FALSE(fs::exists(out / "truth.json"));
+  }
 };
 
 const std::string kBeam = scoleid::test::test_scenario("scole_truth_cli_test/cli-beam");
@@ -36,43 +49,17 @@ const std::string kBeam = scoleid::test::test_scenario("scole_truth_cli_test/cli
 }  // namespace
 
 TEST_F(ScoleTruthCli, BadFieldValueExits2WithOneLineAndNoOutput) {
-  std::string yaml = kBeam;
-  yaml.replace(yaml.find("rho_A: 67"), 9, "rho_A: -3");
-  const std::string file = write("bad.yaml", yaml);
-  const fs::path out = dir_ / "out";
-  const CliResult r = run("--scenario " + file + " --out " + out.string());
-  EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("beam.rho_A"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("-3"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out / "truth.csv"));
-  EXPECT_FALSE(fs::exists(out / "truth.json"));
+  expect_refused(scoleid::test::replaced(kBeam, "rho_A: 67", "rho_A: -3"), {"beam.rho_A", "-3"});
 }
 
 TEST_F(ScoleTruthCli, EulerBernoulliMastIsRefusedByTheChain) {
   // Rigid segments always carry the section's bending rotary inertia (docs/theory.md §3.3).
-  const std::string file = write("eb.yaml", scoleid::test::test_scenario("scole_truth_cli_test/cli-eb"));
-  const fs::path out = dir_ / "out";
-  const CliResult r = run("--scenario " + file + " --out " + out.string());
-  EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("scole.bending_rotary_inertia"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("false"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out));
+  expect_refused(scoleid::test::test_scenario("scole_truth_cli_test/cli-eb"), {"scole.bending_rotary_inertia", "false"});
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
 TEST_F(ScoleTruthCli, InputTheStructureCannotTakeExits2) {
-  std::string yaml = kBeam;
-  yaml.replace(yaml.find("at: beam, kind: force"), 8, "at: shuttle");
-  const std::string file = write("bad.yaml", yaml);
-  const fs::path out = dir_ / "out";
-  const CliResult r = run("--scenario " + file + " --out " + out.string());
-  EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("inputs[0].at"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("shuttle"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out / "truth.csv"));
+  expect_refused(scoleid::test::replaced(kBeam, "at: beam", "at: shuttle"), {"inputs[0].at", "shuttle"});
 }
 
 TEST_F(ScoleTruthCli, UnknownIntegratorAndUnknownScenarioExit2) {
