@@ -43,14 +43,7 @@ int main(int argc, char** argv) {
   // of the same layout is read the same way.
   const identify::Measurements m =
       identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 1e-3, /*add_noise=*/true);
-  io::DataTable table;
-  table.t = m.t;
-  table.names = {sc.inputs[0].name, sc.sensors[0].name};
-  table.columns.resize(2);
-  for (std::size_t k = 0; k < m.t.size(); ++k) {
-    table.columns[0].push_back(sc.inputs[0].signal(m.t[k]));
-    table.columns[1].push_back(m.z(static_cast<Eigen::Index>(k), 0));
-  }
+  const io::DataTable table = identify::measurement_table(sc, m);
   const std::string csv = (dir / "measured.csv").string();
   io::write_csv(csv, table);
   std::printf("\nstep 2: wrote %s (%zu samples, sensor %s, %g m noise)\n", csv.c_str(), m.t.size(),

@@ -302,6 +302,23 @@ void add_sensor_errors(const io::Scenario& sc, bool add_noise, Measurements& m) 
 }
 }  // namespace
 
+io::DataTable measurement_table(const io::Scenario& sc, const Measurements& m) {
+  io::DataTable table;
+  table.t = m.t;
+  for (const auto& in : sc.inputs) {
+    table.names.push_back(in.name);
+    table.columns.emplace_back();
+    for (double t : m.t) table.columns.back().push_back(in.signal(t));
+  }
+  for (std::size_t j = 0; j < m.names.size(); ++j) {
+    table.names.push_back(m.names[j]);
+    table.columns.emplace_back(m.t.size());
+    for (std::size_t k = 0; k < m.t.size(); ++k)
+      table.columns.back()[k] = m.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+  }
+  return table;
+}
+
 Measurements synthesize_series(const io::Scenario& sc, int terms) {
   using io::EndCondition;
   if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1 || sc.beam.left != EndCondition::Pinned ||

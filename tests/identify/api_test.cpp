@@ -20,15 +20,7 @@ namespace {
 // on a mesh four times finer than the identifier's, with 20 µm of noise).
 io::DataTable measured_table(const io::Scenario& sc) {
   const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 1e-3, true);
-  io::DataTable t;
-  t.t = m.t;
-  t.names = {sc.inputs[0].name, sc.sensors[0].name};
-  t.columns.resize(2);
-  for (std::size_t k = 0; k < m.t.size(); ++k) {
-    t.columns[0].push_back(sc.inputs[0].signal(m.t[k]));
-    t.columns[1].push_back(m.z(static_cast<Eigen::Index>(k), 0));
-  }
-  return t;
+  return identify::measurement_table(sc, m);
 }
 
 io::Scenario noisy_beam() {

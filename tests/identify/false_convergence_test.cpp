@@ -85,10 +85,7 @@ TEST(FalseConvergence, ShortNoisyRecordsAreNeverCalledConvergedWhenWrong) {
   int covered = 0, wrong = 0, not_converged = 0;
   for (unsigned seed = 1; seed <= 60; ++seed) {
     auto sc = scoleid::io::parse_scenario(short_record(seed, 1e-4), "short record");
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     const Outcome o = classify(*p, r);
     covered += o == Outcome::Covered;
     wrong += o == Outcome::False;
@@ -111,10 +108,7 @@ TEST(FalseConvergence, TheSmoothedRestartLeavesBeamEi8sSawtoothMinimum) {
     auto sc = scoleid::io::load_scenario("beam-ei8");
     for (auto& s : sc.sensors) s.noise_std = 1e-4;
     sc.simulation.seed = seed;
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     const VectorXd truth = p->params->truth();
     ASSERT_TRUE(r.converged()) << "seed " << seed;
     const auto& chosen = r.attempts[static_cast<std::size_t>(r.chosen_attempt)];

@@ -9,6 +9,7 @@
 
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
+#include "test_support.h"
 
 using namespace scoleid::identify;
 
@@ -61,10 +62,7 @@ TEST(Interval, WhiteNoiseOnACorrectModelGivesTheCramerRaoIntervalAndCovers) {
   std::vector<double> ratio;
   for (int s = 0; s < seeds; ++s) {
     sc.simulation.seed = 300 + static_cast<unsigned>(s);
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     ASSERT_TRUE(r.summary.converged());
     const VectorXd truth = p->params->truth();
     bool all = true;
@@ -105,10 +103,7 @@ identification: {parameterization: physical, estimate: [EI, rho_A, zeta], initia
   int covered = 0, beyond_two_std = 0;
   for (int s = 0; s < seeds; ++s) {
     sc.simulation.seed = 1 + static_cast<unsigned>(s);
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     ASSERT_TRUE(r.converged()) << r.fit.message;
     const VectorXd truth = p->params->truth();
     const ConsiderTerm* disc = nullptr;
@@ -204,15 +199,8 @@ truth: {overrides: {beam: {tip_mass: 21}}}
 TEST(Interval, ToleranceOnAnEstimatedQuantityIsRefused) {
   auto sc = scoleid::io::load_scenario("paper-beam-1");
   sc.identification.uncertain.push_back({"beam.rho_A", 2.0, false, false});
-  auto p = make_problem(sc, std::nullopt);
-  RunOptions ro;
-  ro.verbose = false;
-  try {
-    run_identification(*p, ro);
-    FAIL() << "a tolerance on an estimated quantity gave an interval";
-  } catch (const scoleid::io::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("identification.uncertain.beam.rho_A"), std::string::npos) << e.what();
-  }
+  const std::string e = test_support::run_error(sc);
+  EXPECT_NE(e.find("identification.uncertain.beam.rho_A"), std::string::npos) << e;
 }
 
 // A parameter with a small share in a direction the data cannot see has no std to give: the

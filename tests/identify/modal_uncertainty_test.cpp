@@ -117,10 +117,7 @@ TEST(ModalUncertainty, FrequencyScatterOverSeedsMatchesItsPropagatedStd) {
   int covered = 0;
   for (int s = 0; s < seeds; ++s) {
     sc.simulation.seed = 500 + static_cast<unsigned>(s);
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     ASSERT_TRUE(r.converged());
     ASSERT_FALSE(r.modes.empty());
     const ModalEstimate& m = r.modes[0];

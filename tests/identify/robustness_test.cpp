@@ -23,6 +23,7 @@
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
+#include "test_support.h"
 
 using namespace scoleid::identify;
 
@@ -276,11 +277,7 @@ TEST(Identification, ManySectionsStartFromTheLadderWhichStopsWhereTheDataAreExpl
   auto sc = beam_sections(ei);
   sc.identification.method = scoleid::io::Method::GaussNewtonKrylov;
   sc.simulation.duration = 3.0;
-  auto p = make_problem(sc, std::nullopt);
-  RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = false;
-  const RunResult r = run_identification(*p, ro);
+  auto [p, r] = test_support::quiet_run(sc, false);
   ASSERT_FALSE(r.attempts.empty());
   const auto& a = r.attempts[0];
   std::printf("first attempt: %s, %s, %d iterations; worst error %.3g\n", a.strategy.c_str(), a.termination.c_str(),
@@ -308,11 +305,7 @@ TEST(Identification, ALadderThatEndsInAWrongBasinIsFollowedByThePlainStart) {
   auto sc = scoleid::io::load_scenario("beam-ei8");
   sc.identification.start = scoleid::io::Start::CoarseToFine;
   sc.identification.elements = 16;
-  auto p = make_problem(sc, std::nullopt);
-  RunOptions ro;
-  ro.verbose = false;
-  ro.compute_std = false;
-  const RunResult r = run_identification(*p, ro);
+  auto [p, r] = test_support::quiet_run(sc, false);
   for (const auto& a : r.attempts)
     std::printf("%-52s %-15s %3d iterations, J = %.3e, explains the data %d\n", a.strategy.c_str(), a.termination.c_str(),
                 a.iterations, a.cost, a.explains_data);
@@ -362,10 +355,7 @@ TEST(Identifiability, AProfileThatItsMirrorFitsAsWellIsFlaggedAndOneThatItDoesNo
     sc.sensors[0].noise_std = 1e-5;
     sc.identification.initial.clear();
     sc.identification.initial["EI"] = 30000.0;
-    auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.verbose = false;
-    const RunResult r = run_identification(*p, ro);
+    auto [p, r] = test_support::quiet_run(sc);
     ASSERT_TRUE(r.converged()) << r.fit.message;
     std::printf("sensor at %g: EI_1 %.6g, EI_2 %.6g, mirror chi-square difference %.3g\n", sensor_at, r.estimate[0],
                 r.estimate[1], r.ident.mirror_chi2_difference);
@@ -389,15 +379,8 @@ TEST(Identifiability, AProfileThatItsMirrorFitsAsWellIsFlaggedAndOneThatItDoesNo
 TEST(Identification, StartCoarseToFineNeedsSections) {
   auto sc = scoleid::io::load_scenario("paper-beam-1");
   sc.identification.start = scoleid::io::Start::CoarseToFine;
-  auto p = make_problem(sc, std::nullopt);
-  RunOptions ro;
-  ro.verbose = false;
-  try {
-    run_identification(*p, ro);
-    ADD_FAILURE() << "no error";
-  } catch (const scoleid::io::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("identification.start"), std::string::npos) << e.what();
-  }
+  const std::string e = test_support::run_error(sc);
+  EXPECT_NE(e.find("identification.start"), std::string::npos) << e;
 }
 
 TEST(TimeStep, ASignalTheStepCannotResolveIsRefusedNamingIt) {

@@ -12,6 +12,7 @@
 
 #include "scoleid/identify/inverse/cvodes_adjoint.h"
 #include "scoleid/identify/run/identify_run.h"
+#include "scoleid/io/error.h"
 
 namespace scoleid::identify::test_support {
 
@@ -115,6 +116,34 @@ inline VectorXd expect_gradients_match_differences(Objective& obj, const VectorX
   EXPECT_LT(max_rel(g_adj, g_fd), 1e-4);
   EXPECT_LT(max_rel(g_gn, g_fd), 1e-4);
   return g_fd;
+}
+
+// A quiet run of the identifier on `sc` and its own synthetic data; the problem kept for its truth.
+struct QuietRun {
+  std::unique_ptr<Problem> p;
+  RunResult r;
+};
+inline QuietRun quiet_run(const io::Scenario& sc, bool compute_std = true) {
+  QuietRun q{make_problem(sc, std::nullopt), {}};
+  RunOptions ro;
+  ro.verbose = false;
+  ro.compute_std = compute_std;
+  q.r = run_identification(*q.p, ro);
+  return q;
+}
+
+// The message of the io::InputError that running the identifier on `sc` throws (the problem is
+// built first, outside the check); "" if the run goes through.
+inline std::string run_error(const io::Scenario& sc) {
+  auto p = make_problem(sc, std::nullopt);
+  RunOptions ro;
+  ro.verbose = false;
+  try {
+    run_identification(*p, ro);
+  } catch (const io::InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // Adaptive BDF at rtol 1e-10: the costate gradient of `yaml` at q against the CVODES adjoint

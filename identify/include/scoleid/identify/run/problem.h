@@ -103,6 +103,9 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::o
 std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const io::DataTable& table, const std::string& source,
                                       const io::TruthMeta* meta = nullptr, const std::string& meta_source = "");
 
+// Measurements as a lab's file holds them: t, then each input's signal as the scenario states it,
+// then each sensor's column (io::write_csv writes it).
+io::DataTable measurement_table(const io::Scenario& scenario, const Measurements& m);
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
 Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
 // The closed-form modal series (`terms` modes) of a uniform simply supported beam under the step
