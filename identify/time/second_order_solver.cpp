@@ -1,5 +1,7 @@
 #include "scoleid/identify/time/second_order_solver.h"
 
+#include "scoleid/identify/time/add_members.h"
+
 #include <arkode/arkode_arkstep.h>
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
@@ -44,13 +46,9 @@ std::string SolverSummary::BriefReport() const {
 }
 
 void SolverSummary::Accumulate(const SolverSummary& o) {
-  steps += o.steps;
-  rhs_evaluations += o.rhs_evaluations;
-  factorizations += o.factorizations;
-  linear_solves += o.linear_solves;
-  error_test_failures += o.error_test_failures;
-  nonlinear_iterations += o.nonlinear_iterations;
-  wall_seconds += o.wall_seconds;
+  using S = SolverSummary;
+  add_members(*this, o, &S::steps, &S::rhs_evaluations, &S::factorizations, &S::linear_solves, &S::error_test_failures,
+              &S::nonlinear_iterations, &S::wall_seconds);
 }
 
 namespace {

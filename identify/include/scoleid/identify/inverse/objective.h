@@ -41,6 +41,7 @@
 #include "scoleid/identify/inverse/measurements.h"
 #include "scoleid/identify/inverse/misfit.h"
 #include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/time/add_members.h"
 #include "scoleid/identify/time/checkpoints.h"
 #include "scoleid/identify/time/second_order_solver.h"
 #include "scoleid/identify/fe/structural_model.h"
@@ -88,16 +89,10 @@ struct ObjectiveCounters {
   SolverSummary solver;  // accumulated over all solves
   // Adds another objective's counts and times (the tied levels of coarse to fine).
   void Accumulate(const ObjectiveCounters& o) {
-    forward_solves += o.forward_solves;
-    costate_solves += o.costate_solves;
-    sensitivity_solves += o.sensitivity_solves;
-    gradient_evaluations += o.gradient_evaluations;
-    forward_seconds += o.forward_seconds;
-    costate_seconds += o.costate_seconds;
-    sensitivity_seconds += o.sensitivity_seconds;
-    quadrature_seconds += o.quadrature_seconds;
-    checkpointed_passes += o.checkpointed_passes;
-    checkpoint_resolves += o.checkpoint_resolves;
+    using C = ObjectiveCounters;
+    add_members(*this, o, &C::forward_solves, &C::costate_solves, &C::sensitivity_solves, &C::gradient_evaluations,
+                &C::forward_seconds, &C::costate_seconds, &C::sensitivity_seconds, &C::quadrature_seconds,
+                &C::checkpointed_passes, &C::checkpoint_resolves);
     solver.Accumulate(o.solver);
   }
 };
