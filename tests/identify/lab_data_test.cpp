@@ -14,6 +14,7 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "common/test_data.h"
 
 namespace fs = std::filesystem;
 using namespace scoleid;
@@ -203,26 +204,14 @@ TEST(LabData, UnitsThatCannotBeConvertedAreRefusedNamingFileColumnAndBoth) {
 }
 
 TEST(LabData, ScenarioUnitsMustAgreeWithTheUnitSystem) {
-  std::string text = kStrip;
-  text.replace(text.find("unit: m/s^2"), 11, "unit: ft/s^2");
-  try {
-    io::parse_scenario(text, "strip.yaml");
-    FAIL();
-  } catch (const io::InputError& e) {
-    EXPECT_EQ(std::string(e.what()), "strip.yaml: sensors[0].unit must be the acceleration unit of the scenario's units (SI: m/s^2), got 'ft/s^2'");
-  }
-  text = kStrip;
-  text.replace(text.find("unit: N"), 7, "unit: m");
-  try {
-    io::parse_scenario(text, "strip.yaml");
-    FAIL();
-  } catch (const io::InputError& e) {
-    EXPECT_EQ(std::string(e.what()), "strip.yaml: inputs[0].unit must be a unit of force ('m' is not a unit of force), got 'm'");
-  }
+  using scoleid::test::replaced;
+  using scoleid::test::scenario_error;
+  EXPECT_EQ(scenario_error(replaced(kStrip, "unit: m/s^2", "unit: ft/s^2"), "strip.yaml"),
+            "strip.yaml: sensors[0].unit must be the acceleration unit of the scenario's units (SI: m/s^2), got 'ft/s^2'");
+  EXPECT_EQ(scenario_error(replaced(kStrip, "unit: N", "unit: m"), "strip.yaml"),
+            "strip.yaml: inputs[0].unit must be a unit of force ('m' is not a unit of force), got 'm'");
   // The same unit spelled otherwise is the same unit.
-  text = kStrip;
-  text.replace(text.find("unit: m/s^2"), 11, "unit: m s-2");
-  EXPECT_NO_THROW(io::parse_scenario(text, "strip.yaml"));
+  EXPECT_NO_THROW(io::parse_scenario(replaced(kStrip, "unit: m/s^2", "unit: m s-2"), "strip.yaml"));
 }
 
 TEST(LabData, TheSameRecordAsAUniversalFileIdentifiesTheSame) {

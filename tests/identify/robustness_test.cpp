@@ -252,6 +252,13 @@ TEST(Identification, CoarseToFineRestartRecoversFourSectionsFromStartsFifteenAnd
 }
 
 namespace {
+// EI_1 … EI_N estimated, every section from EI = 30 000.
+void estimate_sections(scoleid::io::Scenario& sc, int N) {
+  sc.identification.estimate.clear();
+  for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
+  sc.identification.initial = {{"EI", 30000.0}};
+}
+
 // beam-ei8 with the truth's EI on N = ei.size() sections, N identifier elements, every section
 // estimated from EI = 30 000.
 scoleid::io::Scenario beam_sections(const std::vector<double>& ei) {
@@ -260,9 +267,7 @@ scoleid::io::Scenario beam_sections(const std::vector<double>& ei) {
   sc.beam.EI = ei;
   sc.identification.sections = 0;
   sc.identification.elements = N;
-  sc.identification.estimate.clear();
-  for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
-  sc.identification.initial = {{"EI", 30000.0}};
+  estimate_sections(sc, N);
   return sc;
 }
 }  // namespace
@@ -453,9 +458,7 @@ scoleid::io::Scenario sections_scenario(int N) {
   sc.identification.elements = 64;
   sc.identification.data_elements = 128;
   sc.identification.sections = N;
-  sc.identification.estimate.clear();
-  for (int k = 1; k <= N; ++k) sc.identification.estimate.push_back("EI_" + std::to_string(k));
-  sc.identification.initial = {{"EI", 30000.0}};
+  estimate_sections(sc, N);
   return sc;
 }
 

@@ -34,6 +34,13 @@ protected:
     ss << in.rdbuf();
     return ss.str();
   }
+  // root_/run as an earlier run (or a user) left it: one file `name` holding `text`.
+  fs::path existing_run(const std::string& name, const std::string& text) {
+    const fs::path out = root_ / "run";
+    fs::create_directories(out);
+    write_text_atomic((out / name).string(), text);
+    return out;
+  }
   // Names in root_ other than `keep`: staging directories left behind would show here.
   std::vector<std::string> leftovers(const std::string& keep) const {
     std::vector<std::string> out;
@@ -62,9 +69,7 @@ TEST_F(RunDirectoryTest, NewDirectoryAppearsOnlyAtCommit) {
 }
 
 TEST_F(RunDirectoryTest, EarlierRunIsReplacedWhole) {
-  const fs::path out = root_ / "run";
-  fs::create_directories(out);
-  write_text_atomic((out / "a.csv").string(), "old a\n");
+  const fs::path out = existing_run("a.csv", "old a\n");
   write_text_atomic((out / "b.json").string(), "old b\n");
   {
     RunDirectory d(out.string(), owned_, "test");
@@ -77,9 +82,7 @@ TEST_F(RunDirectoryTest, EarlierRunIsReplacedWhole) {
 }
 
 TEST_F(RunDirectoryTest, FailedRunLeavesTheEarlierRunUntouched) {
-  const fs::path out = root_ / "run";
-  fs::create_directories(out);
-  write_text_atomic((out / "a.csv").string(), "old a\n");
+  const fs::path out = existing_run("a.csv", "old a\n");
   try {
     RunDirectory d(out.string(), owned_, "test");
     write_text_atomic(d.path("a.csv"), "half");
@@ -107,9 +110,7 @@ TEST_F(RunDirectoryTest, InterruptedRunDoesNotCommit) {
 }
 
 TEST_F(RunDirectoryTest, ForeignFilesAndNonDirectoriesAreRefused) {
-  const fs::path out = root_ / "run";
-  fs::create_directories(out);
-  write_text_atomic((out / "notes.txt").string(), "mine\n");
+  const fs::path out = existing_run("notes.txt", "mine\n");
   try {
     RunDirectory d(out.string(), owned_, "test");
     ADD_FAILURE() << "accepted a directory with a user file";
