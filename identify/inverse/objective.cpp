@@ -472,60 +472,145 @@ void count_checkpointed_pass(ObjectiveCounters& c, const SolverSummary& sum, con
 }
 }  // namespace
 
-double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out,
-                                        bool residual, std::vector<Checkpoint> ckpts, std::size_t spacing,
-                                        VectorXd& gc) {
-  const int n = model_.ndof, ns = data_.sensors();
-  const double t0 = data_.t.front();
-  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
-  const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
-  const SecondOrderSolver::Forcing force = state_forcing(s);
-  CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
-  const std::vector<double> bp_tau = reversed_breakpoints();
-  // Costate source from the recorded outputs: C x(t) is the Hermite interpolant of (C x_k, C v_k),
-  // the same numbers as C times the state's interpolant.
-  VectorXd yb(ns), ydb(ns), zb(ns);
-  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
-    const double t = T_ - tau;
-    out.eval(t, yb.data(), ydb.data());
-    if (residual) {
-      data_.eval(t, zb.data());
-      yb -= zb;
+// ---- The costates' sources (docs/theory.md §6.1–6.2) ----
+// What forces the backward equations and what Eq. 25's quadrature takes from their solution. Two
+// kinds: displacement sensors (one costate P, p = P(T − t)) and rate sensors (P and Y, p = P + Y' − μ).
+// The backward passes below (state stored or checkpointed) take either.
+class Objective::CostateSources {
+ public:
+  // y(t): the part of the residual the model gives (C u, or A₀u + A₁u̇ for rate sensors), from
+  // wherever the pass holds the state or its outputs.
+  using ModelPart = std::function<void(double t, VectorXd& y)>;
+  virtual ~CostateSources() = default;
+  // Costates solved together: 1 (P) or 2 (P and Y, stacked in a window).
+  virtual int equations() const = 0;
+  // Equation k's forcing at τ (k = 0: P's, 1: Y's).
+  virtual void force(double tau, int k, double* F) = 0;
+  // At the quadrature point t, with the state (x, v) and the costates' value c and derivative cd in
+  // τ there (P, or P and Y stacked): the multiplier p, ṗ and (rate sensors) ü in a for Eq. 25.
+  // Returns Σ R r² when the sources carry the residual, else 0.
+  virtual double at(double t, const VectorXd& x, const VectorXd& v, const VectorXd& c, const VectorXd& cd, VectorXd& p,
+                    VectorXd& pd, VectorXd& a) = 0;
+  bool rates() const { return equations() == 2; }
+};
+
+// Displacement sensors: M P'' + D P' + K P = −CᵀR y(T − τ), y the model's outputs minus the data
+// (`residual`), or the outputs alone (a Gauss–Newton product's tangent).
+class Objective::DisplacementSources final : public CostateSources {
+ public:
+  DisplacementSources(const Objective& o, ModelPart part, bool residual)
+      : o_(o), part_(std::move(part)), residual_(residual), y_(o.data_.sensors()), z_(o.data_.sensors()) {
+    const Eigen::Map<const VectorXd> Rv(o.R_.data(), o.data_.sensors());
+    CtR_ = o.C_.transpose() * Rv.asDiagonal();
+  }
+  int equations() const override { return 1; }
+  void force(double tau, int, double* F) override {
+    const double t = o_.T_ - tau;
+    part_(t, y_);
+    if (residual_) {
+      o_.data_.eval(t, z_.data());
+      y_ -= z_;
     }
-    Eigen::Map<VectorXd>(F, n).noalias() = -CtR * yb;
-  };
-  double J = 0.0;
-  VectorXd x(n), xv(n), a(n), p(n), pd(n), z(ns), r(ns);
-  std::vector<double> grid;
-  double quadrature = 0.0, resolve = 0.0;
-  // Each costate window [τa, τb] is t in [T − τb, T − τa]: the state there from its checkpoints.
-  WindowedSink windows(n, spacing, [&](const Trajectory& P) {
-    if (!cover_window(P, state, grid, resolve)) return;
-    const auto tq = Clock::now();
-    for_each_gauss_point(grid, [&](double t, double wt) {
-      state.eval(t, x.data(), xv.data());
-      P.eval(T_ - t, p.data(), pd.data());
-      pd = -pd;  // ṗ(t) = −P'(T − t)
-      if (residual) {
-        data_.eval(t, z.data());
-        r.noalias() = C_ * x;
-        r -= z;
-        double e = 0.0;
-        for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-        J += 0.5 * wt * e;
-      }
-      add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
-    });
-    quadrature += since(tq);
-  });
-  const auto tc = Clock::now();
-  SolverSummary sum;
-  solver.stream(0.0, T_ - t0, g, bp_tau, [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, nullptr,
-                std::numeric_limits<double>::infinity(), StepAnchor::End);
-  windows.finish();
-  count_checkpointed_pass(counters_, sum, state, 1, since(tc), quadrature, resolve);
-  return J;
-}
+    Eigen::Map<VectorXd>(F, o_.model_.ndof).noalias() = -CtR_ * y_;
+  }
+  double at(double t, const VectorXd& x, const VectorXd&, const VectorXd& c, const VectorXd& cd, VectorXd& p,
+            VectorXd& pd, VectorXd&) override {
+    p = c;
+    pd = -cd;  // ṗ(t) = −P'(T − t)
+    if (!residual_) return 0.0;
+    o_.data_.eval(t, z_.data());
+    y_.noalias() = o_.C_ * x;
+    y_ -= z_;
+    double e = 0.0;
+    for (Eigen::Index j = 0; j < y_.size(); ++j) e += o_.R_[static_cast<std::size_t>(j)] * y_[j] * y_[j];
+    return e;
+  }
+
+ private:
+  const Objective& o_;
+  ModelPart part_;
+  bool residual_;
+  MatrixXd CtR_;
+  VectorXd y_, z_;
+};
+
+// Rate sensors (§6.1a): the sources w₀ = A₀ᵀ R r and w₁ = A₁ᵀ R r at t = T − τ (the left limit in t at
+// a breakpoint), with the model's part A₀ u(t) + A₁ u̇(t), evaluated once per τ for both equations.
+class Objective::RateSources final : public CostateSources {
+ public:
+  RateSources(const Objective& o, const RateTerms& rt, const SecondOrderSolver& solver,
+              const SecondOrderSolver::Forcing& state_force, ModelPart part)
+      : o_(o),
+        rt_(rt),
+        solver_(solver),
+        state_force_(state_force),
+        part_(std::move(part)),
+        y_(o.data_.sensors()),
+        z_(o.data_.sensors()),
+        r_(o.data_.sensors()),
+        F_(o.model_.ndof) {}
+  int equations() const override { return 2; }
+  void force(double tau, int k, double* F) override {
+    sources_at(tau);
+    Eigen::Map<VectorXd>(F, o_.model_.ndof) = k == 0 ? -w0_ : -w1_;
+  }
+  double at(double t, const VectorXd& x, const VectorXd& v, const VectorXd& c, const VectorXd& cd, VectorXd& p,
+            VectorXd& pd, VectorXd& a) override {
+    const int n = o_.model_.ndof;
+    F_.setZero();
+    state_force_(t, F_.data());
+    solver_.acceleration(F_.data(), x.data(), v.data(), a.data());  // ü from the equation of motion
+    o_.data_.eval(t, z_.data());
+    VectorXd& r = r_;
+    r.noalias() = o_.C_ * x;
+    r.noalias() += o_.C1_ * v;
+    if (o_.accelerations_) r.noalias() += o_.C2_ * a;
+    r -= z_;
+    double e = 0.0;
+    for (Eigen::Index j = 0; j < r.size(); ++j) e += o_.R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+    // Multiplier of §6.1a: p = p₀ − ẏ − μ with ṗ₀(t) = −P'(T − t), ẏ(t) = −Y'(T − t).
+    p = c.head(n) + cd.tail(n);
+    pd = -cd.head(n);
+    if (o_.accelerations_) {
+      const Eigen::Map<const VectorXd> Rv(o_.R_.data(), r.size());
+      p.noalias() -= rt_.MinvC2t * Rv.cwiseProduct(r);  // μ
+    }
+    return e;
+  }
+
+ private:
+  // With an acceleration output r jumps where the input does. The stepper asks for the right limit
+  // in τ at τ_b = T − t_b, which is the left limit in t (the signals are right-continuous).
+  double time_of(double tau) const {
+    const double t = o_.T_ - tau;
+    for (double tb : o_.breakpoints_)
+      if (std::abs(t - tb) <= 1e-12 * std::max(1.0, std::abs(tb)))
+        return tau >= o_.T_ - tb ? std::nextafter(tb, -std::numeric_limits<double>::infinity()) : tb;
+    return t;
+  }
+  void sources_at(double tau) {
+    if (tau == tau_) return;
+    tau_ = tau;
+    const double t = time_of(tau);
+    part_(t, y_);
+    o_.data_.eval(t, z_.data());
+    y_ -= z_;
+    for (std::size_t i = 0; i < o_.inputs_.size(); ++i) {
+      const double fi = o_.inputs_[i](t);
+      if (fi != 0.0) y_ += fi * rt_.G.col(static_cast<Eigen::Index>(i));
+    }
+    for (Eigen::Index j = 0; j < y_.size(); ++j) y_[j] *= o_.R_[static_cast<std::size_t>(j)];
+    w0_.noalias() = rt_.A0.transpose() * y_;
+    w1_.noalias() = rt_.A1.transpose() * y_;
+  }
+  const Objective& o_;
+  const RateTerms& rt_;
+  const SecondOrderSolver& solver_;
+  const SecondOrderSolver::Forcing& state_force_;
+  ModelPart part_;
+  VectorXd y_, z_, r_, F_, w0_, w1_;
+  double tau_ = std::numeric_limits<double>::quiet_NaN();
+};
 
 Objective::RateTerms Objective::rate_terms(const Setup& s, const SecondOrderSolver& solver) const {
   const int n = model_.ndof, ns = data_.sensors();
@@ -546,103 +631,101 @@ Objective::RateTerms Objective::rate_terms(const Setup& s, const SecondOrderSolv
   return rt;
 }
 
-struct Objective::RateSources {
-  using ModelPart = std::function<void(double t, VectorXd& y)>;  // y = A₀u(t) + A₁u̇(t)
-  RateSources(const Objective& o, const RateTerms& rt, ModelPart part)
-      : o_(o), rt_(rt), part_(std::move(part)), y_(o.data_.sensors()), z_(o.data_.sensors()) {}
-  // With an acceleration output r jumps where the input does. The stepper asks for the right limit
-  // in τ at τ_b = T − t_b, which is the left limit in t (the signals are right-continuous).
-  double time_of(double tau) const {
-    const double t = o_.T_ - tau;
-    for (double tb : o_.breakpoints_)
-      if (std::abs(t - tb) <= 1e-12 * std::max(1.0, std::abs(tb)))
-        return tau >= o_.T_ - tb ? std::nextafter(tb, -std::numeric_limits<double>::infinity()) : tb;
-    return t;
-  }
-  void at(double tau) {
-    if (tau == tau_) return;
-    tau_ = tau;
-    const double t = time_of(tau);
-    part_(t, y_);
-    o_.data_.eval(t, z_.data());
-    y_ -= z_;
-    for (std::size_t i = 0; i < o_.inputs_.size(); ++i) {
-      const double fi = o_.inputs_[i](t);
-      if (fi != 0.0) y_ += fi * rt_.G.col(static_cast<Eigen::Index>(i));
-    }
-    for (Eigen::Index j = 0; j < y_.size(); ++j) y_[j] *= o_.R_[static_cast<std::size_t>(j)];
-    w0.noalias() = rt_.A0.transpose() * y_;
-    w1.noalias() = rt_.A1.transpose() * y_;
-  }
-  VectorXd w0, w1;
-
-private:
-  const Objective& o_;
-  const RateTerms& rt_;
-  ModelPart part_;
-  VectorXd y_, z_;
-  double tau_ = std::numeric_limits<double>::quiet_NaN();
-};
-
-double Objective::backward_rates_checkpointed(const Setup& s, const SecondOrderSolver& solver, const RateTerms& rt,
-                                              const Trajectory& out, std::vector<Checkpoint> ckpts,
-                                              std::size_t spacing, VectorXd& gc) {
-  const int n = model_.ndof, ns = data_.sensors();
+// ---- The backward passes: the costates in reversed time τ = T − t and Eq. 25's quadrature ----
+double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, CostateSources& src,
+                                        std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc) {
+  const int n = model_.ndof, m = src.equations();
   const double t0 = data_.t.front();
-  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   const SecondOrderSolver::Forcing force = state_forcing(s);
   CheckpointedState state(solver, force, breakpoints_, T_, std::move(ckpts));
   const std::vector<double> bp_tau = reversed_breakpoints();
-  // The sources from the recorded (A₀u, A₁u̇): the same numbers as A₀, A₁ times the state's interpolant.
-  VectorXd yo(2 * ns), ydo(2 * ns);
-  RateSources src(*this, rt, [&](double t, VectorXd& y) {
-    out.eval(t, yo.data(), ydo.data());
-    y = yo.head(ns) + yo.tail(ns);
-  });
-  SecondOrderSolver::Forcing g0 = [&](double tau, double* F) {
-    src.at(tau);
-    Eigen::Map<VectorXd>(F, n) = -src.w0;
-  };
-  SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*, double* F) {
-    src.at(tau);
-    Eigen::Map<VectorXd>(F, n) = -src.w1;
-  };
   double J = 0.0;
-  VectorXd x(n), xv(n), a(n), F(n), py(2 * n), pyd(2 * n), p(n), pd(n), z(ns), r(ns);
+  VectorXd x(n), xv(n), a(n), p(n), pd(n), c(m * n), cd(m * n);
   std::vector<double> grid;
   double quadrature = 0.0, resolve = 0.0;
-  // Each window holds P and Y stacked over [τa, τb], i.e. t in [T − τb, T − τa].
-  WindowedSink windows(n, spacing, [&](const Trajectory& W) {
-    if (!cover_window(W, state, grid, resolve)) return;
-    const auto tq = Clock::now();
-    for_each_gauss_point(grid, [&](double t, double wt) {
-      state.eval(t, x.data(), xv.data());
-      F.setZero();
-      force(t, F.data());
-      solver.acceleration(F.data(), x.data(), xv.data(), a.data());  // ü from the equation of motion
-      data_.eval(t, z.data());
-      r.noalias() = C_ * x;
-      r.noalias() += C1_ * xv;
-      if (accelerations_) r.noalias() += C2_ * a;
-      r -= z;
-      double e = 0.0;
-      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-      J += 0.5 * wt * e;
-      // Multiplier of §6.1a: p = p₀ − ẏ − μ with ṗ₀(t) = −P'(T − t), ẏ(t) = −Y'(T − t).
-      W.eval(T_ - t, py.data(), pyd.data());
-      p = py.head(n) + pyd.tail(n);
-      pd = -pyd.head(n);
-      if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
-      add_coefficient_gradient(t, wt, p, pd, x, xv, a, true, gc);
-    });
-    quadrature += since(tq);
-  }, 2);
+  // Each costate window [τa, τb] (P, or P and Y stacked) is t in [T − τb, T − τa]: the state there
+  // from its checkpoints.
+  WindowedSink windows(
+      n, spacing,
+      [&](const Trajectory& W) {
+        if (!cover_window(W, state, grid, resolve)) return;
+        const auto tq = Clock::now();
+        for_each_gauss_point(grid, [&](double t, double wt) {
+          state.eval(t, x.data(), xv.data());
+          W.eval(T_ - t, c.data(), cd.data());
+          J += 0.5 * wt * src.at(t, x, xv, c, cd, p, pd, a);
+          add_coefficient_gradient(t, wt, p, pd, x, xv, a, src.rates(), gc);
+        });
+        quadrature += since(tq);
+      },
+      m);
   const auto tc = Clock::now();
   SolverSummary sum;
-  solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau,
-                        [&](const SecondOrderSolver::Point& pt) { windows(pt); }, &sum, StepAnchor::End);
+  const SecondOrderSolver::Forcing g0 = [&](double tau, double* F) { src.force(tau, 0, F); };
+  const auto visit = [&](const SecondOrderSolver::Point& pt) { windows(pt); };
+  if (m == 1) {
+    solver.stream(0.0, T_ - t0, g0, bp_tau, visit, &sum, nullptr, std::numeric_limits<double>::infinity(),
+                  StepAnchor::End);
+  } else {  // Y stepped with P on P's stages
+    const SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*,
+                                                     double* F) { src.force(tau, 1, F); };
+    solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, visit, &sum, StepAnchor::End);
+  }
   windows.finish();
-  count_checkpointed_pass(counters_, sum, state, 2, since(tc), quadrature, resolve);
+  count_checkpointed_pass(counters_, sum, state, m, since(tc), quadrature, resolve);
+  return J;
+}
+
+void Objective::costates_stored(const SecondOrderSolver& solver, CostateSources& src, Trajectory& P, Trajectory& Y) {
+  const double t0 = data_.t.front();
+  const std::vector<double> bp_tau = reversed_breakpoints();
+  const auto tc = Clock::now();
+  SolverSummary sum;
+  const SecondOrderSolver::Forcing g0 = [&](double tau, double* F) { src.force(tau, 0, F); };
+  if (src.equations() == 1) {
+    P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum, StepAnchor::End);
+    counters_.solver.Accumulate(sum);
+  } else if (solver.has_tangent_solve()) {
+    // Y stepped with P on P's stages, sharing the factorisations and the forcing evaluations.
+    const SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*,
+                                                     double* F) { src.force(tau, 1, F); };
+    auto sol = solver.solve_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, &sum, StepAnchor::End);
+    counters_.solver.Accumulate(sum);
+    P = std::move(sol.state);
+    Y = std::move(sol.tangents.front());
+  } else {
+    const SecondOrderSolver::Forcing g1 = [&](double tau, double* F) { src.force(tau, 1, F); };
+    P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum, StepAnchor::End);
+    counters_.solver.Accumulate(sum);
+    Y = solver.solve(0.0, T_ - t0, g1, bp_tau, &sum, StepAnchor::End);
+    counters_.solver.Accumulate(sum);
+  }
+  counters_.costate_solves += src.equations();
+  counters_.costate_seconds += since(tc);
+}
+
+double Objective::backward_stored(const SecondOrderSolver& solver, const Trajectory& u, CostateSources& src,
+                                  const std::vector<double>& more_times, VectorXd& gc) {
+  const int n = model_.ndof, m = src.equations();
+  Trajectory P, Y;
+  costates_stored(solver, src, P, Y);
+  const auto tq = Clock::now();
+  std::vector<double> ptimes, ytimes;
+  ptimes.reserve(P.size());
+  for (double tau : P.times()) ptimes.push_back(T_ - tau);
+  if (m == 2)
+    for (double tau : Y.times()) ytimes.push_back(T_ - tau);
+  const auto grid = union_grid({&u.times(), &ptimes, &ytimes, &more_times}, T_);
+  VectorXd x(n), v(n), a(n), p(n), pd(n), c(m * n), cd(m * n);
+  double J = 0.0;
+  for_each_gauss_point(grid, [&](double t, double wt) {
+    u.eval(t, x.data(), v.data());
+    P.eval(T_ - t, c.data(), cd.data());
+    if (m == 2) Y.eval(T_ - t, c.data() + n, cd.data() + n);
+    J += 0.5 * wt * src.at(t, x, v, c, cd, p, pd, a);
+    add_coefficient_gradient(t, wt, p, pd, x, v, a, src.rates(), gc);
+  });
+  counters_.quadrature_seconds += since(tq);
   return J;
 }
 
@@ -689,124 +772,45 @@ double Objective::gradient_checkpointed(const Setup& s, const SecondOrderSolver&
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(tf);
-  return rates ? backward_rates_checkpointed(s, solver, rt, out, std::move(ck.checkpoints()), L, gc)
-               : backward_checkpointed(s, solver, out, true, std::move(ck.checkpoints()), L, gc);
-}
-
-// The backward solves on a stored state u, in reversed time τ = T − t (docs/theory.md §6.2):
-//   P(τ) = p₀(T − τ),  M P'' + D P' + K P = −w₀(T − τ)
-//   Y(τ) = y(T − τ),   M Y'' + D Y' + K Y = −w₁(T − τ)   (velocity and acceleration sensors only)
-// with w₀ = C₀ᵀRr − Kμ, w₁ = C₁ᵀRr − Dμ, μ = M⁻¹C₂ᵀRr (§6.1a; w₀ = CᵀRr without rate sensors).
-void Objective::costates_stored(const SecondOrderSolver& solver, const Trajectory& u, const RateTerms* rt,
-                                Trajectory& P, Trajectory& Y) {
-  const int n = model_.ndof, ns = data_.sensors();
-  const double t0 = data_.t.front();
-  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
-  const std::vector<double> bp_tau = reversed_breakpoints();
-  const auto tc = Clock::now();
-  SolverSummary sum;
-  if (!rt) {
-    VectorXd xb(n), vb(n), zb(ns), rb(ns);
-    const MatrixXd CtR = C_.transpose() * Rv.asDiagonal();
-    SecondOrderSolver::Forcing g = [&](double tau, double* F) {
-      const double t = T_ - tau;
-      u.eval(t, xb.data(), vb.data());
-      data_.eval(t, zb.data());
-      rb = C_ * xb - zb;
-      Eigen::Map<VectorXd>(F, n) = -CtR * rb;
-    };
-    P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum, StepAnchor::End);
-    counters_.solver.Accumulate(sum);
-    ++counters_.costate_solves;
-  } else {
-    VectorXd xb(n), vb(n);
-    RateSources src(*this, *rt, [&](double t, VectorXd& y) {
-      u.eval(t, xb.data(), vb.data());
-      y.noalias() = rt->A0 * xb;
-      y.noalias() += rt->A1 * vb;
-    });
-    auto weights_at = [&](double tau) { src.at(tau); };
-    const VectorXd& w0 = src.w0;
-    const VectorXd& w1 = src.w1;
-    SecondOrderSolver::Forcing g0 = [&](double tau, double* F) {
-      weights_at(tau);
-      Eigen::Map<VectorXd>(F, n) = -w0;
-    };
-    if (solver.has_tangent_solve()) {
-      // Y stepped with P on P's stages, sharing the factorisations and the forcing evaluations.
-      SecondOrderSolver::TangentForcing g1 = [&](double tau, const double*, const double*, const double*, double* F) {
-        weights_at(tau);
-        Eigen::Map<VectorXd>(F, n) = -w1;
-      };
-      auto sol = solver.solve_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, &sum, StepAnchor::End);
-      counters_.solver.Accumulate(sum);
-      P = std::move(sol.state);
-      Y = std::move(sol.tangents.front());
-    } else {
-      SecondOrderSolver::Forcing g1 = [&](double tau, double* F) {
-        weights_at(tau);
-        Eigen::Map<VectorXd>(F, n) = -w1;
-      };
-      P = solver.solve(0.0, T_ - t0, g0, bp_tau, &sum, StepAnchor::End);
-      counters_.solver.Accumulate(sum);
-      Y = solver.solve(0.0, T_ - t0, g1, bp_tau, &sum, StepAnchor::End);
-      counters_.solver.Accumulate(sum);
-    }
-    counters_.costate_solves += 2;
+  // The sources from the recorded outputs: the same numbers as C (or A₀, A₁) times the state's
+  // interpolant.
+  if (!rates) {
+    DisplacementSources src(
+        *this, [&](double t, VectorXd& yb) { out.eval(t, yb.data(), yd.data()); }, true);
+    return backward_checkpointed(s, solver, src, std::move(ck.checkpoints()), L, gc);
   }
-  counters_.costate_seconds += since(tc);
-}
-
-// The gradient on a stored state: forward, costates, then the cost's and the coefficient
-// gradient's quadrature (three Gauss points on every interval of the union of the grids).
-double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solver, VectorXd& gc) {
-  const bool rates = C1_.size() != 0;
-  const Trajectory u = forward(solver, s, T_);
-  const int n = model_.ndof, ns = data_.sensors();
-  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   const SecondOrderSolver::Forcing force = state_forcing(s);
-  RateTerms rt;
-  if (rates) rt = rate_terms(s, solver);
-  Trajectory P, Y;
-  costates_stored(solver, u, rates ? &rt : nullptr, P, Y);
-
-  // Quadratures: cost and coefficient gradients.
-  const auto tq = Clock::now();
-  std::vector<double> ptimes, ytimes;
-  ptimes.reserve(P.size());
-  for (double tau : P.times()) ptimes.push_back(T_ - tau);
-  if (rates)
-    for (double tau : Y.times()) ytimes.push_back(T_ - tau);
-  const auto grid = union_grid({&u.times(), &ptimes, &ytimes}, T_);
-  VectorXd x(n), v(n), a(n), F(n), p(n), pd(n), yx(n), yd(n), z(ns), r(ns);
-  double J = 0.0;
-  for_each_gauss_point(grid, [&](double t, double wt) {
-    u.eval(t, x.data(), v.data());
-    P.eval(T_ - t, p.data(), pd.data());
-    pd = -pd;  // ṗ(t) = −P'(T − t)
-    data_.eval(t, z.data());
-    if (!rates) {
-      r = C_ * x - z;
-    } else {
-      F.setZero();
-      force(t, F.data());
-      solver.acceleration(F.data(), x.data(), v.data(), a.data());  // ü from the equation of motion
-      r = C_ * x + C1_ * v - z;
-      if (accelerations_) r += C2_ * a;
-      // Multiplier of §6.1a: p = p₀ − ẏ − μ, ẏ(t) = −Y'(T − t).
-      Y.eval(T_ - t, yx.data(), yd.data());
-      p += yd;
-      if (accelerations_) p.noalias() -= rt.MinvC2t * Rv.cwiseProduct(r);  // μ
-    }
-    double e = 0.0;
-    for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-    J += 0.5 * wt * e;
-    add_coefficient_gradient(t, wt, p, pd, x, v, a, rates, gc);
+  RateSources src(*this, rt, solver, force, [&](double t, VectorXd& yb) {
+    out.eval(t, y.data(), yd.data());
+    yb = y.head(ns) + y.tail(ns);
   });
-  counters_.quadrature_seconds += since(tq);
-  return J;
+  return backward_checkpointed(s, solver, src, std::move(ck.checkpoints()), L, gc);
 }
 
+// The gradient on a stored state: forward, then the backward pass with the sources read from it.
+double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solver, VectorXd& gc) {
+  const Trajectory u = forward(solver, s, T_);
+  const int n = model_.ndof;
+  VectorXd xb(n), vb(n);
+  if (C1_.size() == 0) {
+    DisplacementSources src(
+        *this,
+        [&](double t, VectorXd& y) {
+          u.eval(t, xb.data(), vb.data());
+          y.noalias() = C_ * xb;
+        },
+        true);
+    return backward_stored(solver, u, src, {}, gc);
+  }
+  const SecondOrderSolver::Forcing force = state_forcing(s);
+  const RateTerms rt = rate_terms(s, solver);
+  RateSources src(*this, rt, solver, force, [&](double t, VectorXd& y) {
+    u.eval(t, xb.data(), vb.data());
+    y.noalias() = rt.A0 * xb;
+    y.noalias() += rt.A1 * vb;
+  });
+  return backward_stored(solver, u, src, {}, gc);
+}
 
 void Objective::add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
                                          const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const {
@@ -1000,6 +1004,13 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   return J;
 }
 
+void Objective::interval_cuts(double a, double b, std::size_t& next, std::vector<double>& cuts) const {
+  cuts.assign(1, a);
+  while (next < data_.t.size() && data_.t[next] <= a) ++next;
+  for (std::size_t k = next; k < data_.t.size() && data_.t[k] < b; ++k) cuts.push_back(data_.t[k]);
+  cuts.push_back(b);
+}
+
 double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end,
                                         VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
   // All P tangents stepped with the state in one pass (docs/theory.md §7.9); between consecutive
@@ -1057,10 +1068,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
       if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
       const auto tq = Clock::now();
       const double h = pt.t - t_prev;
-      cuts.assign(1, a_end);
-      while (next_data < data_.t.size() && data_.t[next_data] <= a_end) ++next_data;
-      for (std::size_t k = next_data; k < data_.t.size() && data_.t[k] < b_end; ++k) cuts.push_back(data_.t[k]);
-      cuts.push_back(b_end);
+      interval_cuts(a_end, b_end, next_data, cuts);
       for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
         const double hk = cuts[k + 1] - cuts[k];
         for (int gq = 0; gq < 3; ++gq) {
@@ -1270,42 +1278,27 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
     ++counters_.forward_solves;
     ++counters_.sensitivity_solves;
     counters_.sensitivity_seconds += since(ts);
-    VectorXd gc = VectorXd::Zero(model_.ncoef);
-    backward_checkpointed(s, solver, out, false, std::move(ck.checkpoints()), L, gc);
+    VectorXd gc = VectorXd::Zero(model_.ncoef), yd(ns);
+    DisplacementSources src(
+        *this, [&](double t, VectorXd& y) { out.eval(t, y.data(), yd.data()); }, false);
+    backward_checkpointed(s, solver, src, std::move(ck.checkpoints()), L, gc);
     return s.dcdq.transpose() * gc;
   }
   // Tangent along v: M Ṡ̈ + D Ṡ + K S = −(∂_v M ü + ∂_v D u̇ + ∂_v K u − ∂_v B f), ∂_v = Σ v_i ∂_i.
   Trajectory u;
   const std::vector<Trajectory> S = solve_tangents(solver, s, T_, T_, u, {derivative_along(s.dcdq * v)});
   const Trajectory& Sv = S.front();
-  // Costate with the tangent's output in place of the residual: M P'' + D P' + K P = −Cᵀ R C S(T − τ).
-  const std::vector<double> bp_tau = reversed_breakpoints();
-  const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
-  const MatrixXd CtRC = C_.transpose() * Rv.asDiagonal() * C_;
-  auto tc = Clock::now();
-  VectorXd sx(n), sv(n);
-  SecondOrderSolver::Forcing g = [&](double tau, double* F) {
-    Sv.eval(T_ - tau, sx.data(), sv.data());
-    Eigen::Map<VectorXd>(F, n).noalias() = -CtRC * sx;
-  };
-  SolverSummary sum;
-  const Trajectory P = solver.solve(0.0, T_ - t0, g, bp_tau, &sum, StepAnchor::End);
-  counters_.solver.Accumulate(sum);
-  ++counters_.costate_solves;
-  counters_.costate_seconds += since(tc);
-  // Eq. 25 on that costate and the state.
-  const auto tq = Clock::now();
-  std::vector<double> ptimes;
-  for (double tau : P.times()) ptimes.push_back(T_ - tau);
-  const auto grid = union_grid({&u.times(), &Sv.times(), &ptimes}, T_);
-  VectorXd x(n), xv(n), a(n), p(n), pd(n), gc = VectorXd::Zero(model_.ncoef);
-  for_each_gauss_point(grid, [&](double t, double wt) {
-    u.eval(t, x.data(), xv.data());
-    P.eval(T_ - t, p.data(), pd.data());
-    pd = -pd;
-    add_coefficient_gradient(t, wt, p, pd, x, xv, a, false, gc);
-  });
-  counters_.quadrature_seconds += since(tq);
+  // Costate with the tangent's output in place of the residual: M P'' + D P' + K P = −Cᵀ R C S(T − τ),
+  // then Eq. 25 on it and the state.
+  VectorXd sx(n), sv(n), gc = VectorXd::Zero(model_.ncoef);
+  DisplacementSources src(
+      *this,
+      [&](double t, VectorXd& y) {
+        Sv.eval(t, sx.data(), sv.data());
+        y.noalias() = C_ * sx;
+      },
+      false);
+  backward_stored(solver, u, src, Sv.times(), gc);
   return s.dcdq.transpose() * gc;
 }
 

@@ -216,28 +216,16 @@ private:
   // least 1, at most P).
   int sensitivity_block(double t_end) const;
   void default_weights();
+  // [a, b] cut at the sample times strictly inside it (a and b included); `next`, left at the first sample
+  // above a, only moves forward, so consecutive intervals walk the samples once.
+  void interval_cuts(double a, double b, std::size_t& next, std::vector<double>& cuts) const;
   // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly.
   double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
                                MatrixXd& H, MisfitProfile* profile);
   // cost_and_gradient's two ways into gc (the coefficient gradient): the state checkpointed every
-  // L points, or stored whole, with its backward solves (P, and Y with rate sensors: rt given).
+  // L points, or stored whole, each with its backward pass.
   double gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc);
   double gradient_stored(const Setup& s, const SecondOrderSolver& solver, VectorXd& gc);
-  struct RateTerms;
-  void costates_stored(const SecondOrderSolver& solver, const Trajectory& u, const RateTerms* rt, Trajectory& P,
-                       Trajectory& Y);
-  // The checkpoint spacing for a state over [t0, T] with this solver; 0 = store the whole state.
-  std::size_t checkpoint_spacing(const SecondOrderSolver& solver) const;
-  // The backward pass on a checkpointed state (docs/theory.md §7.9): the costate with source
-  // −Cᵀ R y(t) (y = out(t), minus the data when `residual`), streamed in windows, and the Eq. 25
-  // quadrature into gc with the state re-solved from `ckpts`. Returns the cost when `residual`.
-  double backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, const Trajectory& out, bool residual,
-                               std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc);
-  // A costate window W (in τ) as t in [ta, tb]: the state re-solved over it (time added to
-  // resolve_seconds) and its quadrature grid (W's times, the state's and the samples', sorted and
-  // unique). False when the window holds no time of the data.
-  bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
-                    double& resolve_seconds) const;
   // Rate sensors (docs/theory.md §6.1a): with ü = M⁻¹(f − D u̇ − K u) the residual is
   //   r = A₀ u + A₁ u̇ + Σ_i f_i G_i − z̃,   A₀ = C₀ − C₂M⁻¹K,  A₁ = C₁ − C₂M⁻¹D,  G_i = C₂M⁻¹b_i,
   // dense ns × n, and μ = M⁻¹C₂ᵀ R r = (M⁻¹C₂ᵀ) R r: ns mass solves per gradient, none per forcing.
@@ -245,16 +233,30 @@ private:
     MatrixXd A0, A1, MinvC2t, G;
   };
   RateTerms rate_terms(const Setup& s, const SecondOrderSolver& solver) const;
-  // The rate-sensor costate's two sources at τ, w₀ = A₀ᵀ R r and w₁ = A₁ᵀ R r at t = T − τ (the
-  // left limit in t at a breakpoint), with `model_part(t, y)` giving A₀ u(t) + A₁ u̇(t); evaluated
-  // once per τ for both backward equations.
-  struct RateSources;
-  // The rate-sensor backward pass on a checkpointed state: `out` records (A₀u, A₁u̇) with their
-  // derivatives (2 ns columns), P and Y are streamed together in windows, the state re-solved from
-  // `ckpts` for the quadrature. Returns the cost.
-  double backward_rates_checkpointed(const Setup& s, const SecondOrderSolver& solver, const RateTerms& rt,
-                                     const Trajectory& out, std::vector<Checkpoint> ckpts, std::size_t spacing,
-                                     VectorXd& gc);
+  // The costates' sources and what Eq. 25 takes from the costates (objective.cpp): displacement
+  // sensors (one costate) or rate sensors (two).
+  class CostateSources;
+  class DisplacementSources;
+  class RateSources;
+  // The checkpoint spacing for a state over [t0, T] with this solver; 0 = store the whole state.
+  std::size_t checkpoint_spacing(const SecondOrderSolver& solver) const;
+  // The backward pass on a checkpointed state (docs/theory.md §7.9): the costates of `src` streamed
+  // in windows, and the Eq. 25 quadrature into gc with the state re-solved from `ckpts`. Returns
+  // ½ Σ_k R_k ∫ r_k² when the sources carry the residual (else 0).
+  double backward_checkpointed(const Setup& s, const SecondOrderSolver& solver, CostateSources& src,
+                               std::vector<Checkpoint> ckpts, std::size_t spacing, VectorXd& gc);
+  // The backward pass on a stored state u (docs/theory.md §6.2): the costates of `src` whole, then
+  // the quadrature on every interval of the union of the state's, the costates', the samples' and
+  // `more_times`. Returns as backward_checkpointed.
+  double backward_stored(const SecondOrderSolver& solver, const Trajectory& u, CostateSources& src,
+                         const std::vector<double>& more_times, VectorXd& gc);
+  // The costates of `src` over the whole record: P, and Y for rate sensors.
+  void costates_stored(const SecondOrderSolver& solver, CostateSources& src, Trajectory& P, Trajectory& Y);
+  // A costate window W (in τ) as t in [ta, tb]: the state re-solved over it (time added to
+  // resolve_seconds) and its quadrature grid (W's times, the state's and the samples', sorted and
+  // unique). False when the window holds no time of the data.
+  bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
+                    double& resolve_seconds) const;
 
   // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
   // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.
