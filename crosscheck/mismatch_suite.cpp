@@ -403,19 +403,14 @@ void check_suite_result(const json& f, const std::string& file) {
   for (const char* key : {"family", "mismatch", "size_unit", "reason"}) s.text(f, key, "");
   s.optional(f, "expectations_met", [&] { s.flag(f, "expectations_met", ""); });
   s.optional(f, "checks", [&] {
-    const auto& checks = s.objects(f, "checks", "");
-    for (std::size_t i = 0; i < checks.size(); ++i) {
-      const std::string w = "checks[" + std::to_string(i) + "].";
-      s.flag(checks[i], "held", w);
-      s.text(checks[i], "what", w);
-      s.text(checks[i], "measured", w);
-    }
+    s.each(f, "checks", "", [&](const json& check, const std::string& w) {
+      s.flag(check, "held", w);
+      s.text(check, "what", w);
+      s.text(check, "measured", w);
+    });
   });
   if (!f.value("expectations_met", false) && !f.contains("checks")) s.fail("checks", "present when expectations_met is not true", nullptr);
-  const auto& cases = s.objects(f, "cases", "");
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    const std::string w = "cases[" + std::to_string(k) + "].";
-    const auto& c = cases[k];
+  s.each(f, "cases", "", [&](const json& c, const std::string& w) {
     s.text(c, "label", w);
     s.number(c, "size", w);
     if (!c.at("size").is_number()) s.fail(w + "size", "a number", &c.at("size"));
@@ -426,19 +421,15 @@ void check_suite_result(const json& f, const std::string& file) {
     });
     s.optional(c, "seed_statistics", [&] {
       if (!c.contains("seeds")) s.fail(w + "seeds", "present with seed_statistics", nullptr);
-      const auto& st = s.objects(c, "seed_statistics", w);
-      for (std::size_t i = 0; i < st.size(); ++i) s.text(st[i], "name", w + "seed_statistics[" + std::to_string(i) + "].");
+      s.each(c, "seed_statistics", w, [&](const json& st, const std::string& sw) { s.text(st, "name", sw); });
     });
-    const auto& params = s.objects(c, "parameters", w);
-    for (std::size_t i = 0; i < params.size(); ++i) {
-      const std::string pw = w + "parameters[" + std::to_string(i) + "].";
-      const auto& q = params[i];
+    s.each(c, "parameters", w, [&](const json& q, const std::string& pw) {
       s.text(q, "name", pw);
       s.flag(q, "identifiable", pw);
       s.flag(q, "covered", pw);
       for (const char* key : {"truth", "estimate", "relative_error", "relative_half_width"}) s.number(q, key, pw);
-    }
-  }
+    });
+  });
 }
 
 SuiteSummary summarise_suite(const std::vector<json>& families) {

@@ -43,15 +43,13 @@ void check_modes(const nlohmann::json& m, const std::string& file) {
   if (!m.is_object()) s.fail("(top level)", "an object", &m);
   s.text(m, "scenario", "");
   const std::size_t levels = s.array(m, "segments", "", 0, "segment counts", is_count).size();
-  const auto& modes = s.objects(m, "modes", "");
-  for (std::size_t k = 0; k < modes.size(); ++k) {
-    const std::string w = "modes[" + std::to_string(k) + "].";
-    s.count(modes[k], "index", w);
-    s.array(modes[k], "chain_hz", w, levels, "numbers", is_number_or_null);
-    s.array(modes[k], "fe_hz", w, 0, "numbers", is_number_or_null);
+  s.each(m, "modes", "", [&](const nlohmann::json& mode, const std::string& w) {
+    s.count(mode, "index", w);
+    s.array(mode, "chain_hz", w, levels, "numbers", is_number_or_null);
+    s.array(mode, "fe_hz", w, 0, "numbers", is_number_or_null);
     for (const char* key : {"chain_extrapolated_hz", "analytic_hz", "extrapolated_vs_fe", "chain_rate", "fe_rate", "mac"})
-      s.number(modes[k], key, w);
-  }
+      s.number(mode, key, w);
+  });
 }
 
 void check_trajectories(const nlohmann::json& t, const std::string& file) {
@@ -60,14 +58,12 @@ void check_trajectories(const nlohmann::json& t, const std::string& file) {
   s.text(t, "scenario", "");
   const std::size_t levels = s.array(t, "segments", "", 0, "segment counts", is_count).size();
   s.count(t, "elements", "");
-  const auto& sensors = s.objects(t, "sensors", "");
-  for (std::size_t k = 0; k < sensors.size(); ++k) {
-    const std::string w = "sensors[" + std::to_string(k) + "].";
-    s.text(sensors[k], "name", w);
-    s.text(sensors[k], "kind", w);
-    s.array(sensors[k], "relative_rms", w, levels, "numbers", is_number_or_null);
-    s.number(sensors[k], "rate", w);
-  }
+  s.each(t, "sensors", "", [&](const nlohmann::json& sensor, const std::string& w) {
+    s.text(sensor, "name", w);
+    s.text(sensor, "kind", w);
+    s.array(sensor, "relative_rms", w, levels, "numbers", is_number_or_null);
+    s.number(sensor, "rate", w);
+  });
 }
 
 void check_identify(const nlohmann::json& id, const std::string& file) {
@@ -77,20 +73,18 @@ void check_identify(const nlohmann::json& id, const std::string& file) {
   s.text(id, "data", "");
   s.flag(id, "all_converged", "");
   const std::size_t levels = s.array(id, "segments", "", 0, "segment counts", is_count).size();
-  const auto& params = s.objects(id, "parameters", "");
-  for (std::size_t k = 0; k < params.size(); ++k) {
-    const std::string w = "parameters[" + std::to_string(k) + "].";
-    const auto& p = params[k];
+  s.each(id, "parameters", "", [&](const nlohmann::json& p, const std::string& w) {
     s.text(p, "name", w);
     s.number(p, "truth", w);
-    for (const char* key : {"extrapolated_relative_error", "observed_rate", "fe_on_fe_relative_error"}) s.number(p, key, w);
+    for (const char* key : {"extrapolated_relative_error", "observed_rate", "fe_on_fe_relative_error"})
+      s.number(p, key, w);
     s.array(p, "relative_error", w, levels, "numbers", is_number_or_null);
     s.array(p, "std", w, levels, "numbers", is_number_or_null);
     s.array(p, "covered_by_2std", w, levels, "true or false", is_flag);
     if (p.contains("half_width")) s.array(p, "half_width", w, levels, "numbers", is_number_or_null);
     if (p.contains("half_width") || p.contains("covered_by_interval"))
       s.array(p, "covered_by_interval", w, levels, "true or false", is_flag);
-  }
+  });
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -38,6 +39,21 @@ void displace(const MultibodySystem& system, const State& base, const Vector& de
   matter_of(system).multiplyByN(base, false, delta, dq);
   out.updQ() = base.getQ() + dq;
 }
+
+// ∂value/∂δ_j at `base` by central differences: `value` of the state displaced by ±h along the
+// generalized speed j (q = q0 + N(q0) δ, through `s`), (value₊ − value₋) / 2h.
+Eigen::VectorXd central_difference(const MultibodySystem& system, const State& base, int j, double h, State& s,
+                                   const std::function<Eigen::VectorXd(const State&)>& value) {
+  Vector delta(base.getNU(), 0.0);
+  delta[j] = h;
+  displace(system, base, delta, s);
+  const Eigen::VectorXd plus = value(s);
+  delta[j] = -h;
+  displace(system, base, delta, s);
+  const Eigen::VectorXd minus = value(s);
+  io::check_interrupt();
+  return (plus - minus) / (2 * h);
+}
 }  // namespace
 
 Eigen::MatrixXd state_jacobian(const MultibodySystem& system, const State& eq, const LinearisationOptions& opt) {
@@ -48,17 +64,8 @@ Eigen::MatrixXd state_jacobian(const MultibodySystem& system, const State& eq, c
   A.block(0, nu, nu, nu).setIdentity();
   State s = eq;
   const double h = opt.step;
-  for (int j = 0; j < nu; ++j) {
-    Vector delta(nu, 0.0);
-    delta[j] = h;
-    displace(system, eq, delta, s);
-    const Eigen::VectorXd ap = generalized_accelerations(system, s);
-    delta[j] = -h;
-    displace(system, eq, delta, s);
-    const Eigen::VectorXd am = generalized_accelerations(system, s);
-    A.block(nu, j, nu, 1) = (ap - am) / (2 * h);
-    io::check_interrupt();
-  }
+  const auto accelerations = [&](const State& st) { return generalized_accelerations(system, st); };
+  for (int j = 0; j < nu; ++j) A.block(nu, j, nu, 1) = central_difference(system, eq, j, h, s, accelerations);
   s.updQ() = eq.getQ();
   for (int j = 0; j < nu; ++j) {
     s.updU() = eq.getU();
@@ -110,18 +117,15 @@ ModeShapes undamped_modes(const MultibodySystem& system, const State& eq, const 
   Eigen::MatrixXd K(nu, nu), Cy(ny, nu);
   State s = base;
   const double h = opt.step;
+  const auto accelerations_and_outputs = [&](const State& st) {
+    Eigen::VectorXd v(nu + ny);
+    v << generalized_accelerations(system, st), outputs(st);
+    return v;
+  };
   for (int j = 0; j < nu; ++j) {
-    Vector delta(nu, 0.0);
-    delta[j] = h;
-    displace(system, base, delta, s);
-    const Eigen::VectorXd ap = generalized_accelerations(system, s);
-    const Eigen::VectorXd yp = outputs(s);
-    delta[j] = -h;
-    displace(system, base, delta, s);
-    const Eigen::VectorXd am = generalized_accelerations(system, s);
-    const Eigen::VectorXd ym = outputs(s);
-    K.col(j) = -(ap - am) / (2 * h);
-    Cy.col(j) = (yp - ym) / (2 * h);
+    const Eigen::VectorXd d = central_difference(system, base, j, h, s, accelerations_and_outputs);
+    K.col(j) = -d.head(nu);
+    Cy.col(j) = d.tail(ny);
   }
   // Rigid-body and constraint directions have omega^2 = 0 up to the round-off of the differenced
   // accelerations, about eps * max K_ii (the largest terms cancel); 30 times that is the floor.

@@ -59,18 +59,27 @@ public:
     a[kTy] = -sc_.mast_root[0];
     return a;
   }
+  // The element e holding mast station s, its local coordinate xi and the four Hermite functions
+  // there (`basis`: hermite::shape or hermite::slope); `add(ux, uy, value)` gets each one's full
+  // DOF indices in the two bending planes.
+  template <class Basis, class Add>
+  int hermite_row(double s, Basis basis, double& xi, Add add) const {
+    const int e = element_of(s, sc_.length, ne_, xi);
+    const hermite::Vec4 f = basis(xi, sc_.length / ne_);
+    for (int a = 0; a < 4; ++a) {
+      const int node = e + a / 2, slope = a % 2;
+      add(full_node(node, ScoleFE::kUx + slope), full_node(node, ScoleFE::kUy + slope), f[a]);
+    }
+    return e;
+  }
   // Absolute displacement (u_x, u_y, w) of mast station s.
   MatrixXd displacement(double s) const {
     MatrixXd R = zero();
     double xi = 0.0;
-    const double h = sc_.length / ne_;
-    const int e = element_of(s, sc_.length, ne_, xi);
-    const hermite::Vec4 n = hermite::shape(xi, h);
-    for (int a = 0; a < 4; ++a) {
-      const int node = e + a / 2, slope = a % 2;
-      R(0, full_node(node, ScoleFE::kUx + slope)) += n[a];
-      R(1, full_node(node, ScoleFE::kUy + slope)) += n[a];
-    }
+    hermite_row(s, hermite::shape, xi, [&](int ux, int uy, double n) {
+      R(0, ux) += n;
+      R(1, uy) += n;
+    });
     R.row(2) = axial();
     return R;
   }
@@ -78,14 +87,10 @@ public:
   MatrixXd rotation(double s) const {
     MatrixXd R = zero();
     double xi = 0.0;
-    const double h = sc_.length / ne_;
-    const int e = element_of(s, sc_.length, ne_, xi);
-    const hermite::Vec4 d = hermite::slope(xi, h);
-    for (int a = 0; a < 4; ++a) {
-      const int node = e + a / 2, slope = a % 2;
-      R(0, full_node(node, ScoleFE::kUy + slope)) += d[a];
-      R(1, full_node(node, ScoleFE::kUx + slope)) -= d[a];
-    }
+    const int e = hermite_row(s, hermite::slope, xi, [&](int ux, int uy, double d) {
+      R(0, uy) += d;
+      R(1, ux) -= d;
+    });
     R(2, full_node(e, ScoleFE::kPsi)) += 1.0 - xi;
     R(2, full_node(e + 1, ScoleFE::kPsi)) += xi;
     return R;

@@ -290,9 +290,16 @@ struct ReflectorOnly {
   Model m;
   ScoleNonlinear::Dynamics dyn;
   Matrix3d J;
-  ReflectorOnly() : m(make_model(scenario(), 4)), dyn(m.nl->at(coefficients(m))) {
+  int ne;
+  ReflectorOnly() : m(make_model(scenario(), 4)), dyn(m.nl->at(coefficients(m))), ne(m.nl->elastic()) {
     const auto& I = m.sc.scole.reflector;
     J << I.Ixx, I.Ixy, I.Ixz, I.Ixy, I.Iyy, I.Iyz, I.Ixz, I.Iyz, I.Izz;
+  }
+  // The model's state at rest in the shuttle's frame with the elastic coordinates e.
+  VectorXd state(const VectorXd& e) const {
+    VectorXd y = VectorXd::Zero(m.nl->state_size());
+    y.segment(6, ne) = e;
+    return y;
   }
   static scoleid::io::Scenario scenario() {
     auto sc = builtin("paper-scole-1");
@@ -320,17 +327,13 @@ TEST(ScoleNonlinear, TheReflectorsRotationalEnergyIsTheTurningBodysExactly) {
   // the stiffnesses zero. A general inertia, not the flat SCOLE reflector's.
   const ReflectorOnly r;
   const Model& m = r.m;
-  const auto& sc = m.sc;
-  const int ne = m.nl->elastic();
-  const auto& dyn = r.dyn;
-  const Matrix3d& J = r.J;
+  const int ne = r.ne;
   const auto deflection = random_deflection(ne, 9);
   const VectorXd &e0 = deflection.first, &v0 = deflection.second;
-  const double L = sc.scole.length;
+  const double L = m.sc.scole.length;
   for (double eps : {0.01, 0.05, 0.2}) {
     const VectorXd e = eps * e0, ed = eps * v0;
-    VectorXd y = VectorXd::Zero(m.nl->state_size());
-    y.segment(6, ne) = e;
+    VectorXd y = r.state(e);
     y.tail(ne) = ed;
     const double d = 1e-4;
     auto R_at = [&](double t) { return section_rotation(m.fe, ne, VectorXd(e + t * ed), L); };
@@ -338,7 +341,7 @@ TEST(ScoleNonlinear, TheReflectorsRotationalEnergyIsTheTurningBodysExactly) {
     const Matrix3d Rdot = (R_at(-2 * d) - 8.0 * R_at(-d) + 8.0 * R_at(d) - R_at(2 * d)) / (12 * d);
     const Matrix3d W = Rdot * R.transpose();
     const Vector3d w(0.5 * (W(2, 1) - W(1, 2)), 0.5 * (W(0, 2) - W(2, 0)), 0.5 * (W(1, 0) - W(0, 1)));
-    const double exact = 0.5 * w.dot(R * J * R.transpose() * w), model = dyn.energy(y.data());
+    const double exact = 0.5 * w.dot(R * r.J * R.transpose() * w), model = r.dyn.energy(y.data());
     std::printf("  eps %.2f  |theta_L| %.3f  exact %.6e  relative difference %.2e\n", eps,
                 (m.fe.mast_rotation(L).leftCols(ne) * e).norm(), exact, std::abs(model - exact) / exact);
     EXPECT_LT(std::abs(model - exact), 1e-9 * exact);
@@ -354,22 +357,18 @@ TEST(ScoleNonlinear, TheReflectorsInertiaTurnsExactlyInASpinningFrame) {
   // other mass is made negligible (the shuttle's energy, constant, is subtracted at e = 0), the
   // stiffnesses zero.
   const ReflectorOnly r;
-  const Model& m = r.m;
-  const auto& sc = m.sc;
-  const int ne = m.nl->elastic();
-  const auto& dyn = r.dyn;
+  const int ne = r.ne;
   const Matrix3d& J = r.J;
   const VectorXd e0 = random_deflection(ne, 11).first;
   const Vector3d W0(0.07, -0.03, 0.05);
   auto model_energy = [&](const VectorXd& e) {
-    VectorXd y = VectorXd::Zero(m.nl->state_size());
-    y.segment(6, ne) = e;
+    VectorXd y = r.state(e);
     y.segment<3>(6 + ne + 3) = W0;
-    return dyn.energy(y.data());
+    return r.dyn.energy(y.data());
   };
   const double E0 = model_energy(VectorXd::Zero(ne));
   for (double eps : {0.01, 0.05, 0.2}) {
-    const Matrix3d R = section_rotation(m.fe, ne, VectorXd(eps * e0), sc.scole.length);
+    const Matrix3d R = section_rotation(r.m.fe, ne, VectorXd(eps * e0), r.m.sc.scole.length);
     const double exact = 0.5 * W0.dot((R * J * R.transpose() - J) * W0), model = model_energy(eps * e0) - E0;
     std::printf("  eps %.2f  exact change %+.6e  relative difference %.2e\n", eps, exact, std::abs(model - exact) / std::abs(exact));
     EXPECT_LT(std::abs(model - exact), 1e-8 * std::abs(exact));

@@ -62,6 +62,12 @@ public:
       if (!v[i].is_object()) fail(where + key + "[" + std::to_string(i) + "]", "an object", &v[i]);
     return v;
   }
+  // `check(entry, prefix)` for each object of the array `key`, the prefix naming it ("key[i].").
+  template <class Check>
+  void each(const nlohmann::json& obj, const std::string& key, const std::string& where, Check check) const {
+    const auto& v = objects(obj, key, where);
+    for (std::size_t i = 0; i < v.size(); ++i) check(v[i], where + key + "[" + std::to_string(i) + "].");
+  }
 
 private:
   std::string file_;
