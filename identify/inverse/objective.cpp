@@ -40,13 +40,18 @@ constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
 constexpr double kGw[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
 
 // The quadrature walker: the three-point Gauss–Legendre rule on every interval of `grid`
-// (docs/theory.md §6.4), f(t, weight) at each point in order.
-template <class F>
-void for_each_gauss_point(const std::vector<double>& grid, F&& f) {
+// (docs/theory.md §6.4), f(t, weight) at each point in order, then interval_done(its right end).
+template <class F, class Done>
+void for_each_gauss_point(const std::vector<double>& grid, F&& f, Done&& interval_done) {
   for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
     const double h = grid[k + 1] - grid[k];
     for (int gq = 0; gq < 3; ++gq) f(grid[k] + kGx[gq] * h, kGw[gq] * h);
+    interval_done(grid[k + 1]);
   }
+}
+template <class F>
+void for_each_gauss_point(const std::vector<double>& grid, F&& f) {
+  for_each_gauss_point(grid, std::forward<F>(f), [](double) {});
 }
 
 // A quadrature grid sorted, with points closer than rounding (1e-12 relative) merged into the
@@ -251,18 +256,14 @@ double Objective::misfit_window(const Setup& s, const SecondOrderSolver& solver,
   window_grid(w, t_end, grid);
   VectorXd x(n), v(n), z(ns);
   double J = 0.0;
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int g = 0; g < 3; ++g) {
-      const double t = grid[k] + kGx[g] * h;
-      w.eval(t, x.data(), v.data());
-      z_of.eval(t, z.data());
-      const VectorXd r = output_at(s, solver, t, x, v) - z;
-      double e = 0.0;
-      for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
-      J += 0.5 * kGw[g] * h * e;
-    }
-  }
+  for_each_gauss_point(grid, [&](double t, double wt) {
+    w.eval(t, x.data(), v.data());
+    z_of.eval(t, z.data());
+    const VectorXd r = output_at(s, solver, t, x, v) - z;
+    double e = 0.0;
+    for (int j = 0; j < ns; ++j) e += R_[static_cast<std::size_t>(j)] * r[j] * r[j];
+    J += 0.5 * wt * e;
+  });
   return J;
 }
 
@@ -361,18 +362,16 @@ void Objective::profile_window(const Setup& s, const SecondOrderSolver& solver, 
   std::vector<double> grid;
   window_grid(w, data_.t.back(), grid);
   VectorXd x(n), v(n), z(ns);
-  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
-    const double h = grid[k + 1] - grid[k];
-    for (int g = 0; g < 3; ++g) {
-      const double t = grid[k] + kGx[g] * h;
-      w.eval(t, x.data(), v.data());
-      data_.eval(t, z.data());
-      const VectorXd r = output_at(s, solver, t, x, v) - z;
-      sums.rr += kGw[g] * h * r.cwiseAbs2();
-      sums.zz += kGw[g] * h * z.cwiseAbs2();
-    }
-    sums.report(grid[k + 1]);
-  }
+  for_each_gauss_point(
+      grid,
+      [&](double t, double wt) {
+        w.eval(t, x.data(), v.data());
+        data_.eval(t, z.data());
+        const VectorXd r = output_at(s, solver, t, x, v) - z;
+        sums.rr += wt * r.cwiseAbs2();
+        sums.zz += wt * z.cwiseAbs2();
+      },
+      [&](double t_end) { sums.report(t_end); });
 }
 
 double Objective::interpolation_misfit(const VectorXd& q) {
@@ -1069,34 +1068,31 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
       const auto tq = Clock::now();
       const double h = pt.t - t_prev;
       interval_cuts(a_end, b_end, next_data, cuts);
-      for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
-        const double hk = cuts[k + 1] - cuts[k];
-        for (int gq = 0; gq < 3; ++gq) {
-          const double t = cuts[k] + kGx[gq] * hk, wt = kGw[gq] * hk;
-          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
-          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
-          if (output_space) {
-            Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
-            data_.eval(t, z.data());
-            const VectorXd r = Ys.col(0) - z;
-            add_gauss_newton_point(wt, r, Ys.rightCols(P), Rv, J, gradient, H);
-            continue;
-          }
-          Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
-          Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
-          x = Xs.col(0);
-          v = Vs.col(0);
+      for_each_gauss_point(cuts, [&](double t, double wt) {
+        const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
+        const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2,
+                     h11 = (s3 - s2) * h;
+        if (output_space) {
+          Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
           data_.eval(t, z.data());
-          const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-          for (int i = 0; i < P; ++i) {
-            si = Xs.col(1 + i);
-            svi = Vs.col(1 + i);
-            CS.col(i) = tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, x, v, a,
-                                          si, svi);
-          }
-          add_gauss_newton_point(wt, r, CS, Rv, J, gradient, H);
+          const VectorXd r = Ys.col(0) - z;
+          add_gauss_newton_point(wt, r, Ys.rightCols(P), Rv, J, gradient, H);
+          return;
         }
-      }
+        Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
+        Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
+        x = Xs.col(0);
+        v = Vs.col(0);
+        data_.eval(t, z.data());
+        const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
+        for (int i = 0; i < P; ++i) {
+          si = Xs.col(1 + i);
+          svi = Vs.col(1 + i);
+          CS.col(i) = tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, x, v,
+                                        a, si, svi);
+        }
+        add_gauss_newton_point(wt, r, CS, Rv, J, gradient, H);
+      });
       quadrature += since(tq);
     }
     if (output_space) {

@@ -119,17 +119,22 @@ struct ScoleSpec {
   double actuator_lag = 0.0;
 };
 
-// A point input. `at` names the body it acts on: "beam" or "mast" (then `location` is s),
-// "shuttle", "reflector", or "actuatorK" (K = 1, 2: the proof mass's commanded force along its
-// slider). `direction` is a unit axis in the shuttle frame ([0,1,0] etc.); beam inputs act
-// transversally and ignore it.
-struct InputSpec {
+// Where on the structure an input acts or a sensor reads, and the unit of its signal: `at` the
+// body ("beam" or "mast", then `location` is the station s; "shuttle", "reflector", "actuatorK"),
+// `direction` a unit axis in the shuttle frame ([0,1,0] etc.; beams act and read transversally and
+// ignore it).
+struct PointSpec {
   std::string name;
   Site at = Site::Beam;
-  InputKind kind = InputKind::Force;
   double location = 0.0;
   std::vector<double> direction = {0.0, 0.0, 0.0};
   std::string unit;
+};
+
+// A point input, a force or a moment. At "actuatorK" (K = 1, 2) it is the proof mass's commanded
+// force along its slider.
+struct InputSpec : PointSpec {
+  InputKind kind = InputKind::Force;
   // With a data file (scole-identify --data): "auto" drives the input by the file's column of the
   // same name when there is one, else by `signal`; "data" requires the column (an error if it is
   // missing); "scenario" always uses `signal`. The truth always uses `signal`.
@@ -147,13 +152,8 @@ struct InputSpec {
 // from the neutral axis (+ on the side w points to: a positive curvature w_ss shortens it),
 // dimensionless (docs/theory.md §3.5). For SCOLE: the mast station at `location` (or the
 // reflector), measured in the shuttle frame along `direction`.
-struct SensorSpec {
-  std::string name;
-  Site at = Site::Beam;
+struct SensorSpec : PointSpec {
   SensorKind kind = SensorKind::Displacement;
-  double location = 0.0;
-  std::vector<double> direction = {0.0, 0.0, 0.0};
-  std::string unit;
   double noise_std = 0.0;
   double offset = 0.0;  // strain: distance of the gauge from the neutral axis (≠ 0); other kinds: 0
   // The sensor's own error in the truth, in its unit: the truth writes
