@@ -87,21 +87,32 @@ void check_identify(const nlohmann::json& id, const std::string& file) {
   });
 }
 
+// The verbs' files, each with its shape check, in the order they are read.
+using ShapeCheck = void (*)(const nlohmann::json&, const std::string&);
+struct ReportFile {
+  const char* name;
+  ShapeCheck check;
+  nlohmann::json ReportInputs::*member;
+};
+const ReportFile kReportFiles[] = {{"modes.json", check_modes, &ReportInputs::modes},
+                                   {"trajectories.json", check_trajectories, &ReportInputs::trajectories},
+                                   {"identify.json", check_identify, &ReportInputs::identify}};
 }  // namespace
 
 ReportInputs read_report_inputs(const std::string& dir) {
   ReportInputs in;
-  auto get = [&](const std::string& name, void (*check)(const nlohmann::json&, const std::string&)) {
-    const fs::path p = fs::path(dir) / name;
-    if (!fs::exists(p)) return nlohmann::json();
-    nlohmann::json j = io::read_json(p.string());
-    check(j, p.string());
-    return j;
-  };
-  in.modes = get("modes.json", check_modes);
-  in.trajectories = get("trajectories.json", check_trajectories);
-  in.identify = get("identify.json", check_identify);
+  for (const ReportFile& f : kReportFiles) {
+    const fs::path p = fs::path(dir) / f.name;
+    if (!fs::exists(p)) continue;
+    in.*f.member = io::read_json(p.string());
+    f.check(in.*f.member, p.string());
+  }
   return in;
+}
+
+void check_report_inputs(const ReportInputs& in, const std::string& dir) {
+  for (const ReportFile& f : kReportFiles)
+    if (!(in.*f.member).is_null()) f.check(in.*f.member, (fs::path(dir) / f.name).string());
 }
 
 std::vector<std::string> summary_lines(const ReportInputs& in) {

@@ -24,8 +24,12 @@ struct ReportInputs {
   nlohmann::json modes, trajectories, identify;   // null when absent
 };
 
-// Reads the verbs' JSON from `dir` (absent files stay null).
+// Reads the verbs' JSON from `dir` (absent files stay null), each checked as check_report_inputs does.
 ReportInputs read_report_inputs(const std::string& dir);
+// Checks that every present input is shaped as its verb writes it (the fields summary_lines and
+// make_report read, with their types and sizes): else io::InputError naming the file (as in `dir`)
+// and the field.
+void check_report_inputs(const ReportInputs& in, const std::string& dir);
 
 // The one-screen summary lines.
 std::vector<std::string> summary_lines(const ReportInputs& in);
