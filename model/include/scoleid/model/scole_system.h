@@ -38,10 +38,11 @@ public:
   SimTK::MobilizedBodyIndex reflector() const { return reflector_; }
 
 private:
-  SimTK::MobilizedBodyIndex shuttle_, reflector_;
-  Station reflector_station_;
-  std::vector<SimTK::MobilizedBodyIndex> sliders_;  // [2 (k-1) + axis]
-  double actuator_lag_ = 0.0;
+ struct Build;  // the per-body builders (scole_system.cpp)
+ SimTK::MobilizedBodyIndex shuttle_, reflector_;
+ Station reflector_station_;
+ std::vector<SimTK::MobilizedBodyIndex> sliders_;  // [2 (k-1) + axis]
+ double actuator_lag_ = 0.0;
 };
 
 }  // namespace scoleid::model
