@@ -63,6 +63,11 @@
 //              S along d, a_i · d.
 // At rest (q = 0, u = 0) the linearisation is the linear model in the coordinates (X, θ, e):
 // M(0) = Gᵀ M_lin G, the same K, D, loads and sensor rows.
+//
+// Implemented in identify/fe/scole_nonlinear/, one part per file: kinematics (rows, a point's and
+// a rotor's motion with the section), assembly (the bodies' mass points and rotors, inputs,
+// sensors), foreshortening, dynamics (coupling energy, rigid and foreshortening rows), mass (the
+// mass matrix and its solves) and equations (residual, Jacobians, products, outputs).
 #include <array>
 #include <functional>
 #include <memory>
@@ -367,7 +372,7 @@ private:
     void coefficients(const std::vector<G>& gamma, G zero, Visit&& visit) const;
   };
 
-  // The constructor's parts, in order (scole_nonlinear.cpp).
+  // The constructor's parts, in order (scole_nonlinear/assembly.cpp).
   MatrixXd on_e(const MatrixXd& rows) const;  // rows restricted to the elastic DOFs e
   void add_mast(const ScoleFE& fe);
   void add_foreshortening(const ScoleFE& fe);
