@@ -55,7 +55,9 @@ const KindTable& beam_kind() {
                            [](Scenario&) { return std::vector<std::pair<std::string, bool*>>{}; },
                            parameters,
                            set_stiffness,
-                           shape_stations};
+                           shape_stations,
+                           {SensorKind::Displacement, SensorKind::Rotation, SensorKind::Velocity,
+                            SensorKind::Acceleration, SensorKind::Strain}};
   return t;
 }
 

@@ -413,6 +413,23 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
 
 double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
 
+// A sensor kind the structure's models read (its table's sensor_kinds).
+void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind) {
+  const std::vector<SensorKind>& kinds = kind_table(sc.structure).sensor_kinds;
+  if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) return;
+  std::string list, readers;
+  for (SensorKind k : kinds) list += (list.empty() ? "" : "|") + std::string(to_string(k));
+  for (const auto& row : Names<Structure>::rows) {
+    const std::vector<SensorKind>& other = kind_table(row.first).sensor_kinds;
+    if (std::find(other.begin(), other.end(), kind) != other.end())
+      readers += std::string(readers.empty() ? "" : ", ") + row.second;
+  }
+  fail_field(sc.source, field,
+             "is not read on a " + std::string(to_string(sc.structure)) + " structure (it reads " + list + ")" +
+                 (readers.empty() ? "" : "; it is read with structure: " + readers),
+             quoted(kind));
+}
+
 void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "") {
   if (!has_station(at)) return;
   const double L = structure_length(sc);
@@ -479,6 +496,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.at = r.choice_among("at", sc.structure == Structure::Scole ? Site::Mast : Site::Beam,
                           {Site::Beam, Site::Mast, Site::Reflector, Site::Shuttle});
     s.kind = r.choice_of("kind", SensorKind::Displacement);
+    check_sensor_kind(sc, r.field("kind"), s.kind);
     s.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), s.at, s.location);
     s.direction = parse_direction(r, "direction");
@@ -488,8 +506,6 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(s.kind), s.unit, s.column_unit);
     if (s.kind == SensorKind::Strain) {
-      if (sc.structure != Structure::Beam)
-        fail_field(sc.source, r.field("kind"), "is a beam's strain gauge (structure: beam)", "'strain'");
       if (!r.has("offset")) fail_field(sc.source, r.field("offset"), "is required for a strain gauge (its distance from the neutral axis)", "none");
       s.offset = r.num("offset", 0.0);
       if (!(s.offset != 0.0)) fail_field(sc.source, r.field("offset"), "must be nonzero (a gauge on the neutral axis reads nothing)", format_value(s.offset));

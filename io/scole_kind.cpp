@@ -76,7 +76,9 @@ const KindTable& scole_kind() {
       },
       parameters,
       set_stiffness,
-      shape_stations};
+      shape_stations,
+      {SensorKind::Displacement, SensorKind::Rotation, SensorKind::Velocity, SensorKind::Acceleration,
+       SensorKind::LineOfSight}};
   return t;
 }
 

@@ -87,13 +87,8 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     const io::SensorSpec& se = sc.sensors[i];
     const std::string field = "sensors[" + std::to_string(i) + "]";
     ResolvedSensor r;
-    using K = ResolvedSensor::Kind;
-    r.kind = se.kind == io::SensorKind::Rotation       ? K::Rotation
-             : se.kind == io::SensorKind::Velocity     ? K::Velocity
-             : se.kind == io::SensorKind::Acceleration ? K::Acceleration
-             : se.kind == io::SensorKind::LineOfSight  ? K::LineOfSight
-             : se.kind == io::SensorKind::Strain       ? K::Strain
-                                                       : K::Displacement;
+    using K = io::SensorKind;
+    r.kind = se.kind;
     r.reference = st.reference_body();
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
@@ -126,7 +121,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
 double read_sensor(const SimbodyMatterSubsystem& matter, const State& state, const ResolvedSensor& s) {
   const MobilizedBody& B = matter.getMobilizedBody(s.station.body);
   const MobilizedBody& R = matter.getMobilizedBody(s.reference);
-  using K = ResolvedSensor::Kind;
+  using K = io::SensorKind;
   switch (s.kind) {
     case K::Displacement: {
       const Vec3 p_RP = B.findStationLocationInAnotherBody(state, s.station.p_BS, R);

@@ -1,6 +1,7 @@
 // io/types.h: every closed choice has one name, and the name gives the value back.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
 
 #include "scoleid/io/error.h"
@@ -52,5 +53,31 @@ TEST(Types, TheNamesAreTheScenarioFileSpellings) {
     EXPECT_NE(m.find("identification.method"), std::string::npos) << m;
     EXPECT_NE(m.find(names_joined<Method>()), std::string::npos) << m;
     EXPECT_NE(m.find("'newton'"), std::string::npos) << m;
+  }
+}
+
+TEST(Types, EverySensorKindIsReadBySomeStructureAndRefusedByNameElsewhere) {
+  // The reader takes a sensor kind only where the structure's models read it (its kind table);
+  // elsewhere one line names the field, the kind and the structures that do read it.
+  const std::map<std::string, std::string> heads = {{"beam", "structure: beam\ninputs: [{name: P, location: 5}]\n"},
+                                                    {"scole", "structure: scole\ninputs: [{name: F, direction: y}]\n"}};
+  for (const auto& kind : names<SensorKind>()) {
+    int readers = 0;
+    for (const auto& [structure, head] : heads) {
+      const std::string extra = kind == "strain" ? ", offset: 0.01" : "";
+      const std::string yaml =
+          head + "sensors: [{name: s, kind: " + kind + ", location: 5, direction: y" + extra + "}]\n";
+      try {
+        const Scenario sc = parse_scenario(yaml, "scenario 'x.yaml'");
+        EXPECT_EQ(to_string(sc.sensors.at(0).kind), kind);
+        ++readers;
+      } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("sensors[0].kind"), std::string::npos) << m;
+        EXPECT_NE(m.find("'" + kind + "'"), std::string::npos) << m;
+        EXPECT_NE(m.find("not read on a " + structure + " structure"), std::string::npos) << m;
+      }
+    }
+    EXPECT_GE(readers, 1) << kind << " is read by no structure";
   }
 }

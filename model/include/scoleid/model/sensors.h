@@ -38,8 +38,7 @@
 namespace scoleid::model {
 
 struct ResolvedSensor {
-  enum class Kind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain };
-  Kind kind = Kind::Displacement;
+  io::SensorKind kind = io::SensorKind::Displacement;
   Station station;
   SimTK::MobilizedBodyIndex second;      // rotation: (1 - w) rot(station.body) + w rot(second)
   double weight = 0.0;
