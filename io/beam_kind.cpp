@@ -55,9 +55,7 @@ const KindTable& beam_kind() {
                            [](Scenario&) { return std::vector<std::pair<std::string, bool*>>{}; },
                            parameters,
                            set_stiffness,
-                           shape_stations,
-                           {SensorKind::Displacement, SensorKind::Rotation, SensorKind::Velocity,
-                            SensorKind::Acceleration, SensorKind::Strain}};
+                           shape_stations};
   return t;
 }
 

@@ -413,17 +413,14 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
 
 double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
 
-// A sensor kind the structure's models read (its table's sensor_kinds).
+// A sensor kind the structure's models read (types.h, reads).
 void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind) {
-  const std::vector<SensorKind>& kinds = kind_table(sc.structure).sensor_kinds;
-  if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) return;
+  if (reads(sc.structure, kind)) return;
   std::string list, readers;
-  for (SensorKind k : kinds) list += (list.empty() ? "" : "|") + std::string(to_string(k));
-  for (const auto& row : Names<Structure>::rows) {
-    const std::vector<SensorKind>& other = kind_table(row.first).sensor_kinds;
-    if (std::find(other.begin(), other.end(), kind) != other.end())
-      readers += std::string(readers.empty() ? "" : ", ") + row.second;
-  }
+  for (const auto& [k, name] : Names<SensorKind>::rows)
+    if (reads(sc.structure, k)) list += (list.empty() ? "" : "|") + std::string(name);
+  for (const auto& [st, name] : Names<Structure>::rows)
+    if (reads(st, kind)) readers += (readers.empty() ? "" : ", ") + std::string(name);
   fail_field(sc.source, field,
              "is not read on a " + std::string(to_string(sc.structure)) + " structure (it reads " + list + ")" +
                  (readers.empty() ? "" : "; it is read with structure: " + readers),

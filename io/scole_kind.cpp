@@ -76,9 +76,7 @@ const KindTable& scole_kind() {
       },
       parameters,
       set_stiffness,
-      shape_stations,
-      {SensorKind::Displacement, SensorKind::Rotation, SensorKind::Velocity, SensorKind::Acceleration,
-       SensorKind::LineOfSight}};
+      shape_stations};
   return t;
 }
 

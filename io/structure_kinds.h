@@ -36,8 +36,6 @@ struct KindTable {
   // bending planes) and, for sections, EI_1..EI_N as a whole profile.
   void (*set_stiffness)(Scenario&, const std::map<std::string, double>&);
   std::vector<ShapeSensor> (*shape_sensors)(const Scenario&, int count);
-  // The sensor kinds the kind's models read (the scenario reader refuses the others).
-  std::vector<SensorKind> sensor_kinds;
 };
 
 const KindTable& kind_table(Structure kind);  // structure_kinds.cpp

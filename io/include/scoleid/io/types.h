@@ -105,6 +105,12 @@ constexpr int derivative_order(SensorKind k) {
   return k == SensorKind::Velocity ? 1 : k == SensorKind::Acceleration ? 2 : 0;
 }
 
+// Whether the models of a structure kind read this sensor kind (the scenario reader refuses the
+// others): a strain gauge is a beam's (its curvature), a line of sight SCOLE's (feed to reflector).
+constexpr bool reads(Structure s, SensorKind k) {
+  return k == SensorKind::Strain ? s == Structure::Beam : k == SensorKind::LineOfSight ? s == Structure::Scole : true;
+}
+
 // The name a scenario, a command line and identify.json use.
 template <class E, class = decltype(Names<E>::rows)>
 const char* to_string(E v) {
