@@ -57,7 +57,7 @@ TEST(Types, TheNamesAreTheScenarioFileSpellings) {
 }
 
 TEST(Types, EverySensorKindIsReadBySomeStructureAndRefusedByNameElsewhere) {
-  // The reader takes a sensor kind only where the structure's models read it (its kind table);
+  // The reader takes a sensor kind only where the structure's models read it (types.h, reads);
   // elsewhere one line names the field, the kind and the structures that do read it.
   const std::map<std::string, std::string> heads = {{"beam", "structure: beam\ninputs: [{name: P, location: 5}]\n"},
                                                     {"scole", "structure: scole\ninputs: [{name: F, direction: y}]\n"}};
