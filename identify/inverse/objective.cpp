@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "scoleid/identify/inverse/coefficient_quadrature.h"
+
 namespace scoleid::identify {
 
 namespace {
@@ -14,7 +16,8 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Appends the outputs (C x, C v, C a) at t to `out`: what a checkpointed costate reads (§7.9).
-void push_outputs(const Eigen::MatrixXd& C, Trajectory& out, double t, const double* x, const double* v, const double* a) {
+void push_outputs(const Eigen::SparseMatrix<double, Eigen::RowMajor>& C, Trajectory& out, double t, const double* x,
+                  const double* v, const double* a) {
   const auto n = C.cols();
   const Eigen::VectorXd y = C * Eigen::Map<const Eigen::VectorXd>(x, n), yv = C * Eigen::Map<const Eigen::VectorXd>(v, n),
                         ya = C * Eigen::Map<const Eigen::VectorXd>(a, n);
@@ -72,6 +75,7 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
     throw std::invalid_argument("Objective: one measurement column per model sensor");
   if (data_.t.size() < 2) throw std::invalid_argument("Objective: at least two samples");
   C_ = model_.output_matrix(0);
+  Cs_ = C_.sparseView(0.0, 0.0);
   if (model_.has_rate_outputs()) {
     C1_ = model_.output_matrix(1);
     C2_ = model_.output_matrix(2);
@@ -87,22 +91,6 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   } else {
     default_weights();
   }
-  auto add_terms = [&](const std::vector<OperatorTerm>& ts, int kind) {
-    for (const auto& t : ts) {
-      if (t.coefficient < 0) continue;
-      TermEntries e{t.coefficient, kind, {}, {}, {}};
-      for (int k = 0; k < t.matrix.outerSize(); ++k)
-        for (SparseMatrix::InnerIterator it(t.matrix, k); it; ++it) {
-          e.row.push_back(static_cast<int>(it.row()));
-          e.col.push_back(static_cast<int>(it.col()));
-          e.value.push_back(it.value());
-        }
-      terms_.push_back(std::move(e));
-    }
-  };
-  add_terms(model_.mass, 0);
-  add_terms(model_.damping, 1);
-  add_terms(model_.stiffness, 2);
   for (const auto& s : inputs_)
     for (double b : s.breakpoints())
       if (b > t0 && b < T_) breakpoints_.push_back(b);
@@ -498,10 +486,7 @@ class Objective::CostateSources {
 class Objective::DisplacementSources final : public CostateSources {
  public:
   DisplacementSources(const Objective& o, ModelPart part, bool residual)
-      : o_(o), part_(std::move(part)), residual_(residual), y_(o.data_.sensors()), z_(o.data_.sensors()) {
-    const Eigen::Map<const VectorXd> Rv(o.R_.data(), o.data_.sensors());
-    CtR_ = o.C_.transpose() * Rv.asDiagonal();
-  }
+      : o_(o), part_(std::move(part)), residual_(residual), y_(o.data_.sensors()), z_(o.data_.sensors()) {}
   int equations() const override { return 1; }
   void force(double tau, int, double* F) override {
     const double t = o_.T_ - tau;
@@ -510,7 +495,8 @@ class Objective::DisplacementSources final : public CostateSources {
       o_.data_.eval(t, z_.data());
       y_ -= z_;
     }
-    Eigen::Map<VectorXd>(F, o_.model_.ndof).noalias() = -CtR_ * y_;
+    for (Eigen::Index j = 0; j < y_.size(); ++j) y_[j] *= -o_.R_[static_cast<std::size_t>(j)];
+    Eigen::Map<VectorXd>(F, o_.model_.ndof).noalias() = o_.Cs_.transpose() * y_;
   }
   double at(double t, const VectorXd& x, const VectorXd&, const VectorXd& c, const VectorXd& cd, VectorXd& p,
             VectorXd& pd, VectorXd&) override {
@@ -518,7 +504,7 @@ class Objective::DisplacementSources final : public CostateSources {
     pd = -cd;  // ṗ(t) = −P'(T − t)
     if (!residual_) return 0.0;
     o_.data_.eval(t, z_.data());
-    y_.noalias() = o_.C_ * x;
+    y_.noalias() = o_.Cs_ * x;
     y_ -= z_;
     double e = 0.0;
     for (Eigen::Index j = 0; j < y_.size(); ++j) e += o_.R_[static_cast<std::size_t>(j)] * y_[j] * y_[j];
@@ -529,7 +515,6 @@ class Objective::DisplacementSources final : public CostateSources {
   const Objective& o_;
   ModelPart part_;
   bool residual_;
-  MatrixXd CtR_;
   VectorXd y_, z_;
 };
 
@@ -642,6 +627,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   VectorXd x(n), xv(n), a(n), p(n), pd(n), c(m * n), cd(m * n);
   std::vector<double> grid;
   double quadrature = 0.0, resolve = 0.0;
+  CoefficientQuadrature eq25(model_, src.rates(), CoefficientQuadrature::needed_coefficients(s.dcdq));
   // Each costate window [τa, τb] (P, or P and Y stacked) is t in [T − τb, T − τa]: the state there
   // from its checkpoints.
   WindowedSink windows(
@@ -653,7 +639,8 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
           state.eval(t, x.data(), xv.data());
           W.eval(T_ - t, c.data(), cd.data());
           J += 0.5 * wt * src.at(t, x, xv, c, cd, p, pd, a);
-          add_coefficient_gradient(t, wt, p, pd, x, xv, a, src.rates(), gc);
+          eq25.add(wt, p, pd, x, xv, a);
+          add_input_gradient(t, wt, p, gc);
         });
         quadrature += since(tq);
       },
@@ -671,6 +658,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
     solver.stream_tangent(0.0, T_ - t0, g0, 1, g1, T_ - t0, bp_tau, visit, &sum, StepAnchor::End);
   }
   windows.finish();
+  eq25.contract(gc);
   count_checkpointed_pass(counters_, sum, state, m, since(tc), quadrature, resolve);
   return J;
 }
@@ -703,8 +691,9 @@ void Objective::costates_stored(const SecondOrderSolver& solver, CostateSources&
   counters_.costate_seconds += since(tc);
 }
 
-double Objective::backward_stored(const SecondOrderSolver& solver, const Trajectory& u, CostateSources& src,
-                                  const std::vector<double>& more_times, VectorXd& gc) {
+double Objective::backward_stored(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u,
+                                  CostateSources& src, const std::vector<double>& more_times, VectorXd& gc) {
+  const std::vector<bool> needed = CoefficientQuadrature::needed_coefficients(s.dcdq);
   const int n = model_.ndof, m = src.equations();
   Trajectory P, Y;
   costates_stored(solver, src, P, Y);
@@ -715,15 +704,20 @@ double Objective::backward_stored(const SecondOrderSolver& solver, const Traject
   if (m == 2)
     for (double tau : Y.times()) ytimes.push_back(T_ - tau);
   const auto grid = union_grid({&u.times(), &ptimes, &ytimes, &more_times}, T_);
-  VectorXd x(n), v(n), a(n), p(n), pd(n), c(m * n), cd(m * n);
+  VectorXd x(n), v = VectorXd::Zero(n), a(n), p(n), pd(n), c(m * n), cd = VectorXd::Zero(m * n);
   double J = 0.0;
+  CoefficientQuadrature eq25(model_, src.rates(), needed);
+  // Displacement sources read x and the multiplier alone: v and ṗ are interpolated when Eq. 25 reads them.
+  const bool v_read = m == 2 || eq25.reads_velocity(), pd_read = m == 2 || eq25.reads_multiplier_rate();
   for_each_gauss_point(grid, [&](double t, double wt) {
-    u.eval(t, x.data(), v.data());
-    P.eval(T_ - t, c.data(), cd.data());
+    u.eval(t, x.data(), v_read ? v.data() : nullptr);
+    P.eval(T_ - t, c.data(), pd_read ? cd.data() : nullptr);
     if (m == 2) Y.eval(T_ - t, c.data() + n, cd.data() + n);
     J += 0.5 * wt * src.at(t, x, v, c, cd, p, pd, a);
-    add_coefficient_gradient(t, wt, p, pd, x, v, a, src.rates(), gc);
+    eq25.add(wt, p, pd, x, v, a);
+    add_input_gradient(t, wt, p, gc);
   });
+  eq25.contract(gc);
   counters_.quadrature_seconds += since(tq);
   return J;
 }
@@ -757,7 +751,7 @@ double Objective::gradient_checkpointed(const Setup& s, const SecondOrderSolver&
                 [&](const SecondOrderSolver::Point& pt) {
                   ck(pt);
                   if (!rates) {
-                    push_outputs(C_, out, pt.t, pt.x, pt.v, pt.a);
+                    push_outputs(Cs_, out, pt.t, pt.x, pt.v, pt.a);
                     return;
                   }
                   const Eigen::Map<const VectorXd> x(pt.x, n), v(pt.v, n), a(pt.a, n);
@@ -792,14 +786,15 @@ double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solve
   const int n = model_.ndof;
   VectorXd xb(n), vb(n);
   if (C1_.size() == 0) {
+    // The sources read the outputs C u at the state's points, interpolated like u (the same numbers
+    // as C times u's interpolant, a sensors-long interpolation per costate stage instead of an n-long one).
+    Trajectory out(data_.sensors());
+    out.reserve(u.size());
+    for (std::size_t k = 0; k < u.size(); ++k)
+      push_outputs(Cs_, out, u.times()[k], u.x(k).data(), u.v(k).data(), u.a(k).data());
     DisplacementSources src(
-        *this,
-        [&](double t, VectorXd& y) {
-          u.eval(t, xb.data(), vb.data());
-          y.noalias() = C_ * xb;
-        },
-        true);
-    return backward_stored(solver, u, src, {}, gc);
+        *this, [&](double t, VectorXd& y) { out.eval(t, y.data(), vb.data()); }, true);
+    return backward_stored(s, solver, u, src, {}, gc);
   }
   const SecondOrderSolver::Forcing force = state_forcing(s);
   const RateTerms rt = rate_terms(s, solver);
@@ -808,21 +803,12 @@ double Objective::gradient_stored(const Setup& s, const SecondOrderSolver& solve
     y.noalias() = rt.A0 * xb;
     y.noalias() += rt.A1 * vb;
   });
-  return backward_stored(solver, u, src, {}, gc);
+  return backward_stored(s, solver, u, src, {}, gc);
 }
 
-void Objective::add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
-                                         const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const {
-  // Without rate sensors the mass term is taken by parts, −ṗᵀ M_j u̇ (p(T) = 0); with them p(T) ≠ 0
-  // and it is pᵀ M_j ü. Damping pᵀ D_j u̇, stiffness pᵀ K_j u.
-  for (const auto& e : terms_) {
-    const bool by_parts = e.kind == 0 && !rates;
-    const double* left = by_parts ? pd.data() : p.data();
-    const double* right = e.kind == 2 ? x.data() : (e.kind == 0 && rates ? a.data() : v.data());
-    double acc = 0.0;
-    for (std::size_t mm = 0; mm < e.value.size(); ++mm) acc += left[e.row[mm]] * e.value[mm] * right[e.col[mm]];
-    gc[e.coefficient] += (by_parts ? -wt : wt) * acc;
-  }
+// The input coefficients' share of Eq. 25 at a quadrature point: −wt f_i(t) pᵀ b_i (the operator
+// terms' share is CoefficientQuadrature's).
+void Objective::add_input_gradient(double t, double wt, const VectorXd& p, VectorXd& gc) const {
   for (std::size_t i = 0; i < model_.inputs.size(); ++i) {
     const int ci = model_.inputs[i].coefficient;
     if (ci >= 0) gc[ci] -= wt * inputs_[i](t) * p.dot(model_.inputs[i].vector);
@@ -1267,7 +1253,7 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
                           [&](const SecondOrderSolver::Point& pt) {
                             ck(pt);
                             if (pt.columns < 2) throw std::logic_error("gauss_newton_product: the tangent stopped early");
-                            push_outputs(C_, out, pt.t, pt.x + n, pt.v + n, pt.a + n);  // the tangent's column
+                            push_outputs(Cs_, out, pt.t, pt.x + n, pt.v + n, pt.a + n);  // the tangent's column
                           },
                           &sum);
     counters_.solver.Accumulate(sum);
@@ -1294,7 +1280,7 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
         y.noalias() = C_ * sx;
       },
       false);
-  backward_stored(solver, u, src, Sv.times(), gc);
+  backward_stored(s, solver, u, src, Sv.times(), gc);
   return s.dcdq.transpose() * gc;
 }
 

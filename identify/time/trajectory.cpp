@@ -96,7 +96,7 @@ std::size_t Trajectory::locate(double t, bool right) const {
 void Trajectory::eval(double t, double* x, double* v, double* a, bool right) const {
   if (t_.size() == 1) {
     std::copy_n(X_.data(), n_, x);
-    std::copy_n(V_.data(), n_, v);
+    if (v) std::copy_n(V_.data(), n_, v);
     if (a) std::copy_n(A_.data(), n_, a);
     return;
   }
@@ -112,9 +112,13 @@ void Trajectory::eval(double t, double* x, double* v, double* a, bool right) con
   const double* v1 = v0 + n_;
   const double* a0 = A_.data() + k * n_;
   const double* a1 = a0 + n_;
-  for (int i = 0; i < n_; ++i) {
-    x[i] = h00 * x0[i] + h10 * v0[i] + h01 * x1[i] + h11 * v1[i];
-    v[i] = h00 * v0[i] + h10 * a0[i] + h01 * v1[i] + h11 * a1[i];
+  if (v) {
+    for (int i = 0; i < n_; ++i) {
+      x[i] = h00 * x0[i] + h10 * v0[i] + h01 * x1[i] + h11 * v1[i];
+      v[i] = h00 * v0[i] + h10 * a0[i] + h01 * v1[i] + h11 * a1[i];
+    }
+  } else {
+    for (int i = 0; i < n_; ++i) x[i] = h00 * x0[i] + h10 * v0[i] + h01 * x1[i] + h11 * v1[i];
   }
   if (a)
     for (int i = 0; i < n_; ++i) a[i] = (1 - s) * a0[i] + s * a1[i];

@@ -204,10 +204,8 @@ private:
   // The state and the tangents of the given derivatives (as solve_with_sensitivities).
   std::vector<Trajectory> solve_tangents(const SecondOrderSolver& solver, const Setup& s, double state_end,
                                          double tangent_end, Trajectory& u, const std::vector<Derivative>& d);
-  // Adds the quadrature point's share of ∂J/∂c (Eq. 25) to gc: weight wt, multiplier p (and ṗ for
-  // the mass term by parts when `by_parts_mass`), state x, v and acceleration a.
-  void add_coefficient_gradient(double t, double wt, const VectorXd& p, const VectorXd& pd, const VectorXd& x,
-                                const VectorXd& v, const VectorXd& a, bool rates, VectorXd& gc) const;
+  // Adds the input coefficients' share of ∂J/∂c (Eq. 25) at a quadrature point of weight wt.
+  void add_input_gradient(double t, double wt, const VectorXd& p, VectorXd& gc) const;
   // The state over [t0, state_end] and the sensitivities to parameters first … first + count − 1
   // (count < 0: to the last) over [t0, tangent_end] (tangent_end <= state_end).
   std::vector<Trajectory> solve_with_sensitivities(const SecondOrderSolver& solver, const Setup& s, double state_end,
@@ -248,7 +246,7 @@ private:
   // The backward pass on a stored state u (docs/theory.md §6.2): the costates of `src` whole, then
   // the quadrature on every interval of the union of the state's, the costates', the samples' and
   // `more_times`. Returns as backward_checkpointed.
-  double backward_stored(const SecondOrderSolver& solver, const Trajectory& u, CostateSources& src,
+  double backward_stored(const Setup& s, const SecondOrderSolver& solver, const Trajectory& u, CostateSources& src,
                          const std::vector<double>& more_times, VectorXd& gc);
   // The costates of `src` over the whole record: P, and Y for rate sensors.
   void costates_stored(const SecondOrderSolver& solver, CostateSources& src, Trajectory& P, Trajectory& Y);
@@ -258,15 +256,6 @@ private:
   bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
                     double& resolve_seconds) const;
 
-  // Nonzeros of every coefficient-carrying term, so that the gradient quadrature costs
-  // nnz(M) + nnz(D) + nnz(K) per point however many sections carry coefficients.
-  struct TermEntries {
-    int coefficient;
-    int kind;  // 0 mass, 1 damping, 2 stiffness
-    std::vector<int> row, col;
-    std::vector<double> value;
-  };
-  std::vector<TermEntries> terms_;
 
   const StructuralModel& model_;
   const Parameterization& params_;
@@ -274,6 +263,7 @@ private:
   Measurements data_;
   ObjectiveOptions options_;
   MatrixXd C_;            // rows on u
+  Eigen::SparseMatrix<double, Eigen::RowMajor> Cs_;  // the nonzeros of C_ (a sensor reads a few dofs)
   MatrixXd C1_, C2_;      // rows on u̇ and ü (empty without velocity or acceleration sensors)
   bool accelerations_ = false;
   std::vector<double> R_;

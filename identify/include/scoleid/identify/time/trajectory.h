@@ -32,6 +32,7 @@ public:
   // Room for `points` recorded points without reallocation (from the pool when it can).
   void reserve(std::size_t points);
   // x(t), v(t) (and a(t), linear in between) by Hermite interpolation; t is clamped to the range.
+  // v (like a) may be null when only x is wanted.
   // When t coincides with a duplicated breakpoint time, `right` selects the right limit.
   void eval(double t, double* x, double* v, double* a = nullptr, bool right = true) const;
   Eigen::Map<const Eigen::VectorXd> x(std::size_t k) const { return {X_.data() + k * n_, n_}; }
