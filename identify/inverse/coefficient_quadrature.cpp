@@ -24,9 +24,10 @@ std::vector<bool> CoefficientQuadrature::needed_coefficients(const Eigen::Matrix
   return needed;
 }
 
-// The kind's pattern: the union of its coefficient-carrying terms' nonzeros. The band's half-width
-// b is the widest for which the band is at least half filled by the pattern (a band sum over empty
-// cells costs a vector lane; a pair outside costs an indexed multiply-add).
+// The kind's pattern: the union of its coefficient-carrying terms' nonzeros. A diagonal s − r = d is
+// summed as a vector when the pattern fills at least 1/kDiagonalFill of it (a vector lane per
+// cell against an indexed multiply-add per pair); the pairs on the other diagonals form the list.
+constexpr long kDiagonalFill = 3;
 void CoefficientQuadrature::build(Kind& k, const std::vector<OperatorTerm>& terms, int n, double sign,
                                   const std::vector<bool>& needed) {
   const auto carried = [&](const OperatorTerm& t) {
@@ -43,19 +44,22 @@ void CoefficientQuadrature::build(Kind& k, const std::vector<OperatorTerm>& term
   k.used = true;
   std::sort(pattern.begin(), pattern.end());
   pattern.erase(std::unique(pattern.begin(), pattern.end()), pattern.end());
-  std::vector<long> by_offset(static_cast<std::size_t>(n), 0);  // pairs with |s − r| = d
-  for (std::int64_t p : pattern) ++by_offset[static_cast<std::size_t>(std::abs(p % n - p / n))];
-  long inside = 0;
-  for (int b = 0; b < n; ++b) {
-    inside += by_offset[static_cast<std::size_t>(b)];
-    const long cells = static_cast<long>(2 * b + 1) * n - static_cast<long>(b) * (b + 1);
-    if (by_offset[static_cast<std::size_t>(b)] > 0 && 2 * inside >= cells) k.b = b;
+  std::vector<long> by_offset(static_cast<std::size_t>(2 * n - 1), 0);  // pairs with s − r = d, at d + n − 1
+  for (std::int64_t p : pattern) ++by_offset[static_cast<std::size_t>(p % n - p / n + n - 1)];
+  std::vector<int> column_of(by_offset.size(), -1);  // a diagonal's column in k.band, or −1
+  for (int d = 1 - n; d < n; ++d) {
+    const long count = by_offset[static_cast<std::size_t>(d + n - 1)];
+    if (count > 0 && kDiagonalFill * count >= n - std::abs(d)) {
+      column_of[static_cast<std::size_t>(d + n - 1)] = static_cast<int>(k.offsets.size());
+      k.offsets.push_back(d);
+    }
   }
-  k.band = Eigen::MatrixXd::Zero(n, 2 * k.b + 1);
+  const auto on_band = [&](int r, int s) { return column_of[static_cast<std::size_t>(s - r + n - 1)]; };
+  k.band = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(k.offsets.size()));
   std::vector<int> outside_index(pattern.size(), -1);  // a pattern pair's place among those outside
   for (std::size_t i = 0; i < pattern.size(); ++i) {
     const int r = static_cast<int>(pattern[i] / n), s = static_cast<int>(pattern[i] % n);
-    if (std::abs(s - r) > k.b) {
+    if (on_band(r, s) < 0) {
       outside_index[i] = static_cast<int>(k.row.size());
       k.row.push_back(r);
       k.col.push_back(s);
@@ -68,8 +72,8 @@ void CoefficientQuadrature::build(Kind& k, const std::vector<OperatorTerm>& term
       for (SparseMatrix::InnerIterator it(t.matrix, c); it; ++it) {
         const int r = static_cast<int>(it.row()), s = static_cast<int>(it.col());
         int where;
-        if (std::abs(s - r) <= k.b) {
-          where = k.b + s - r;
+        if (on_band(r, s) >= 0) {
+          where = on_band(r, s);
         } else {
           const auto pos = std::lower_bound(pattern.begin(), pattern.end(), key(r, s, n));
           where = -1 - outside_index[static_cast<std::size_t>(pos - pattern.begin())];
@@ -86,12 +90,13 @@ void CoefficientQuadrature::reset() {
   }
 }
 
-// band(r, b + d) += wt · left_r · right_{r+d} for every r with 0 ≤ r + d < n.
+// band(r, column of d) += wt · left_r · right_{r+d} for every r with 0 ≤ r + d < n.
 void CoefficientQuadrature::accumulate(Kind& k, double wt, const Eigen::VectorXd& left, const Eigen::VectorXd& right) {
   const Eigen::Index n = left.size();
-  for (int d = -k.b; d <= k.b; ++d) {
+  for (std::size_t c = 0; c < k.offsets.size(); ++c) {
+    const int d = k.offsets[c];
     const Eigen::Index r0 = d < 0 ? -d : 0, len = n - std::abs(d);
-    k.band.col(k.b + d).segment(r0, len).array() +=
+    k.band.col(static_cast<Eigen::Index>(c)).segment(r0, len).array() +=
         wt * left.segment(r0, len).array() * right.segment(r0 + d, len).array();
   }
   for (std::size_t i = 0; i < k.row.size(); ++i)

@@ -9,11 +9,12 @@
 // (ṗ, u̇), (p, ü), (p, u̇) or (p, u). The integral ∫ left_r right_s dt depends on the pair (r, s) and
 // the kind of term only, not on the coefficient, so it is summed once per quadrature point over
 // the union of the kind's nonzero patterns, and contracted with the terms' values once at the end.
-// The pattern is stored as the diagonals of a band, |s − r| ≤ b, summed as whole vectors (the
-// interior of a finite-element matrix), with the few pairs outside it (the couplings to a rigid
-// body's degrees of freedom) as a list. A point then costs (2b + 1)·n vector multiply-adds per kind
-// instead of one indexed multiply-add per nonzero of every term: the cost of a point no longer grows
-// with the number of coefficients, and the band sums vectorise.
+// The pattern is stored by diagonals s − r = d: those it fills well (the interior of a
+// finite-element matrix, whatever the interleaving of its fields) are summed as whole vectors, the
+// few pairs elsewhere (the couplings to a rigid body's degrees of freedom) as a list. A point then
+// costs about n vector multiply-adds per well-filled diagonal per kind instead of one indexed
+// multiply-add per nonzero of every term: the cost of a point no longer grows with the number of
+// coefficients, and the diagonal sums vectorise.
 #include <vector>
 
 #include <Eigen/Dense>
@@ -48,8 +49,8 @@ class CoefficientQuadrature {
   // One kind of term (mass, damping, stiffness): its band sums and its pairs outside the band.
   struct Kind {
     bool used = false;
-    int b = 0;                     // half-bandwidth of the band part
-    Eigen::MatrixXd band;          // n × (2b + 1): column b + d holds Σ wt left_r right_{r+d}
+    std::vector<int> offsets;      // the diagonals s − r = d summed as vectors
+    Eigen::MatrixXd band;          // n × offsets: column c holds Σ wt left_r right_{r+offsets[c]}
     std::vector<int> row, col;     // pairs outside the band
     Eigen::VectorXd outside;       // Σ wt left_r right_s for each of them
     struct Entry {
