@@ -28,6 +28,7 @@ bench: build
 	$(BUILD)/identify/scole-nonlinear-bench
 	$(BUILD)/identify/scole-experiments-bench
 	$(BUILD)/crosscheck/scole-crosscheck-bench
+	$(BUILD)/identify/scole-sections-bench --part 4
 
 deps:
 	bash .ci/install-deps

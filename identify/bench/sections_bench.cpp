@@ -1,5 +1,5 @@
 // scole-sections-bench: how the identifier scales with the number of EI sections, how robust
-// Gauss–Newton is from nearby starts, and what checkpointing costs. Three parts, printed as tables
+// Gauss–Newton is from nearby starts, and what checkpointing costs. Parts printed as tables
 // (and written to --json PATH):
 //   1. EI(x) on N sections (N = 2, 8, 32, 64 by default), Gauss–Newton and L-BFGS: a simply
 //      supported beam, 64 identifier elements, synthetic data on 128 elements, two loads, 16
@@ -16,6 +16,8 @@
 //      flags it, and an error there is not a false claim.
 //   3. Checkpointing (docs/theory.md §7.9): part 1's problem, a fixed workload of gradients and
 //      Gauss–Newton products at several checkpoint spacings, peak RSS against wall time.
+//   4. (--part 4) part 1's problem over 5 s against the exact-discretisation least-squares peer
+//      (peers/exact_discretisation.py): the same data and model, wall time and RMS error of each.
 // Wall times are single runs (steady_clock), not minima over repetitions.
 #include <sys/resource.h>
 #include <sys/types.h>
@@ -592,6 +594,144 @@ void write_json(const std::string& path, const json& j) {
   std::filesystem::rename(tmp, path);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Part 4: part 1's problem (5 s) against the exact-discretisation peer (bench/peers/): the same
+// data, the same 64-element model, EI on N sections from the same start. scoleid runs in this
+// process (identification only, no standard deviations: the peer computes none); the peer in
+// python3 (numpy, scipy) on a JSON export of the problem (data, sampled loads, geometry), its own wall clock.
+
+// The problem as the peer reads it.
+json peer_problem(const scoleid::io::Scenario& sc, const Problem& p, int N) {
+  json j;
+  j["length"] = sc.beam.length;
+  j["rho_A"] = sc.beam.rho_A;
+  j["elements"] = sc.identification.elements;
+  j["sections"] = N;
+  json sensors = json::array(), loads_at = json::array(), loads = json::array(), data = json::array();
+  for (const auto& s : sc.sensors) sensors.push_back(s.location);
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    loads_at.push_back(sc.inputs[i].location);
+    json col = json::array();
+    for (double t : p.data.t) col.push_back(p.signals[i](t));
+    loads.push_back(col);
+  }
+  for (int k = 0; k < p.data.sensors(); ++k) {
+    json col = json::array();
+    for (Eigen::Index r = 0; r < p.data.z.rows(); ++r) col.push_back(p.data.z(r, k));
+    data.push_back(col);
+  }
+  j["sensor_locations"] = sensors;
+  j["load_locations"] = loads_at;
+  j["t"] = p.data.t;
+  j["loads"] = loads;
+  j["data"] = data;
+  j["initial_EI"] = std::vector<double>(static_cast<std::size_t>(N), sc.identification.initial.at("EI"));
+  return j;
+}
+
+// The peer's result (its last JSON line), or {"error": …}.
+// The interpreter: $SCOLEID_PYTHON, else the system's /usr/bin/python3 (where Debian's numpy and
+// scipy are), else python3 on the PATH.
+std::string peer_python() {
+  if (const char* e = std::getenv("SCOLEID_PYTHON"); e && *e) return e;
+  return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+}
+
+json run_peer(const std::string& problem_path) {
+  const std::string cmd =
+      "'" + peer_python() + "' '" + std::string(SCOLEID_PEER_SCRIPT) + "' '" + problem_path + "' 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return {{"error", "cannot start python3"}};
+  std::string last, line;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) {
+    line += buf;
+    if (!line.empty() && line.back() == '\n') {
+      if (line.front() == '{')
+        last = line;
+      else
+        std::fprintf(stderr, "peer: %s", line.c_str());
+      line.clear();
+    }
+  }
+  const int status = pclose(pipe);
+  if (status != 0 || last.empty()) return {{"error", "the peer failed (exit status " + std::to_string(status) + ")"}};
+  return json::parse(last);
+}
+
+double rms_against(const std::vector<double>& estimate, const std::vector<double>& truth) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < truth.size(); ++k) s += std::pow(estimate[k] / truth[k] - 1.0, 2);
+  return std::sqrt(s / static_cast<double>(truth.size()));
+}
+
+json part4(const std::vector<int>& sections) {
+  std::printf(
+      "4. EI(x) against the exact-discretisation peer (64 elements, 16 sensors, 5 s at 0.01 s, start EI 30000)\n");
+  std::printf("%6s %14s %10s %14s %10s %8s %8s\n", "N", "scoleid [s]", "rms err", "peer [s]", "rms err", "evals",
+              "ratio");
+  json rows = json::array();
+  const auto dir = std::filesystem::temp_directory_path() / ("scole-sections-peer-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  for (int N : sections) {
+    auto sc = part1_scenario(N);
+    sc.simulation.duration = 5.0;
+    auto p = make_problem(sc, std::nullopt);
+    const std::string path = (dir / ("problem-" + std::to_string(N) + ".json")).string();
+    write_json(path, peer_problem(sc, *p, N));
+    RunOptions ro;
+    ro.compute_std = false;
+    ro.verbose = false;
+    const auto t0 = Clock::now();
+    const RunResult r = run_identification(*p, ro);
+    const double ours = seconds_since(t0);
+    const double ours_rms =
+        rms_against(std::vector<double>(r.estimate.data(), r.estimate.data() + r.estimate.size()), sc.beam.EI);
+    const json peer = run_peer(path);
+    json row{
+        {"N", N}, {"scoleid_seconds", ours}, {"scoleid_rms_error", ours_rms}, {"scoleid_converged", r.converged()}};
+    if (peer.contains("error")) {
+      std::printf("%6d %14.3f %10.2e %14s\n", N, ours, ours_rms, peer["error"].get<std::string>().c_str());
+      row["peer_error"] = peer["error"];
+    } else {
+      const double theirs = peer["wall_seconds"].get<double>();
+      const double their_rms = rms_against(peer["estimate"].get<std::vector<double>>(), sc.beam.EI);
+      std::printf("%6d %14.3f %10.2e %14.3f %10.2e %8d %8.1f\n", N, ours, ours_rms, theirs, their_rms,
+                  peer["evaluations"].get<int>(), theirs / ours);
+      row["peer_seconds"] = theirs;
+      row["peer_rms_error"] = their_rms;
+      row["peer_evaluations"] = peer["evaluations"];
+      row["ratio"] = theirs / ours;
+    }
+    rows.push_back(row);
+  }
+  // With the smoothness prior (the discrepancy principle) on the most sections: the principle needs
+  // a stated noise level, so the data carry noise of 1 % of the largest response.
+  if (!sections.empty()) {
+    const int N = sections.back();
+    auto sc = part1_scenario(N);
+    sc.simulation.duration = 5.0;
+    const double peak = make_problem(sc, std::nullopt)->data.z.cwiseAbs().maxCoeff();
+    for (auto& sensor : sc.sensors) sensor.noise_std = 0.01 * peak;
+    sc.identification.smoothness = -1.0;
+    auto p = make_problem(sc, std::nullopt);
+    RunOptions ro;
+    ro.compute_std = false;
+    ro.verbose = false;
+    const auto t0 = Clock::now();
+    const RunResult r = run_identification(*p, ro);
+    const double ours = seconds_since(t0);
+    const double rms =
+        rms_against(std::vector<double>(r.estimate.data(), r.estimate.data() + r.estimate.size()), sc.beam.EI);
+    std::printf("%6d %14.3f %10.2e   (scoleid, data with 1 %% noise, smoothness prior by the discrepancy principle)\n",
+                N, ours, rms);
+    rows.push_back({{"N", N}, {"prior", "discrepancy"}, {"scoleid_seconds", ours}, {"scoleid_rms_error", rms}});
+  }
+  std::filesystem::remove_all(dir);
+  std::printf("\n");
+  return rows;
+}
+
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -602,16 +742,21 @@ std::vector<std::string> split(const std::string& s) {
 }
 
 const char* kUsage =
-    "usage: scole-sections-bench [--part 1|2|3] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
+    "usage: scole-sections-bench [--part 1|2|3|4] [--sections 2,8,32,64] [--methods gauss-newton,lbfgs]\n"
     "                            [--timeout S] [--no-std] [--json PATH] [--noise SD] [--smoothness S]\n"
     "                            [--checkpoint L] [--seed K] [--time-step H] [--step-rule parameters|data]\n"
-    "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step unless --time-step), each (N, method) in a\n"
+    "  Part 1: EI(x) on N sections (64 elements, 16 sensors, automatic step unless --time-step), each (N, method) in "
+    "a\n"
     "          child process: iterations, wall time, step, solves, errors, peak RSS; default sections\n"
     "          2,8,32,64, methods gauss-newton,lbfgs (auto also accepted), timeout 600 s per case.\n"
     "  Part 2: EI_1..EI_4 + rho_A from the analytic modal series, Gauss-Newton from 10 starts.\n"
     "  Part 3: checkpointing's memory/recompute curve: part 1's problem on the last --sections N (64),\n"
     "          3 gradients + 3 Gauss-Newton products per checkpoint spacing L, wall and peak RSS.\n"
-    "  All parts run unless --part selects one. --no-std skips identifiability in part 1.\n"
+    "  Part 4 (only when selected): part 1's problem over 5 s against the exact-discretisation peer\n"
+    "          (identify/bench/peers/exact_discretisation.py; numpy and scipy, $SCOLEID_PYTHON or\n"
+    "          /usr/bin/python3) on --sections (default\n"
+    "          2,64): wall time and RMS error of each, the ratio; then scoleid with the smoothness prior.\n"
+    "  Parts 1-3 run unless --part selects one. --no-std skips identifiability in part 1.\n"
     "  --checkpoint L sets part 1's checkpoint spacing: 0 = store the whole state, L > 0 = every L\n"
     "  points, -1 (default) = checkpoint when the state exceeds the trajectory budget (32 MiB).\n"
     "  --json PATH writes the results as JSON (temp file, then renamed).\n"
@@ -628,6 +773,7 @@ const char* kUsage =
 int main(int argc, char** argv) {
   int part = 0, case_n = -1, curve_n = -1;
   std::vector<int> sections = {2, 8, 32, 64};
+  bool sections_given = false;
   using scoleid::io::Method;
   std::vector<std::string> methods = {scoleid::io::to_string(Method::GaussNewton), scoleid::io::to_string(Method::Lbfgs)};
   std::string method = scoleid::io::to_string(Method::GaussNewton), json_path;
@@ -645,8 +791,9 @@ int main(int argc, char** argv) {
         return 0;
       } else if (a == "--part") {
         part = std::stoi(value());
-        if (part < 1 || part > 3) throw std::invalid_argument("--part must be 1, 2 or 3");
+        if (part < 1 || part > 4) throw std::invalid_argument("--part must be 1, 2, 3 or 4");
       } else if (a == "--sections") {
+        sections_given = true;
         sections.clear();
         for (const auto& s : split(value())) {
           const int n = std::stoi(s);
@@ -707,6 +854,7 @@ int main(int argc, char** argv) {
     if (part == 0 || part == 1) out["part1"] = part1(sections, methods, compute_std, timeout_s);
     if (part == 0 || part == 2) out["part2"] = part2();
     if (part == 0 || part == 3) out["part3"] = part3(sections.empty() ? 64 : sections.back(), timeout_s);
+    if (part == 4) out["part4"] = part4(sections_given ? sections : std::vector<int>{2, 64});
     if (!json_path.empty()) write_json(json_path, out);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "scole-sections-bench: %s\n", e.what());
