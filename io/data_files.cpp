@@ -15,6 +15,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/signal.h"
 #include "scoleid/io/input_file.h"
+#include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
 
 #include "scoleid/io/limits.h"
@@ -207,6 +208,7 @@ DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOp
   tab.columns.assign(tab.names.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
+    if (lineno % 4096 == 0) check_interrupt();  // a DAQ export of millions of lines takes seconds
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     if (line[0] == '#') continue;
     auto f = split_csv_line(line, sep);
@@ -283,6 +285,7 @@ void write_csv(const std::string& path, const DataTable& tab) {
   for (const auto& n : tab.names) os << ',' << csv_field(n);
   os << '\n' << std::setprecision(17);
   for (std::size_t i = 0; i < tab.t.size(); ++i) {
+    if (i % 4096 == 0) check_interrupt();
     os << tab.t[i];
     for (const auto& c : tab.columns) os << ',' << c[i];
     os << '\n';

@@ -18,6 +18,7 @@
 #include <system_error>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
 
@@ -224,6 +225,7 @@ class Cursor {
   std::size_t pos() const { return pos_; }
   std::string_view bytes() const { return s_; }
   Line next() {
+    if (line_ % 4096 == 0) check_interrupt();  // a file of millions of lines takes seconds
     const std::size_t b = pos_;
     std::size_t e = s_.find_first_of("\r\n", b);
     if (e == std::string_view::npos) e = s_.size();

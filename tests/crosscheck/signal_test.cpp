@@ -1,12 +1,14 @@
 // Every program and every long-running verb ends on SIGTERM: launched on a default-sized run and
 // signalled 1.5 s in (inside its setup or its first solves), each exits 143 within a second and
 // leaves nothing beside --out (no staging directory, no temporary file); every verb but the
-// resumable campaign leaves no --out either.
+// resumable campaign leaves no --out either. scole-data reads a large DAQ export for as long.
+// (scole-crosscheck report re-renders an earlier run in well under a second: nothing to signal.)
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -54,7 +56,8 @@ Outcome run_and_terminate(const std::vector<std::string>& argv, const fs::path& 
 }  // namespace
 
 TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideOut) {
-  const std::string truth = SCOLE_TRUTH_EXE, identify = SCOLE_IDENTIFY_EXE, xc = SCOLE_CROSSCHECK_EXE;
+  const std::string truth = SCOLE_TRUTH_EXE, identify = SCOLE_IDENTIFY_EXE, xc = SCOLE_CROSSCHECK_EXE,
+                    data = SCOLE_DATA_EXE;
   const std::string family = std::string(SCOLEID_SOURCE_DIR) + "/crosscheck/mismatch/01-chain-discretisation.yaml";
   struct Case {
     const char* name;
@@ -70,20 +73,35 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
       {"crosscheck all", {xc, "all", "--scenario", "paper-scole-1", "--out", "out"}, false},
       {"crosscheck suite", {xc, "suite", "--only", family, "--out", "out", "-q"}, false},
       {"crosscheck campaign", {xc, "campaign", "camp.yaml", "--out", "out"}, true},
+      // A DAQ export of two channels in g, 2·10⁶ samples each (80 MB: seconds of parsing).
+      {"scole-data info", {data, "info", "daq.csv"}, false},
+      {"scole-data convert", {data, "convert", "daq.csv", "--out", "out.csv", "-q"}, false},
+  };
+  const auto inputs = [](const fs::path& d, bool daq) {
+    std::ofstream(d / "camp.yaml") << "campaign: c\nscenarios: [paper-scole-1]\ngrid: {truth.segments: [80, 160]}\n";
+    if (!daq) return;
+    std::FILE* f = std::fopen((d / "daq.csv").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, "# exported by a DAQ\ntime [s],acc1 [g],acc2 [g]\n");
+    for (long k = 0; k < 2000000; ++k) {
+      const double t = 1e-4 * static_cast<double>(k);
+      std::fprintf(f, "%.6e,%.6e,%.6e\n", t, 0.01 * std::sin(6.0 * t), 0.02 * std::cos(6.0 * t));
+    }
+    ASSERT_EQ(std::fclose(f), 0);
   };
   for (const auto& c : cases) {
     std::string tag = c.name;
     for (char& ch : tag)
       if (ch == ' ') ch = '-';
     const fs::path d = scoleid::test::scratch("xc-signal", tag);
-    std::ofstream(d / "camp.yaml") << "campaign: c\nscenarios: [paper-scole-1]\ngrid: {truth.segments: [80, 160]}\n";
+    inputs(d, tag.rfind("scole-data", 0) == 0);
     const Outcome o = run_and_terminate(c.argv, d, 1.5);
     std::printf("  %-24s exit %d, %.3f s after SIGTERM\n", c.name, o.code, o.after);
     EXPECT_EQ(o.code, 128 + SIGTERM) << c.name;
     EXPECT_LT(o.after, 1.0) << c.name;
     for (const auto& e : fs::directory_iterator(d)) {
       const std::string n = e.path().filename().string();
-      EXPECT_TRUE(n == "camp.yaml" || (c.keeps_out && n == "out")) << c.name << " left " << n;
+      EXPECT_TRUE(n == "camp.yaml" || n == "daq.csv" || (c.keeps_out && n == "out")) << c.name << " left " << n;
     }
     fs::remove_all(d);
   }

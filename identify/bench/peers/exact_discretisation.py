@@ -9,7 +9,8 @@ are linear between samples (first-order hold): one matrix exponential of the aug
 
 per evaluation (scipy.linalg.expm), then x_{k+1} = Phi x_k + Gamma0 u_k + Gamma1 u_{k+1}. The fit is
 scipy.optimize.least_squares on the sensors' residuals with its defaults (trust-region reflective,
-forward-difference Jacobian: one extra evaluation per parameter), in EI over its starting value.
+forward-difference Jacobian: one extra evaluation per parameter), in EI over its starting value,
+bounded below by 1e-3 of it.
 
 Usage: exact_discretisation.py PROBLEM.json    (written by scole-sections-bench --part 4)
 Prints one JSON line: wall_seconds, evaluations (Jacobian columns included), function_evaluations
@@ -111,7 +112,8 @@ def main():
         evaluations += 1
         return (simulate(beam, z * scale, loads_b, c, u, dt) - data).ravel()
 
-    fit = least_squares(residual, np.ones(len(scale)))
+    # EI stays positive (a step to EI <= 0 makes the model unstable and the residuals overflow).
+    fit = least_squares(residual, np.ones(len(scale)), bounds=(1e-3, np.inf))
     wall = time.perf_counter() - t0
     print(json.dumps({"wall_seconds": wall, "evaluations": evaluations, "function_evaluations": int(fit.nfev),
                       "estimate": list(fit.x * scale), "cost": float(fit.cost), "status": int(fit.status)}))
