@@ -1,7 +1,7 @@
 // Every program and every long-running verb ends on SIGTERM: launched on a default-sized run and
 // signalled 1.5 s in (inside its setup or its first solves), each exits 143 within a second and
 // leaves nothing beside --out (no staging directory, no temporary file); every verb but the
-// resumable campaign leaves no --out either. scole-data reads a large DAQ export for as long.
+// resumable campaign leaves no --out either. scole-data reads a large DAQ export (120 MB) for as long.
 // (scole-crosscheck report re-renders an earlier run in well under a second: nothing to signal.)
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -73,7 +73,7 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
       {"crosscheck all", {xc, "all", "--scenario", "paper-scole-1", "--out", "out"}, false},
       {"crosscheck suite", {xc, "suite", "--only", family, "--out", "out", "-q"}, false},
       {"crosscheck campaign", {xc, "campaign", "camp.yaml", "--out", "out"}, true},
-      // A DAQ export of two channels in g, 2·10⁶ samples each (80 MB: seconds of parsing).
+      // A DAQ export of two channels in g, 3·10⁶ samples each (120 MB: seconds of parsing).
       {"scole-data info", {data, "info", "daq.csv"}, false},
       {"scole-data convert", {data, "convert", "daq.csv", "--out", "out.csv", "-q"}, false},
   };
@@ -83,7 +83,7 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
     std::FILE* f = std::fopen((d / "daq.csv").c_str(), "w");
     ASSERT_NE(f, nullptr);
     std::fprintf(f, "# exported by a DAQ\ntime [s],acc1 [g],acc2 [g]\n");
-    for (long k = 0; k < 2000000; ++k) {
+    for (long k = 0; k < 3000000; ++k) {
       const double t = 1e-4 * static_cast<double>(k);
       std::fprintf(f, "%.6e,%.6e,%.6e\n", t, 0.01 * std::sin(6.0 * t), 0.02 * std::cos(6.0 * t));
     }
