@@ -665,6 +665,30 @@ double rms_against(const std::vector<double>& estimate, const std::vector<double
   return std::sqrt(s / static_cast<double>(truth.size()));
 }
 
+// Part 4's problem: part 1's over 5 s.
+scoleid::io::Scenario part4_scenario(int N) {
+  auto sc = part1_scenario(N);
+  sc.simulation.duration = 5.0;
+  return sc;
+}
+
+// scoleid on p (identification only, no standard deviations): wall seconds, RMS error of EI against
+// the scenario's sections, whether converged.
+struct Timed {
+  double seconds, rms;
+  bool converged;
+};
+Timed identify_timed(Problem& p, const std::vector<double>& truth) {
+  RunOptions ro;
+  ro.compute_std = false;
+  ro.verbose = false;
+  const auto t0 = Clock::now();
+  const RunResult r = run_identification(p, ro);
+  const double seconds = seconds_since(t0);
+  return {seconds, rms_against(std::vector<double>(r.estimate.data(), r.estimate.data() + r.estimate.size()), truth),
+          r.converged()};
+}
+
 json part4(const std::vector<int>& sections) {
   std::printf(
       "4. EI(x) against the exact-discretisation peer (64 elements, 16 sensors, 5 s at 0.01 s, start EI 30000)\n");
@@ -674,22 +698,14 @@ json part4(const std::vector<int>& sections) {
   const auto dir = std::filesystem::temp_directory_path() / ("scole-sections-peer-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   for (int N : sections) {
-    auto sc = part1_scenario(N);
-    sc.simulation.duration = 5.0;
+    const auto sc = part4_scenario(N);
     auto p = make_problem(sc, std::nullopt);
     const std::string path = (dir / ("problem-" + std::to_string(N) + ".json")).string();
     write_json(path, peer_problem(sc, *p, N));
-    RunOptions ro;
-    ro.compute_std = false;
-    ro.verbose = false;
-    const auto t0 = Clock::now();
-    const RunResult r = run_identification(*p, ro);
-    const double ours = seconds_since(t0);
-    const double ours_rms =
-        rms_against(std::vector<double>(r.estimate.data(), r.estimate.data() + r.estimate.size()), sc.beam.EI);
+    const Timed t = identify_timed(*p, sc.beam.EI);
+    const double ours = t.seconds, ours_rms = t.rms;
     const json peer = run_peer(path);
-    json row{
-        {"N", N}, {"scoleid_seconds", ours}, {"scoleid_rms_error", ours_rms}, {"scoleid_converged", r.converged()}};
+    json row{{"N", N}, {"scoleid_seconds", ours}, {"scoleid_rms_error", ours_rms}, {"scoleid_converged", t.converged}};
     if (peer.contains("error")) {
       std::printf("%6d %14.3f %10.2e %14s\n", N, ours, ours_rms, peer["error"].get<std::string>().c_str());
       row["peer_error"] = peer["error"];
@@ -709,20 +725,13 @@ json part4(const std::vector<int>& sections) {
   // a stated noise level, so the data carry noise of 1 % of the largest response.
   if (!sections.empty()) {
     const int N = sections.back();
-    auto sc = part1_scenario(N);
-    sc.simulation.duration = 5.0;
+    auto sc = part4_scenario(N);
     const double peak = make_problem(sc, std::nullopt)->data.z.cwiseAbs().maxCoeff();
     for (auto& sensor : sc.sensors) sensor.noise_std = 0.01 * peak;
     sc.identification.smoothness = -1.0;
     auto p = make_problem(sc, std::nullopt);
-    RunOptions ro;
-    ro.compute_std = false;
-    ro.verbose = false;
-    const auto t0 = Clock::now();
-    const RunResult r = run_identification(*p, ro);
-    const double ours = seconds_since(t0);
-    const double rms =
-        rms_against(std::vector<double>(r.estimate.data(), r.estimate.data() + r.estimate.size()), sc.beam.EI);
+    const Timed t = identify_timed(*p, sc.beam.EI);
+    const double ours = t.seconds, rms = t.rms;
     std::printf("%6d %14.3f %10.2e   (scoleid, data with 1 %% noise, smoothness prior by the discrepancy principle)\n",
                 N, ours, rms);
     rows.push_back({{"N", N}, {"prior", "discrepancy"}, {"scoleid_seconds", ours}, {"scoleid_rms_error", rms}});
