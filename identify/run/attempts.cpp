@@ -227,6 +227,32 @@ std::size_t longest(const std::vector<std::vector<int>>& families) {
   return n;
 }
 
+// The ladder's last level explains the data within noise and discretisation (docs/theory.md §7.6):
+// the full parameterization would start there and refit only what the data already hold, so it is
+// not run; the attempt ends at the level's expanded estimate, its cost taken on the whole record.
+OptimizerSummary explained_by_level(const Runner& run, const VectorXd& q, int blocks, std::size_t sections) {
+  AttemptsContext& c = run.c;
+  OptimizerSummary s;
+  s.q = q;
+  c.objective.set_horizon(c.objective.data_end());
+  s.cost = c.objective.cost(q);
+  s.termination = OptimizerSummary::Termination::DataExplained;
+  s.message = "the " + std::to_string(blocks) + "-block level explains the data within noise and discretisation; " +
+              std::to_string(sections) + " sections would refit only what the data already hold";
+  IterationRecord rec;
+  rec.cost = s.cost;
+  rec.q = q;
+  rec.gradient_norm = NAN;  // not evaluated: no step is taken from here
+  rec.horizon = c.objective.data_end();
+  s.iterations.push_back(rec);
+  run.header();
+  if (c.verbose) {
+    run.table.row(rec);
+    std::printf("%s\n", s.message.c_str());
+  }
+  return s;
+}
+
 // The first attempt: plain or from the ladder, with the prior's given or discrepancy weight.
 void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, bool from_ladder) {
   AttemptsContext& c = run.c;
@@ -242,13 +268,19 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     iterations = lad.iterations;
     levels = std::move(lad.levels);
   }
-  run.header();
   const double smoothness = c.problem.scenario.identification.smoothness;
-  if (smoothness >= 0.0) {
+  // Without a prior, a level that explains the data ends the attempt (with one, the prior's weight
+  // is chosen on the full parameterization, from the level's estimate).
+  if (from_ladder && smoothness == 0.0 && !levels.empty() && levels.back().explained) {
+    r.summary = explained_by_level(run, start, levels.back().blocks, longest(families));
+    r.smoothness_weight = 0.0;
+  } else if (smoothness >= 0.0) {
+    run.header();
     c.options.smoothness_weight = smoothness;
     r.summary = run.minimize_from(start, c.options);
     r.smoothness_weight = smoothness;
   } else {
+    run.header();
     r.summary = discrepancy_path(run, r, start, c.options);
     c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
@@ -382,7 +414,9 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   for (const std::string& how : strategies) {
     if (done >= p.scenario.identification.restarts) break;
     bool wanted = false;
-    if (how == "smoothed") wanted = r.summary.q.allFinite();
+    // (not after a level that explained the data: a blocked profile is no sawtooth to smooth)
+    if (how == "smoothed")
+      wanted = r.summary.q.allFinite() && r.summary.termination != OptimizerSummary::Termination::DataExplained;
     else if (how == "spectral") {
       if (!r.converged()) spectral = spectral_start_of(c, r.initial);
       wanted = !r.converged() && spectral.q.size() == r.initial.size();

@@ -101,7 +101,18 @@ struct IterationRecord {
 };
 
 struct OptimizerSummary {
-  enum class Termination { StepTolerance, GradientTolerance, CostFloor, CostStalled, MaxIterations, LineSearchFailed };
+  // DataExplained: not an optimiser's stop but the run layer's (run/attempts.cpp): a coarse level of
+  // the coarse-to-fine ladder already explains the data within noise and discretisation, so the
+  // full parameterization is not run from there (docs/theory.md §7.6).
+  enum class Termination {
+    StepTolerance,
+    GradientTolerance,
+    CostFloor,
+    CostStalled,
+    MaxIterations,
+    LineSearchFailed,
+    DataExplained
+  };
   Termination termination = Termination::MaxIterations;
   std::string message;
   VectorXd q;
@@ -113,7 +124,8 @@ struct OptimizerSummary {
   double wall_seconds = 0.0;
   bool converged() const {
     return termination == Termination::StepTolerance || termination == Termination::GradientTolerance ||
-           termination == Termination::CostFloor || termination == Termination::CostStalled;
+           termination == Termination::CostFloor || termination == Termination::CostStalled ||
+           termination == Termination::DataExplained;
   }
   std::string BriefReport() const;
 };
