@@ -113,14 +113,17 @@ double fit_floor(const Problem& p, Objective& obj, const VectorXd& q) {
 // The smoothness weight by the discrepancy principle (docs/theory.md §7.8): β from 1 down by
 // factors of 10, each solve from the previous estimate, until the data misfit is within the noise's
 // expected misfit plus the fit test's floor at the first weight's estimate. That β (the largest
-// meeting it) and its estimate are kept. The stated noise levels are needed.
+// meeting it) and its estimate are kept; where none can (the misfit levels off above the target),
+// the weight reached when it levels off. The stated noise levels are needed.
+constexpr double kSmallestWeight = 1e-10;  // the path's last weight
 OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorXd& start, OptimizerOptions oo) {
   const Problem& p = run.c.problem;
   double expected = r.smoothness_expected_misfit = noise_misfit(p, run.c.objective);
   VectorXd q = start;
   OptimizerSummary chosen;
   bool have = false, floor_added = false;
-  for (double beta = 1.0; beta >= 1e-10; beta /= 10.0) {
+  double previous_misfit = NAN, previous_drop = NAN;
+  for (double beta = 1.0; beta >= kSmallestWeight; beta /= 10.0) {
     oo.smoothness_weight = beta;
     OptimizerSummary s = run.minimize_from(q, oo);
     const double misfit = s.cost - s.prior_cost;
@@ -141,6 +144,23 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
       r.smoothness_met = true;
       break;
     }
+    // The misfit levels off above the target where the fit already explains the data (the fit
+    // test: within noise and discretisation): past the path's steepest decade (the drop per decade
+    // shrinking), even this decade's drop at every decade left would not reach the target. A
+    // smaller weight would loosen the prior for nothing; the principle is not met either way. (A
+    // plateau between two drops of the path is not taken for this: there the data are not yet
+    // explained.)
+    const double drop = previous_misfit - misfit;
+    if (std::isfinite(previous_drop) && drop < previous_drop &&
+        misfit - drop * std::log10(beta / kSmallestWeight) > expected &&
+        test_fit(p, run.c.objective, q).within_noise_and_discretisation) {
+      if (run.c.verbose)
+        std::printf("the data misfit levels off above the noise's: the discrepancy cannot be met, weight %.0e kept\n",
+                    beta);
+      break;
+    }
+    previous_drop = drop;
+    previous_misfit = misfit;
   }
   if (!have) throw std::logic_error("discrepancy_path: no weight tried");
   return chosen;

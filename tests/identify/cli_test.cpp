@@ -560,6 +560,27 @@ TEST(ScoleIdentifyHardening, AnUnmetDiscrepancyPrincipleExitsOne) {
   EXPECT_FALSE(j.value("converged", true));
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("discrepancy principle not met"), std::string::npos) << r.err;
+  // The path stops where the misfit levels off above the target (docs/theory.md §7.8): its last
+  // decade's drop, smaller than the one before, repeated at every decade left down to 1e-10 would
+  // not reach the expected misfit; every earlier weight would have (so the path is not cut short
+  // of a weight that could meet it), and the last weight is the one kept.
+  const auto& path = j["smoothness"]["path"];
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_LT(path.size(), 11u) << j["smoothness"].dump();
+  const double expected = j["smoothness"]["expected_misfit"].get<double>();
+  const auto reaches = [&](std::size_t k) {
+    const double drop = path[k - 1]["data_misfit"].get<double>() - path[k]["data_misfit"].get<double>();
+    return path[k]["data_misfit"].get<double>() - drop * std::log10(path[k]["weight"].get<double>() / 1e-10) <=
+           expected;
+  };
+  const std::size_t last = path.size() - 1;
+  EXPECT_FALSE(reaches(last));
+  for (std::size_t k = 2; k < last; ++k) {
+    const double drop_k = path[k - 1]["data_misfit"].get<double>() - path[k]["data_misfit"].get<double>();
+    const double drop_before = path[k - 2]["data_misfit"].get<double>() - path[k - 1]["data_misfit"].get<double>();
+    EXPECT_TRUE(reaches(k) || drop_k >= drop_before) << "the path went on past weight " << path[k]["weight"];
+  }
+  EXPECT_EQ(j["smoothness"]["weight"].get<double>(), path[last]["weight"].get<double>());
 }
 
 // A run whose every parameter is flagged says so in words, not only row by row: a displacement
