@@ -343,7 +343,7 @@ io::ModalData chain_modal_data(const io::Scenario& scenario, int segments, int c
   io::Scenario sc = truth_sc;
   sc.sensors.clear();
   for (const auto& s : truth_sc.sensors)
-    if (io::derivative_order(s.kind) == 0 && s.kind != io::SensorKind::Strain) sc.sensors.push_back(s);
+    if (io::sensor_traits(s.kind).mode_shape) sc.sensors.push_back(s);
   if (sc.sensors.empty())
     io::fail_field(scenario.source, "sensors", "needs a displacement, rotation or line-of-sight sensor for mode shapes", "none");
   if (2 * segments > io::limits::kMaxSegments)

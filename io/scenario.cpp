@@ -416,9 +416,8 @@ double structure_length(const Scenario& sc) { return kind_table(sc.structure).le
 // A sensor kind the structure's models read (types.h, reads).
 void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind) {
   if (reads(sc.structure, kind)) return;
-  std::string list, readers;
-  for (const auto& [k, name] : Names<SensorKind>::rows)
-    if (reads(sc.structure, k)) list += (list.empty() ? "" : "|") + std::string(name);
+  const std::string list = sensor_kinds_read_by(sc.structure);
+  std::string readers;
   for (const auto& [st, name] : Names<Structure>::rows)
     if (reads(st, kind)) readers += (readers.empty() ? "" : ", ") + std::string(name);
   fail_field(sc.source, field,
@@ -480,6 +479,35 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
   }
 }
 
+// The numbers the sensor's kind declares (types.h, SensorKindTraits::fields), each checked by its
+// rule, and none that only another kind declares.
+void parse_sensor_fields(const Scenario& sc, Reader& r, SensorSpec& s) {
+  const SensorKindTraits& own = sensor_traits(s.kind);
+  const std::string kind = to_string(s.kind);
+  for (const SensorField& f : own.fields) {
+    if (!f.name) continue;
+    if (!r.has(f.name))
+      fail_field(sc.source, r.field(f.name), "is required for " + std::string(own.plural) + " (" + f.meaning + ")",
+                 "none");
+    const double v = r.num(f.name, 0.0);
+    if (f.rule == SensorField::Rule::Nonzero && !(v != 0.0))
+      fail_field(sc.source, r.field(f.name), "must be nonzero (" + std::string(f.why) + ")", format_value(v));
+    if (f.rule == SensorField::Rule::Station) {
+      check_location(sc, r.field(f.name), s.at, v);
+      if (v == s.location)
+        fail_field(sc.source, r.field(f.name), "must differ from location (" + std::string(f.why) + ")",
+                   format_value(v));
+    }
+    s.fields[f.name] = v;
+  }
+  for (const SensorKindTraits& other : kSensorKinds)
+    for (const SensorField& f : other.fields)
+      if (f.name && !s.fields.count(f.name) && r.has(f.name))
+        fail_field(sc.source, r.field(f.name),
+                   "belongs to " + std::string(other.plural) + " (kind: " + to_string(other.kind) + ")",
+                   "'" + kind + "' sensor");
+}
+
 void parse_sensors(const YAML::Node& n, Scenario& sc) {
   if (!n || n.IsNull()) return;
   if (!n.IsSequence()) fail_field(sc.source, "sensors", "must be a list", Reader::kind(n));
@@ -502,13 +530,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.column = r.str("column", "");
     s.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(s.kind), s.unit, s.column_unit);
-    if (s.kind == SensorKind::Strain) {
-      if (!r.has("offset")) fail_field(sc.source, r.field("offset"), "is required for a strain gauge (its distance from the neutral axis)", "none");
-      s.offset = r.num("offset", 0.0);
-      if (!(s.offset != 0.0)) fail_field(sc.source, r.field("offset"), "must be nonzero (a gauge on the neutral axis reads nothing)", format_value(s.offset));
-    } else if (r.has("offset")) {
-      fail_field(sc.source, r.field("offset"), "belongs to strain gauges (kind: strain)", "'" + std::string(to_string(s.kind)) + "' sensor");
-    }
+    parse_sensor_fields(sc, r, s);
     // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
     // cannot explain, so they belong to the truth's side of a mismatch study only.
     for (const char* key : {"bias", "drift"})
@@ -867,7 +889,7 @@ nlohmann::json to_json(const Scenario& s) {
   for (const auto& se : s.sensors) {
     j["sensors"].push_back({{"name", se.name}, {"at", to_string(se.at)}, {"kind", to_string(se.kind)}, {"location", se.location},
                             {"direction", se.direction}, {"unit", se.unit}, {"noise_std", se.noise_std}});
-    if (se.kind == SensorKind::Strain) j["sensors"].back()["offset"] = se.offset;
+    for (const auto& [name, value] : se.fields) j["sensors"].back()[name] = value;
     if (!se.column.empty()) j["sensors"].back()["column"] = se.column;
     if (!se.column_unit.empty()) j["sensors"].back()["column_unit"] = se.column_unit;
   }

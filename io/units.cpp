@@ -1,5 +1,7 @@
 #include "scoleid/io/units.h"
 
+#include "scoleid/io/types.h"
+
 #include <udunits2.h>
 
 #include <cctype>
@@ -114,11 +116,7 @@ const char* quantity_name(Quantity q) {
 }
 
 std::optional<Quantity> quantity_of_kind(const std::string& kind) {
-  if (kind == "displacement") return Quantity::Length;
-  if (kind == "rotation" || kind == "line_of_sight") return Quantity::Angle;
-  if (kind == "velocity") return Quantity::Velocity;
-  if (kind == "acceleration") return Quantity::Acceleration;
-  if (kind == "strain") return Quantity::Strain;
+  if (const auto k = io::parse<io::SensorKind>(kind)) return io::sensor_traits(*k).quantity;
   if (kind == "force") return Quantity::Force;
   if (kind == "moment") return Quantity::Moment;
   return std::nullopt;

@@ -66,7 +66,7 @@ void resolve_strain(const io::BeamSpec& beam, const Structure& st, const io::Sen
   r.joints[0] = joint(j);
   r.joints[1] = joint(j + 1);
   r.weight = std::clamp(se.location / h - j, 0.0, 1.0);
-  r.scale = -se.offset / EI.at(se.location);
+  r.scale = -se.field("offset") / EI.at(se.location);
 }
 
 double joint_moment(const SimbodyMatterSubsystem& matter, const State& state, const ResolvedSensor::Joint& jt) {
@@ -95,15 +95,15 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     if (planar) {
       if (se.at != io::Site::Beam)
         io::fail_field(sc.source, field + ".at", "must be 'beam' for a " + kind + " structure", io::quoted(se.at));
-      if (r.kind == K::LineOfSight)
-        io::fail_field(sc.source, field + ".kind", "is not defined for a " + kind + " structure", "'line_of_sight'");
+      if (!io::reads(st.kind(), r.kind))
+        io::fail_field(sc.source, field + ".kind", "is not defined for a " + kind + " structure", io::quoted(r.kind));
       r.station = st.station_at(se.location);
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
       if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
       if (r.kind == K::Strain) resolve_strain(sc.beam, st, se, r);
     } else {
-      if (r.kind == K::Strain)
-        io::fail_field(sc.source, field + ".kind", "is a beam's strain gauge (structure: beam)", "'strain'");
+      if (!io::reads(st.kind(), r.kind))
+        io::fail_field(sc.source, field + ".kind", "is not read on a " + kind + " structure", io::quoted(r.kind));
       if (se.at == io::Site::Beam)
         io::fail_field(sc.source, field + ".at", "must not be 'beam' for a " + kind + " structure", "'beam'");
       if (d.norm() == 0)

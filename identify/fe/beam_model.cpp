@@ -1,6 +1,7 @@
 #include "scoleid/identify/fe/beam_model.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "scoleid/identify/fe/hermite_beam.h"
 #include "scoleid/io/error.h"
@@ -63,29 +64,44 @@ void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io:
   }
 }
 
-// The sensors' rows: w(s) or w_s(s); velocity and acceleration the displacement row on u̇, ü.
+// A sensor's output row on u (docs/theory.md §3.5): w(s) or w_s(s); velocity and acceleration the
+// displacement row, read on u̇, ü (ModelSensor::order); a strain gauge ε = −offset · w_ss, the
+// Hermite curvature row (linear in each element).
+Eigen::RowVectorXd beam_sensor_row(const BeamFE& fe, const io::SensorSpec& se) {
+  using K = io::SensorKind;
+  switch (se.kind) {
+    case K::Displacement:
+    case K::Velocity:
+    case K::Acceleration:
+      return fe.displacement_row(se.location);
+    case K::Rotation:
+      return fe.rotation_row(se.location);
+    case K::Strain:
+      return -se.field("offset") * fe.curvature_row(se.location);
+    case K::LineOfSight:
+      break;
+  }
+  throw std::logic_error("beam_sensor_row: a sensor kind the beam does not read");
+}
+
 void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::SensorSpec>& sensors, const std::string& source) {
   StructuralModel& m = fe.model;
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
     if (se.at != io::Site::Beam) fail_field(source, f + ".at", "must be 'beam' for a beam structure", io::quoted(se.at));
-    if (se.kind == io::SensorKind::LineOfSight)
+    if (!io::reads(io::Structure::Beam, se.kind))
       fail_field(source, f + ".kind",
-                 "is not supported by the beam identifier (displacement|rotation|velocity|acceleration|strain)",
-                 "'" + std::string(io::to_string(se.kind)) + "'");
+                 "is not supported by the beam identifier (" + io::sensor_kinds_read_by(io::Structure::Beam) + ")",
+                 io::quoted(se.kind));
     if (!(se.location >= 0.0 && se.location <= beam.length))
       fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
                  format_value(se.location));
     ModelSensor ms;
     ms.name = se.name;
     ms.kind = se.kind;
-    // velocity and acceleration: w_t, w_tt — the displacement row on u̇, ü.
     ms.order = io::derivative_order(se.kind);
-    // strain: ε = −offset · w_ss, the Hermite curvature row (linear in each element).
-    ms.row = se.kind == io::SensorKind::Rotation ? fe.rotation_row(se.location)
-             : se.kind == io::SensorKind::Strain ? Eigen::RowVectorXd(-se.offset * fe.curvature_row(se.location))
-                                   : fe.displacement_row(se.location);
+    ms.row = beam_sensor_row(fe, se);
     m.sensors.push_back(std::move(ms));
   }
 }

@@ -427,10 +427,10 @@ ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpe
   if (io::derivative_order(se.kind) > 0) {
     ms.order = io::derivative_order(se.kind);
     row = rate_sensor_row(fr, se, d, ms.order, fe.spec.length, f, source);
-  } else if (se.kind == io::SensorKind::Strain) {
+  } else if (!io::reads(io::Structure::Scole, se.kind)) {
     fail_field(source, f + ".kind",
-               "is not supported by the SCOLE identifier (displacement|rotation|line_of_sight|velocity|acceleration)",
-               "'" + std::string(io::to_string(se.kind)) + "'");
+               "is not supported by the SCOLE identifier (" + io::sensor_kinds_read_by(io::Structure::Scole) + ")",
+               io::quoted(se.kind));
   } else {
     row = position_sensor_row(fe, fr, se, d, f, source);
   }

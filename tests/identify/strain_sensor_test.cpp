@@ -43,7 +43,7 @@ TEST(StrainSensor, TheHermiteCantileverReadsTheStaticMomentExactly) {
     g.name = "eps";
     g.kind = scoleid::io::SensorKind::Strain;
     g.location = s;
-    g.offset = c;
+    g.fields["offset"] = c;
     gauges.push_back(g);
   }
   const BeamFE fe = build_beam(beam, 3, 1, {tip}, gauges, "test");
@@ -81,7 +81,7 @@ TEST(StrainSensor, TheScenarioStatesTheGaugesOffsetAndNothingElseTakesOne) {
   };
   const std::string head = "beam: {left: clamped, right: free}\ninputs: [{name: F, location: 10}]\n";
   const auto sc = scoleid::io::parse_scenario(head + "sensors: [{name: e, kind: strain, location: 1, offset: -0.002}]\n", "x");
-  EXPECT_EQ(sc.sensors[0].offset, -0.002);
+  EXPECT_EQ(sc.sensors[0].field("offset"), -0.002);
   EXPECT_EQ(scoleid::io::to_json(sc)["sensors"][0]["offset"].get<double>(), -0.002);
   EXPECT_NE(error_of(head + "sensors: [{name: e, kind: strain, location: 1}]\n").find("sensors[0].offset"), std::string::npos);
   EXPECT_NE(error_of(head + "sensors: [{name: e, kind: strain, location: 1, offset: 0}]\n").find("must be nonzero"),

@@ -64,7 +64,10 @@ TEST(Types, EverySensorKindIsReadBySomeStructureAndRefusedByNameElsewhere) {
   for (const auto& kind : names<SensorKind>()) {
     int readers = 0;
     for (const auto& [structure, head] : heads) {
-      const std::string extra = kind == "strain" ? ", offset: 0.01" : "";
+      // The kind's own fields (types.h, kSensorKinds), each with a value its rule takes.
+      std::string extra;
+      for (const SensorField& f : sensor_traits(*parse<SensorKind>(kind)).fields)
+        if (f.name) extra += std::string(", ") + f.name + (f.rule == SensorField::Rule::Station ? ": 2" : ": 0.01");
       const std::string yaml =
           head + "sensors: [{name: s, kind: " + kind + ", location: 5, direction: y" + extra + "}]\n";
       try {

@@ -146,7 +146,8 @@ struct InputSpec : PointSpec {
   std::string column_unit;
 };
 
-// A sensor. kind: displacement | rotation | velocity | acceleration | line_of_sight | strain.
+// A sensor. kind: one of the sensor kinds (io/types.h, kSensorKinds: what each reads and which
+// structures read it; a kind's own fields, such as a strain gauge's offset, are in `fields`).
 // For beams: transverse displacement w(s) or slope w_s(s) at `location`; a strain gauge (beams
 // only) reads the axial surface strain ε = −offset · w_ss(s), `offset` the gauge's signed distance
 // from the neutral axis (+ on the side w points to: a positive curvature w_ss shortens it),
@@ -155,7 +156,11 @@ struct InputSpec : PointSpec {
 struct SensorSpec : PointSpec {
   SensorKind kind = SensorKind::Displacement;
   double noise_std = 0.0;
-  double offset = 0.0;  // strain: distance of the gauge from the neutral axis (≠ 0); other kinds: 0
+  // The numbers its kind declares besides the common fields (types.h, SensorKindTraits::fields),
+  // by name, e.g. a strain gauge's "offset"; empty for the kinds that declare none.
+  std::map<std::string, double> fields;
+  // The value of a field its kind declares (std::out_of_range if the sensor has none by that name).
+  double field(const std::string& name) const { return fields.at(name); }
   // The sensor's own error in the truth, in its unit: the truth writes
   //   y(t) = y_ideal(t) + bias + drift·t + noise,
   // bias a constant offset, drift a rate [unit/s]. Set only under truth.overrides.sensors (the

@@ -14,13 +14,16 @@
 //   SignalFrom  inputs[].signal_from                 what drives an input with a data file (§9)
 //
 // Adding a value: one enumerator and one row of its table, here; the reader, --help and the JSON
-// writers follow, and a switch over the type that misses it is a compiler warning.
+// writers follow, and a switch over the type that misses it is a compiler warning. A sensor kind
+// also has one row of kSensorKinds (what it reads, which structures read it, its own fields).
 #include <array>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "scoleid/io/units.h"
 
 namespace scoleid::io {
 
@@ -99,17 +102,88 @@ constexpr bool has_station(Site s) { return s == Site::Beam || s == Site::Mast; 
 // The proof-mass actuator a site names (0, 1), or -1.
 constexpr int actuator_index(Site s) { return s == Site::Actuator1 ? 0 : s == Site::Actuator2 ? 1 : -1; }
 
-// The time derivative of the structure's motion a sensor of this kind reads: 0 (displacement,
-// rotation, line of sight, strain), 1 (velocity), 2 (acceleration).
-constexpr int derivative_order(SensorKind k) {
-  return k == SensorKind::Velocity ? 1 : k == SensorKind::Acceleration ? 2 : 0;
+// A number a sensor kind needs besides the fields every sensor has (name, at, location,
+// direction, unit, noise_std, column): the scenario reader requires it on a sensor of the kind,
+// checks it by its rule, keeps it in SensorSpec::fields and refuses it on a sensor of any other
+// kind; the JSON writer writes it.
+struct SensorField {
+  enum class Rule {
+    Nonzero,  // a number ≠ 0 (`why` says what a zero would mean)
+    Station   // a station on the sensor's site, like `location`, and apart from it
+  };
+  const char* name = nullptr;  // nullptr: no field
+  const char* meaning = nullptr;
+  Rule rule = Rule::Nonzero;
+  const char* why = nullptr;
+};
+
+// What a sensor of each kind reads (docs/theory.md §3.5), one row per kind:
+//   order       the time derivative of the structure's motion it reads: 0 (displacement-like),
+//               1 (velocity), 2 (acceleration);
+//   quantity    the physical quantity of its values (the dimension its unit must have);
+//   structures  the structure kinds whose models read it (the scenario reader refuses the rest),
+//               a bit per Structure (structures_of);
+//   mode_shape  whether its value in a mode is an ordinate of the mode shape the cross-check's
+//               modal data hold (a displacement or a rotation of one point);
+//   plural      what messages call sensors of the kind;
+//   fields      the numbers it needs besides the common ones.
+struct SensorKindTraits {
+  SensorKind kind;
+  int order;
+  units::Quantity quantity;
+  unsigned structures;
+  bool mode_shape;
+  const char* plural;
+  std::array<SensorField, 2> fields;
+};
+
+constexpr unsigned structures_of(Structure s) { return 1u << static_cast<unsigned>(s); }
+inline constexpr unsigned kEveryStructure = ~0u;
+
+inline constexpr std::array<SensorKindTraits, 6> kSensorKinds{{
+    {SensorKind::Displacement, 0, units::Quantity::Length, kEveryStructure, true, "displacement sensors", {}},
+    {SensorKind::Rotation, 0, units::Quantity::Angle, kEveryStructure, true, "rotation sensors", {}},
+    {SensorKind::Velocity, 1, units::Quantity::Velocity, kEveryStructure, false, "velocity sensors", {}},
+    {SensorKind::Acceleration, 2, units::Quantity::Acceleration, kEveryStructure, false, "accelerometers", {}},
+    {SensorKind::LineOfSight,
+     0,
+     units::Quantity::Angle,
+     structures_of(Structure::Scole),
+     true,
+     "line-of-sight sensors",
+     {}},
+    // ε = −offset · w_ss: the beam's curvature (docs/theory.md §3.5).
+    {SensorKind::Strain,
+     0,
+     units::Quantity::Strain,
+     structures_of(Structure::Beam),
+     false,
+     "strain gauges",
+     {{{"offset", "its distance from the neutral axis", SensorField::Rule::Nonzero,
+        "a gauge on the neutral axis reads nothing"}}}},
+}};
+
+// The row of a sensor kind.
+constexpr const SensorKindTraits& sensor_traits(SensorKind k) {
+  for (const auto& row : kSensorKinds)
+    if (row.kind == k) return row;
+  return kSensorKinds[0];  // unreachable: every kind has a row (below)
 }
 
-// Whether the models of a structure kind read this sensor kind (the scenario reader refuses the
-// others): a strain gauge is a beam's (its curvature), a line of sight SCOLE's (feed to reflector).
-constexpr bool reads(Structure s, SensorKind k) {
-  return k == SensorKind::Strain ? s == Structure::Beam : k == SensorKind::LineOfSight ? s == Structure::Scole : true;
+constexpr bool every_sensor_kind_has_its_row() {
+  if (kSensorKinds.size() != Names<SensorKind>::rows.size()) return false;
+  for (std::size_t i = 0; i < kSensorKinds.size(); ++i)
+    if (kSensorKinds[i].kind != Names<SensorKind>::rows[i].first) return false;
+  return true;
 }
+static_assert(every_sensor_kind_has_its_row(), "kSensorKinds: one row per SensorKind, in the order of its names");
+
+// The time derivative of the structure's motion a sensor of this kind reads (traits.order).
+constexpr int derivative_order(SensorKind k) { return sensor_traits(k).order; }
+
+// Whether the models of a structure kind read this sensor kind (the scenario reader refuses the
+// others).
+constexpr bool reads(Structure s, SensorKind k) { return (sensor_traits(k).structures & structures_of(s)) != 0; }
 
 // The name a scenario, a command line and identify.json use.
 template <class E, class = decltype(Names<E>::rows)>
@@ -117,6 +191,14 @@ const char* to_string(E v) {
   for (const auto& [value, name] : Names<E>::rows)
     if (value == v) return name;
   return "?";
+}
+
+// The names of the sensor kinds a structure kind's models read, joined by `sep`.
+inline std::string sensor_kinds_read_by(Structure s, const char* sep = "|") {
+  std::string out;
+  for (const auto& [k, name] : Names<SensorKind>::rows)
+    if (reads(s, k)) out += (out.empty() ? "" : sep) + std::string(name);
+  return out;
 }
 
 // The name in single quotes, as a message shows a field's value: 'moment'.
