@@ -101,6 +101,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
       if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
       if (r.kind == K::Strain) resolve_strain(sc.beam, st, se, r);
+      if (r.kind == K::RelativeDisplacement) r.apart = st.station_at(se.field("reference"));
     } else {
       if (!io::reads(st.kind(), r.kind))
         io::fail_field(sc.source, field + ".kind", "is not read on a " + kind + " structure", io::quoted(r.kind));
@@ -143,6 +144,12 @@ double read_sensor(const SimbodyMatterSubsystem& matter, const State& state, con
       const Vec3 u0 = (s.station.p_RS0 - s.root_R).normalize();
       const Vec3 u = (p_RP - s.root_R).normalize();
       return dot(cross(u0, u), s.d_R);
+    }
+    case K::RelativeDisplacement: {
+      const MobilizedBody& A = matter.getMobilizedBody(s.apart.body);
+      const Vec3 p_RP = B.findStationLocationInAnotherBody(state, s.station.p_BS, R);
+      const Vec3 p_RA = A.findStationLocationInAnotherBody(state, s.apart.p_BS, R);
+      return dot((p_RP - s.station.p_RS0) - (p_RA - s.apart.p_RS0), s.d_R);
     }
     case K::Strain:
       return s.scale * ((1.0 - s.weight) * joint_moment(matter, state, s.joints[0]) +

@@ -66,7 +66,7 @@ void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io:
 
 // A sensor's output row on u (docs/theory.md §3.5): w(s) or w_s(s); velocity and acceleration the
 // displacement row, read on u̇, ü (ModelSensor::order); a strain gauge ε = −offset · w_ss, the
-// Hermite curvature row (linear in each element).
+// Hermite curvature row (linear in each element); a relative-displacement gauge w(s) − w(reference).
 Eigen::RowVectorXd beam_sensor_row(const BeamFE& fe, const io::SensorSpec& se) {
   using K = io::SensorKind;
   switch (se.kind) {
@@ -78,6 +78,8 @@ Eigen::RowVectorXd beam_sensor_row(const BeamFE& fe, const io::SensorSpec& se) {
       return fe.rotation_row(se.location);
     case K::Strain:
       return -se.field("offset") * fe.curvature_row(se.location);
+    case K::RelativeDisplacement:
+      return fe.displacement_row(se.location) - fe.displacement_row(se.field("reference"));
     case K::LineOfSight:
       break;
   }

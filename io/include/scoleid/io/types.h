@@ -32,7 +32,7 @@ enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent
 enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
-enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain };
+enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain, RelativeDisplacement };
 enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
 enum class InputKind { Force, Moment };
 enum class SignalFrom { Auto, Data, Scenario };
@@ -69,12 +69,14 @@ struct Names<StepRule> {
 
 template <>
 struct Names<SensorKind> {
-  static constexpr std::array<std::pair<SensorKind, const char*>, 6> rows{{{SensorKind::Displacement, "displacement"},
-                                                                          {SensorKind::Rotation, "rotation"},
-                                                                          {SensorKind::Velocity, "velocity"},
-                                                                          {SensorKind::Acceleration, "acceleration"},
-                                                                          {SensorKind::LineOfSight, "line_of_sight"},
-                                                                          {SensorKind::Strain, "strain"}}};
+  static constexpr std::array<std::pair<SensorKind, const char*>, 7> rows{
+      {{SensorKind::Displacement, "displacement"},
+       {SensorKind::Rotation, "rotation"},
+       {SensorKind::Velocity, "velocity"},
+       {SensorKind::Acceleration, "acceleration"},
+       {SensorKind::LineOfSight, "line_of_sight"},
+       {SensorKind::Strain, "strain"},
+       {SensorKind::RelativeDisplacement, "relative_displacement"}}};
 };
 
 template <>
@@ -140,7 +142,7 @@ struct SensorKindTraits {
 constexpr unsigned structures_of(Structure s) { return 1u << static_cast<unsigned>(s); }
 inline constexpr unsigned kEveryStructure = ~0u;
 
-inline constexpr std::array<SensorKindTraits, 6> kSensorKinds{{
+inline constexpr std::array<SensorKindTraits, 7> kSensorKinds{{
     {SensorKind::Displacement, 0, units::Quantity::Length, kEveryStructure, true, "displacement sensors", {}},
     {SensorKind::Rotation, 0, units::Quantity::Angle, kEveryStructure, true, "rotation sensors", {}},
     {SensorKind::Velocity, 1, units::Quantity::Velocity, kEveryStructure, false, "velocity sensors", {}},
@@ -161,6 +163,15 @@ inline constexpr std::array<SensorKindTraits, 6> kSensorKinds{{
      "strain gauges",
      {{{"offset", "its distance from the neutral axis", SensorField::Rule::Nonzero,
         "a gauge on the neutral axis reads nothing"}}}},
+    // w(location) − w(reference): a transducer between two stations of the beam (§3.5).
+    {SensorKind::RelativeDisplacement,
+     0,
+     units::Quantity::Length,
+     structures_of(Structure::Beam),
+     false,
+     "relative-displacement gauges",
+     {{{"reference", "the station its other end is fixed to", SensorField::Rule::Station,
+        "a gauge whose two ends meet reads nothing"}}}},
 }};
 
 // The row of a sensor kind.

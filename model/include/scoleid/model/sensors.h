@@ -19,6 +19,8 @@
 //                  clamped end's against ground; pinned and free ends carry none), k_j φ_j =
 //                  EI w_ss(s_j) to O(h²) (hencky.h), and M is linear between the two joints
 //                  around s (exact for point loads between them).
+//   relative_displacement  (beams) the displacement read-out at `location` less the one at
+//                  `reference`: a transducer between two stations, w(s) − w(s_ref).
 // Shuttle sensors ("at: shuttle") measure the shuttle itself in ground: CM displacement and the
 // attitude rotation vector relative to its initial orientation.
 // d need not be an axis: every read-out is linear in d (a projection onto it, or the rotation
@@ -53,6 +55,7 @@ struct ResolvedSensor {
   };
   Joint joints[2];
   double scale = 0.0;
+  Station apart;  // relative_displacement: the station at `reference`, read like `station`, subtracted
 };
 
 std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& scenario, const Structure& structure);
