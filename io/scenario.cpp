@@ -479,6 +479,19 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
   }
 }
 
+// A value v of a sensor kind's own field f for sensor s (read from `source`, at `field`), by
+// the field's rule.
+void check_sensor_field(const Scenario& sc, const std::string& source, const std::string& field, const SensorField& f,
+                        const SensorSpec& s, double v) {
+  if (f.rule == SensorField::Rule::Nonzero && !(v != 0.0))
+    fail_field(source, field, "must be nonzero (" + std::string(f.why) + ")", format_value(v));
+  if (f.rule == SensorField::Rule::Station) {
+    check_location(sc, field, s.at, v, source);
+    if (v == s.location)
+      fail_field(source, field, "must differ from location (" + std::string(f.why) + ")", format_value(v));
+  }
+}
+
 // The numbers the sensor's kind declares (types.h, SensorKindTraits::fields), each checked by its
 // rule, and none that only another kind declares.
 void parse_sensor_fields(const Scenario& sc, Reader& r, SensorSpec& s) {
@@ -490,14 +503,7 @@ void parse_sensor_fields(const Scenario& sc, Reader& r, SensorSpec& s) {
       fail_field(sc.source, r.field(f.name), "is required for " + std::string(own.plural) + " (" + f.meaning + ")",
                  "none");
     const double v = r.num(f.name, 0.0);
-    if (f.rule == SensorField::Rule::Nonzero && !(v != 0.0))
-      fail_field(sc.source, r.field(f.name), "must be nonzero (" + std::string(f.why) + ")", format_value(v));
-    if (f.rule == SensorField::Rule::Station) {
-      check_location(sc, r.field(f.name), s.at, v);
-      if (v == s.location)
-        fail_field(sc.source, r.field(f.name), "must differ from location (" + std::string(f.why) + ")",
-                   format_value(v));
-    }
+    check_sensor_field(sc, sc.source, r.field(f.name), f, s, v);
     s.fields[f.name] = v;
   }
   for (const SensorKindTraits& other : kSensorKinds)
@@ -686,6 +692,13 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
         fail_field(source, r.field("direction"), "does not apply to a beam sensor (it measures w or w_s)",
                    Reader::kind(r.child("direction")));
       se.direction = parse_direction(r, "direction");
+    }
+    // The kind's own fields (a strain gauge's offset, a relative gauge's reference), by their rules.
+    for (const SensorField& f : sensor_traits(se.kind).fields) {
+      if (!f.name || !(r.has(f.name) || r.has("location"))) continue;
+      const double v = r.has(f.name) ? r.num(f.name, 0.0) : se.field(f.name);
+      check_sensor_field(t, source, r.field(r.has(f.name) ? f.name : "location"), f, se, v);
+      se.fields[f.name] = v;
     }
     se.bias = r.num("bias", se.bias);
     se.drift = r.num("drift", se.drift);
@@ -918,7 +931,9 @@ nlohmann::json to_json(const Scenario& s) {
   // Sensor overrides: per sensor, its name and the fields in which the truth's sensor differs.
   json sensor_overrides = json::array();
   auto sensor_fields = [](const SensorSpec& se) {
-    return json{{"location", se.location}, {"direction", se.direction}, {"bias", se.bias}, {"drift", se.drift}};
+    json f{{"location", se.location}, {"direction", se.direction}, {"bias", se.bias}, {"drift", se.drift}};
+    for (const auto& [name, value] : se.fields) f[name] = value;
+    return f;
   };
   for (std::size_t i = 0; i < s.sensors.size() && i < ts.sensors.size(); ++i) {
     const json base = sensor_fields(s.sensors[i]), truth = sensor_fields(ts.sensors[i]);

@@ -345,3 +345,56 @@ TEST(ActuatorLag, FiniteElementModelRefusesALag) {
   EXPECT_NO_THROW(scoleid::identify::make_structure(ov, 4));
   EXPECT_DOUBLE_EQ(io::truth_scenario(ov).scole.actuator_lag, 0.05);
 }
+
+TEST(SensorOverrides, AKindsOwnFieldsAreOverriddenByTheirRules) {
+  // A strain gauge bonded twice as far from the neutral axis reads exactly twice the strain
+  // (ε = −offset · M / EI); a relative gauge whose reference end is moved reads what a gauge placed
+  // there reads. The truth records both; a value its kind's rule refuses is refused by name.
+  namespace io = scoleid::io;
+  const std::string head =
+      "name: gauges\n"
+      "beam: {length: 0.6, left: clamped, right: free, rho_A: 0.4, EI: 30}\n"
+      "inputs: [{name: F, location: 0.55, signal: {type: haversine, amplitude: 2, t0: 0.001, width: 0.004}}]\n"
+      "sensors:\n"
+      "  - {name: eps, kind: strain, location: 0.04, offset: 0.0015}\n"
+      "  - {name: rel, kind: relative_displacement, location: 0.6, reference: 0.3}\n"
+      "  - {name: rel_02, kind: relative_displacement, location: 0.6, reference: 0.2}\n"
+      "simulation: {duration: 0.02, sample_interval: 0.0005}\n";
+  const auto truth = [&](const std::string& overrides) {
+    return head + "truth:\n  overrides:\n    sensors:\n" + overrides;
+  };
+  const io::Scenario base = io::parse_scenario(head, "gauges");
+  const io::Scenario sc = io::parse_scenario(
+      truth("      - {name: eps, offset: 0.003}\n      - {name: rel, reference: 0.2}\n"), "gauges-moved");
+  EXPECT_EQ(sc.sensors[0].field("offset"), 0.0015);  // the identifier's gauges are as stated
+  const auto r0 = scoleid::model::run_truth(base);
+  const auto r = scoleid::model::run_truth(sc);
+  const auto &eps = column(r.table, "eps"), &eps0 = column(r0.table, "eps");
+  ASSERT_EQ(eps.size(), eps0.size());
+  for (std::size_t k = 0; k < eps.size(); ++k) EXPECT_EQ(eps[k], 2.0 * eps0[k]) << "sample " << k;
+  EXPECT_GT(max_abs(eps0), 0.0);
+  EXPECT_EQ(column(r.table, "rel"), column(r.table, "rel_02"));
+  EXPECT_GT(relative_difference(column(r0.table, "rel"), column(r0.table, "rel_02")), 0.1);
+  const nlohmann::json& ov = r.meta.settings["truth"]["overrides"]["sensors"];
+  ASSERT_EQ(ov.size(), 2u);
+  EXPECT_EQ(ov[0], (nlohmann::json{{"name", "eps"}, {"offset", 0.003}}));
+  EXPECT_EQ(ov[1], (nlohmann::json{{"name", "rel"}, {"reference", 0.2}}));
+  const auto error_of = [&](const std::string& overrides) {
+    try {
+      io::parse_scenario(truth(overrides), "gauges-wrong");
+    } catch (const io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string ends = error_of("      - {name: rel, reference: 0.6}\n");
+  EXPECT_NE(ends.find("truth.overrides.sensors[0].reference"), std::string::npos) << ends;
+  EXPECT_NE(ends.find("must differ from location"), std::string::npos) << ends;
+  const std::string onto = error_of("      - {name: rel, location: 0.3}\n");
+  EXPECT_NE(onto.find("truth.overrides.sensors[0].location"), std::string::npos) << onto;
+  const std::string off = error_of("      - {name: rel, reference: 0.7}\n");
+  EXPECT_NE(off.find("must lie on the beam"), std::string::npos) << off;
+  const std::string zero = error_of("      - {name: eps, offset: 0}\n");
+  EXPECT_NE(zero.find("truth.overrides.sensors[0].offset"), std::string::npos) << zero;
+  EXPECT_NE(zero.find("must be nonzero"), std::string::npos) << zero;
+}
