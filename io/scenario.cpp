@@ -826,23 +826,41 @@ Scenario load_scenario(const std::string& name_or_file) {
   return parse_scenario(read_text_file(name_or_file, "scenario file"), "scenario '" + name_or_file + "'");
 }
 
+namespace {
+
+// A signal's terms as the scenario writes them.
+nlohmann::json signal_json(const Signal& sig) {
+  using nlohmann::json;
+  json terms = json::array();
+  for (const auto& t : sig.terms()) {
+    json j{{"type", to_string(t.type)}, {"amplitude", t.amplitude}, {"t0", t.t0}};
+    if (t.width > 0) j["width"] = t.width;
+    if (t.type == SignalTerm::Type::Sine) {
+      j["frequency"] = t.f0;
+      j["phase"] = t.phase;
+      j["duration"] = t.duration;
+    }
+    if (t.type == SignalTerm::Type::Chirp) {
+      j["f0"] = t.f0;
+      j["f1"] = t.f1;
+      j["duration"] = t.duration;
+    }
+    if (t.type == SignalTerm::Type::Table || t.type == SignalTerm::Type::CubicTable) {
+      j["times"] = t.times;
+      j["values"] = t.values;
+    }
+    terms.push_back(j);
+  }
+  return terms;
+}
+
+}  // namespace
+
 nlohmann::json to_json(const Scenario& s) {
   using nlohmann::json;
   auto rigid = [](const RigidBodySpec& b) {
     return json{{"mass", b.mass}, {"Ixx", b.Ixx}, {"Iyy", b.Iyy}, {"Izz", b.Izz},
                 {"Ixy", b.Ixy}, {"Ixz", b.Ixz}, {"Iyz", b.Iyz}};
-  };
-  auto signal = [](const Signal& sig) {
-    json terms = json::array();
-    for (const auto& t : sig.terms()) {
-      json j{{"type", to_string(t.type)}, {"amplitude", t.amplitude}, {"t0", t.t0}};
-      if (t.width > 0) j["width"] = t.width;
-      if (t.type == SignalTerm::Type::Sine) { j["frequency"] = t.f0; j["phase"] = t.phase; j["duration"] = t.duration; }
-      if (t.type == SignalTerm::Type::Chirp) { j["f0"] = t.f0; j["f1"] = t.f1; j["duration"] = t.duration; }
-      if (t.type == SignalTerm::Type::Table || t.type == SignalTerm::Type::CubicTable) { j["times"] = t.times; j["values"] = t.values; }
-      terms.push_back(j);
-    }
-    return terms;
   };
   json j;
   j["name"] = s.name;
@@ -892,9 +910,14 @@ nlohmann::json to_json(const Scenario& s) {
   }
   j["inputs"] = json::array();
   for (const auto& in : s.inputs) {
-    j["inputs"].push_back({{"name", in.name}, {"at", to_string(in.at)}, {"kind", to_string(in.kind)}, {"location", in.location},
-                           {"direction", in.direction}, {"unit", in.unit}, {"signal_from", to_string(in.signal_from)},
-                           {"signal", signal(in.signal)}});
+    j["inputs"].push_back({{"name", in.name},
+                           {"at", to_string(in.at)},
+                           {"kind", to_string(in.kind)},
+                           {"location", in.location},
+                           {"direction", in.direction},
+                           {"unit", in.unit},
+                           {"signal_from", to_string(in.signal_from)},
+                           {"signal", signal_json(in.signal)}});
     if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
     if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;
   }
