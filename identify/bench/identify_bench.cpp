@@ -8,13 +8,17 @@
 //      (data synthesis, identification, identifiability, outputs), with the split;
 //   6. the banded solve of P right-hand sides (the sensitivities' stage solves): P one-column
 //      sweeps against one sweep over all P columns, on a beam's and SCOLE's Newton matrix.
-// Each figure is the minimum over repetitions (wall clock, steady_clock).
+// Each figure is the minimum over repetitions (wall clock, steady_clock). `--part K` (repeatable)
+// runs only the parts named; the summary line then shows 0 for the others.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <cstdlib>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "best_of.h"
 #include "scoleid/identify/time/banded_cholesky.h"
@@ -63,13 +67,25 @@ BandedCholesky newton_factor(const Problem& p) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  std::vector<int> parts;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--part" && i + 1 < argc && std::atoi(argv[i + 1]) >= 1 && std::atoi(argv[i + 1]) <= 6) {
+      parts.push_back(std::atoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: scole-identify-bench [--part K]...  (K = 1..6; all parts when none is named)\n");
+      return a == "--help" || a == "-h" ? 0 : 2;
+    }
+  }
+  const auto want = [&](int k) { return parts.empty() || std::find(parts.begin(), parts.end(), k) != parts.end(); };
   std::printf("scole-identify-bench (wall clock, best of repetitions)\n\n");
 
-  std::printf("1. Gradient cost relative to one forward solve (64 elements, 1 s, h = 1e-4)\n");
-  std::printf("%6s %12s %12s %10s %12s %10s\n", "N", "forward [s]", "adjoint [s]", "ratio", "central FD", "ratio");
+  if (want(1)) std::printf("1. Gradient cost relative to one forward solve (64 elements, 1 s, h = 1e-4)\n");
+  if (want(1)) std::printf("%6s %12s %12s %10s %12s %10s\n", "N", "forward [s]", "adjoint [s]", "ratio", "central FD", "ratio");
   double ratio_n2 = 0, ratio_n64 = 0, grad_n2 = 0, grad_n64 = 0;
   for (int N : {2, 64}) {
+    if (!want(1)) break;
     auto p = make_problem(sections_scenario(N, 64), std::nullopt);
     Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
     const VectorXd q = p->params->initial();
@@ -86,13 +102,14 @@ int main() {
     (N == 2 ? ratio_n2 : ratio_n64) = tg / tf;
     (N == 2 ? grad_n2 : grad_n64) = tg;
   }
-  std::printf("   adjoint gradient time N=64 / N=2: %.2f\n\n", grad_n64 / grad_n2);
+  if (want(1)) std::printf("   adjoint gradient time N=64 / N=2: %.2f\n\n", grad_n64 / grad_n2);
 
-  std::printf("2. Forward solve vs elements (paper-beam-1 geometry, 10 s, h = 0.01)\n");
-  std::printf("%10s %8s %12s %12s\n", "elements", "dofs", "forward [s]", "growth exp");
+  if (want(2)) std::printf("2. Forward solve vs elements (paper-beam-1 geometry, 10 s, h = 0.01)\n");
+  if (want(2)) std::printf("%10s %8s %12s %12s\n", "elements", "dofs", "forward [s]", "growth exp");
   double prev = 0;
   int prev_ne = 0;
   for (int ne : {10, 20, 40, 80}) {
+    if (!want(2)) break;
     auto sc = scoleid::io::load_scenario("paper-beam-1");
     sc.identification.elements = ne;
     sc.identification.data_elements = 2 * ne;
@@ -109,11 +126,11 @@ int main() {
     prev_ne = ne;
   }
 
-  std::printf("\n3. paper-beam-1 identification (Gauss-Newton, 10 elements)\n");
+  if (want(3)) std::printf("\n3. paper-beam-1 identification (Gauss-Newton, 10 elements)\n");
   auto sc = scoleid::io::load_scenario("paper-beam-1");
-  double t_ident = 1e300, t_total = 1e300;
+  double t_ident = want(3) ? 1e300 : 0.0, t_total = want(3) ? 1e300 : 0.0;
   int iters = 0;
-  for (int r = 0; r < 3; ++r) {
+  for (int r = 0; r < 3 && want(3); ++r) {
     const auto t0 = Clock::now();
     auto p = make_problem(sc, std::nullopt);
     const auto t1 = Clock::now();
@@ -126,12 +143,12 @@ int main() {
     t_ident = std::min(t_ident, std::chrono::duration<double>(t2 - t1).count());
     t_total = std::min(t_total, std::chrono::duration<double>(t2 - t0).count());
   }
-  std::printf("   identification from data in memory: %.3f s (%d iterations)\n", t_ident, iters);
-  std::printf("   with data synthesis (20 elements):  %.3f s\n", t_total);
+  if (want(3)) std::printf("   identification from data in memory: %.3f s (%d iterations)\n", t_ident, iters);
+  if (want(3)) std::printf("   with data synthesis (20 elements):  %.3f s\n", t_total);
 
-  std::printf("\n4. SCOLE (paper-scole-2 parameters EI, rho_A, rho_I_psi, zeta; 20 elements per field, 20 s)\n");
+  if (want(4)) std::printf("\n4. SCOLE (paper-scole-2 parameters EI, rho_A, rho_I_psi, zeta; 20 elements per field, 20 s)\n");
   double scole_ratio = 0;
-  {
+  if (want(4)) {
     auto ssc = scoleid::io::load_scenario("paper-scole-2");
     ssc.identification.elements = 20;
     ssc.identification.data_elements = 40;
@@ -140,7 +157,7 @@ int main() {
     const VectorXd q = p->params->initial();
     VectorXd g;
     const auto [tf, tg] = best_of_alternating(
-        7, [&] { obj.cost(q); }, [&] { obj.cost_and_gradient(q, g); });
+        15, [&] { obj.cost(q); }, [&] { obj.cost_and_gradient(q, g); });
     scole_ratio = tg / tf;
     obj.reset_counters();
     obj.cost_and_gradient(q, g);
@@ -150,9 +167,9 @@ int main() {
     std::printf("   %d DOFs, step %.2e s: forward %.4f s, adjoint gradient %.4f s, ratio %.2f\n", p->model().ndof,
                 p->objective_options.solver.step, tf, tg, scole_ratio);
   }
-  std::printf("\n5. paper-scole-2 end to end (EI, rho_A, rho_I_psi, zeta from the paper's start; best of 3)\n");
-  double e2e = 1e300;
-  {
+  if (want(5)) std::printf("\n5. paper-scole-2 end to end (EI, rho_A, rho_I_psi, zeta from the paper's start; best of 3)\n");
+  double e2e = 0;
+  if (want(5)) {
     const auto dir = std::filesystem::temp_directory_path() / "scole-identify-bench";
     struct Split {
       double synth, ident, forward, costate, sens, quad, opt, fisher, out, total;
@@ -197,11 +214,12 @@ int main() {
                 best.forward, best.costate, best.sens, best.quad, best.fwd_solves, best.sens_solves);
     std::printf("   %d iterations, identifiable parameters within 1e-4 at iteration %d\n", best.iters, best.within);
   }
-  std::printf("\n6. Banded solve of P right-hand sides: P one-column sweeps / one P-column sweep (same results)\n");
-  std::printf("%-28s %6s %6s %6s %4s %14s %14s %8s\n", "matrix", "dofs", "band", "border", "P", "P x 1 [us]", "1 x P [us]",
+  if (want(6)) std::printf("\n6. Banded solve of P right-hand sides: P one-column sweeps / one P-column sweep (same results)\n");
+  if (want(6)) std::printf("%-28s %6s %6s %6s %4s %14s %14s %8s\n", "matrix", "dofs", "band", "border", "P", "P x 1 [us]", "1 x P [us]",
               "ratio");
   double solve_ratio16 = 0;
   for (const char* which : {"beam, 64 elements", "paper-scole-2, 20 elements"}) {
+    if (!want(6)) break;
     std::unique_ptr<Problem> p;
     if (which[0] == 'b') {
       p = make_problem(sections_scenario(2, 64), std::nullopt);
@@ -241,6 +259,6 @@ int main() {
 
   std::printf("\nsummary: gradient/forward %.2f (N=2), %.2f (N=64), %.2f (SCOLE); N=64/N=2 gradient time %.2f; Case I %.3f s; "
               "paper-scole-2 end to end %.3f s; 16-column banded solve %.2fx faster than 16 one-column solves\n",
-              ratio_n2, ratio_n64, scole_ratio, grad_n64 / grad_n2, t_ident, e2e, solve_ratio16);
+              ratio_n2, ratio_n64, scole_ratio, grad_n2 > 0 ? grad_n64 / grad_n2 : 0.0, t_ident, e2e, solve_ratio16);
   return 0;
 }
