@@ -92,15 +92,18 @@ void CoefficientQuadrature::reset() {
 
 // band(r, column of d) += wt · left_r · right_{r+d} for every r with 0 ≤ r + d < n.
 void CoefficientQuadrature::accumulate(Kind& k, double wt, const Eigen::VectorXd& left, const Eigen::VectorXd& right) {
-  const Eigen::Index n = left.size();
+  const int n = static_cast<int>(left.size());
+  scaled_.resize(n);
+  double* L = scaled_.data();
+  for (int r = 0; r < n; ++r) L[r] = wt * left[r];  // (wt · left_r) · right_s, rounded as wt · left_r · right_s
+  const double* R = right.data();
   for (std::size_t c = 0; c < k.offsets.size(); ++c) {
     const int d = k.offsets[c];
-    const Eigen::Index r0 = d < 0 ? -d : 0, len = n - std::abs(d);
-    k.band.col(static_cast<Eigen::Index>(c)).segment(r0, len).array() +=
-        wt * left.segment(r0, len).array() * right.segment(r0 + d, len).array();
+    double* acc = k.band.col(static_cast<Eigen::Index>(c)).data();
+    const int r0 = d < 0 ? -d : 0, r1 = d > 0 ? n - d : n;
+    for (int r = r0; r < r1; ++r) acc[r] += L[r] * R[r + d];
   }
-  for (std::size_t i = 0; i < k.row.size(); ++i)
-    k.outside[static_cast<Eigen::Index>(i)] += wt * left[k.row[i]] * right[k.col[i]];
+  for (std::size_t i = 0; i < k.row.size(); ++i) k.outside[static_cast<Eigen::Index>(i)] += L[k.row[i]] * R[k.col[i]];
 }
 
 void CoefficientQuadrature::add(double wt, const Eigen::VectorXd& p, const Eigen::VectorXd& pd,

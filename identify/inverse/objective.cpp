@@ -57,6 +57,17 @@ void for_each_gauss_point(const std::vector<double>& grid, F&& f) {
   for_each_gauss_point(grid, std::forward<F>(f), [](double) {});
 }
 
+// 2-point Gauss–Legendre on [0, 1]: 1/2 ∓ 1/(2√3), weights 1/2. Eq. 25's coefficient integrand with
+// displacement sensors (docs/theory.md §6.4): f(t, weight) at both points of every interval of `grid`.
+constexpr double kG2x[2] = {0.21132486540518711775, 0.78867513459481288225};
+template <class F>
+void for_each_two_point(const std::vector<double>& grid, F&& f) {
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    const double h = grid[k + 1] - grid[k];
+    for (int gq = 0; gq < 2; ++gq) f(grid[k] + kG2x[gq] * h, 0.5 * h);
+  }
+}
+
 // A quadrature grid sorted, with points closer than rounding (1e-12 relative) merged into the
 // first: the state's and the costate's grids mirror each other (t = T − τ) and meet again only up
 // to rounding, and a sliver of 1e-16 s between them would cost three Gauss points for nothing.
@@ -211,10 +222,14 @@ std::vector<double> Objective::reversed_breakpoints() const {
   return out;
 }
 
-std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const {
+std::vector<double> Objective::union_grid(const std::vector<const std::vector<double>*>& sets, double t_end,
+                                          bool samples) const {
   std::vector<double> g;
   for (const auto* s : sets) g.insert(g.end(), s->begin(), s->end());
-  g.insert(g.end(), data_.t.begin(), data_.t.end());
+  if (samples)
+    g.insert(g.end(), data_.t.begin(), data_.t.end());
+  else
+    g.push_back(data_.t.front());
   g.push_back(t_end);
   sort_grid(g);
   const double t0 = data_.t.front();
@@ -423,9 +438,10 @@ std::size_t Objective::checkpoint_spacing(const SecondOrderSolver& solver) const
 }
 
 bool Objective::cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
-                             double& resolve_seconds) const {
+                             std::vector<double>* steps, double& resolve_seconds) const {
   // The costate window [τa, τb] is t in [T − τb, T − τa] (within the data): the state there from
-  // its checkpoints, and the grid of the window's times (in t), the state's and the samples'.
+  // its checkpoints, and the grid of the window's times (in t), the state's and the samples' (in
+  // `steps`, when asked: the same without the samples').
   const double ta = std::max(data_.t.front(), T_ - W.t_end()), tb = std::min(T_, T_ - W.t_begin());
   if (!(tb > ta)) return false;
   const auto tr = Clock::now();
@@ -434,12 +450,19 @@ bool Objective::cover_window(const Trajectory& W, CheckpointedState& state, std:
   grid.clear();
   for (double tau : W.times()) grid.push_back(T_ - tau);
   state.times_in(ta, tb, grid);
-  for (double t : data_.t)
-    if (t >= ta && t <= tb) grid.push_back(t);
   grid.push_back(ta);
   grid.push_back(tb);
-  sort_grid(grid);
-  grid.erase(std::remove_if(grid.begin(), grid.end(), [&](double t) { return t < ta || t > tb; }), grid.end());
+  const auto finish = [&](std::vector<double>& g) {
+    sort_grid(g);
+    g.erase(std::remove_if(g.begin(), g.end(), [&](double t) { return t < ta || t > tb; }), g.end());
+  };
+  if (steps) {
+    *steps = grid;
+    finish(*steps);
+  }
+  for (double t : data_.t)
+    if (t >= ta && t <= tb) grid.push_back(t);
+  finish(grid);
   return true;
 }
 
@@ -478,6 +501,12 @@ class Objective::CostateSources {
   // Returns Σ R r² when the sources carry the residual, else 0.
   virtual double at(double t, const VectorXd& x, const VectorXd& v, const VectorXd& c, const VectorXd& cd, VectorXd& p,
                     VectorXd& pd, VectorXd& a) = 0;
+  // Displacement sources (split_rule): J's share Σ R r² at t from the outputs alone, and `at`
+  // gives the multiplier only (returns 0). Then the multiplier is the costate's interpolant, a
+  // polynomial on every interval of the steps' union, and Eq. 25's n-long part takes a rule of its
+  // own there (docs/theory.md §6.4).
+  virtual bool split_rule() const { return false; }
+  virtual double misfit(double) { return 0.0; }
   bool rates() const { return equations() == 2; }
 };
 
@@ -498,13 +527,17 @@ class Objective::DisplacementSources final : public CostateSources {
     for (Eigen::Index j = 0; j < y_.size(); ++j) y_[j] *= -o_.R_[static_cast<std::size_t>(j)];
     Eigen::Map<VectorXd>(F, o_.model_.ndof).noalias() = o_.Cs_.transpose() * y_;
   }
-  double at(double t, const VectorXd& x, const VectorXd&, const VectorXd& c, const VectorXd& cd, VectorXd& p,
-            VectorXd& pd, VectorXd&) override {
+  double at(double, const VectorXd&, const VectorXd&, const VectorXd& c, const VectorXd& cd, VectorXd& p, VectorXd& pd,
+            VectorXd&) override {
     p = c;
     pd = -cd;  // ṗ(t) = −P'(T − t)
+    return 0.0;
+  }
+  bool split_rule() const override { return true; }
+  double misfit(double t) override {
     if (!residual_) return 0.0;
+    part_(t, y_);
     o_.data_.eval(t, z_.data());
-    y_.noalias() = o_.Cs_ * x;
     y_ -= z_;
     double e = 0.0;
     for (Eigen::Index j = 0; j < y_.size(); ++j) e += o_.R_[static_cast<std::size_t>(j)] * y_[j] * y_[j];
@@ -625,7 +658,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   const std::vector<double> bp_tau = reversed_breakpoints();
   double J = 0.0;
   VectorXd x(n), xv(n), a(n), p(n), pd(n), c(m * n), cd(m * n);
-  std::vector<double> grid;
+  std::vector<double> grid, steps;
   double quadrature = 0.0, resolve = 0.0;
   CoefficientQuadrature eq25(model_, src.rates(), CoefficientQuadrature::needed_coefficients(s.dcdq));
   // Each costate window [τa, τb] (P, or P and Y stacked) is t in [T − τb, T − τa]: the state there
@@ -633,15 +666,21 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   WindowedSink windows(
       n, spacing,
       [&](const Trajectory& W) {
-        if (!cover_window(W, state, grid, resolve)) return;
+        if (!cover_window(W, state, grid, src.split_rule() ? &steps : nullptr, resolve)) return;
         const auto tq = Clock::now();
-        for_each_gauss_point(grid, [&](double t, double wt) {
+        const auto point = [&](double t, double wt) {
           state.eval(t, x.data(), xv.data());
           W.eval(T_ - t, c.data(), cd.data());
           J += 0.5 * wt * src.at(t, x, xv, c, cd, p, pd, a);
           eq25.add(wt, p, pd, x, xv, a);
           add_input_gradient(t, wt, p, gc);
-        });
+        };
+        if (src.split_rule()) {
+          for_each_gauss_point(grid, [&](double t, double wt) { J += 0.5 * wt * src.misfit(t); });
+          for_each_two_point(steps, point);
+        } else {
+          for_each_gauss_point(grid, point);
+        }
         quadrature += since(tq);
       },
       m);
@@ -709,14 +748,20 @@ double Objective::backward_stored(const Setup& s, const SecondOrderSolver& solve
   CoefficientQuadrature eq25(model_, src.rates(), needed);
   // Displacement sources read x and the multiplier alone: v and ṗ are interpolated when Eq. 25 reads them.
   const bool v_read = m == 2 || eq25.reads_velocity(), pd_read = m == 2 || eq25.reads_multiplier_rate();
-  for_each_gauss_point(grid, [&](double t, double wt) {
+  const auto point = [&](double t, double wt) {
     u.eval(t, x.data(), v_read ? v.data() : nullptr);
     P.eval(T_ - t, c.data(), pd_read ? cd.data() : nullptr);
     if (m == 2) Y.eval(T_ - t, c.data() + n, cd.data() + n);
     J += 0.5 * wt * src.at(t, x, v, c, cd, p, pd, a);
     eq25.add(wt, p, pd, x, v, a);
     add_input_gradient(t, wt, p, gc);
-  });
+  };
+  if (src.split_rule()) {
+    for_each_gauss_point(grid, [&](double t, double wt) { J += 0.5 * wt * src.misfit(t); });
+    for_each_two_point(union_grid({&u.times(), &ptimes, &ytimes, &more_times}, T_, false), point);
+  } else {
+    for_each_gauss_point(grid, point);
+  }
   eq25.contract(gc);
   counters_.quadrature_seconds += since(tq);
   return J;

@@ -63,10 +63,11 @@ class CoefficientQuadrature {
   };
   static void build(Kind& k, const std::vector<OperatorTerm>& terms, int n, double sign,
                     const std::vector<bool>& needed);
-  static void accumulate(Kind& k, double wt, const Eigen::VectorXd& left, const Eigen::VectorXd& right);
+  void accumulate(Kind& k, double wt, const Eigen::VectorXd& left, const Eigen::VectorXd& right);
 
   bool rates_;
   Kind mass_, damping_, stiffness_;
+  Eigen::VectorXd scaled_;  // wt · left at the current point
 };
 
 }  // namespace scoleid::identify

@@ -25,7 +25,9 @@
 //             (esdirk_stepper.h): the exact derivatives of the discrete u, one factorisation for
 //             all; otherwise each is integrated on its own with u interpolated.
 // All time integrals use 3-point Gauss–Legendre on every interval of the union of the solvers'
-// steps and the sample times, on the Hermite interpolants of the recorded solutions.
+// steps and the sample times, on the Hermite interpolants of the recorded solutions; with
+// displacement sensors the costate gradient's coefficient integrand (Eq. 25's n-long part) takes
+// the 2-point rule on the intervals of the steps alone (docs/theory.md §6.4).
 // R is diagonal; by default R_kk = 1 / ((T − t0) · mean z_k²) over the samples in [t0, T], so J is
 // the relative mean-square misfit.
 //
@@ -184,9 +186,11 @@ private:
   // Output sensitivity at t: C_0 S + C_1 Ṡ + C_2 S̈, S̈ from the sensitivity equation.
   VectorXd tangent_output_at(const SecondOrderSolver& solver, const Derivative& d, double t, const VectorXd& x,
                              const VectorXd& v, const VectorXd& a, const VectorXd& si, const VectorXd& svi) const;
-  // Union of the given time sets and the sample times, restricted to [t0, t_end].
   std::vector<double> reversed_breakpoints() const;
-  std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end) const;
+  // Union of the given time sets and the sample times (without `samples`: t0 alone), restricted
+  // to [t0, t_end].
+  std::vector<double> union_grid(const std::vector<const std::vector<double>*>& sets, double t_end,
+                                 bool samples = true) const;
   SecondOrderSolver::Forcing state_forcing(const Setup& s) const;
   // ∂_i M, ∂_i D, ∂_i K and ∂_i b per input, for the sensitivity forcing.
   struct Derivative {
@@ -252,8 +256,9 @@ private:
   void costates_stored(const SecondOrderSolver& solver, CostateSources& src, Trajectory& P, Trajectory& Y);
   // A costate window W (in τ) as t in [ta, tb]: the state re-solved over it (time added to
   // resolve_seconds) and its quadrature grid (W's times, the state's and the samples', sorted and
-  // unique). False when the window holds no time of the data.
-  bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid,
+  // unique); `steps` (if not null): the same without the samples. False when the window holds no
+  // time of the data.
+  bool cover_window(const Trajectory& W, CheckpointedState& state, std::vector<double>& grid, std::vector<double>* steps,
                     double& resolve_seconds) const;
 
 
