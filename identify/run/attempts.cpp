@@ -178,6 +178,7 @@ struct Ladder {
   int iterations = 0;
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
+  FitTest fit;  // the last level's fit test at q (the full model's prediction there)
 };
 Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& families, const VectorXd& start) {
   const Problem& p = c.problem;
@@ -205,7 +206,11 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     out.iterations += sl.iterations_done;
     if (sl.q.allFinite()) out.q = tied.expand(sl.q);
     out.label += " " + std::to_string(B);
-    const bool explained = sl.q.allFinite() && test_fit(p, c.objective, out.q).within_noise_and_discretisation;
+    bool explained = false;
+    if (sl.q.allFinite()) {
+      out.fit = test_fit(p, c.objective, out.q);
+      explained = out.fit.within_noise_and_discretisation;
+    }
     out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
     if (c.verbose)
       std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,
@@ -227,7 +232,10 @@ RunResult::Attempt attempt_record(AttemptsContext& c, const std::string& strateg
   c.objective.set_horizon(c.objective.data_end());
   a.cost = INFINITY;
   try {
-    if (s.q.allFinite()) a.cost = c.objective.cost(s.q);
+    if (s.termination == OptimizerSummary::Termination::DataExplained)
+      a.cost = s.cost;  // taken on the whole record already (explained_by_level)
+    else if (s.q.allFinite())
+      a.cost = c.objective.cost(s.q);
   } catch (const io::Interrupted&) {
     throw;
   } catch (const std::exception&) {
@@ -280,6 +288,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   std::string label = std::string("plain ") + io::to_string(c.options.method);
   int iterations = 0;
   std::vector<RunResult::Attempt::Level> levels;
+  FitTest level_fit;
   if (from_ladder) {
     if (c.verbose) std::printf("%zu sections: coarse to fine from the start\n", longest(families));
     Ladder lad = coarse_to_fine(c, families, r.initial);
@@ -287,11 +296,13 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     label = lad.label;
     iterations = lad.iterations;
     levels = std::move(lad.levels);
+    level_fit = std::move(lad.fit);
   }
   const double smoothness = c.problem.scenario.identification.smoothness;
   // Without a prior, a level that explains the data ends the attempt (with one, the prior's weight
   // is chosen on the full parameterization, from the level's estimate).
-  if (from_ladder && smoothness == 0.0 && !levels.empty() && levels.back().explained) {
+  const bool level_ends = from_ladder && smoothness == 0.0 && !levels.empty() && levels.back().explained;
+  if (level_ends) {
     r.summary = explained_by_level(run, start, levels.back().blocks, longest(families));
     r.smoothness_weight = 0.0;
   } else if (smoothness >= 0.0) {
@@ -304,7 +315,8 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     r.summary = discrepancy_path(run, r, start, c.options);
     c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
-  r.fit = test_fit(c.problem, c.objective, r.summary.q);
+  // The level's estimate is the attempt's: its fit test is the one the ladder just made.
+  r.fit = level_ends ? std::move(level_fit) : test_fit(c.problem, c.objective, r.summary.q);
   r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
 }
 
