@@ -12,6 +12,14 @@
 
 namespace scoleid::identify {
 
+FitTest AttemptsContext::fit_at(const VectorXd& q) {
+  if (fit_q.size() != q.size() || !(fit_q.array() == q.array()).all()) {
+    fit = test_fit(problem, objective, q);
+    fit_q = q;
+  }
+  return fit;
+}
+
 namespace {
 
 // Paper-style iteration table: iteration, parameters, physical values, cost.
@@ -97,8 +105,9 @@ double noise_misfit(const Problem& p, const Objective& obj) {
 // discretisation estimate d_k and the declared model error m of the RMS signal z_k — a weight is
 // chosen only if its fit would pass the fit test), plus what sampling leaves between the samples
 // of a perfect fit (Objective::interpolation_misfit).
-double fit_floor(const Problem& p, Objective& obj, const VectorXd& q) {
-  const FitTest f = test_fit(p, obj, q);
+double fit_floor(AttemptsContext& c, const VectorXd& q) {
+  Objective& obj = c.objective;
+  const FitTest f = c.fit_at(q);
   const auto& R = obj.weights();
   const double span = obj.data_end() - obj.data_start();
   double floor = 0.0;
@@ -129,7 +138,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     const double misfit = s.cost - s.prior_cost;
     if (!floor_added && s.q.allFinite()) {
       floor_added = true;
-      r.smoothness_expected_misfit = expected += fit_floor(p, run.c.objective, s.q);
+      r.smoothness_expected_misfit = expected += fit_floor(run.c, s.q);
       if (run.c.verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
     }
     r.smoothness_path.push_back({beta, misfit, s.prior_cost, s.iterations_done, s.converged()});
@@ -153,7 +162,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     const double drop = previous_misfit - misfit;
     if (std::isfinite(previous_drop) && drop < previous_drop &&
         misfit - drop * std::log10(beta / kSmallestWeight) > expected &&
-        test_fit(p, run.c.objective, q).within_noise_and_discretisation) {
+        run.c.fit_at(q).within_noise_and_discretisation) {
       if (run.c.verbose)
         std::printf("the data misfit levels off above the noise's: the discrepancy cannot be met, weight %.0e kept\n",
                     beta);
@@ -178,7 +187,6 @@ struct Ladder {
   int iterations = 0;
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
-  FitTest fit;  // the last level's fit test at q (the full model's prediction there)
 };
 Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& families, const VectorXd& start) {
   const Problem& p = c.problem;
@@ -206,11 +214,7 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     out.iterations += sl.iterations_done;
     if (sl.q.allFinite()) out.q = tied.expand(sl.q);
     out.label += " " + std::to_string(B);
-    bool explained = false;
-    if (sl.q.allFinite()) {
-      out.fit = test_fit(p, c.objective, out.q);
-      explained = out.fit.within_noise_and_discretisation;
-    }
+    const bool explained = sl.q.allFinite() && c.fit_at(out.q).within_noise_and_discretisation;
     out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
     if (c.verbose)
       std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,
@@ -288,7 +292,6 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   std::string label = std::string("plain ") + io::to_string(c.options.method);
   int iterations = 0;
   std::vector<RunResult::Attempt::Level> levels;
-  FitTest level_fit;
   if (from_ladder) {
     if (c.verbose) std::printf("%zu sections: coarse to fine from the start\n", longest(families));
     Ladder lad = coarse_to_fine(c, families, r.initial);
@@ -296,7 +299,6 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     label = lad.label;
     iterations = lad.iterations;
     levels = std::move(lad.levels);
-    level_fit = std::move(lad.fit);
   }
   const double smoothness = c.problem.scenario.identification.smoothness;
   // Without a prior, a level that explains the data ends the attempt (with one, the prior's weight
@@ -315,8 +317,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     r.summary = discrepancy_path(run, r, start, c.options);
     c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
-  // The level's estimate is the attempt's: its fit test is the one the ladder just made.
-  r.fit = level_ends ? std::move(level_fit) : test_fit(c.problem, c.objective, r.summary.q);
+  r.fit = c.fit_at(r.summary.q);
   r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
 }
 
@@ -400,7 +401,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     s = run.minimize_from(r.initial, oc);
   }
   iterations += s.iterations_done;
-  const FitTest f = test_fit(c.problem, c.objective, s.q);
+  const FitTest f = c.fit_at(s.q);
   r.attempts.push_back(attempt_record(c, label, s, f, iterations, std::move(levels)));
   c.objective.set_horizon(c.objective.data_end());
   if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)], c.objective.data_points())) {

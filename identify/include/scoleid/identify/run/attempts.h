@@ -18,6 +18,14 @@ struct AttemptsContext {
   OptimizerOptions options;  // the run's; the discrepancy principle leaves its chosen weight here
   bool verbose = true;
   ObjectiveCounters extra{};  // solves of the coarse-to-fine levels' own objectives
+
+  // The fit test at q (test_fit, identify_run.h), the last one kept: the run asks again at an
+  // estimate it has just tested (a ladder level that ends the attempt, the discrepancy path's
+  // plateau at its chosen weight), and each asks a forward solve on the mesh and one on the
+  // doubled mesh at a quarter of the step.
+  FitTest fit_at(const VectorXd& q);
+  VectorXd fit_q{};  // fit_at's last q and its test
+  FitTest fit{};
 };
 
 // Fills r.summary, r.fit, r.attempts, r.chosen_attempt and the smoothness fields; r.summary.cost is
