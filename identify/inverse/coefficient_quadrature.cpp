@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/coefficient_quadrature.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 
@@ -8,6 +9,21 @@ namespace scoleid::identify {
 
 namespace {
 std::int64_t key(int r, int s, int n) { return static_cast<std::int64_t>(r) * n + s; }
+
+// A matrix whose values differ from their transposes' by rounding at most (an assembly adds the
+// same element entries in different orders): |A_rs − A_sr| ≤ 1e-13 · max |A| (an entry on one side
+// only counts as its value against zero).
+constexpr double kSymmetryTolerance = 1e-13;
+bool symmetric_to_rounding(const SparseMatrix& A) {
+  if (A.rows() != A.cols()) return false;
+  const SparseMatrix D = A - SparseMatrix(A.transpose());
+  double largest = 0.0, asymmetry = 0.0;
+  for (int c = 0; c < A.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) largest = std::max(largest, std::abs(it.value()));
+  for (int c = 0; c < D.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(D, c); it; ++it) asymmetry = std::max(asymmetry, std::abs(it.value()));
+  return asymmetry <= kSymmetryTolerance * largest;
+}
 }  // namespace
 
 CoefficientQuadrature::CoefficientQuadrature(const StructuralModel& model, bool rates, const std::vector<bool>& needed)
@@ -33,11 +49,31 @@ void CoefficientQuadrature::build(Kind& k, const std::vector<OperatorTerm>& term
   const auto carried = [&](const OperatorTerm& t) {
     return t.coefficient >= 0 && (needed.empty() || needed[static_cast<std::size_t>(t.coefficient)]);
   };
-  std::vector<std::int64_t> pattern;
+  // Every carried term symmetric (to rounding): a pair r < s is summed with its mirror,
+  // left_r right_s + left_s right_r, against the term's mean value ½(A_rs + A_sr), and only the
+  // upper triangle (d ≥ 0) is kept, half the cells.
+  k.symmetric = true;
+  for (const auto& t : terms)
+    if (carried(t) && !symmetric_to_rounding(t.matrix)) k.symmetric = false;
+  std::vector<SparseMatrix> upper;  // per carried term: its upper triangle (symmetric kind) or itself
   for (const auto& t : terms) {
-    if (!carried(t)) continue;
-    for (int c = 0; c < t.matrix.outerSize(); ++c)
-      for (SparseMatrix::InnerIterator it(t.matrix, c); it; ++it)
+    if (!carried(t)) {
+      upper.emplace_back();
+      continue;
+    }
+    if (!k.symmetric) {
+      upper.push_back(t.matrix);
+      continue;
+    }
+    const SparseMatrix mean = 0.5 * (t.matrix + SparseMatrix(t.matrix.transpose()));
+    upper.push_back(mean.triangularView<Eigen::Upper>());
+  }
+  std::vector<std::int64_t> pattern;
+  for (std::size_t ti = 0; ti < terms.size(); ++ti) {
+    if (!carried(terms[ti])) continue;
+    const SparseMatrix& A = upper[ti];
+    for (int c = 0; c < A.outerSize(); ++c)
+      for (SparseMatrix::InnerIterator it(A, c); it; ++it)
         pattern.push_back(key(static_cast<int>(it.row()), static_cast<int>(it.col()), n));
   }
   if (pattern.empty()) return;
@@ -66,10 +102,12 @@ void CoefficientQuadrature::build(Kind& k, const std::vector<OperatorTerm>& term
     }
   }
   k.outside = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k.row.size()));
-  for (const auto& t : terms) {
+  for (std::size_t ti = 0; ti < terms.size(); ++ti) {
+    const auto& t = terms[ti];
     if (!carried(t)) continue;
-    for (int c = 0; c < t.matrix.outerSize(); ++c)
-      for (SparseMatrix::InnerIterator it(t.matrix, c); it; ++it) {
+    const SparseMatrix& A = upper[ti];
+    for (int c = 0; c < A.outerSize(); ++c)
+      for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
         const int r = static_cast<int>(it.row()), s = static_cast<int>(it.col());
         int where;
         if (on_band(r, s) >= 0) {
@@ -90,7 +128,8 @@ void CoefficientQuadrature::reset() {
   }
 }
 
-// band(r, column of d) += wt · left_r · right_{r+d} for every r with 0 ≤ r + d < n.
+// band(r, column of d) += wt · left_r · right_{r+d} for every r with 0 ≤ r + d < n (a symmetric
+// kind's d > 0: + wt · left_{r+d} · right_r, the mirror pair's share).
 void CoefficientQuadrature::accumulate(Kind& k, double wt, const Eigen::VectorXd& left, const Eigen::VectorXd& right) {
   const int n = static_cast<int>(left.size());
   scaled_.resize(n);
@@ -100,10 +139,17 @@ void CoefficientQuadrature::accumulate(Kind& k, double wt, const Eigen::VectorXd
   for (std::size_t c = 0; c < k.offsets.size(); ++c) {
     const int d = k.offsets[c];
     double* acc = k.band.col(static_cast<Eigen::Index>(c)).data();
-    const int r0 = d < 0 ? -d : 0, r1 = d > 0 ? n - d : n;
-    for (int r = r0; r < r1; ++r) acc[r] += L[r] * R[r + d];
+    if (k.symmetric && d > 0) {
+      for (int r = 0; r + d < n; ++r) acc[r] += L[r] * R[r + d] + L[r + d] * R[r];
+    } else {
+      const int r0 = d < 0 ? -d : 0, r1 = d > 0 ? n - d : n;
+      for (int r = r0; r < r1; ++r) acc[r] += L[r] * R[r + d];
+    }
   }
-  for (std::size_t i = 0; i < k.row.size(); ++i) k.outside[static_cast<Eigen::Index>(i)] += L[k.row[i]] * R[k.col[i]];
+  for (std::size_t i = 0; i < k.row.size(); ++i) {
+    const int r = k.row[i], s = k.col[i];
+    k.outside[static_cast<Eigen::Index>(i)] += k.symmetric && r != s ? L[r] * R[s] + L[s] * R[r] : L[r] * R[s];
+  }
 }
 
 void CoefficientQuadrature::add(double wt, const Eigen::VectorXd& p, const Eigen::VectorXd& pd,

@@ -111,6 +111,31 @@ TEST(CoefficientQuadrature, PatternSumsEqualTheSumOverEveryTermsNonzeros) {
   }
 }
 
+// Symmetric element blocks (and border couplings), one of them off symmetry by a rounding-sized
+// amount as assembly leaves it: the kinds are summed over the upper triangle, each pair with its
+// mirror, and agree with the direct sum over every nonzero of the terms as they are.
+TEST(CoefficientQuadrature, SymmetricTermsSummedOnTheUpperTriangleEqualTheDirectSum) {
+  std::mt19937 rng(5);
+  const int n = 21, ncoef = 4;
+  StructuralModel m = model_with_border(n, ncoef, rng);
+  for (auto* terms : {&m.mass, &m.damping, &m.stiffness})
+    for (auto& t : *terms) t.matrix = 0.5 * (t.matrix + SparseMatrix(t.matrix.transpose()));
+  ASSERT_GT(m.stiffness.front().matrix.coeff(0, 1), -2.0);
+  m.stiffness.front().matrix.coeffRef(0, 1) *= 1.0 + 4e-16;
+  const std::vector<Point> pts = random_points(n, 4, rng);
+  for (bool rates : {false, true}) {
+    const VectorXd ref = direct(m, pts, rates, {});
+    const VectorXd got = pattern_sums(m, pts, rates, {}, VectorXd::Zero(ncoef));
+    EXPECT_GT(ref.cwiseAbs().minCoeff(), 1e-3);
+    EXPECT_LT((got - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff()) << "rates " << rates;
+  }
+  // A term off symmetry by more than rounding: that kind is summed over the whole pattern, still exact.
+  m.damping.front().matrix.coeffRef(0, 1) += 0.25;
+  const VectorXd ref = direct(m, pts, false, {});
+  const VectorXd got = pattern_sums(m, pts, false, {}, VectorXd::Zero(ncoef));
+  EXPECT_LT((got - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+}
+
 TEST(CoefficientQuadrature, CoefficientsNotNeededAreLeftAsTheyWere) {
   std::mt19937 rng(11);
   const int n = 17, ncoef = 5;

@@ -14,7 +14,9 @@
 // few pairs elsewhere (the couplings to a rigid body's degrees of freedom) as a list. A point then
 // costs about n vector multiply-adds per well-filled diagonal per kind instead of one indexed
 // multiply-add per nonzero of every term: the cost of a point no longer grows with the number of
-// coefficients, and the diagonal sums vectorise.
+// coefficients, and the diagonal sums vectorise. When every term of a kind is symmetric (to the
+// rounding of its assembly) only the upper triangle is kept, each pair summed with its mirror
+// against the mean of the two values: half the cells.
 #include <vector>
 
 #include <Eigen/Dense>
@@ -49,6 +51,7 @@ class CoefficientQuadrature {
   // One kind of term (mass, damping, stiffness): its band sums and its pairs outside the band.
   struct Kind {
     bool used = false;
+    bool symmetric = false;        // pairs r ≤ s only, each summed with its mirror
     std::vector<int> offsets;      // the diagonals s − r = d summed as vectors
     Eigen::MatrixXd band;          // n × offsets: column c holds Σ wt left_r right_{r+offsets[c]}
     std::vector<int> row, col;     // pairs outside the band
