@@ -14,12 +14,24 @@ namespace {
 double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB[1][0], R_GB[0][0]); }
 }  // namespace
 
+void JointForces::index_joints(const State& state) const {
+  std::call_once(indexed_, [&] {
+    for (const auto& j : joints_) {
+      const MobilizedBody& b = matter_.getMobilizedBody(j.body);
+      q_at_.push_back(static_cast<int>(b.getFirstQIndex(state)) + j.which);
+      u_at_.push_back(static_cast<int>(b.getFirstUIndex(state)) + j.which);
+    }
+  });
+}
+
 void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces, Vector_<Vec3>&,
                             Vector& mobility_forces) const {
-  for (const auto& j : joints_) {
-    const MobilizedBody& b = matter_.getMobilizedBody(j.body);
-    const Real f = -j.k * b.getOneQ(state, j.which) - j.c * b.getOneU(state, j.which);
-    b.applyOneMobilityForce(state, j.which, f, mobility_forces);
+  index_joints(state);
+  const Vector& q = matter_.getQ(state);
+  const Vector& u = matter_.getU(state);
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const Real f = -joints_[i].k * q[q_at_[i]] - joints_[i].c * u[u_at_[i]];
+    mobility_forces[u_at_[i]] += f;  // as MobilizedBody::applyOneMobilityForce adds it
   }
   for (const auto& a : anchors_) {
     const MobilizedBody& b = matter_.getMobilizedBody(a.body);

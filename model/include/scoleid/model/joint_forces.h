@@ -10,6 +10,7 @@
 // relative to a reference body, per axis of the reference frame: torque -R_GR diag(c) R_GR^T
 // (omega_B - omega_R) on the body and its opposite on the reference (a torque pair: momentum
 // conserved; docs/theory.md §9.3 uses it for the mast's square-root damping).
+#include <mutex>
 #include <vector>
 
 #include <Simbody.h>
@@ -39,6 +40,13 @@ public:
   SimTK::Real calcPotentialEnergy(const SimTK::State& state) const override;
 
 private:
+  // Each joint's q and u as places in the matter subsystem's q and u vectors, found once from the
+  // first state (the topology fixes them): a mobilizer looked up per joint per evaluation costs
+  // more than the spring it carries.
+  void index_joints(const SimTK::State& state) const;
+  mutable std::once_flag indexed_;
+  mutable std::vector<int> q_at_, u_at_;
+
   const SimTK::SimbodyMatterSubsystem& matter_;
   std::vector<JointSpring> joints_;
   std::vector<AnchorSpring> anchors_;
