@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
 
     struct Trial { const char* integrator; double accuracy; };
     const std::vector<Trial> trials = {
+        {"gauss-legendre", 1e-8}, {"gauss-legendre", 1e-9}, {"gauss-legendre", 1e-10},
         {"trapezoidal", 1e-8}, {"trapezoidal", 1e-9}, {"trapezoidal", 1e-10},
         {"rk-merson", 1e-6}, {"rk-merson", 1e-8},
         {"rk3", 1e-6}, {"rk3", 1e-8},

@@ -8,19 +8,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "scoleid/model/linearisation.h"
+#include "implicit_support.h"
 
 namespace scoleid::model {
 
 using namespace SimTK;
-
-namespace {
-std::string str(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.9g", x);
-  return b;
-}
-}  // namespace
+using detail::str;
+using detail::view;
 
 bool TrapezoidalOptions::IsValid(std::string* why) const {
   auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
@@ -38,23 +32,14 @@ TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, cons
     : system_(system), matter_(system.getMatterSubsystem()), options_(options), state_(initial), trial_(initial) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("TrapezoidalIntegrator: " + why);
-  if (initial.getNU() == 0) throw std::invalid_argument("TrapezoidalIntegrator: the system has no mobilities");
-  if (matter_.getNumConstraints() > 0)
-    throw std::invalid_argument("TrapezoidalIntegrator: the system has constraints, which this method does not project onto");
+  detail::require_unconstrained(system_, initial, "TrapezoidalIntegrator");
   realize(state_);
   q_initial_ = state_.getQ();
   refresh_jacobian(state_);
   if (options_.reference_omega > 0) {
     summary_.lowest_omega = options_.reference_omega;
   } else {
-    // Modes about the system's default state (undeformed, at rest): a spinning or deformed
-    // initial state would add slow modes of unsprung bodies (proof masses on sliders) in the
-    // accelerated frame.
-    const State rest = system_.getDefaultState();
-    const Eigen::MatrixXd J0 = state_jacobian(system_, rest);
-    summary_.realizations += 4 * rest.getNU();
-    const auto modes = modes_of(J0, LinearisationOptions{}.zero_tolerance);
-    summary_.lowest_omega = modes.empty() ? 0.0 : modes.front().omega;
+    summary_.lowest_omega = detail::default_state_omega(system_, &summary_.realizations);
   }
   if (options_.max_step > 0) summary_.max_step = options_.max_step;
   else if (summary_.lowest_omega > 0) summary_.max_step = std::cbrt(12.0 * options_.accuracy) / summary_.lowest_omega;
@@ -64,12 +49,9 @@ TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, cons
 void TrapezoidalIntegrator::realize(State& s) const { system_.realize(s, Stage::Acceleration); }
 
 void TrapezoidalIntegrator::refresh_jacobian(const State& at) {
-  const int nu = at.getNU();
-  const Eigen::MatrixXd J = state_jacobian(system_, at);
-  summary_.realizations += 4 * nu;
+  detail::acceleration_jacobian(system_, at, A_, B_);
+  summary_.realizations += 4 * at.getNU();
   ++summary_.jacobians;
-  A_ = J.block(nu, 0, nu, nu);
-  B_ = J.block(nu, nu, nu, nu);
   factors_.clear();
 }
 
@@ -94,13 +76,6 @@ void TrapezoidalIntegrator::advance_to(double t_end, bool left_limit) {
     step(t1 - time(), left_limit && i == n);
   }
 }
-
-namespace {
-// Simbody's state vectors are contiguous: read them through Eigen without element accessors.
-Eigen::Map<const Eigen::VectorXd> view(const Vector& v) {
-  return {v.size() ? &v[0] : nullptr, v.size()};
-}
-}  // namespace
 
 void TrapezoidalIntegrator::step(double h, bool left_limit) {
   const double t1 = state_.getTime() + h;

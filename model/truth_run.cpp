@@ -22,6 +22,7 @@
 #include "scoleid/model/linearisation.h"
 #include "scoleid/model/scole_system.h"
 #include "scoleid/model/sensors.h"
+#include "scoleid/model/gauss_legendre.h"
 #include "scoleid/model/trapezoidal.h"
 
 namespace scoleid::model {
@@ -35,7 +36,7 @@ using namespace SimTK;
 const char* const kDefaultIntegrator = "rk-merson";
 
 std::vector<std::string> integrator_names() {
-  return {"auto", "trapezoidal", "rk-merson", "rk-feldberg", "rk3", "cpodes", "cpodes-bdf2", "verlet",
+  return {"auto", "gauss-legendre", "trapezoidal", "rk-merson", "rk-feldberg", "rk3", "cpodes", "cpodes-bdf2", "verlet",
           "semi-explicit-euler2"};
 }
 
@@ -176,16 +177,17 @@ void sample_loop(const SimulateOptions& opt, double t_start, Clock::time_point w
   if (opt.progress && next_progress > 2.0) std::fprintf(stderr, "\n");
 }
 
-// simulate() on the trapezoidal rule (trapezoidal.h): steps end on every sample time and every
-// input breakpoint.
-void simulate_trapezoidal(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
-                          const std::function<void(const State&)>& on_sample, Clock::time_point wall0,
-                          SimulateSummary& sum) {
-  TrapezoidalOptions to;
+// simulate() on one of the implicit fixed-step methods (trapezoidal.h, gauss_legendre.h): steps
+// end on every sample time and every input breakpoint.
+template <class Integrator, class Options>
+void simulate_fixed_step(const MultibodySystem& system, const State& initial, const SimulateOptions& opt,
+                         const std::function<void(const State&)>& on_sample, Clock::time_point wall0,
+                         SimulateSummary& sum, const char* error_formula) {
+  Options to;
   to.accuracy = opt.accuracy;
   to.max_step = opt.max_step;
   to.reference_omega = opt.reference_omega;
-  TrapezoidalIntegrator integ(system, initial, to);
+  Integrator integ(system, initial, to);
   const double eps = 1e-12 * std::max(1.0, opt.final_time);
   sample_loop(
       opt, initial.getTime(), wall0,
@@ -194,16 +196,16 @@ void simulate_trapezoidal(const MultibodySystem& system, const State& initial, c
         else integ.advance_to(tk);
       },
       [&] { return integ.time(); }, [&]() -> const State& { return integ.state(); }, on_sample, sum);
-  const TrapezoidalSummary& ts = integ.summary();
+  const auto& ts = integ.summary();
   sum.steps_taken = sum.steps_attempted = ts.steps;
   sum.realizations = ts.realizations;
   sum.simulated_seconds = integ.time() - initial.getTime();
-  char buf[256];
+  char buf[320];
   std::snprintf(buf, sizeof buf,
                 "step %.4g s, %d Newton corrections, %d Jacobians, %d factorizations; frequency error "
-                "(omega h)^2/12 = %.2g at %.4g Hz (the fundamental flexible mode, or the fastest input sine above it)",
-                ts.largest_step, ts.newton_iterations, ts.jacobians, ts.factorizations, ts.lowest_mode_frequency_error(),
-                ts.lowest_omega / (2 * Pi));
+                "%s = %.2g at %.4g Hz (the fundamental flexible mode, or the fastest input sine above it)",
+                ts.largest_step, ts.newton_iterations, ts.jacobians, ts.factorizations, error_formula,
+                ts.lowest_mode_frequency_error(), ts.lowest_omega / (2 * Pi));
   sum.message = buf;
   sum.max_step = ts.largest_step;
 }
@@ -245,7 +247,12 @@ SimulateSummary simulate(const MultibodySystem& system, const State& initial, co
   SimulateSummary sum;
   const auto wall0 = Clock::now();
   sum.integrator = opt.integrator == "auto" ? choose_integrator(system, initial) : opt.integrator;
-  if (sum.integrator == "trapezoidal") simulate_trapezoidal(system, initial, opt, on_sample, wall0, sum);
+  if (sum.integrator == "trapezoidal")
+    simulate_fixed_step<TrapezoidalIntegrator, TrapezoidalOptions>(system, initial, opt, on_sample, wall0, sum,
+                                                                   "(omega h)^2/12");
+  else if (sum.integrator == "gauss-legendre")
+    simulate_fixed_step<GaussLegendreIntegrator, GaussLegendreOptions>(system, initial, opt, on_sample, wall0, sum,
+                                                                       "(omega h)^4/720");
   else simulate_simbody(system, initial, opt, on_sample, wall0, sum);
   sum.wall_seconds = seconds_since(wall0);
   return sum;
@@ -399,7 +406,7 @@ void check_truth_request(const io::Scenario& sc, const std::string& integrator, 
 }
 
 // The integration plan: integrator, accuracy, horizon, sample interval (denser behind an
-// anti-alias filter), breakpoints and, for the trapezoidal rule, the frequency its step follows.
+// anti-alias filter), breakpoints and, for the implicit fixed-step methods, the frequency their step follows.
 // Inputs the samples cannot resolve and runs over the step limit are refused here.
 SimulateOptions simulation_plan(const io::Scenario& sc, Structure& structure, State& state,
                                 const std::string& integrator, double accuracy, int n) {
@@ -425,21 +432,23 @@ SimulateOptions simulation_plan(const io::Scenario& sc, Structure& structure, St
                      io::format_value(f));
   }
   if (so.integrator == "auto") so.integrator = choose_integrator(structure.system(), state);
-  if (so.integrator == "trapezoidal") {
-    // The trapezoidal rule's step follows the structure's fundamental mode, free of the inputs
-    // (a load acting at t = 0 adds slow modes of the accelerated system, e.g. of the proof masses).
+  if (so.integrator == "trapezoidal" || so.integrator == "gauss-legendre") {
+    // The implicit fixed-step methods' step follows the structure's fundamental mode, free of the
+    // inputs (a load acting at t = 0 adds slow modes of the accelerated system, e.g. of the proof masses).
     const auto bare = build_structure(sc, n);
     bare->system().realizeTopology();
     const auto modes = natural_modes(bare->system(), bare->system().getDefaultState());
     if (!modes.empty()) so.reference_omega = modes.front().omega;
     // ... and the fastest sine the inputs drive it with, whose forced response it must follow alike.
     so.reference_omega = std::max(so.reference_omega, 2 * Pi * f_input);
-    // Its step is (12 accuracy)^(1/3) / omega_1 at most (trapezoidal.h): refuse a run that would
-    // take more steps than io::limits allows before starting it.
-    const double steps = so.final_time * so.reference_omega / std::cbrt(12.0 * accuracy);
+    // Its step is (12 accuracy)^(1/3) / omega_1 (trapezoidal.h) or (720 accuracy)^(1/5) / omega_1
+    // (gauss_legendre.h) at most: refuse a run that would take more steps than io::limits allows
+    // before starting it.
+    const double phase = so.integrator == "trapezoidal" ? std::cbrt(12.0 * accuracy) : std::pow(720.0 * accuracy, 0.2);
+    const double steps = so.final_time * so.reference_omega / phase;
     if (!(steps <= io::limits::kMaxSteps))
       io::fail_field(sc.source, "truth.accuracy",
-                     "gives about " + io::format_value(std::ceil(steps)) + " trapezoidal steps over " +
+                     "gives about " + io::format_value(std::ceil(steps)) + " " + so.integrator + " steps over " +
                          io::format_value(so.final_time) + " s (fundamental mode " +
                          io::format_value(so.reference_omega / (2 * Pi)) + " Hz), more than the limit of " +
                          io::format_value(io::limits::kMaxSteps),

@@ -139,7 +139,7 @@ truth: {segments: 6, integrator: rk-merson, accuracy: 1e-6, anti_alias_hz: 200}
 
 TEST(TruthRun, ASineTheRecordWouldAliasIsRefusedBeforeAnyStep) {
   // paper-beam-2 driven at 1e20 Hz (the record samples at 100 Hz): refused at once, naming the
-  // input's frequency; below the Nyquist frequency it runs, the trapezoidal step following the sine.
+  // input's frequency; below the Nyquist frequency it runs, the implicit methods' step following the sine.
   io::Scenario sc = io::load_scenario("paper-beam-2");
   sc.simulation.duration = 0.5;
   sc.truth.segments = 6;
@@ -161,6 +161,10 @@ TEST(TruthRun, ASineTheRecordWouldAliasIsRefusedBeforeAnyStep) {
   const TruthResult r = run_truth(sc);
   EXPECT_EQ(r.table.t.size(), 51u);
   EXPECT_LE(r.summary.max_step, std::cbrt(12.0 * sc.truth.accuracy) / (2 * M_PI * 40.0) * (1 + 1e-12));
+  sc.truth.integrator = "gauss-legendre";
+  const TruthResult g = run_truth(sc);
+  EXPECT_EQ(g.table.t.size(), 51u);
+  EXPECT_LE(g.summary.max_step, std::pow(720.0 * sc.truth.accuracy, 0.2) / (2 * M_PI * 40.0) * (1 + 1e-12));
 }
 
 TEST(TruthRun, ARecordOfNothingIsRefusedNamingWhatIsMissing) {
