@@ -31,6 +31,8 @@ bool GaussLegendreOptions::IsValid(std::string* why) const {
   if (!(newton_fraction > 0 && newton_fraction <= 1)) return bad("newton_fraction must be in (0, 1]");
   if (max_newton_iterations < 2) return bad("max_newton_iterations must be >= 2");
   if (!(refresh_contraction > 0 && refresh_contraction < 1)) return bad("refresh_contraction must be in (0, 1)");
+  if (output_stage != Stage::Velocity && output_stage != Stage::Acceleration)
+    return bad("output_stage must be Velocity or Acceleration");
   return true;
 }
 
@@ -117,6 +119,10 @@ void GaussLegendreIntegrator::predict(double h) {
       zu_[i] = std::move(nu[i]);
     }
   } else {
+    if (state_.getSystemStage() < Stage::Acceleration) {   // y0' (the step ends are realized to output_stage)
+      realize(state_);
+      ++summary_.realizations;
+    }
     for (int i = 0; i < 2; ++i) {
       zq_[i] = kC[i] * h * view(state_.getQDot());
       zu_[i] = kC[i] * h * view(state_.getUDot());
@@ -217,7 +223,7 @@ void GaussLegendreIntegrator::step(double h) {
   view_mut(state_.updQ()) = q0 + kD[0] * zq_[0] + kD[1] * zq_[1];
   view_mut(state_.updU()) = u0 + kD[0] * zu_[0] + kD[1] * zu_[1];
   state_.setTime(t1);
-  realize(state_);
+  system_.realize(state_, options_.output_stage);
   ++summary_.realizations;
   h_prev_ = h;
   u_scale_ = std::max(u_scale_, view(state_.getU()).cwiseAbs().maxCoeff());

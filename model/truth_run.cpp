@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include <random>
 #include <sstream>
+#include <type_traits>
 #include <stdexcept>
 
 #include "scoleid/io/band_filter.h"
@@ -187,6 +188,7 @@ void simulate_fixed_step(const MultibodySystem& system, const State& initial, co
   to.accuracy = opt.accuracy;
   to.max_step = opt.max_step;
   to.reference_omega = opt.reference_omega;
+  if constexpr (std::is_same_v<Options, GaussLegendreOptions>) to.output_stage = opt.sample_stage;
   Integrator integ(system, initial, to);
   const double eps = 1e-12 * std::max(1.0, opt.final_time);
   sample_loop(
@@ -536,6 +538,11 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
 
   SimulateOptions so = simulation_plan(sc, *structure, state, integrator, accuracy, n);
   so.progress = opt.progress;
+  // Only accelerometers read the Acceleration stage (sensors.h); the guards read positions.
+  so.sample_stage = std::any_of(sensors.begin(), sensors.end(),
+                                [](const ResolvedSensor& r) { return r.kind == io::SensorKind::Acceleration; })
+                        ? Stage::Acceleration
+                        : Stage::Velocity;
   const int oversample = sc.truth.anti_alias_hz > 0 ? kAntiAliasOversample : 1;
 
   TruthResult res;

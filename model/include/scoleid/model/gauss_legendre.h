@@ -57,6 +57,10 @@ struct GaussLegendreOptions {
   double reference_omega = 0.0;    // omega_1 [rad/s]; 0 = lowest oscillatory mode of the default state
   int max_newton_iterations = 6;   // per step, before the Jacobian is refreshed (twice at most)
   double refresh_contraction = 0.3;  // refresh the Jacobian when successive corrections shrink slower
+  // How far each step's end is realized (Velocity or Acceleration): the method itself needs only
+  // its stages' accelerations, so a caller that reads positions and velocities saves the step
+  // end's dynamics.
+  SimTK::Stage output_stage = SimTK::Stage::Acceleration;
   bool IsValid(std::string* why) const;
 };
 
@@ -91,7 +95,7 @@ class GaussLegendreIntegrator {
   // so the next step does not extrapolate this one's stages across it.
   void advance_to(double t_end, bool breakpoint = false);
 
-  // The current state, realized to Acceleration.
+  // The current state, realized to options.output_stage (the initial state: to Acceleration).
   const SimTK::State& state() const { return state_; }
   double time() const { return state_.getTime(); }
   double max_step() const { return summary_.max_step; }

@@ -72,6 +72,9 @@ struct SimulateOptions {
   double wall_limit = 0.0;           // seconds; > 0: stop early (Termination::WallLimit)
   double max_step = 0.0;             // trapezoidal, gauss-legendre: step bound, 0 = from accuracy
   double reference_omega = 0.0;      // trapezoidal, gauss-legendre: omega_1 of the step rule, 0 = from the initial state
+  // The stage on_sample reads (Velocity when no sensor reads accelerations): gauss-legendre then
+  // realizes its step ends no further. The other methods deliver Acceleration always.
+  SimTK::Stage sample_stage = SimTK::Stage::Acceleration;
   bool IsValid(std::string* why) const;
 };
 
@@ -92,7 +95,7 @@ struct SimulateSummary {
 };
 
 // Integrates `system` from `initial` (realized or not) and calls on_sample(state) at every
-// sample time with the state realized to Acceleration. Throws std::runtime_error on failure.
+// sample time with the state realized to options.sample_stage at least. Throws std::runtime_error on failure.
 // With a wall_limit it may stop early: then termination == WallLimit and simulated_seconds is
 // the time reached.
 SimulateSummary simulate(const SimTK::MultibodySystem& system, const SimTK::State& initial,
