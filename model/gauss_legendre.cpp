@@ -24,13 +24,8 @@ const double kD[2] = {-kR3, kR3};   // b^T a^-1: y1 = y0 + sum_i d_i Z_i
 }  // namespace
 
 bool GaussLegendreOptions::IsValid(std::string* why) const {
+  if (!ImplicitStepOptions::IsValid(why)) return false;
   auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
-  if (!(accuracy > 0 && accuracy < 1)) return bad("accuracy must be in (0, 1)");
-  if (!(max_step >= 0)) return bad("max_step must be >= 0");
-  if (!(reference_omega >= 0)) return bad("reference_omega must be >= 0");
-  if (!(newton_fraction > 0 && newton_fraction <= 1)) return bad("newton_fraction must be in (0, 1]");
-  if (max_newton_iterations < 2) return bad("max_newton_iterations must be >= 2");
-  if (!(refresh_contraction > 0 && refresh_contraction < 1)) return bad("refresh_contraction must be in (0, 1)");
   if (output_stage != Stage::Velocity && output_stage != Stage::Acceleration)
     return bad("output_stage must be Velocity or Acceleration");
   return true;
@@ -48,9 +43,7 @@ GaussLegendreIntegrator::GaussLegendreIntegrator(const MultibodySystem& system, 
   refresh_jacobian(state_);
   summary_.lowest_omega = options_.reference_omega > 0 ? options_.reference_omega
                                                        : detail::default_state_omega(system_, &summary_.realizations);
-  if (options_.max_step > 0) summary_.max_step = options_.max_step;
-  else if (summary_.lowest_omega > 0) summary_.max_step = std::pow(720.0 * options_.accuracy, 0.2) / summary_.lowest_omega;
-  else summary_.max_step = std::numeric_limits<double>::infinity();
+  summary_.max_step = implicit_step_bound(options_, summary_.lowest_omega, std::pow(720.0 * options_.accuracy, 0.2));
   for (int i = 0; i < 2; ++i) {
     zq_[i].setZero(state_.getNQ());
     zu_[i].setZero(state_.getNU());
@@ -88,7 +81,7 @@ void GaussLegendreIntegrator::advance_to(double t_end, bool breakpoint) {
   const double t0 = time();
   if (!(t_end > t0)) return;
   const double span = t_end - t0;
-  const long long n = std::max<long long>(1, static_cast<long long>(std::ceil(span / summary_.max_step - 1e-9)));
+  const long long n = equal_steps(span, summary_.max_step);
   const double h = span / static_cast<double>(n);
   for (long long i = 1; i <= n; ++i) {
     const double t1 = i == n ? t_end : t0 + static_cast<double>(i) * h;

@@ -16,17 +16,6 @@ using namespace SimTK;
 using detail::str;
 using detail::view;
 
-bool TrapezoidalOptions::IsValid(std::string* why) const {
-  auto bad = [why](const std::string& m) { if (why) *why = m; return false; };
-  if (!(accuracy > 0 && accuracy < 1)) return bad("accuracy must be in (0, 1)");
-  if (!(max_step >= 0)) return bad("max_step must be >= 0");
-  if (!(reference_omega >= 0)) return bad("reference_omega must be >= 0");
-  if (!(newton_fraction > 0 && newton_fraction <= 1)) return bad("newton_fraction must be in (0, 1]");
-  if (max_newton_iterations < 2) return bad("max_newton_iterations must be >= 2");
-  if (!(refresh_contraction > 0 && refresh_contraction < 1)) return bad("refresh_contraction must be in (0, 1)");
-  return true;
-}
-
 TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, const State& initial,
                                              const TrapezoidalOptions& options)
     : system_(system), matter_(system.getMatterSubsystem()), options_(options), state_(initial), trial_(initial) {
@@ -36,14 +25,9 @@ TrapezoidalIntegrator::TrapezoidalIntegrator(const MultibodySystem& system, cons
   realize(state_);
   q_initial_ = state_.getQ();
   refresh_jacobian(state_);
-  if (options_.reference_omega > 0) {
-    summary_.lowest_omega = options_.reference_omega;
-  } else {
-    summary_.lowest_omega = detail::default_state_omega(system_, &summary_.realizations);
-  }
-  if (options_.max_step > 0) summary_.max_step = options_.max_step;
-  else if (summary_.lowest_omega > 0) summary_.max_step = std::cbrt(12.0 * options_.accuracy) / summary_.lowest_omega;
-  else summary_.max_step = std::numeric_limits<double>::infinity();
+  summary_.lowest_omega = options_.reference_omega > 0 ? options_.reference_omega
+                                                       : detail::default_state_omega(system_, &summary_.realizations);
+  summary_.max_step = implicit_step_bound(options_, summary_.lowest_omega, std::cbrt(12.0 * options_.accuracy));
 }
 
 void TrapezoidalIntegrator::realize(State& s) const { system_.realize(s, Stage::Acceleration); }
@@ -69,7 +53,7 @@ void TrapezoidalIntegrator::advance_to(double t_end, bool left_limit) {
   const double t0 = time();
   if (!(t_end > t0)) return;
   const double span = t_end - t0;
-  const long long n = std::max<long long>(1, static_cast<long long>(std::ceil(span / summary_.max_step - 1e-9)));
+  const long long n = equal_steps(span, summary_.max_step);
   const double h = span / static_cast<double>(n);
   for (long long i = 1; i <= n; ++i) {
     const double t1 = i == n ? t_end : t0 + static_cast<double>(i) * h;

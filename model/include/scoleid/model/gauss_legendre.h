@@ -46,17 +46,11 @@
 #include <Eigen/Dense>
 #include <Simbody.h>
 
+#include "scoleid/model/implicit_step.h"
+
 namespace scoleid::model {
 
-struct GaussLegendreOptions {
-  double accuracy = 1e-9;          // phase error per step of the fundamental flexible mode
-  // Newton tolerance = newton_fraction * accuracy, relative to the running state scale (not below
-  // 1e-13, the residual's round-off).
-  double newton_fraction = 1e-1;
-  double max_step = 0.0;           // s; 0 = from accuracy and omega_1
-  double reference_omega = 0.0;    // omega_1 [rad/s]; 0 = lowest oscillatory mode of the default state
-  int max_newton_iterations = 6;   // per step, before the Jacobian is refreshed (twice at most)
-  double refresh_contraction = 0.3;  // refresh the Jacobian when successive corrections shrink slower
+struct GaussLegendreOptions : ImplicitStepOptions {
   // How far each step's end is realized (Velocity or Acceleration): the method itself needs only
   // its stages' accelerations, so a caller that reads positions and velocities saves the step
   // end's dynamics.
