@@ -16,6 +16,7 @@ using detail::view;
 using detail::view_mut;
 
 namespace {
+constexpr int kMaxSplits = 6;   // a failing step is halved at most this many times
 // The two-stage Gauss–Legendre tableau.
 const double kR3 = std::sqrt(3.0);
 const double kC[2] = {0.5 - kR3 / 6.0, 0.5 + kR3 / 6.0};
@@ -85,7 +86,7 @@ void GaussLegendreIntegrator::advance_to(double t_end, bool breakpoint) {
   const double h = span / static_cast<double>(n);
   for (long long i = 1; i <= n; ++i) {
     const double t1 = i == n ? t_end : t0 + static_cast<double>(i) * h;
-    step(t1 - time());
+    step_or_split(t1 - time(), 0);
   }
   if (breakpoint) h_prev_ = 0.0;   // the inputs jump: do not extrapolate across
 }
@@ -123,7 +124,20 @@ void GaussLegendreIntegrator::predict(double h) {
   }
 }
 
-void GaussLegendreIntegrator::step(double h) {
+// A step whose Newton iteration fails is taken as two halves (each split again if it fails, down
+// to 1/64 of the step); the run fails only below that.
+void GaussLegendreIntegrator::step_or_split(double h, int depth) {
+  std::string why;
+  if (step(h, &why)) return;
+  if (depth == kMaxSplits) throw std::runtime_error(why);
+  ++summary_.split_steps;
+  h_prev_ = 0.0;   // start the halves from Euler increments
+  const double t1 = time() + h;
+  step_or_split(0.5 * h, depth + 1);
+  step_or_split(t1 - time(), depth + 1);
+}
+
+bool GaussLegendreIntegrator::step(double h, std::string* why) {
   const double t0 = state_.getTime(), t1 = t0 + h;
   const int nu = state_.getNU(), nq = state_.getNQ();
   const Eigen::VectorXd q0 = view(state_.getQ()), u0 = view(state_.getU());
@@ -145,8 +159,14 @@ void GaussLegendreIntegrator::step(double h) {
       view_mut(s.updQ()) = q0 + zq_[i];
       view_mut(s.updU()) = u0 + zu_[i];
       s.setTime(t0 + kC[i] * h);
-      realize(s);
       ++summary_.realizations;
+      try {
+        realize(s);
+      } catch (const std::exception& e) {   // an iterate Simbody cannot evaluate (NaN inertia, ...)
+        *why = "Gauss-Legendre rule: a Newton iterate cannot be evaluated at t = " + str(t0 + kC[i] * h) + " (step " +
+               str(h) + " s): " + e.what();
+        return false;
+      }
     }
     for (int i = 0; i < 2; ++i) {
       Eigen::VectorXd Gq = zq_[i], Gu = zu_[i];
@@ -178,8 +198,10 @@ void GaussLegendreIntegrator::step(double h) {
       ds = std::max(ds, (q0 + zq_[i] - qi).cwiseAbs().maxCoeff());
     }
     const double norm = std::max(nu_max / std::max(us, tiny), nd_max / std::max(ds, tiny));
-    if (!std::isfinite(norm))
-      throw std::runtime_error("Gauss-Legendre rule: Newton correction is not finite at t = " + str(t1));
+    if (!std::isfinite(norm)) {
+      *why = "Gauss-Legendre rule: Newton correction is not finite at t = " + str(t1) + " (step " + str(h) + " s)";
+      return false;
+    }
     if (prev < std::numeric_limits<double>::infinity()) {
       const double theta = norm / prev;
       eta = theta < 1.0 ? theta / (1.0 - theta) : std::numeric_limits<double>::infinity();
@@ -203,9 +225,9 @@ void GaussLegendreIntegrator::step(double h) {
           summary_.largest_roundoff_correction = std::max(summary_.largest_roundoff_correction, norm);
           break;
         }
-        throw std::runtime_error("Gauss-Legendre rule: Newton iteration does not converge at t = " + str(t1) +
-                                 " (correction " + str(norm) + " of the state scale, step " + str(h) +
-                                 " s; the trapezoidal rule's shorter steps may converge)");
+        *why = "Gauss-Legendre rule: Newton iteration does not converge at t = " + str(t1) + " (correction " +
+               str(norm) + " of the state scale, step " + str(h) + " s; the trapezoidal rule's shorter steps may converge)";
+        return false;
       }
     }
     // The stages solve the step to within the tolerance: the correction left is below it, or a
@@ -216,13 +238,23 @@ void GaussLegendreIntegrator::step(double h) {
   view_mut(state_.updQ()) = q0 + kD[0] * zq_[0] + kD[1] * zq_[1];
   view_mut(state_.updU()) = u0 + kD[0] * zu_[0] + kD[1] * zu_[1];
   state_.setTime(t1);
-  system_.realize(state_, options_.output_stage);
   ++summary_.realizations;
+  try {
+    system_.realize(state_, options_.output_stage);
+  } catch (const std::exception& e) {   // the step's end cannot be evaluated: back to y0
+    *why = "Gauss-Legendre rule: the step's end cannot be evaluated at t = " + str(t1) + " (step " + str(h) + " s): " + e.what();
+    view_mut(state_.updQ()) = q0;
+    view_mut(state_.updU()) = u0;
+    state_.setTime(t0);
+    system_.realize(state_, options_.output_stage);
+    return false;
+  }
   h_prev_ = h;
   u_scale_ = std::max(u_scale_, view(state_.getU()).cwiseAbs().maxCoeff());
   d_scale_ = std::max(d_scale_, (view(state_.getQ()) - qi).cwiseAbs().maxCoeff());
   summary_.largest_step = std::max(summary_.largest_step, h);
   ++summary_.steps;
+  return true;
 }
 
 }  // namespace scoleid::model

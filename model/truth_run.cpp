@@ -209,6 +209,14 @@ void simulate_fixed_step(const MultibodySystem& system, const State& initial, co
                 ts.largest_step, ts.newton_iterations, ts.jacobians, ts.factorizations, error_formula,
                 ts.lowest_mode_frequency_error(), ts.lowest_omega / (2 * Pi));
   sum.message = buf;
+  if constexpr (std::is_same_v<Options, GaussLegendreOptions>) {
+    if (ts.split_steps > 0) sum.message += "; " + std::to_string(ts.split_steps) + " steps split in two (Newton failed)";
+    if (ts.roundoff_limited_steps > 0) {
+      std::snprintf(buf, sizeof buf, "; %d steps ended at the residual's round-off (largest correction %.2g of the state scale)",
+                    ts.roundoff_limited_steps, ts.largest_roundoff_correction);
+      sum.message += buf;
+    }
+  }
   sum.max_step = ts.largest_step;
 }
 

@@ -33,7 +33,8 @@
 // later steps stop one correction short; the undamped cantilever's energy then drifts 100x.)
 // A slowly contracting iteration refreshes the Jacobian at y0 (twice per step at most), then goes
 // on while it contracts; corrections that stop shrinking within 100 tol are the residual's
-// round-off and end the step (counted in the summary), beyond that the run fails.
+// round-off and end the step (counted in the summary). A step whose iteration still fails is
+// taken as two halves (down to 1/64 of it, counted), and only then does the run fail.
 //
 // Step: h_max = (720 accuracy)^(1/5) / omega_1, the step whose phase error on the fundamental
 // flexible mode omega_1 is `accuracy` per step; steps land on every requested time, so
@@ -71,6 +72,7 @@ struct GaussLegendreSummary {
   // (the residual's round-off, at steps long against the chain's top modes), and the largest
   // such correction (relative to the state scale).
   int roundoff_limited_steps = 0;
+  int split_steps = 0;             // steps whose Newton iteration failed, taken as two halves
   double largest_roundoff_correction = 0.0;
   // Relative frequency error of the method at omega_1 with the largest step, (omega h)^4/720.
   double lowest_mode_frequency_error() const {
@@ -99,7 +101,9 @@ class GaussLegendreIntegrator {
   void refresh_jacobian(const SimTK::State& at);
   const Eigen::PartialPivLU<Eigen::MatrixXd>& newton_matrix(double h);
   void predict(double h);
-  void step(double h);
+  // One step; false (and the state unchanged, the reason in *why) if its Newton iteration fails.
+  bool step(double h, std::string* why);
+  void step_or_split(double h, int depth);
   void realize(SimTK::State& s) const;
 
   const SimTK::MultibodySystem& system_;
