@@ -152,7 +152,7 @@ bool GaussLegendreIntegrator::step(double h, std::string* why) {
   double prev = std::numeric_limits<double>::infinity();
   int since_refresh = 0, refreshes = 0;
   Vector gq(nq), gd(nu), dd_s(nu), dq(nq);
-  Eigen::VectorXd g(2 * nu), Ag(2 * nu), rhs(2 * nu), du(2 * nu), dd(nu);
+  Eigen::VectorXd g(2 * nu), Ag(2 * nu), rhs(2 * nu), du(2 * nu), dqi(nq), Gq_all[2], Ndu[2];
   for (;;) {
     for (int i = 0; i < 2; ++i) {
       State& s = stage_[i];
@@ -175,6 +175,7 @@ bool GaussLegendreIntegrator::step(double h, std::string* why) {
         Gu -= h * kA[i][j] * view(stage_[j].getUDot());
       }
       view_mut(gq) = Gq;
+      Gq_all[i] = std::move(Gq);
       matter_.multiplyByNInv(stage_[i], false, gq, gd);
       g.segment(i * nu, nu) = view(gd);
       Ag.segment(i * nu, nu).noalias() = A_ * view(gd);
@@ -184,16 +185,22 @@ bool GaussLegendreIntegrator::step(double h, std::string* why) {
       for (int j = 0; j < 2; ++j) rhs.segment(i * nu, nu) -= h * kA[i][j] * Ag.segment(j * nu, nu);
     du = newton_matrix(h).solve(rhs);
     ++summary_.newton_iterations;
+    // Position corrections in q itself: delta q_i = -G_q,i + h sum_j a_ij N(Q_j) du_j. Going
+    // through N_i delta_i instead would leave the part of G_q,i outside N_i's range unsolved (a
+    // quaternion's radial part), and that error is first order in h.
+    for (int j = 0; j < 2; ++j) {
+      view_mut(dd_s) = du.segment(j * nu, nu);
+      matter_.multiplyByN(stage_[j], false, dd_s, dq);
+      Ndu[j] = view(dq);
+    }
     double nu_max = 0.0, nd_max = 0.0, us = std::max(u_scale_, u0.cwiseAbs().maxCoeff()), ds = d_scale_;
     for (int i = 0; i < 2; ++i) {
-      dd = -g.segment(i * nu, nu);
-      for (int j = 0; j < 2; ++j) dd += h * kA[i][j] * du.segment(j * nu, nu);
-      view_mut(dd_s) = dd;
-      matter_.multiplyByN(stage_[i], false, dd_s, dq);
-      zq_[i] += view(dq);
+      dqi = -Gq_all[i];
+      for (int j = 0; j < 2; ++j) dqi += h * kA[i][j] * Ndu[j];
+      zq_[i] += dqi;
       zu_[i] += du.segment(i * nu, nu);
       nu_max = std::max(nu_max, du.segment(i * nu, nu).cwiseAbs().maxCoeff());
-      nd_max = std::max(nd_max, dd.cwiseAbs().maxCoeff());
+      nd_max = std::max(nd_max, dqi.cwiseAbs().maxCoeff());
       us = std::max(us, (u0 + zu_[i]).cwiseAbs().maxCoeff());
       ds = std::max(ds, (q0 + zq_[i] - qi).cwiseAbs().maxCoeff());
     }

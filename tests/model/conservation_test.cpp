@@ -153,15 +153,19 @@ TEST(Conservation, FreeFloatingScoleMomentumTrapezoidalConvergesSecondOrder) {
 }
 
 // Two-stage Gauss–Legendre on the same run: at steps where the trapezoidal rule's change is at its
-// second-order asymptote, Gauss–Legendre's is two to three orders of magnitude smaller (measured:
-// 1.8e-7 against 5.9e-5 at 2.5 ms, 9.5e-8 against 1.5e-5 at 1.25 ms). It does not fall at fourth
-// order here: the initial deformation excites the chain's top modes, at omega h > 1 on these steps.
+// second-order asymptote, Gauss–Legendre's is three to four orders of magnitude smaller and falls
+// at (at least) the method's fourth order (measured: 1.2e-8 against 5.9e-5 at 2.5 ms, 3.1e-10
+// against 1.5e-5 at 1.25 ms, order 5.3). The shuttle's attitude is a quaternion: this holds only
+// with the stage equations solved in q itself (gauss_legendre.h).
 TEST(Conservation, FreeFloatingScoleMomentumGaussLegendreFarBelowTrapezoidal) {
+  std::vector<double> eg;
   for (double h : {0.0025, 0.00125}) {
     const MomentumChange g = momentum_change("gauss-legendre", h, "0");
     const MomentumChange t = momentum_change("trapezoidal", h, "0");
-    const double eg = std::max(g.angular, g.linear), et = std::max(t.angular, t.linear);
-    std::printf("h = %.6f s: max relative momentum change gauss-legendre %.3e, trapezoidal %.3e\n", h, eg, et);
-    EXPECT_LT(eg, 0.02 * et) << h;
+    eg.push_back(std::max(g.angular, g.linear));
+    const double et = std::max(t.angular, t.linear);
+    std::printf("h = %.6f s: max relative momentum change gauss-legendre %.3e, trapezoidal %.3e\n", h, eg.back(), et);
+    EXPECT_LT(eg.back(), 1e-3 * et) << h;
   }
+  EXPECT_GT(std::log2(eg[0] / eg[1]), 3.5);
 }

@@ -23,7 +23,10 @@
 // stage, eliminating the stage position corrections delta_i = -g_i + h sum_j a_ij du_j
 // (g_i = N^-1 G_q,i) leaves one 2 nu x 2 nu system for both stages' velocity corrections,
 //     (I - h a (x) B - h^2 a^2 (x) A) du = -G_u - h (a (x) A) g,
-// factorised once per (Jacobian, h). The stages start from the previous step's collocation
+// factorised once per (Jacobian, h). The positions are then corrected in q itself,
+// dq_i = -G_q,i + h sum_j a_ij N(Q_j) du_j, so the whole residual G_q is driven to zero: for a
+// quaternion (nq > nu) N^-1 drops G_q's radial part, and y1 = y0 + sqrt3 (Z_2 - Z_1) turns what a
+// stage keeps of it into an attitude error first order in h. The stages start from the previous step's collocation
 // polynomial extrapolated (from Euler increments at the first step and after an input
 // breakpoint). The iteration stops when eta ||dZ|| <= tol, eta = theta / (1 - theta) the
 // estimated error factor left by a correction, theta the contraction of this step's successive
