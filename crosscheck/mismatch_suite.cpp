@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "scoleid/crosscheck/case_identification.h"
+#include "scoleid/crosscheck/richardson.h"
 #include "scoleid/crosscheck/scenario_overlay.h"
 #include "study_yaml.h"
 #include "scoleid/crosscheck/table.h"
@@ -329,29 +330,47 @@ void case_checks(const SuiteFile& f, const json& c, json& checks) {
     }
 }
 
-// The observed order of each parameter's error between consecutive cases, against the family's band.
+// The observed order of each parameter's estimate against the family's band. With three or more
+// cases in geometric progression of size it is the self-convergence order (richardson.h) of
+// consecutive triples: the differences between cases, so an n-independent floor the family does
+// not vary (the identifier's own mesh) neither hides nor fakes the rate, and the Richardson limit
+// from the two finest cases is reported; with two cases, the order of the error itself.
 void rate_checks(const SuiteFile& f, json& res, json& checks) {
   if (f.expect.rate.empty() || res["cases"].size() < 2) return;
   const auto& cs = res["cases"];
+  const std::size_t m = cs.size();
+  auto size = [&](std::size_t k) { return cs[k]["size"].get<double>(); };
+  bool geometric = m >= 3;
+  for (std::size_t k = 0; geometric && k + 2 < m; ++k)
+    geometric = std::abs(size(k + 2) / size(k + 1) - size(k + 1) / size(k)) <= 1e-9 * (size(k + 1) / size(k));
   for (std::size_t i = 0; i < cs[0]["parameters"].size(); ++i) {
     const std::string n = cs[0]["parameters"][i]["name"];
     auto band = f.expect.rate.find(n);
     if (band == f.expect.rate.end()) band = f.expect.rate.find("");
     if (band == f.expect.rate.end()) continue;
     const std::pair<double, double> range = band->second;
+    auto err = [&](std::size_t k) { return val(cs[k]["parameters"][i]["relative_error"]); };
     json orders = json::array();
     bool ok = true;
     std::string measured;
-    for (std::size_t k = 0; k + 1 < cs.size(); ++k) {
-      const double e0 = std::abs(val(cs[k]["parameters"][i]["relative_error"]));
-      const double e1 = std::abs(val(cs[k + 1]["parameters"][i]["relative_error"]));
-      const double order = std::log(e0 / e1) / std::log(cs[k + 1]["size"].get<double>() / cs[k]["size"].get<double>());
+    auto add = [&](double order) {
       orders.push_back(num(order));
       ok = ok && order >= range.first && order <= range.second;  // false for NaN
       measured += (measured.empty() ? "" : ", ") + fmt("%.2f", order);
+    };
+    if (geometric) {
+      double last = std::nan("");
+      for (std::size_t k = 0; k + 2 < m; ++k) add(last = observed_order(err(k), err(k + 1), err(k + 2), size(k + 1) / size(k)));
+      const double p = std::isfinite(last) ? last : 0.5 * (range.first + range.second);
+      res["richardson_limit_error"][n] = num(richardson(err(m - 2), err(m - 1), size(m - 1) / size(m - 2), p));
+    } else {
+      for (std::size_t k = 0; k + 1 < m; ++k)
+        add(std::log(std::abs(err(k)) / std::abs(err(k + 1))) / std::log(size(k + 1) / size(k)));
     }
     res["observed_orders"][n] = orders;
-    checks.push_back(check(n + " error falls at order in [" + fmt("%.3g", range.first) + ", " + fmt("%.3g", range.second) + "]",
+    res["order_kind"] = geometric ? "self-convergence" : "error";
+    checks.push_back(check(n + (geometric ? " estimate converges" : " error falls") + " at order in [" +
+                               fmt("%.3g", range.first) + ", " + fmt("%.3g", range.second) + "]",
                            ok, measured));
   }
 }

@@ -38,13 +38,12 @@ int main(int argc, char** argv) {
   app.add_option("--segments", segments,
                  "override truth.segments (2.." + std::to_string(io::limits::kMaxSegments) + ")");
   app.add_option("--integrator", integrator,
-                 "override truth.integrator: auto (default: trapezoidal for unconstrained, lightly damped chains "
-                 "such as SCOLE; cpodes when the top chain modes are overdamped; rk-merson for constrained "
-                 "chains), gauss-legendre (fourth order: on records from rest under smooth loads, such as the "
-                 "SCOLE built-ins, about 3x faster than trapezoidal and 100x more accurate; its step follows "
-                 "the fundamental alone, so for chains started deformed or struck, whose top modes carry "
-                 "energy, prefer trapezoidal), trapezoidal, rk-merson, rk-feldberg, rk3, cpodes, cpodes-bdf2, "
-                 "verlet, semi-explicit-euler2");
+                 "override truth.integrator: auto (default: gauss-legendre for unconstrained, lightly damped chains "
+                 "such as SCOLE started at rest, as every truth run is; trapezoidal for such chains started deformed or "
+                 "moving; cpodes when the top chain modes are overdamped; rk-merson for constrained chains), "
+                 "gauss-legendre (fourth order, A-stable; on SCOLE about 3x faster than trapezoidal and 100x more "
+                 "accurate), trapezoidal (second order, A-stable, energy-conserving), rk-merson, rk-feldberg, rk3, "
+                 "cpodes, cpodes-bdf2, verlet, semi-explicit-euler2");
   app.add_option("--accuracy", accuracy,
                  "override truth.accuracy: local error per step (trapezoidal: on the fundamental mode, "
                  "step <= (12 accuracy)^(1/3) / omega_1; the default 1e-9 keeps the energy drift below 1e-6 over 50 "

@@ -41,6 +41,8 @@ std::vector<std::string> integrator_names() {
           "semi-explicit-euler2"};
 }
 
+bool starts_at_rest(const MultibodySystem& system, const State& state);
+
 std::string choose_integrator(const MultibodySystem& system, const State& state) {
   if (state.getNU() == 0) return kDefaultIntegrator;
   State eq = state;
@@ -53,7 +55,18 @@ std::string choose_integrator(const MultibodySystem& system, const State& state)
     if (std::abs(lambda[i]) > std::abs(top)) top = lambda[i];
   const double damping = std::abs(top) > 0 ? -top.real() / std::abs(top) : 0.0;
   if (damping >= 0.5) return "cpodes";
-  return system.getMatterSubsystem().getNumConstraints() > 0 ? kDefaultIntegrator : "trapezoidal";
+  if (system.getMatterSubsystem().getNumConstraints() > 0) return kDefaultIntegrator;
+  return starts_at_rest(system, state) ? "gauss-legendre" : "trapezoidal";
+}
+
+bool starts_at_rest(const MultibodySystem& system, const State& state) {
+  const State& d = system.getDefaultState();
+  if (state.getNQ() != d.getNQ() || state.getNU() != d.getNU()) return false;
+  for (int i = 0; i < state.getNU(); ++i)
+    if (state.getU()[i] != 0.0) return false;
+  for (int i = 0; i < state.getNQ(); ++i)
+    if (state.getQ()[i] != d.getQ()[i]) return false;
+  return true;
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system, double accuracy) {

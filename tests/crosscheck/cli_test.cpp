@@ -187,9 +187,9 @@ TEST(CrosscheckSuite, BadFamilyFileIsOneLineExitTwoNothingWritten) {
   fs::remove_all(d);
 }
 
-// A small family on a beam (the paper's Case I, chain of 10 and 20 segments): the family's results
-// and the suite's report; the chain's error in q2 falls at second order and the report states the
-// coverage it measured. --collect without the family's results is an incomplete suite: refused (exit 2).
+// A small family on a beam (the paper's Case I, chain of 10, 20 and 40 segments): the family's
+// results and the suite's report; the estimate of q2 self-converges at second order, its Richardson
+// limit is nearer the truth than the finest case, and the report states the coverage it measured. --collect without the family's results is an incomplete suite: refused (exit 2).
 TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
   const fs::path d = scratch("suite-beam");
   fs::create_directories(d / "families");
@@ -198,19 +198,26 @@ TEST(CrosscheckSuite, ChainFamilyOnABeamRunsAndReportsCoverage) {
         "scenario: paper-beam-1\n"
         "cases:\n  - {label: n10, size: 10, overlay: {truth: {segments: 10}}}\n"
         "  - {label: n20, size: 20, overlay: {truth: {segments: 20}}}\n"
+        "  - {label: n40, size: 40, overlay: {truth: {segments: 40}}}\n"
         "expect: {rate: {q2: [1.5, 2.5]}}\n");
   const fs::path out = d / "out";
   const std::string dir = " --suite-dir " + (d / "families").string() + " --out " + out.string();
   EXPECT_EQ(sh(exe + " suite --collect -q" + dir + " > /dev/null 2>&1"), 2);
   ASSERT_EQ(sh(exe + " suite --only beam-chain -q" + dir), 0);
   const auto r = nlohmann::json::parse(slurp(out / "results" / "beam-chain.json"));
-  ASSERT_EQ(r["cases"].size(), 2u);
+  ASSERT_EQ(r["cases"].size(), 3u);
   // q2 (1/rho_A) carries the chain's lumping; q1 sits on the geometric nonlinearity's floor.
+  EXPECT_EQ(r["order_kind"], "self-convergence");
   ASSERT_EQ(r["observed_orders"]["q2"].size(), 1u);
   for (const auto& order : r["observed_orders"]["q2"]) {
     EXPECT_GT(order.get<double>(), 1.5);
     EXPECT_LT(order.get<double>(), 2.5);
   }
+  const double finest = r["cases"][2]["parameters"][1]["relative_error"].get<double>();
+  ASSERT_EQ(r["cases"][2]["parameters"][1]["name"], "q2");
+  std::printf("q2: error %.3e at n = 40, Richardson limit %.3e, order %.2f\n", finest,
+              r["richardson_limit_error"]["q2"].get<double>(), r["observed_orders"]["q2"][0].get<double>());
+  EXPECT_LT(std::abs(r["richardson_limit_error"]["q2"].get<double>()), 0.25 * std::abs(finest));
   EXPECT_TRUE(r["expectations_met"].get<bool>());
   // Every estimate carries its interval and whether it covers the truth.
   int covered = 0, n = 0;

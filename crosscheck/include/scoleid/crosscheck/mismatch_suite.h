@@ -15,7 +15,10 @@
 //   noise:       {relative: r, seeds: K, seed: s0}  optional: Gaussian noise of r × each sensor's
 //                RMS, K draws on one noise-free truth (added here; draw j of case k seeded s0 + 1000003 k + j)
 //   expect:      {max_relative_error: {param: bound}, flagged: [param], all_covered: bool,
-//                 rate: [lo, hi] | {param: [lo, hi]} (observed order of the error against size),
+//                 rate: [lo, hi] | {param: [lo, hi]} (observed order against size: with three or
+//                 more cases in geometric progression the self-convergence order of the estimates,
+//                 richardson.h, and the Richardson limit's error is reported; with two, the
+//                 order of the error),
 //                 scatter_over_crb: [lo, hi], noise_bias_sigmas: b}
 // Every case runs the truth (model/, written as truth.csv/truth.json as scole-truth writes them)
 // and the identifier on it (identify/, from the files), with the interval.

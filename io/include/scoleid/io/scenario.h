@@ -259,8 +259,10 @@ struct DataSpec {
 struct TruthModelSpec {
   int segments = 40;
   std::string integrator = "auto";
-  // Local error per step. 1e-9: the default trapezoidal rule keeps the energy drift of a deformed
-  // undamped chain below 1e-6 over 50 periods from here (model/trapezoidal.h).
+  // Local error per step (the phase error per step on the fundamental mode for the implicit
+  // rules). 1e-9: the trapezoidal rule keeps the energy drift of a deformed undamped chain below
+  // 1e-6 over 50 periods from here (model/trapezoidal.h); Gauss–Legendre, auto's choice from rest,
+  // is then bounded by the samples on the SCOLE records (model/gauss_legendre.h).
   double accuracy = 1e-9;
   double output_interval = 0.0;   // 0 = simulation.sample_interval
   // The acquisition's anti-alias filter (Hz; 0 = none, the default): every channel, inputs and

@@ -43,14 +43,16 @@ extern const char* const kDefaultIntegrator;
 // (-Re/|lambda| >= 0.5: Kelvin–Voigt damping makes the top chain modes overdamped, as in
 // paper-beam-2), the stiffness is dissipative and BDF (cpodes) steps over it; otherwise the top
 // modes ring (SCOLE's zeta, undamped beams), BDF orders > 2 go unstable on them, BDF2 damps the
-// response, and the trapezoidal rule (A-stable, energy-conserving, one evaluation per step) is
-// the fastest method that meets the energy criterion (model/bench.cpp). It does not project onto
-// constraints, so a constrained chain (simple supports) takes the explicit kDefaultIntegrator
-// (rk-merson) instead. Gauss–Legendre is not chosen: its step follows the fundamental alone, and
-// on a chain whose top modes carry energy (started deformed, struck) it leaves their nonlinear
-// coupling unresolved (energy drift 1e-4 where the trapezoidal rule keeps 1e-6,
-// conservation_test.cpp); it is the faster and more accurate choice on records from rest under
-// smooth loads, by name.
+// response, and an A-stable method whose amplification on an undamped mode has modulus one is
+// needed. It must not project onto constraints, so a constrained chain (simple supports) takes the
+// explicit kDefaultIntegrator (rk-merson) instead. Unconstrained: two-stage Gauss–Legendre
+// (gauss_legendre.h) when the run starts at rest in the default configuration, as every truth run
+// does, whatever its inputs (step, bang-bang and pulse loads included: their trajectories are
+// closer to a tight RK-Merson reference than the trapezoidal rule's, in a third of the time,
+// docs/theory.md §9.5); the trapezoidal rule (trapezoidal.h) for a chain started deformed or
+// moving, whose top modes carry energy from the start: Gauss–Legendre's step follows the
+// fundamental alone and leaves their nonlinear coupling unresolved (energy drift 1e-4 where the
+// trapezoidal rule keeps 1e-6, conservation_test.cpp).
 std::string choose_integrator(const SimTK::MultibodySystem& system, const SimTK::State& state);
 std::vector<std::string> integrator_names();
 std::unique_ptr<SimTK::Integrator> make_integrator(const std::string& name, const SimTK::System& system,
