@@ -213,6 +213,27 @@ int main(int argc, char** argv) {
                 "quadrature %.3f (%ld state solves, %ld sensitivities)\n",
                 best.forward, best.costate, best.sens, best.quad, best.fwd_solves, best.sens_solves);
     std::printf("   %d iterations, identifiable parameters within 1e-4 at iteration %d\n", best.iters, best.within);
+    // The step rule's choice against the third-order table at its own damping-bounded step, on the
+    // same data, alternating (identification only: synthesis and outputs excluded).
+    auto p = make_problem(scoleid::io::load_scenario("paper-scole-2"), std::nullopt);
+    const IdentifierStep chosen = identifier_integration(p->scenario, p->model(), *p->params, p->signals);
+    if (chosen.third_order_step < chosen.step) {
+      RunOptions ro;
+      ro.verbose = false;
+      double worst[2] = {0.0, 0.0};
+      auto run = [&](int which) {
+        p->objective_options.solver.dirk_table = which == 0 ? chosen.dirk_table : -1;
+        p->objective_options.solver.step = which == 0 ? chosen.step : chosen.third_order_step;
+        const RunResult r = run_identification(*p, ro);
+        for (int i = 0; i < r.estimate.size(); ++i)
+          worst[which] = std::max(worst[which], std::abs(r.estimate[i] / p->true_values.at(r.names[static_cast<std::size_t>(i)]) - 1.0));
+      };
+      const auto [t4, t3] = best_of_alternating(3, [&] { run(0); }, [&] { run(1); });
+      std::printf("   identification with %s at h = %.3g s: %.3f s, largest error %.2e; %s at its own bound h = %.3g s: "
+                  "%.3f s, largest error %.2e; ratio %.2f\n",
+                  ButcherTable::name(chosen.dirk_table).c_str(), chosen.step, t4, worst[0], ButcherTable::name(-1).c_str(),
+                  chosen.third_order_step, t3, worst[1], t3 / t4);
+    }
   }
   if (want(6)) std::printf("\n6. Banded solve of P right-hand sides: P one-column sweeps / one P-column sweep (same results)\n");
   if (want(6)) std::printf("%-28s %6s %6s %6s %4s %14s %14s %8s\n", "matrix", "dofs", "band", "border", "P", "P x 1 [us]", "1 x P [us]",

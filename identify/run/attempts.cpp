@@ -202,7 +202,10 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     // (BDF chooses its own steps: the level keeps the full run's options.)
     if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
         lo.solver.integrator != SolverOptions::Integrator::Bdf)
-      lo.solver.step = std::max(lo.solver.step, identifier_step(p.scenario, p.model(), tied, p.signals));
+      if (const IdentifierStep is = identifier_integration(p.scenario, p.model(), tied, p.signals); is.step > lo.solver.step) {
+        lo.solver.step = is.step;
+        lo.solver.dirk_table = is.dirk_table;
+      }
     Objective level(p.model(), tied, p.signals, p.data, lo);
     OptimizerOptions ol = c.options;
     ol.method = resolve_method(io::Method::Auto, tied.size(), true, level.has_matrix_free_products());

@@ -182,9 +182,29 @@ double smallest_modal_damping(const StructuralModel& model, const Parameterizati
 }
 }  // namespace
 
-double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
-                       const std::vector<io::Signal>& signals) {
-  if (sc.identification.time_step > 0) return sc.identification.time_step;
+namespace {
+// The longest step at most h0 whose numerical damping ratio at frequency w is at most target
+// (ζ_num grows with x = ω h on (0, 0.3]).
+double damping_bounded_step(const ButcherTable& table, double w, double h0, double target) {
+  if (!(numerical_damping_ratio(table, w * h0) > target)) return h0;
+  double lo = 0.0, hi = w * h0;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (numerical_damping_ratio(table, mid) > target ? hi : lo) = mid;
+  }
+  return lo / w;
+}
+
+int implicit_stages(const ButcherTable& t) {
+  int k = 0;
+  for (int i = 0; i < t.stages; ++i) k += t.a(i, i) != 0.0;
+  return k;
+}
+}  // namespace
+
+IdentifierStep identifier_integration(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
+                                      const std::vector<io::Signal>& signals) {
+  if (sc.identification.time_step > 0) return {sc.identification.time_step, -1, sc.identification.time_step};
   // Resolve (ω h <= 0.3) modes 1 … K, K = min(P + 2, modes below Nyquist) (data_content): an
   // L-stable step damps what it does not resolve, keeping its quasi-static part.
   const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
@@ -195,20 +215,24 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   // A damping parameter is read from decay rates: the step's own damping in that band must be
   // small against the physical one, ζ_num(ω_K h) <= 1 % of the smallest modal damping ratio
   // there (docs/theory.md §5.2), or the fit absorbs the integrator's damping into the estimate.
+  IdentifierStep out{h, -1, h};
   if (w > 0 && estimates_damping(model, params)) {
     const double target = 0.01 * smallest_modal_damping(model, params, content.mode);
-    const ButcherTable table = ButcherTable::arkode_dirk(SolverOptions{}.dirk_table);
-    if (target > 0.0 && numerical_damping_ratio(table, w * h) > target) {
-      double lo = 0.0, hi = w * h;  // ζ_num grows with x = ω h on (0, 0.3]
-      for (int it = 0; it < 60; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (numerical_damping_ratio(table, mid) > target ? hi : lo) = mid;
-      }
-      h = lo / w;
+    if (target > 0.0) {
+      const ButcherTable third = ButcherTable::arkode_dirk(-1), fourth = ButcherTable::arkode_dirk(ButcherTable::esdirk436_id());
+      const double h3 = damping_bounded_step(third, w, h, target), h4 = damping_bounded_step(fourth, w, h, target);
+      out = {h3, -1, h3};
+      if (h3 < h && implicit_stages(fourth) / h4 < implicit_stages(third) / h3) out = {h4, ButcherTable::esdirk436_id(), h3};
     }
   }
-  return h;
+  return out;
 }
+
+double identifier_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
+                       const std::vector<io::Signal>& signals) {
+  return identifier_integration(sc, model, params, signals).step;
+}
+
 
 namespace {
 // Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
@@ -335,12 +359,13 @@ Measurements synthesize_series(const io::Scenario& sc, int terms) {
   return m;
 }
 
-Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise) {
+Measurements synthesize(const io::Scenario& sc, int elements, double rtol, double step, bool add_noise, int dirk_table) {
   const auto [model, coefficients] = true_model(sc, elements);
   const AssembledModel ops = assemble(model, coefficients);
   SolverOptions so;
   so.rtol = rtol;
   so.step = step;
+  so.dirk_table = dirk_table;
   SecondOrderSolver solver(ops.M, ops.D, ops.K, model.dof_group, so);
   const auto signals = scenario_signals(sc);
   const int n = model.ndof;
@@ -624,7 +649,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
 
 // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step 4x
 // finer than the identifier's. Returns the identifier's step.
-double synthesize_data(Problem& p) {
+IdentifierStep synthesize_data(Problem& p) {
   const auto& sc = p.scenario;
   const auto& id = sc.identification;
   const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
@@ -632,7 +657,8 @@ double synthesize_data(Problem& p) {
     fail_field(sc.source, "identification.data_elements",
                "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
                std::to_string(data_elements));
-  const double step = identifier_step(sc, p.model(), *p.params, p.signals);
+  const IdentifierStep is = identifier_integration(sc, p.model(), *p.params, p.signals);
+  const double step = is.step;
   check_step(sc, p.model(), *p.params, p.signals, step, true);
   p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
                            id.step_rule == io::StepRule::Data);
@@ -643,17 +669,18 @@ double synthesize_data(Problem& p) {
                "data with scole-truth and pass them with --data)",
                io::format_value(truth_sc.scole.actuator_lag));
   p.data = id.model == io::Model::Nonlinear ? synthesize_nonlinear(truth_sc, data_elements, step / 4.0, true)
-                                            : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true);
+                                            : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true, is.dirk_table);
   p.data_source = "synthetic (" + std::to_string(data_elements) + " elements)";
   set_true_values(p, truth_sc);
-  return step;
+  return is;
 }
 
 // The identifier's step for measured data (the inputs as they will drive the model: a data column
 // replaces a scenario signal), within the limits for the record's own span.
-double measured_data_step(Problem& p, const std::string& csv) {
+IdentifierStep measured_data_step(Problem& p, const std::string& csv) {
   const auto& sc = p.scenario;
-  const double step = identifier_step(sc, p.model(), *p.params, p.signals);
+  const IdentifierStep is = identifier_integration(sc, p.model(), *p.params, p.signals);
+  const double step = is.step;
   check_step(sc, p.model(), *p.params, p.signals, step, false);
   const double span = p.data.t.back() - p.data.t.front(), steps = step > 0 ? span / step : 0.0;
   if (!(steps <= io::limits::kMaxSteps))
@@ -662,7 +689,7 @@ double measured_data_step(Problem& p, const std::string& csv) {
                      " s; the limit is " + io::format_value(io::limits::kMaxSteps) + " steps");
   p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
                            sc.identification.step_rule == io::StepRule::Data);
-  return step;
+  return is;
 }
 
 // identification.band (inverse/band_filter.h): the inputs' samples at the data's times and the
@@ -704,7 +731,7 @@ void apply_band(Problem& p) {
 
 // The solver's options, once the data are in: a record in which no sensor moves is refused (every
 // parameter fits it the same until the model moves, and then only worse).
-void finish_problem(Problem& p, double step, const std::string* csv) {
+void finish_problem(Problem& p, const IdentifierStep& step, const std::string* csv) {
   const auto& id = p.scenario.identification;
   if (p.data.z.size() > 0 && (p.data.z.array() == 0.0).all()) {
     if (csv) throw InputError("data file '" + *csv + "': every sensor's column is zero: nothing to identify from");
@@ -733,7 +760,8 @@ void finish_problem(Problem& p, double step, const std::string* csv) {
   }
   apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
-  p.objective_options.solver.step = step;
+  p.objective_options.solver.step = step.step;
+  p.objective_options.solver.dirk_table = step.dirk_table;
   p.objective_options.noise_std = p.noise_std;
   p.objective_options.noise_independent_fraction = p.band_gain;
   p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf

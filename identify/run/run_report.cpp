@@ -19,10 +19,10 @@ namespace {
 double safe(double v) { return std::isfinite(v) ? v : 0.0; }
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-const char* integrator_name(SolverOptions::Integrator i) {
-  switch (i) {
-    case SolverOptions::Integrator::Esdirk: return "esdirk324l2sa";
-    case SolverOptions::Integrator::EsdirkArkode: return "arkode-esdirk324l2sa";
+std::string integrator_name(const SolverOptions& o) {
+  switch (o.integrator) {
+    case SolverOptions::Integrator::Esdirk: return ButcherTable::name(o.dirk_table);
+    case SolverOptions::Integrator::EsdirkArkode: return "arkode-" + ButcherTable::name(o.dirk_table);
     case SolverOptions::Integrator::Bdf: return "cvodes-bdf";
   }
   return "?";
@@ -117,7 +117,7 @@ json integrator_json(const RunResult& r, const Problem& p) {
   const bool nonlinear = r.model == io::Model::Nonlinear;
   const auto& id = p.scenario.identification;
   return {{"name", nonlinear ? std::string("esdirk-newton (nonlinear model)")
-                             : std::string(integrator_name(p.objective_options.solver.integrator))},
+                             : integrator_name(p.objective_options.solver)},
           {"step", nonlinear ? r.integrator_step : p.objective_options.solver.step},
           {"rtol", nonlinear ? json(nullptr) : json(p.objective_options.solver.rtol)},
           {"steps", r.counters.solver.steps},

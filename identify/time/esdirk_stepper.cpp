@@ -47,6 +47,14 @@ ButcherTable ButcherTable::arkode_dirk(int id) {
   return t;
 }
 
+int ButcherTable::esdirk436_id() { return ARKODE_ESDIRK436L2SA_6_3_4; }
+
+std::string ButcherTable::name(int id) {
+  if (id < 0 || id == ARKODE_ESDIRK324L2SA_4_2_3) return "esdirk324l2sa";
+  if (id == ARKODE_ESDIRK436L2SA_6_3_4) return "esdirk436l2sa";
+  return "arkode-dirk-" + std::to_string(id);
+}
+
 std::vector<double> segment_ends(const std::vector<double>& breakpoints, double t0, double t1) {
   std::vector<double> stops;
   for (double b : breakpoints)

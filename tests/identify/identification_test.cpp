@@ -91,10 +91,11 @@ TEST(Identification, PaperCasesReachOneInTenThousandInHalfThePaperIterations) {
 }
 
 TEST(Identification, InverseCrimeRecoversTruthToOneInAMillion) {
-  // Data from the identifier's own mesh and time step: the only error left is the optimiser's.
+  // Data from the identifier's own mesh, time step and table: the only error left is the optimiser's.
   auto sc = scoleid::io::load_scenario("paper-beam-2");
   auto p = make_problem(sc, std::nullopt);
-  p->data = synthesize(sc, sc.identification.elements, sc.identification.rtol, p->objective_options.solver.step, false);
+  p->data = synthesize(sc, sc.identification.elements, sc.identification.rtol, p->objective_options.solver.step, false,
+                       p->objective_options.solver.dirk_table);
   const RunResult r = identify_builtin(*p);
   std::printf("  inverse crime: max relative error %.3e\n", max_rel_error(*p, r.estimate));
   EXPECT_LT(max_rel_error(*p, r.estimate), 1e-6);
@@ -108,7 +109,8 @@ TEST(Identification, PaperFormWithZetaRecoversAllThreeFromTheFarStart) {
   sc.identification.estimate.push_back("zeta");
   sc.identification.initial["zeta"] = 0.05;
   auto p = make_problem(sc, std::nullopt);
-  p->data = synthesize(sc, sc.identification.elements, sc.identification.rtol, p->objective_options.solver.step, false);
+  p->data = synthesize(sc, sc.identification.elements, sc.identification.rtol, p->objective_options.solver.step, false,
+                       p->objective_options.solver.dirk_table);
   const RunResult r = identify_builtin(*p);
   ASSERT_EQ(r.names.back(), "zeta");
   std::printf("  paper form with zeta: max relative error %.3e\n", max_rel_error(*p, r.estimate));

@@ -104,6 +104,45 @@ TEST(ScoleIdentification, CaseTwoZetaIsResolvedAndTheStepDampsLessThanOnePercent
   EXPECT_LT(zh_max, 0.0125 * z_min);
 }
 
+// The damping bound's two tables: ESDIRK3(2)4L[2]SA's numerical damping grows as (ω h)³,
+// ESDIRK4(3)6L[2]SA's as (ω h)⁵ (measured on ζ_num between ω h = 0.05 and 0.1). paper-scole-2
+// estimates ζ, the bound shortens the third-order step, and the fourth-order table at its own bound
+// needs fewer implicit stages per second: the run takes it. paper-scole-1 estimates no damping and
+// keeps the third-order table at min(sample interval, 0.3 / ω_K).
+TEST(ScoleIdentification, TheDampingBoundTakesTheTableWithFewerImplicitStagesPerSecond) {
+  const ButcherTable third = ButcherTable::arkode_dirk(-1), fourth = ButcherTable::arkode_dirk(ButcherTable::esdirk436_id());
+  const double o3 = std::log2(numerical_damping_ratio(third, 0.1) / numerical_damping_ratio(third, 0.05));
+  const double o4 = std::log2(numerical_damping_ratio(fourth, 0.1) / numerical_damping_ratio(fourth, 0.05));
+  std::printf("  zeta_num order in omega h: third-order table %.2f, fourth-order table %.2f\n", o3, o4);
+  EXPECT_NEAR(o3, 3.0, 0.2);
+  EXPECT_NEAR(o4, 5.0, 0.2);
+
+  auto p = make_problem(scoleid::io::load_scenario("paper-scole-2"), std::nullopt);
+  const IdentifierStep is = identifier_integration(p->scenario, p->model(), *p->params, p->signals);
+  EXPECT_EQ(is.dirk_table, ButcherTable::esdirk436_id());
+  EXPECT_EQ(p->objective_options.solver.dirk_table, is.dirk_table);
+  EXPECT_EQ(p->objective_options.solver.step, is.step);
+  // At that step the third-order table damps ω_K by more than 1.1 % of the starting ζ (the largest
+  // modal damping ratio there), so the bound must shorten it; the fourth-order one, by less than
+  // 1 % of a tenth of it (the smallest modal ratio, CaseTwoZetaIsResolved...); the third-order
+  // table's own bounded step is shorter than 3/5 of it (more implicit stages per second).
+  const double w = p->content.omega, zeta0 = p->scenario.identification.initial.at("zeta");
+  const double z3 = numerical_damping_ratio(third, w * is.step), z4 = numerical_damping_ratio(fourth, w * is.step);
+  std::printf("  paper-scole-2: step %.4g s, omega_K h %.3f; zeta_num %.2e (fourth) against %.2e (third); zeta0 %.2e\n",
+              is.step, w * is.step, z4, z3, zeta0);
+  EXPECT_GT(z3, 0.011 * zeta0);
+  EXPECT_LT(z4, 0.001 * zeta0);
+  EXPECT_LT(is.third_order_step, 0.6 * is.step);
+  EXPECT_NEAR(is.step, std::min(p->scenario.simulation.sample_interval, 0.3 / w), 1e-15);
+
+  auto p1 = make_problem(scoleid::io::load_scenario("paper-scole-1"), std::nullopt);
+  const IdentifierStep is1 = identifier_integration(p1->scenario, p1->model(), *p1->params, p1->signals);
+  EXPECT_EQ(is1.dirk_table, -1);
+  EXPECT_EQ(is1.third_order_step, is1.step);
+  EXPECT_EQ(p1->objective_options.solver.dirk_table, -1);
+  EXPECT_EQ(p1->objective_options.solver.step, is1.step);
+}
+
 TEST(ScoleIdentification, CaseTwoFromThePaperStartInAtMostEightIterations) {
   // From the paper's start: EI, ρA and ρI_ψ within 1e-4 of the truth and ζ within 1e-3 in at
   // most 8 Gauss–Newton iterations (all iterations counted, on every horizon), each identifiable

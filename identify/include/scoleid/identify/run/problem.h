@@ -107,7 +107,8 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const io::Da
 // then each sensor's column (io::write_csv writes it).
 io::DataTable measurement_table(const io::Scenario& scenario, const Measurements& m);
 // Noise-free (or noisy, per the scenario) synthetic measurements on `elements` elements.
-Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise);
+Measurements synthesize(const io::Scenario& scenario, int elements, double rtol, double step, bool add_noise,
+                        int dirk_table = -1);
 // The closed-form modal series (`terms` modes) of a uniform simply supported beam under the step
 // load of the scenario's first input, at its first sensor and its sample times: data with no
 // finite elements in them (std::invalid_argument for any other structure).
@@ -126,8 +127,19 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
 // identification.step_rule: data, K_data (data_content),
 // shortened when a damping parameter is estimated until the method's numerical damping ratio at
 // ω_K h is at most 1 % of the smallest modal damping ratio of modes 1 … K (docs/theory.md §5.2).
+// That damping bound is met by one of two ESDIRK tables, the default third-order
+// ESDIRK3(2)4L[2]SA (3 implicit stages) and the fourth-order ESDIRK4(3)6L[2]SA (5), whose
+// damping grows as (ω h)⁵ instead of (ω h)³: the run takes the one with fewer implicit stages per
+// second of record, and the third-order table whenever the bound does not shorten its step.
 // make_problem refuses a given step with ω_K h > 1 and any step whose trajectories exceed
 // io/limits.h.
+struct IdentifierStep {
+  double step = 0.0;
+  int dirk_table = -1;            // SolverOptions::dirk_table
+  double third_order_step = 0.0;  // the step the third-order table alone would take (= step when it is taken)
+};
+IdentifierStep identifier_integration(const io::Scenario& scenario, const StructuralModel& model,
+                                      const Parameterization& params, const std::vector<io::Signal>& signals);
 double identifier_step(const io::Scenario& scenario, const StructuralModel& model, const Parameterization& params,
                        const std::vector<io::Signal>& signals);
 // Numerical damping ratio −ln|R(i x)| / x of one step of a Runge–Kutta table at x = ω h.

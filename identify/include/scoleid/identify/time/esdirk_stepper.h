@@ -50,6 +50,12 @@ struct ButcherTable {
   bool stiffly_accurate() const;      // b = last row of A and c_s = 1: y_{n+1} is the last stage
   // An ARKODE DIRK table by id (ARKODE_DIRKTableID); −1 = ESDIRK3(2)4L[2]SA.
   static ButcherTable arkode_dirk(int id = -1);
+  // The id of ESDIRK4(3)6L[2]SA (Kennedy & Carpenter 2016): fourth order, L-stable, stiffly
+  // accurate, explicit first stage and five implicit ones; its numerical damping on an undamped
+  // mode grows as (ω h)⁵ where ESDIRK3(2)4L[2]SA's grows as (ω h)³.
+  static int esdirk436_id();
+  // A short name of the table with this id ("esdirk324l2sa", "esdirk436l2sa", else "arkode-dirk-<id>").
+  static std::string name(int id);
 };
 
 struct StepperCounters {
