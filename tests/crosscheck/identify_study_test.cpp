@@ -30,9 +30,9 @@ crosscheck::IdentifyStudy study(const io::Scenario& sc, const std::string& tag) 
 TEST(IdentifyStudy, ScoleBiasIsTheChainsLumpingAndExtrapolatesAway) {
   // Both sides carry the section's bending rotary inertia (docs/theory.md §3.3, §9.3): what the
   // chain adds is its lumping, second order in n, and the extrapolated estimates meet the truth to
-  // the chain limit's own difference from the FE continuum (measured with the Gauss–Legendre truth:
-  // q1 3e-5, q2 1.2e-4, while FE-on-FE is 2e-6; a trapezoidal truth's time error shifts both by
-  // about -3e-5).
+  // the truth's geometric nonlinearity (measured with the Gauss–Legendre truth: q1 3e-5, q2 1.2e-4,
+  // ten times smaller with the loads scaled by 0.1, while FE-on-FE is 2e-6; a trapezoidal truth's
+  // time error shifts both by about -3e-5).
   io::Scenario sc = io::load_scenario("paper-scole-1");
   const auto nominal = study(sc, "nominal");
   ASSERT_TRUE(nominal.all_converged());
