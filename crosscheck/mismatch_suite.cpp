@@ -333,8 +333,8 @@ void case_checks(const SuiteFile& f, const json& c, json& checks) {
 // The observed order of each parameter's estimate against the family's band. With three or more
 // cases in geometric progression of size it is the self-convergence order (richardson.h) of
 // consecutive triples: the differences between cases, so an n-independent floor the family does
-// not vary (the identifier's own mesh) neither hides nor fakes the rate, and the Richardson limit
-// from the two finest cases is reported; with two cases, the order of the error itself.
+// not vary (the truth's geometric nonlinearity, say) neither hides nor fakes the rate, and the
+// Richardson limit from the two finest cases is reported; with two cases, the order of the error.
 void rate_checks(const SuiteFile& f, json& res, json& checks) {
   if (f.expect.rate.empty() || res["cases"].size() < 2) return;
   const auto& cs = res["cases"];
