@@ -222,7 +222,10 @@ IdentifierStep identifier_integration(const io::Scenario& sc, const StructuralMo
       const ButcherTable third = ButcherTable::arkode_dirk(-1), fourth = ButcherTable::arkode_dirk(ButcherTable::esdirk436_id());
       const double h3 = damping_bounded_step(third, w, h, target), h4 = damping_bounded_step(fourth, w, h, target);
       out = {h3, -1, h3};
-      if (h3 < h && implicit_stages(fourth) / h4 < implicit_stages(third) / h3) out = {h4, ButcherTable::esdirk436_id(), h3};
+      // (The nonlinear model steps with its own third-order table, nonlinear_forward.h.)
+      const bool linear = sc.identification.model != io::Model::Nonlinear;
+      if (linear && h3 < h && implicit_stages(fourth) / h4 < implicit_stages(third) / h3)
+        out = {h4, ButcherTable::esdirk436_id(), h3};
     }
   }
   return out;

@@ -135,6 +135,14 @@ TEST(ScoleIdentification, TheDampingBoundTakesTheTableWithFewerImplicitStagesPer
   EXPECT_LT(is.third_order_step, 0.6 * is.step);
   EXPECT_NEAR(is.step, std::min(p->scenario.simulation.sample_interval, 0.3 / w), 1e-15);
 
+  // The nonlinear model steps with its own third-order table: the bound's third-order step.
+  auto sn = scoleid::io::load_scenario("paper-scole-2");
+  sn.identification.model = scoleid::io::Model::Nonlinear;
+  const auto pn = make_problem(p->scenario, std::nullopt);
+  const IdentifierStep isn = identifier_integration(sn, pn->model(), *pn->params, pn->signals);
+  EXPECT_EQ(isn.dirk_table, -1);
+  EXPECT_EQ(isn.step, is.third_order_step);
+
   auto p1 = make_problem(scoleid::io::load_scenario("paper-scole-1"), std::nullopt);
   const IdentifierStep is1 = identifier_integration(p1->scenario, p1->model(), *p1->params, p1->signals);
   EXPECT_EQ(is1.dirk_table, -1);

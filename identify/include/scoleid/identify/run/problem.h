@@ -130,7 +130,8 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
 // That damping bound is met by one of two ESDIRK tables, the default third-order
 // ESDIRK3(2)4L[2]SA (3 implicit stages) and the fourth-order ESDIRK4(3)6L[2]SA (5), whose
 // damping grows as (ω h)⁵ instead of (ω h)³: the run takes the one with fewer implicit stages per
-// second of record, and the third-order table whenever the bound does not shorten its step.
+// second of record, and the third-order table whenever the bound does not shorten its step (and
+// always for identification.model: nonlinear, whose stepper has its own third-order table).
 // make_problem refuses a given step with ω_K h > 1 and any step whose trajectories exceed
 // io/limits.h.
 struct IdentifierStep {
