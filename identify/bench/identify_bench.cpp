@@ -234,6 +234,22 @@ int main(int argc, char** argv) {
                   ButcherTable::name(chosen.dirk_table).c_str(), chosen.step, t4, worst[0], ButcherTable::name(-1).c_str(),
                   chosen.third_order_step, t3, worst[1], t3 / t4);
     }
+    // One thread per sweep against the automatic split (two when the machine has them), on the
+    // same data, alternating; the estimates must agree bit for bit.
+    {
+      auto q = make_problem(scoleid::io::load_scenario("paper-scole-2"), std::nullopt);
+      RunOptions ro;
+      ro.verbose = false;
+      VectorXd est[2];
+      auto run = [&](int threads) {
+        q->objective_options.sweep_threads = threads;
+        est[threads == 1 ? 0 : 1] = run_identification(*q, ro).estimate;
+      };
+      const auto [t_one, t_auto] = best_of_alternating(3, [&] { run(1); }, [&] { run(0); });
+      std::printf("   identification with one thread per sweep %.3f s, with the automatic split %.3f s: ratio %.2f; "
+                  "estimates %s\n",
+                  t_one, t_auto, t_one / t_auto, est[0] == est[1] ? "identical" : "DIFFER");
+    }
   }
   if (want(6)) std::printf("\n6. Banded solve of P right-hand sides: P one-column sweeps / one P-column sweep (same results)\n");
   if (want(6)) std::printf("%-28s %6s %6s %6s %4s %14s %14s %8s\n", "matrix", "dofs", "band", "border", "P", "P x 1 [us]", "1 x P [us]",

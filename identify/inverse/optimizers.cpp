@@ -235,6 +235,15 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       }
       if (k >= r.opt.max_iterations) break;
       const TrustRegionStep st = s.step(x, cur, radius, full() ? 0.0 : r.opt.short_horizon_floor * cur.J);
+      // On the whole record the undamped step's predicted decrease is the most the Gauss–Newton
+      // model can gain. A gain of J/N (the stall threshold) is a move of about one standard
+      // deviation (δᵀFδ ≈ N ΔJ / J with F ≈ H N / 2J), so below a thousandth of it the step left
+      // is within 0.03 std of the minimum: end the run without paying for the trial's solve.
+      if (full() && !st.on_boundary && st.predicted <= 1e-3 * r.gauss_newton_stall() * cur.J) {
+        r.sum.termination = T::CostStalled;
+        r.sum.message = "the Gauss-Newton step left predicts a decrease below 1e-3 of the stall threshold: at the minimum";
+        break;
+      }
       Point trial;
       const bool profile = continuation && !full();
       const bool ok = s.evaluate(x + st.delta, trial, profile) && trial.J < cur.J;

@@ -279,8 +279,9 @@ std::string noise_origin(const Problem& p, const std::string& fisher_source) {
 
 void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r) {
   const auto ti = std::chrono::steady_clock::now();
-  // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval.
-  const MatrixXd Y = obj.predict(r.estimate);
+  // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval
+  // (the outputs are the fit test's, when it kept them).
+  const MatrixXd Y = r.predicted.size() > 0 ? r.predicted : obj.predict(r.estimate);
   const MatrixXd G = obj.output_sensitivities(r.estimate);
   r.ident = identifiability_from(band_information(p, fisher_information(obj.data(), Y, G, sensors_with_noise(p))), r.estimate);
   flag_mirror_ambiguity(p, obj, r, Y);

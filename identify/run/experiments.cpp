@@ -347,7 +347,10 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   std::vector<JointMisfit::Component> parts;
   for (std::size_t i = 0; i < ep.runs.size(); ++i) {
     Problem& p = *ep.runs[i];
-    objs.push_back(std::make_unique<Objective>(p.model(), *p.params, p.signals, p.data, p.objective_options));
+    ObjectiveOptions oo = p.objective_options;
+    // Several parts are already solved side by side: one thread per sweep.
+    if (ep.runs.size() + (ep.modes ? 1 : 0) > 1) oo.sweep_threads = 1;
+    objs.push_back(std::make_unique<Objective>(p.model(), *p.params, p.signals, p.data, oo));
     parts.push_back({ep.spec.runs[i].name, objs.back().get()});
   }
   std::unique_ptr<ModalMisfit> modal;

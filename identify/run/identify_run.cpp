@@ -68,6 +68,7 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
   }
   FitTest f = fit_test(in);
   f.discretisation = std::move(in.discretisation);
+  f.predicted = std::move(Y);
   return f;
 }
 
@@ -137,6 +138,9 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   c.options.smoothness_chains = chains;
   run_attempts(c, r);
   r.estimate = r.summary.q;
+  // The fit test's outputs at the estimate (the chosen attempt's), kept for the assessment and fit.csv.
+  if (r.fit.predicted.rows() == p.data.z.rows() && r.fit.predicted.cols() == p.data.z.cols() && r.fit.predicted.allFinite())
+    r.predicted = r.fit.predicted;
   if (ro.compute_std) assess_estimate(p, obj, c.options, r);
   estimate_modes(p, r);
   r.counters = obj.counters();

@@ -111,6 +111,76 @@ TEST(EsdirkStepper, GaussNewtonGradientIsTheGradientOfTheDiscreteCost) {
   }
 }
 
+TEST(EsdirkStepper, AWholeRecordGaussNewtonSweepKeepsTheOutputSensitivitiesAtItsPoint) {
+  // The Fisher step at the optimiser's last point costs no solve: the sweep that evaluated it
+  // interpolated the output sensitivities at the samples on the way. Asked at that q they are the
+  // numbers a sweep of their own gives (the same interpolation), without a solve; at another q,
+  // or after a sweep on a shorter horizon, they are solved for.
+  auto p = scole_problem("esdirk");
+  const VectorXd q = p->params->initial();
+  Objective swept(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  Objective fresh(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  VectorXd g;
+  MatrixXd H;
+  swept.gauss_newton(q, g, H);
+  const long solves = swept.counters().sensitivity_solves;
+  const MatrixXd Gk = swept.output_sensitivities(q);
+  EXPECT_EQ(swept.counters().sensitivity_solves, solves);
+  const MatrixXd Gf = fresh.output_sensitivities(q);
+  EXPECT_EQ(fresh.counters().sensitivity_solves, q.size());
+  ASSERT_EQ(Gk.rows(), Gf.rows());
+  ASSERT_EQ(Gk.cols(), Gf.cols());
+  EXPECT_EQ(max_abs(Gk - Gf), 0.0);
+  EXPECT_GT(max_abs(Gf), 0.0);
+  // Another point: solved, and different.
+  VectorXd q2 = q;
+  q2[0] *= 1.01;
+  const MatrixXd G2 = swept.output_sensitivities(q2);
+  EXPECT_EQ(swept.counters().sensitivity_solves, solves + q.size());
+  EXPECT_GT(max_abs(G2 - Gk), 0.0);
+  // A sweep on half the record keeps nothing: the next request at its q is solved.
+  swept.set_horizon(0.5 * (swept.data_start() + swept.data_end()));
+  swept.gauss_newton(q, g, H);
+  const long after_half = swept.counters().sensitivity_solves;
+  swept.set_horizon(swept.data_end());
+  EXPECT_EQ(max_abs(swept.output_sensitivities(q) - Gf), 0.0);
+  EXPECT_EQ(swept.counters().sensitivity_solves, after_half + q.size());
+}
+
+TEST(EsdirkStepper, ASweepSplitOverTwoThreadsGivesTheSameNumbersAsOne) {
+  // The tangents in two groups, each stepped with its own copy of the state: a column's stages do
+  // not depend on the others, so J, g, H, the misfit profile and the output sensitivities are the
+  // one-thread sweep's bit for bit — on the whole record, and on a shorter horizon with the state
+  // carried on to the record's end for the profile.
+  auto p = scole_problem("esdirk");
+  const VectorXd q = p->params->initial();
+  ObjectiveOptions one = p->objective_options, two = p->objective_options;
+  one.sweep_threads = 1;
+  two.sweep_threads = 2;
+  Objective a(p->model(), *p->params, p->signals, p->data, one), b(p->model(), *p->params, p->signals, p->data, two);
+  for (double horizon : {a.data_end(), a.data_start() + 0.4 * (a.data_end() - a.data_start())}) {
+    a.set_horizon(horizon);
+    b.set_horizon(horizon);
+    VectorXd ga, gb;
+    MatrixXd Ha, Hb;
+    Objective::MisfitProfile pa, pb;
+    const double Ja = a.gauss_newton(q, ga, Ha, &pa), Jb = b.gauss_newton(q, gb, Hb, &pb);
+    std::printf("  horizon %.2f s: J %.12e, |g| %.6e\n", horizon, Ja, ga.norm());
+    EXPECT_GT(Ja, 0.0);
+    EXPECT_EQ(Ja, Jb);
+    EXPECT_EQ(max_abs(ga - gb), 0.0);
+    EXPECT_EQ(max_abs(Ha - Hb), 0.0);
+    EXPECT_EQ(pa.t, pb.t);
+    EXPECT_EQ(pa.misfit, pb.misfit);
+    EXPECT_FALSE(pa.t.empty());
+  }
+  a.set_horizon(a.data_end());
+  b.set_horizon(b.data_end());
+  VectorXd q2 = q;
+  q2[1] *= 1.02;  // a point neither has kept
+  EXPECT_EQ(max_abs(a.output_sensitivities(q2) - b.output_sensitivities(q2)), 0.0);
+}
+
 TEST(EsdirkStepper, AnEndAnchoredReversedRunStepsOnTheForwardGridMirrored) {
   // Two undamped oscillators (ω = 3, 7) under a unit step force from rest, x(t) = (1 − cos ωt)/ω²,
   // over [0, 2] with breakpoints 0.37 and 1.1 and h = 0.03 (which divides no segment). A run in

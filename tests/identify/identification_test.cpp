@@ -8,6 +8,7 @@
 
 #include "scoleid/identify/fe/beam_model.h"
 #include "scoleid/identify/fe/analytic_beam.h"
+#include "scoleid/identify/inverse/gauss_newton_step.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "test_support.h"
 
@@ -87,6 +88,35 @@ TEST(Identification, PaperCasesReachOneInTenThousandInHalfThePaperIterations) {
     EXPECT_LE(k, limit) << name;
     EXPECT_LT(max_rel_error(*p, r.estimate), 1e-4) << name;
     EXPECT_TRUE(r.summary.converged()) << name;
+  }
+}
+
+TEST(Identification, TheStopOnThePredictedStallLeavesLessThanATwentiethOfAStd) {
+  // paper-beam-2 ends when the Gauss–Newton step left predicts less than 1e-3 of J/N, without a
+  // trial solve. Check what was given up: the step from the estimate predicts that little, gains
+  // no more in fact, and moves no parameter by more than 0.05 of its standard deviation.
+  auto p = make_problem(scoleid::io::load_scenario("paper-beam-2"), std::nullopt);
+  RunOptions ro;
+  ro.verbose = false;
+  const RunResult r = run_identification(*p, ro);
+  ASSERT_EQ(r.summary.termination, OptimizerSummary::Termination::CostStalled) << r.summary.BriefReport();
+  Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  const VectorXd q = r.estimate;
+  VectorXd g;
+  MatrixXd H;
+  const double J = obj.gauss_newton(q, g, H);
+  const MatrixXd Hx = q.asDiagonal() * H * q.asDiagonal();
+  const TrustRegionStep st = trust_region_step(Hx, q.cwiseProduct(g), 5.0);
+  const double threshold = J / static_cast<double>(obj.data_points());
+  const double gain = J - obj.cost((q.array().log() + st.delta.array()).exp());
+  std::printf("  J %.6e, J/N %.3e: predicted %.3e, actual %.3e\n", J, threshold, st.predicted, gain);
+  EXPECT_FALSE(st.on_boundary);
+  EXPECT_LE(st.predicted, 1e-3 * threshold);
+  EXPECT_LT(gain, 2e-3 * threshold);
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    const double moved = std::abs(q[i] * std::expm1(st.delta[i]));
+    std::printf("  %s: the step left moves it by %.3e std\n", r.names[static_cast<std::size_t>(i)].c_str(), moved / r.ident.std[i]);
+    EXPECT_LT(moved, 0.05 * r.ident.std[i]) << r.names[static_cast<std::size_t>(i)];
   }
 }
 

@@ -80,6 +80,9 @@ struct FitTest {
   std::string message;
   // The discretisation estimate d (samples × sensors) the test used; empty when none was made.
   Eigen::MatrixXd discretisation;
+  // The model's outputs at the tested point (samples × sensors); empty when the caller did not
+  // keep them (non-finite when the model could not be solved there).
+  Eigen::MatrixXd predicted;
 };
 
 FitTest fit_test(const FitTestInputs& in);

@@ -37,6 +37,7 @@
 // per sample time t_i, the mean over sensors of ∫_{t0}^{t_i} r_k² dt / ∫_{t0}^{t_i} z̃_k² dt, the
 // relative mean-square misfit of the data on [t0, t_i] (used to choose the horizon, optimizers.h).
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,11 @@ struct ObjectiveOptions {
   // to a band (band_filter.h), whose noise the interpolant follows (E∫ñ² = σ²(t − t0)) and whose
   // ∫ñ² varies about 1/g times as much.
   double noise_independent_fraction = 1.0;
+  // Threads of one Gauss–Newton sweep or output-sensitivity pass (esdirk, no acceleration sensors,
+  // two or more parameters): the tangents split in two groups, each stepped with its own copy of
+  // the state on its own thread (docs/theory.md §7.9). 0 = automatic (two when the machine has
+  // two hardware threads), 1 = one thread (callers that already run objectives side by side).
+  int sweep_threads = 0;
 };
 
 struct ObjectiveCounters {
@@ -139,7 +145,9 @@ public:
   // streamed ones above the trajectory budget.
   double interpolation_misfit(const VectorXd& q);
   // Output sensitivities ∂(C u(t_i))/∂q at the sample times: (samples·sensors) × P, row-major by
-  // sample. For Fisher information.
+  // sample. For Fisher information. A Gauss–Newton evaluation on the whole record (esdirk, no
+  // acceleration sensors, within sensitivity_block_bytes) keeps its own at its q: asked at that
+  // same q, they are returned without a solve (the same numbers: one interpolation for both).
   MatrixXd output_sensitivities(const VectorXd& q);
   // The Gauss–Newton matrix times v without forming it (docs/theory.md §7.7): one tangent solve
   // along v (with the state) and one costate solve whose source is the tangent's output C S v in
@@ -221,9 +229,11 @@ private:
   // [a, b] cut at the sample times strictly inside it (a and b included); `next`, left at the first sample
   // above a, only moves forward, so consecutive intervals walk the samples once.
   void interval_cuts(double a, double b, std::size_t& next, std::vector<double>& cuts) const;
-  // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly.
+  // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly; with
+  // `sample_rows` (horizon = the whole record, no acceleration sensors) also the output
+  // sensitivities at the sample times, as output_sensitivities returns them.
   double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
-                               MatrixXd& H, MisfitProfile* profile);
+                               MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows = nullptr);
   // cost_and_gradient's two ways into gc (the coefficient gradient): the state checkpointed every
   // L points, or stored whole, each with its backward pass.
   double gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc);
@@ -284,6 +294,31 @@ private:
   void noise_share();  // noise_ from options_.noise_std and the sample times
   double T_ = 0.0;  // horizon: end of the cost integral
   ObjectiveCounters counters_;
+  // The last whole-record Gauss–Newton evaluation's output sensitivities and its q (empty q: none).
+  struct KeptSensitivities {
+    VectorXd q;
+    MatrixXd G;
+  };
+  KeptSensitivities kept_;
+  // Whether output sensitivities are interpolated in output space (no acceleration sensors) and
+  // fit the memory budget: the Gauss–Newton sweep then keeps them.
+  bool keeps_sensitivities() const;
+  // Yx = C X + C₁ V and Yv = C V + C₁ A of the first `cols` columns of a recorded point, column by
+  // column (a column's outputs do not depend on how many columns are stepped together).
+  void point_outputs(int cols, const double* x, const double* v, const double* a, MatrixXd& Yx, MatrixXd& Yv) const;
+  // Whether a pass over [t0, state_end] steps its tangents on two threads: sweep_threads, the
+  // machine, P >= 2, and the recorded outputs within sensitivity_block_bytes.
+  bool splits_sweep(double state_end) const;
+  // The state and all P tangents stepped over [t0, state_end] (the tangents to tangent_end), every
+  // recorded point's outputs (point_outputs; sensors × (1 + P), or only the state's column once
+  // the tangents have stopped) handed to `at` in time order. On one thread, or (splits_sweep) the
+  // tangents in two groups, each stepped with its own copy of the state on its own thread and
+  // solver, the outputs recorded and handed over in order once both are done — the same numbers
+  // either way. `visit_state` (if set) sees every point of the state as it is stepped.
+  using OutputVisit = std::function<void(double t, int cols, const MatrixXd& Yx, const MatrixXd& Yv)>;
+  void stream_outputs(const Setup& s, const SecondOrderSolver& solver, double state_end, double tangent_end,
+                      const std::vector<Derivative>& d, const SecondOrderSolver::Sink& visit_state,
+                      const OutputVisit& at, SolverSummary& sum) const;
 };
 
 }  // namespace scoleid::identify

@@ -46,7 +46,9 @@
 // Termination (stated in Summary::termination): relative parameter step below step_tolerance,
 // scaled gradient ‖g_x‖∞ below gradient_tolerance·max(J, tiny), cost below cost_floor, relative
 // cost decrease over an accepted step below cost_stall (only directions the data barely see are
-// still moving: the identifiability report flags them), or the iteration limit. cost_stall = 0
+// still moving: the identifiability report flags them) — for Gauss–Newton also before a trial,
+// when the undamped step left predicts below 1e-3 of that (a move of ~0.03 std, docs/theory.md
+// §7.4) — or the iteration limit. cost_stall = 0
 // (default) is automatic: for gauss-newton 1/N, N the number of data values (samples × sensors)
 // on the horizon — fitting one more free parameter to white noise of the residual's size lowers
 // J by J/N on average, so a Gauss–Newton step that gains less is not distinguishable from
