@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -280,17 +281,26 @@ std::string csv_field(const std::string& name) {
 }  // namespace
 
 void write_csv(const std::string& path, const DataTable& tab) {
-  std::ostringstream os;
-  os << "t";
-  for (const auto& n : tab.names) os << ',' << csv_field(n);
-  os << '\n' << std::setprecision(17);
+  std::string out = csv_field(tab.time_name.empty() ? std::string("t") : tab.time_name);
+  for (const auto& n : tab.names) out += ',' + csv_field(n);
+  out += '\n';
+  // Each value in its shortest form that reads back to the same double (std::to_chars).
+  char buf[32];
+  auto put = [&](double v) {
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    out.append(buf, r.ptr);
+  };
+  out.reserve(out.size() + tab.t.size() * (tab.columns.size() + 1) * 24);
   for (std::size_t i = 0; i < tab.t.size(); ++i) {
     if (i % 4096 == 0) check_interrupt();
-    os << tab.t[i];
-    for (const auto& c : tab.columns) os << ',' << c[i];
-    os << '\n';
+    put(tab.t[i]);
+    for (const auto& c : tab.columns) {
+      out += ',';
+      put(c[i]);
+    }
+    out += '\n';
   }
-  write_text_atomic(path, os.str());
+  write_text_atomic(path, out);
 }
 
 void write_json_atomic(const std::string& path, const nlohmann::json& j) {

@@ -57,7 +57,7 @@ void print_info(const io::DataFileInfo& info) {
 
 // OUT.csv and OUT.json (written to temporary files and renamed: both or neither).
 void convert(const std::string& file, const std::string& out, const io::CsvOptions& options, bool quiet) {
-  const io::DataTable tab = io::read_data(file, options);
+  io::DataTable tab = io::read_data(file, options);
   const io::DataFileInfo info = io::describe_data(file, options);
   json cols = json::array();
   for (std::size_t j = 0; j < tab.names.size(); ++j) {
@@ -88,6 +88,7 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
   const json doc{{"format", io::kColumnsFormat}, {"source", file}, {"time", {{"name", "t"}, {"unit", "s"}}},
                  {"columns", cols}};
   io::write_json_atomic(meta.string(), doc);
+  tab.time_name = "t";  // seconds, as the description says
   try {
     io::write_csv(out, tab);
   } catch (...) {

@@ -12,12 +12,20 @@
 
 namespace scoleid::io {
 
-ProcessResult run_program(const std::vector<std::string>& argv, const std::string& cwd) {
+namespace {
+
+struct Child {
+  pid_t pid = -1;
+  bool started = false;
+};
+
+// Forks and execs argv in cwd, stdin/stdout/stderr on /dev/null; returns once the exec has
+// succeeded or failed (a pipe closed on exec tells which).
+Child start_child(const std::vector<std::string>& argv, const std::string& cwd) {
   if (argv.empty()) throw std::invalid_argument("run_program: empty argument vector");
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  // A pipe closed on exec tells the parent whether execvp succeeded.
   int status_pipe[2];
   if (::pipe2(status_pipe, O_CLOEXEC) != 0) throw std::runtime_error("run_program: pipe failed");
   const pid_t pid = ::fork();
@@ -49,33 +57,65 @@ ProcessResult run_program(const std::vector<std::string>& argv, const std::strin
     ::_exit(127);
   }
   ::close(status_pipe[1]);
-  ProcessResult r;
   int child_errno = 0;
   ssize_t got;
   do {
     got = ::read(status_pipe[0], &child_errno, sizeof child_errno);
   } while (got < 0 && errno == EINTR && interrupt_signal() == 0);
   ::close(status_pipe[0]);
-  r.started = got == 0;  // closed on a successful exec, nothing written
-  int status = 0;
-  for (;;) {
-    const pid_t w = ::waitpid(pid, &status, 0);
-    if (w == pid) break;
-    if (w < 0 && errno == EINTR) {
-      if (interrupt_signal() != 0) {
-        ::kill(pid, SIGTERM);
-        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-        }
-        check_interrupt();
+  return {pid, got == 0};  // closed on a successful exec, nothing written
+}
+
+// Terminates and reaps every child not yet reaped (pid > 0).
+void end_children(std::vector<Child>& children) {
+  for (auto& c : children)
+    if (c.pid > 0) ::kill(c.pid, SIGTERM);
+  for (auto& c : children)
+    if (c.pid > 0) {
+      int status = 0;
+      while (::waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
       }
-      continue;
+      c.pid = -1;
     }
-    throw std::runtime_error("run_program: waitpid failed");
+}
+
+}  // namespace
+
+std::vector<ProcessResult> run_programs(const std::vector<std::vector<std::string>>& argvs, const std::string& cwd) {
+  std::vector<Child> children;
+  std::vector<ProcessResult> results(argvs.size());
+  try {
+    for (const auto& argv : argvs) children.push_back(start_child(argv, cwd));
+    for (std::size_t i = 0; i < children.size(); ++i) {
+      Child& c = children[i];
+      results[i].started = c.started;
+      int status = 0;
+      for (;;) {
+        const pid_t w = ::waitpid(c.pid, &status, 0);
+        if (w == c.pid) break;
+        if (w < 0 && errno == EINTR) {
+          if (interrupt_signal() != 0) {
+            end_children(children);
+            check_interrupt();
+          }
+          continue;
+        }
+        throw std::runtime_error("run_program: waitpid failed");
+      }
+      c.pid = -1;
+      if (WIFEXITED(status)) results[i].exit_code = WEXITSTATUS(status);
+      if (WIFSIGNALED(status)) results[i].signal = WTERMSIG(status);
+    }
+  } catch (...) {
+    end_children(children);
+    throw;
   }
   check_interrupt();
-  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
-  return r;
+  return results;
+}
+
+ProcessResult run_program(const std::vector<std::string>& argv, const std::string& cwd) {
+  return run_programs({argv}, cwd).front();
 }
 
 }  // namespace scoleid::io

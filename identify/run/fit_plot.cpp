@@ -70,10 +70,23 @@ std::string spectrum_plot_script(const std::vector<std::string>& sensors, const 
   return gp;
 }
 
-RenderStatus render_gnuplot(const std::string& dir, const std::string& script) {
-  const io::ProcessResult r = io::run_program({"gnuplot", script}, dir);
+namespace {
+RenderStatus status_of(const io::ProcessResult& r) {
   if (!r.started) return RenderStatus::NoGnuplot;
   return r.ok() ? RenderStatus::Rendered : RenderStatus::Failed;
+}
+}  // namespace
+
+RenderStatus render_gnuplot(const std::string& dir, const std::string& script) {
+  return status_of(io::run_program({"gnuplot", script}, dir));
+}
+
+std::vector<RenderStatus> render_gnuplot(const std::string& dir, const std::vector<std::string>& scripts) {
+  std::vector<std::vector<std::string>> argvs;
+  for (const auto& s : scripts) argvs.push_back({"gnuplot", s});
+  std::vector<RenderStatus> out;
+  for (const auto& r : io::run_programs(argvs, dir)) out.push_back(status_of(r));
+  return out;
 }
 
 }  // namespace scoleid::identify

@@ -436,7 +436,7 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   notes.units = sensor_units(p);
   std::tie(notes.zoom_from, notes.zoom_to) = zoom_window(p.data);
   io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost, "fit.csv", "fit.png", notes));
-  render("fit.png", render_gnuplot(dir.staging(), "fit.gp"));
+  std::vector<std::string> scripts{"fit.gp"};
   // spectrum.csv / spectrum.gp / spectrum.png: measured and predicted power spectral densities.
   const Spectrum sm = power_spectrum(p.data.t, p.data.z), sp = power_spectrum(p.data.t, predicted);
   if (!sm.f.empty() && sm.psd.rows() == sp.psd.rows()) {
@@ -454,8 +454,12 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
     std::vector<double> modes_hz;
     for (const auto& m : r.modes) modes_hz.push_back(m.frequency_hz);
     io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title));
-    render("spectrum.png", render_gnuplot(dir.staging(), "spectrum.gp"));
+    scripts.push_back("spectrum.gp");
   }
+  // fit.png and spectrum.png rendered side by side.
+  const std::vector<RenderStatus> rendered = render_gnuplot(dir.staging(), scripts);
+  for (std::size_t i = 0; i < scripts.size(); ++i)
+    render(i == 0 ? "fit.png" : "spectrum.png", rendered[i]);
   io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
 }
 

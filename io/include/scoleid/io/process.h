@@ -17,5 +17,8 @@ struct ProcessResult {
 // /dev/null, stdout and stderr to /dev/null. Waits for it. If this process receives SIGINT or
 // SIGTERM meanwhile (interrupt.h), the child is terminated and Interrupted is thrown.
 ProcessResult run_program(const std::vector<std::string>& argv, const std::string& cwd);
+// Runs several programs at once (as run_program each) and waits for all; their results in order.
+// An interrupt terminates every one still running.
+std::vector<ProcessResult> run_programs(const std::vector<std::vector<std::string>>& argvs, const std::string& cwd);
 
 }  // namespace scoleid::io

@@ -42,5 +42,7 @@ std::string spectrum_plot_script(const std::vector<std::string>& sensors, const 
 enum class RenderStatus { Rendered, NoGnuplot, Failed };
 // Runs `gnuplot SCRIPT` in `dir`. Throws io::Interrupted if the program is interrupted meanwhile.
 RenderStatus render_gnuplot(const std::string& dir, const std::string& script);
+// The same for several scripts at once, one gnuplot each (the plots render side by side).
+std::vector<RenderStatus> render_gnuplot(const std::string& dir, const std::vector<std::string>& scripts);
 
 }  // namespace scoleid::identify
