@@ -343,12 +343,14 @@ void rate_checks(const SuiteFile& f, json& res, json& checks) {
   bool geometric = m >= 3;
   for (std::size_t k = 0; geometric && k + 2 < m; ++k)
     geometric = std::abs(size(k + 2) / size(k + 1) - size(k + 1) / size(k)) <= 1e-9 * (size(k + 1) / size(k));
+  bool rated = false;
   for (std::size_t i = 0; i < cs[0]["parameters"].size(); ++i) {
     const std::string n = cs[0]["parameters"][i]["name"];
     auto band = f.expect.rate.find(n);
     if (band == f.expect.rate.end()) band = f.expect.rate.find("");
     if (band == f.expect.rate.end()) continue;
     const std::pair<double, double> range = band->second;
+    rated = true;
     auto err = [&](std::size_t k) { return val(cs[k]["parameters"][i]["relative_error"]); };
     json orders = json::array();
     bool ok = true;
@@ -368,11 +370,11 @@ void rate_checks(const SuiteFile& f, json& res, json& checks) {
         add(std::log(std::abs(err(k)) / std::abs(err(k + 1))) / std::log(size(k + 1) / size(k)));
     }
     res["observed_orders"][n] = orders;
-    res["order_kind"] = geometric ? "self-convergence" : "error";
     checks.push_back(check(n + (geometric ? " estimate converges" : " error falls") + " at order in [" +
                                fmt("%.3g", range.first) + ", " + fmt("%.3g", range.second) + "]",
                            ok, measured));
   }
+  if (rated) res["order_kind"] = geometric ? "self-convergence" : "error";
 }
 
 // Every parameter an expectation names must be one the family estimates (a misspelt name would

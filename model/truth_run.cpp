@@ -41,7 +41,18 @@ std::vector<std::string> integrator_names() {
           "semi-explicit-euler2"};
 }
 
-bool starts_at_rest(const MultibodySystem& system, const State& state);
+namespace {
+// A state at rest at the default configuration: u = 0 and q = the system's default q.
+bool starts_at_rest(const MultibodySystem& system, const State& state) {
+  const State& d = system.getDefaultState();
+  if (state.getNQ() != d.getNQ() || state.getNU() != d.getNU()) return false;
+  for (int i = 0; i < state.getNU(); ++i)
+    if (state.getU()[i] != 0.0) return false;
+  for (int i = 0; i < state.getNQ(); ++i)
+    if (state.getQ()[i] != d.getQ()[i]) return false;
+  return true;
+}
+}  // namespace
 
 std::string choose_integrator(const MultibodySystem& system, const State& state) {
   if (state.getNU() == 0) return kDefaultIntegrator;
@@ -57,16 +68,6 @@ std::string choose_integrator(const MultibodySystem& system, const State& state)
   if (damping >= 0.5) return "cpodes";
   if (system.getMatterSubsystem().getNumConstraints() > 0) return kDefaultIntegrator;
   return starts_at_rest(system, state) ? "gauss-legendre" : "trapezoidal";
-}
-
-bool starts_at_rest(const MultibodySystem& system, const State& state) {
-  const State& d = system.getDefaultState();
-  if (state.getNQ() != d.getNQ() || state.getNU() != d.getNU()) return false;
-  for (int i = 0; i < state.getNU(); ++i)
-    if (state.getU()[i] != 0.0) return false;
-  for (int i = 0; i < state.getNQ(); ++i)
-    if (state.getQ()[i] != d.getQ()[i]) return false;
-  return true;
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system, double accuracy) {

@@ -236,7 +236,6 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   return identifier_integration(sc, model, params, signals).step;
 }
 
-
 namespace {
 // Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
 // scenario that does not resolve the modes the data contain (ω_K h > 1: the L-stable step would

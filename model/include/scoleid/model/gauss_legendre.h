@@ -26,8 +26,8 @@
 // factorised once per (Jacobian, h). The positions are then corrected in q itself,
 // dq_i = -G_q,i + h sum_j a_ij N(Q_j) du_j, so the whole residual G_q is driven to zero: for a
 // quaternion (nq > nu) N^-1 drops G_q's radial part, and y1 = y0 + sqrt3 (Z_2 - Z_1) turns what a
-// stage keeps of it into an attitude error first order in h. The stages start from the previous step's collocation
-// polynomial extrapolated (from Euler increments at the first step and after an input
+// stage keeps of it into an attitude error first order in h. The stages start from the previous
+// step's collocation polynomial extrapolated (from Euler increments at the first step and after an input
 // breakpoint). The iteration stops when eta ||dZ|| <= tol, eta = theta / (1 - theta) the
 // estimated error factor left by a correction, theta the contraction of this step's successive
 // corrections (Hairer & Wanner, Solving ODEs II, IV.8): at least two corrections per step, unless
