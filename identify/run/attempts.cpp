@@ -20,6 +20,12 @@ FitTest AttemptsContext::fit_at(const VectorXd& q) {
   return fit;
 }
 
+FitTest AttemptsContext::fit_screen(const VectorXd& q) {
+  if (fit.discretisation.size() == 0 || (fit_q.size() == q.size() && (fit_q.array() == q.array()).all())) return fit_at(q);
+  const FitTest screened = test_fit(problem, objective, q, &fit.discretisation);
+  return screened.within_noise_and_discretisation ? fit_at(q) : screened;
+}
+
 namespace {
 
 // Paper-style iteration table: iteration, parameters, physical values, cost.
@@ -217,7 +223,7 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     out.iterations += sl.iterations_done;
     if (sl.q.allFinite()) out.q = tied.expand(sl.q);
     out.label += " " + std::to_string(B);
-    const bool explained = sl.q.allFinite() && c.fit_at(out.q).within_noise_and_discretisation;
+    const bool explained = sl.q.allFinite() && c.fit_screen(out.q).within_noise_and_discretisation;
     out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
     if (c.verbose)
       std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,

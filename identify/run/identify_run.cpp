@@ -5,6 +5,8 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <thread>
 
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/assessment.h"
@@ -23,7 +25,7 @@ double model_error(const Problem& p) {
   return own_model ? 0.0 : 0.01;
 }
 
-FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
+FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const MatrixXd* discretisation) {
   FitTestInputs in;
   in.data = p.data.z;
   in.names = p.data.names;
@@ -34,38 +36,60 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q) {
     in.residual = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));
     return fit_test(in);
   }
-  MatrixXd Y;
-  try {
-    Y = obj.predict(q);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
-    Y = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));  // not explained
-  }
-  in.residual = Y - p.data.z;
+  // The identifier's outputs at q (on this thread) and, when no estimate is given, the refined
+  // model's (on a second one: the two solves are independent).
+  MatrixXd Y, Yfine;
+  auto own = [&] {
+    try {
+      Y = obj.predict(q);
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      Y = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));  // not explained
+    }
+  };
   // The discretisation estimate: the same model on twice the elements at a quarter of the step (the
   // refinement the synthetic data are made with, problem.h), when that fits the limits.
   const int fine_elements = 2 * p.structure->elements();
   const double T = p.data.t.back() - p.data.t.front();
   const double h = p.objective_options.solver.step > 0 ? p.objective_options.solver.step / 4.0 : T / 8000.0;
   const double bytes = (T / h + 1.0) * 2.0 * p.model().ndof * 3.0 * 8.0;
-  if (Y.allFinite() && fine_elements <= io::limits::kMaxDataElements && bytes <= io::limits::kMaxTrajectoryBytes) {
-    try {
-      const auto fine = make_structure(p.scenario, fine_elements);
-      const auto params = fine->parameterize(p.scenario);
-      if (params->names() == p.params->names()) {
-        ObjectiveOptions o = p.objective_options;
-        if (o.solver.step > 0) o.solver.step /= 4.0;
-        Objective fo(fine->model(), *params, p.signals, p.data, o);
-        MatrixXd d = fo.predict(q) - Y;
-        if (d.allFinite()) in.discretisation = std::move(d);
+  if (!discretisation && fine_elements <= io::limits::kMaxDataElements && bytes <= io::limits::kMaxTrajectoryBytes) {
+    std::exception_ptr fine_error;
+    std::thread refined([&] {
+      try {
+        const auto fine = make_structure(p.scenario, fine_elements);
+        const auto params = fine->parameterize(p.scenario);
+        if (params->names() == p.params->names()) {
+          ObjectiveOptions o = p.objective_options;
+          if (o.solver.step > 0) o.solver.step /= 4.0;
+          Objective fo(fine->model(), *params, p.signals, p.data, o);
+          Yfine = fo.predict(q);
+        }
+      } catch (const io::Interrupted&) {
+        fine_error = std::current_exception();
+      } catch (const std::exception&) {
+        // A model that cannot be refined: no discretisation estimate.
       }
-    } catch (const io::Interrupted&) {
+    });
+    try {
+      own();
+    } catch (...) {
+      refined.join();
       throw;
-    } catch (const std::exception&) {
-      // A model that cannot be refined: no discretisation estimate.
     }
+    refined.join();
+    if (fine_error) std::rethrow_exception(fine_error);
+    if (Y.allFinite() && Yfine.rows() == Y.rows() && Yfine.cols() == Y.cols()) {
+      MatrixXd d = Yfine - Y;
+      if (d.allFinite()) in.discretisation = std::move(d);
+    }
+  } else {
+    own();
+    if (discretisation && discretisation->rows() == Y.rows() && discretisation->cols() == Y.cols())
+      in.discretisation = *discretisation;
   }
+  in.residual = Y - p.data.z;
   FitTest f = fit_test(in);
   f.discretisation = std::move(in.discretisation);
   f.predicted = std::move(Y);

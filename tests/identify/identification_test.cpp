@@ -120,6 +120,27 @@ TEST(Identification, TheStopOnThePredictedStallLeavesLessThanATwentiethOfAStd) {
   }
 }
 
+TEST(Identification, TheFitTestWithAGivenDiscretisationEstimateIsTheSameTest) {
+  // The ladder screens its levels with the last discretisation estimate instead of a solve on the
+  // doubled mesh; given the estimate the test made itself, the test must come out the same.
+  auto p = make_problem(scoleid::io::load_scenario("beam-ei8"), std::nullopt);
+  Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  VectorXd q = p->params->initial();
+  for (Eigen::Index i = 0; i < q.size(); ++i) q[i] *= 1.0 + 0.02 * static_cast<double>(i % 3);
+  const FitTest own = test_fit(*p, obj, q);
+  ASSERT_GT(own.discretisation.size(), 0);
+  EXPECT_GT(own.discretisation.cwiseAbs().maxCoeff(), 0.0);
+  const FitTest given = test_fit(*p, obj, q, &own.discretisation);
+  EXPECT_EQ(given.explains_data, own.explains_data);
+  EXPECT_EQ(given.within_noise_and_discretisation, own.within_noise_and_discretisation);
+  EXPECT_EQ(given.ratio, own.ratio);
+  EXPECT_EQ(given.message, own.message);
+  EXPECT_EQ((given.discretisation - own.discretisation).cwiseAbs().maxCoeff(), 0.0);
+  // Twice the estimate allows more: the ratio of residual to allowance falls.
+  const MatrixXd twice = 2.0 * own.discretisation;
+  EXPECT_LT(test_fit(*p, obj, q, &twice).ratio, own.ratio);
+}
+
 TEST(Identification, InverseCrimeRecoversTruthToOneInAMillion) {
   // Data from the identifier's own mesh, time step and table: the only error left is the optimiser's.
   auto sc = scoleid::io::load_scenario("paper-beam-2");

@@ -24,6 +24,12 @@ struct AttemptsContext {
   // plateau at its chosen weight), and each asks a forward solve on the mesh and one on the
   // doubled mesh at a quarter of the step.
   FitTest fit_at(const VectorXd& q);
+  // The coarse-to-fine ladder's screen (docs/theory.md §7.6): the fit test at q with the last
+  // discretisation estimate made (fit_at's), so only the identifier's model is solved. A level it
+  // fails is not explained by the mesh's error as last estimated, and the ladder goes on; a level
+  // it passes is tested again with its own estimate (fit_at) before the ladder may stop there.
+  // Without an earlier estimate it is fit_at.
+  FitTest fit_screen(const VectorXd& q);
   VectorXd fit_q{};  // fit_at's last q and its test
   FitTest fit{};
 };

@@ -138,8 +138,11 @@ void flag_wide_intervals(RunResult& r);
 // identification.model_error, with the automatic value resolved (io/scenario.h).
 double model_error(const Problem& problem);
 // The fit test at q (one forward solve on the identifier's model, one on twice its elements at
-// a quarter of its step for the discretisation estimate; skipped if that model cannot be built).
-FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q);
+// a quarter of its step for the discretisation estimate, side by side; skipped if that model
+// cannot be built). With `discretisation` (samples × sensors) that estimate is taken as given and
+// only the identifier's model is solved.
+FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q,
+                 const MatrixXd* discretisation = nullptr);
 
 // The fit table: per sensor <name>_measured, <name>_predicted (Y, samples × sensors) and
 // <name>_residual (predicted − measured) at the sample times.
