@@ -26,6 +26,16 @@ void push_outputs(const Eigen::SparseMatrix<double, Eigen::RowMajor>& C, Traject
   out.push(t, y.data(), yv.data(), ya.data());
 }
 
+// The cubic Hermite basis at t on [t0, t0 + h]: weights of the ends' values (h00, h01) and of their
+// slopes (h10, h11, h folded in), as Trajectory::eval interpolates between recorded points.
+struct HermiteWeights {
+  double h00, h10, h01, h11;
+};
+HermiteWeights hermite_weights(double t, double t0, double h) {
+  const double sr = (t - t0) / h, s2 = sr * sr, s3 = s2 * sr;
+  return {2 * s3 - 3 * s2 + 1, (s3 - 2 * s2 + sr) * h, -2 * s3 + 3 * s2, (s3 - s2) * h};
+}
+
 // The tangents' outputs at the sample times in (t_prev, t1] (all up to t1 at the first point),
 // Hermite-interpolated between two recorded points in output space — Yx = C X + C₁ V and
 // Yv = C V + C₁ A of every column at each point, the outputs being linear in (X, V) without
@@ -42,8 +52,7 @@ void sample_output_rows(const std::vector<double>& times, std::size_t& next, boo
       G.block(row, 0, ns, P) = Yx1.rightCols(P);
       continue;
     }
-    const double sr = (times[next] - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
-    const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+    const auto [h00, h10, h01, h11] = hermite_weights(times[next], t_prev, h);
     Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
     G.block(row, 0, ns, P) = Ys.rightCols(P);
   }
@@ -1246,9 +1255,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
         const double h = t1 - t_prev;
         interval_cuts(a_end, b_end, next_data, cuts);
         for_each_gauss_point(cuts, [&](double t, double wt) {
-          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
-          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2,
-                       h11 = (s3 - s2) * h;
+          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
           Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
           data_.eval(t, z.data());
           const VectorXd r = Ys.col(0) - z;
@@ -1281,9 +1288,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
         const double h = pt.t - t_prev;
         interval_cuts(a_end, b_end, next_data, cuts);
         for_each_gauss_point(cuts, [&](double t, double wt) {
-          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
-          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2,
-                       h11 = (s3 - s2) * h;
+          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
           Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
           Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
           x = Xs.col(0);
@@ -1412,8 +1417,7 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
         const double t = data_.t[next];
         const double h = have_prev ? pt.t - t_prev : 0.0;
         if (h > 0) {
-          const double sr = (t - t_prev) / h, s2 = sr * sr, s3 = s2 * sr;
-          const double h00 = 2 * s3 - 3 * s2 + 1, h10 = (s3 - 2 * s2 + sr) * h, h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * h;
+          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
           Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
           Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
         } else {
