@@ -1175,7 +1175,11 @@ void Objective::stream_outputs(const Setup& s, const SecondOrderSolver& solver, 
   }
   worker.join();
   if (worker_error) std::rethrow_exception(worker_error);
+  // The work of both (solves, factorisations, forcings); the steps and the wall time once: the two
+  // step one grid side by side, so a run's step count does not depend on how many threads stepped it.
   sum.Accumulate(ra.sum);
+  rb.sum.steps = 0;
+  rb.sum.wall_seconds = 0.0;
   sum.Accumulate(rb.sum);
   if (rb.t != ra.t) throw std::logic_error("stream_outputs: the two tangent groups did not step alike");
   MatrixXd Yx(ns, m), Yv(ns, m);

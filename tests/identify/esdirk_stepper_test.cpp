@@ -179,6 +179,9 @@ TEST(EsdirkStepper, ASweepSplitOverTwoThreadsGivesTheSameNumbersAsOne) {
   VectorXd q2 = q;
   q2[1] *= 1.02;  // a point neither has kept
   EXPECT_EQ(max_abs(a.output_sensitivities(q2) - b.output_sensitivities(q2)), 0.0);
+  // One grid stepped side by side: the steps are counted once, the solves of both.
+  EXPECT_EQ(a.counters().solver.steps, b.counters().solver.steps);
+  EXPECT_GT(b.counters().solver.linear_solves, a.counters().solver.linear_solves);
 }
 
 TEST(EsdirkStepper, AnEndAnchoredReversedRunStepsOnTheForwardGridMirrored) {
