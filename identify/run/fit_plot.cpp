@@ -1,6 +1,8 @@
 #include "scoleid/identify/run/fit_plot.h"
 
 #include <cmath>
+#include <fstream>
+#include <stdexcept>
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/process.h"
@@ -18,8 +20,12 @@ std::string gnuplot_quote(const std::string& text) {
 }
 
 std::string fit_plot_script(const std::vector<std::string>& sensors, const std::vector<std::pair<int, double>>& cost,
-                            const std::string& csv, const std::string& png, const FitPlotAnnotations& notes) {
+                            const std::string& csv, const std::string& png, const FitPlotAnnotations& notes,
+                            int binary_columns) {
   const std::size_t ns = sensors.size();
+  // How each curve reads the table: past the CSV's header line, or as raw rows of float64.
+  const std::string layout =
+      binary_columns > 0 ? " binary format='%" + std::to_string(binary_columns) + "float64' using 1:" : " every ::1 using 1:";
   const bool zoom = notes.zoom_to > notes.zoom_from;
   const std::size_t cols = zoom ? 2 : 1;
   const std::string data = gnuplot_quote(csv);
@@ -34,8 +40,8 @@ std::string fit_plot_script(const std::vector<std::string>& sensors, const std::
           gnuplot_quote(sensors[k] + unit) + "\nset y2tics\nset ytics nomirror\n";
     gp += window ? "set xrange [" + io::format_value(notes.zoom_from) + ":" + io::format_value(notes.zoom_to) + "]\n"
                  : "set autoscale x\n";
-    gp += "plot " + data + " every ::1 using 1:" + std::to_string(c) + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
-          std::to_string(c + 1) + " with lines dt 2 lw 2 title 'predicted', '' every ::1 using 1:" + std::to_string(c + 2) +
+    gp += "plot " + data + layout + std::to_string(c) + " with lines lw 2 title 'measured', ''" + layout +
+          std::to_string(c + 1) + " with lines dt 2 lw 2 title 'predicted', ''" + layout + std::to_string(c + 2) +
           " axes x1y2 with lines lc rgb 'gray' title 'residual (right axis)'\n";
   };
   for (std::size_t k = 0; k < ns; ++k) {
@@ -68,6 +74,18 @@ std::string spectrum_plot_script(const std::vector<std::string>& sensors, const 
   }
   gp += "unset multiplot\n";
   return gp;
+}
+
+void write_plot_binary(const std::string& path, const io::DataTable& tab) {
+  std::vector<double> rows;
+  rows.reserve(tab.t.size() * (tab.columns.size() + 1));
+  for (std::size_t i = 0; i < tab.t.size(); ++i) {
+    rows.push_back(tab.t[i]);
+    for (const auto& c : tab.columns) rows.push_back(c[i]);
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(rows.data()), static_cast<std::streamsize>(rows.size() * sizeof(double)));
+  if (!out) throw std::runtime_error("cannot write " + path);
 }
 
 namespace {

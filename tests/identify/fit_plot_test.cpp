@@ -63,3 +63,42 @@ TEST(FitPlot, HostileNamesAreDrawnNotExecuted) {
   EXPECT_FALSE(fs::exists(marker)) << "a sensor name ran a command";
   fs::remove_all(dir.parent_path());
 }
+
+// fit.png is drawn from a raw float64 copy of fit.csv (write_plot_binary): the CSV holds each value
+// in its shortest round-trip form, so both files draw the same picture, byte for byte.
+TEST(FitPlot, TheBinaryCopyDrawsTheSamePictureAsTheCsv) {
+  if (!scoleid::io::run_program({"gnuplot", "--version"}, ".").ok()) GTEST_SKIP() << "gnuplot is not installed";
+  const fs::path dir = fs::temp_directory_path() / ("scoleid-fitplot-binary-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  scoleid::io::DataTable tab;
+  const std::vector<std::string> sensors = {"tip", "mid"};
+  for (const auto& s : sensors) tab.names.insert(tab.names.end(), {s + "_measured", s + "_predicted", s + "_residual"});
+  tab.columns.resize(tab.names.size());
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.01 * i;
+    tab.t.push_back(t);
+    for (std::size_t k = 0; k < sensors.size(); ++k) {
+      // values with long expansions, so a text round trip that lost a digit would move a pixel
+      const double m = std::exp(-0.3 * t) * std::sin(7.1 * t + k) / 3.0, pr = m * (1.0 + 1e-3 * std::cos(t));
+      tab.columns[3 * k].push_back(m);
+      tab.columns[3 * k + 1].push_back(pr);
+      tab.columns[3 * k + 2].push_back(m - pr);
+    }
+  }
+  scoleid::io::write_csv((dir / "fit.csv").string(), tab);
+  write_plot_binary((dir / "fit.f64").string(), tab);
+  EXPECT_EQ(fs::file_size(dir / "fit.f64"), tab.t.size() * (tab.columns.size() + 1) * sizeof(double));
+  const std::vector<std::pair<int, double>> cost = {{0, 1.0}, {1, 0.1}};
+  std::ofstream(dir / "csv.gp") << fit_plot_script(sensors, cost, "fit.csv", "csv.png");
+  std::ofstream(dir / "bin.gp") << fit_plot_script(sensors, cost, "fit.f64", "bin.png", {}, static_cast<int>(tab.columns.size()) + 1);
+  ASSERT_EQ(render_gnuplot(dir.string(), "csv.gp"), RenderStatus::Rendered);
+  ASSERT_EQ(render_gnuplot(dir.string(), "bin.gp"), RenderStatus::Rendered);
+  auto bytes = [](const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string a = bytes(dir / "csv.png"), b = bytes(dir / "bin.png");
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "the binary copy draws a different picture";
+  fs::remove_all(dir);
+}
