@@ -223,32 +223,32 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
     r.ident.reason[u] = buf;
   }
 }
-// The half-record refit (interval.h): the same fit on the first half of the record, from q̂ (a
-// record too short to halve into two samples gets none: the interval is then not assessed); and
-// the smoothing shift: the refit at a tenth of the prior's weight, from q̂.
-IntervalInputs refits(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r) {
+}  // namespace
+
+IntervalInputs assessment_refits(const Problem& p, Objective& obj, const OptimizerOptions& oo, const VectorXd& estimate,
+                                 int sweep_threads) {
   IntervalInputs ii;
-  ii.estimate = r.estimate;
+  ii.estimate = estimate;
   if (const Measurements half_data = first_half(p.data); half_data.t.size() >= 2) {
-    Objective half(p.model(), *p.params, p.signals, half_data, p.objective_options);
+    ObjectiveOptions o = p.objective_options;
+    if (sweep_threads > 0) o.sweep_threads = sweep_threads;
+    Objective half(p.model(), *p.params, p.signals, half_data, o);
     OptimizerOptions oh = oo;
     oh.continuation = false;
-    const OptimizerSummary s = minimize(half, r.estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
-    r.half_record_estimate = ii.half_record_estimate = s.q;
-    r.half_record_converged = ii.half_record_converged = s.converged();
+    const OptimizerSummary s = minimize(half, estimate, oh, [&](const IterationRecord&) { io::check_interrupt(); });
+    ii.half_record_estimate = s.q;
+    ii.half_record_converged = s.converged();
   }
   if (oo.smoothness_weight > 0.0) {
     OptimizerOptions os = oo;
     os.smoothness_weight = oo.smoothness_weight / 10.0;
     os.continuation = false;
-    const OptimizerSummary s = minimize(obj, r.estimate, os, [&](const IterationRecord&) { io::check_interrupt(); });
+    const OptimizerSummary s = minimize(obj, estimate, os, [&](const IterationRecord&) { io::check_interrupt(); });
     ii.smoothing_estimate = s.q;
     ii.smoothing_converged = s.converged();
   }
   return ii;
 }
-
-}  // namespace
 
 FisherInformation band_information(const Problem& p, FisherInformation fi) {
   if (!(p.band_gain < 1.0) || !fi.stated_noise) return fi;
@@ -277,7 +277,8 @@ std::string noise_origin(const Problem& p, const std::string& fisher_source) {
   return origin;
 }
 
-void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r) {
+void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& oo, RunResult& r,
+                     const IntervalInputs* made_already) {
   const auto ti = std::chrono::steady_clock::now();
   // The model's outputs and their sensitivities at q̂, kept for the mirror test and the interval
   // (the outputs are the fit test's, when it kept them).
@@ -287,7 +288,14 @@ void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& o
   flag_mirror_ambiguity(p, obj, r, Y);
   flag_other_minima(p, obj, r, Y);
   r.ident.noise_source = noise_origin(p, r.ident.noise_source);
-  IntervalInputs ii = refits(p, obj, oo, r);
+  IntervalInputs ii = made_already && made_already->estimate.size() == r.estimate.size() &&
+                             (made_already->estimate.array() == r.estimate.array()).all()
+                         ? *made_already
+                         : assessment_refits(p, obj, oo, r.estimate);
+  if (ii.half_record_estimate.size() != 0) {
+    r.half_record_estimate = ii.half_record_estimate;
+    r.half_record_converged = ii.half_record_converged;
+  }
   ii.consider = consider_terms(p, r.ident, r.estimate, Y, G, r.fit.discretisation);
   r.interval = uncertainty_interval(r.ident, ii);
   flag_wide_intervals(r);

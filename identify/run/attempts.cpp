@@ -12,16 +12,41 @@
 
 namespace scoleid::identify {
 
-FitTest AttemptsContext::fit_at(const VectorXd& q) {
-  if (fit_q.size() != q.size() || !(fit_q.array() == q.array()).all()) {
-    fit = test_fit(problem, objective, q);
+namespace {
+bool same_point(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && (a.array() == b.array()).all(); }
+}  // namespace
+
+FitTest AttemptsContext::fit_at(const VectorXd& q, Alongside alongside) {
+  if (!same_point(fit_q, q)) {
+    std::function<void()> meanwhile;
+    if (alongside != Alongside::Nothing)
+      meanwhile = [this, &q, alongside] {
+        attempt_cost(q);
+        if (alongside == Alongside::CostAndRefits && alongside_fit) alongside_fit(q);
+      };
+    fit = test_fit(problem, objective, q, nullptr, meanwhile);
     fit_q = q;
   }
   return fit;
 }
 
+double AttemptsContext::attempt_cost(const VectorXd& q) {
+  if (same_point(cost_q, q)) return cost;
+  objective.set_horizon(objective.data_end());
+  double J = INFINITY;
+  try {
+    if (q.allFinite()) J = objective.cost(q);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+  }
+  cost_q = q;
+  cost = std::isfinite(J) ? J : INFINITY;
+  return cost;
+}
+
 FitTest AttemptsContext::fit_screen(const VectorXd& q) {
-  if (fit.discretisation.size() == 0 || (fit_q.size() == q.size() && (fit_q.array() == q.array()).all())) return fit_at(q);
+  if (fit.discretisation.size() == 0 || same_point(fit_q, q)) return fit_at(q);
   const FitTest screened = test_fit(problem, objective, q, &fit.discretisation);
   return screened.within_noise_and_discretisation ? fit_at(q) : screened;
 }
@@ -243,16 +268,8 @@ RunResult::Attempt attempt_record(AttemptsContext& c, const std::string& strateg
   a.termination = to_string(s.termination);
   a.optimizer_converged = s.converged();
   c.objective.set_horizon(c.objective.data_end());
-  a.cost = INFINITY;
-  try {
-    if (s.termination == OptimizerSummary::Termination::DataExplained)
-      a.cost = s.cost;  // taken on the whole record already (explained_by_level)
-    else if (s.q.allFinite())
-      a.cost = c.objective.cost(s.q);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
-  }
+  // (taken on the whole record already by explained_by_level; otherwise usually alongside the fit test)
+  a.cost = s.termination == OptimizerSummary::Termination::DataExplained ? s.cost : c.attempt_cost(s.q);
   if (!std::isfinite(a.cost)) a.cost = INFINITY;
   a.iterations = iterations;
   a.explains_data = f.explains_data;
@@ -326,7 +343,9 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     r.summary = discrepancy_path(run, r, start, c.options);
     c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
-  r.fit = c.fit_at(r.summary.q);
+  using A = AttemptsContext::Alongside;
+  const bool explained = r.summary.termination == OptimizerSummary::Termination::DataExplained;  // cost taken
+  r.fit = c.fit_at(r.summary.q, explained ? A::Nothing : families.empty() && r.summary.converged() ? A::CostAndRefits : A::Cost);
   r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
 }
 
@@ -410,7 +429,9 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     s = run.minimize_from(r.initial, oc);
   }
   iterations += s.iterations_done;
-  const FitTest f = c.fit_at(s.q);
+  const FitTest f = c.fit_at(s.q, s.termination == OptimizerSummary::Termination::DataExplained
+                                     ? AttemptsContext::Alongside::Nothing  // its cost taken already
+                                     : AttemptsContext::Alongside::Cost);
   r.attempts.push_back(attempt_record(c, label, s, f, iterations, std::move(levels)));
   c.objective.set_horizon(c.objective.data_end());
   if (better_attempt(r.attempts.back(), r.attempts[static_cast<std::size_t>(r.chosen_attempt)], c.objective.data_points())) {

@@ -25,7 +25,8 @@ double model_error(const Problem& p) {
   return own_model ? 0.0 : 0.01;
 }
 
-FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const MatrixXd* discretisation) {
+FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const MatrixXd* discretisation,
+                 const std::function<void()>& meanwhile) {
   FitTestInputs in;
   in.data = p.data.z;
   in.names = p.data.names;
@@ -74,6 +75,7 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const Matr
     });
     try {
       own();
+      if (meanwhile) meanwhile();
     } catch (...) {
       refined.join();
       throw;
@@ -160,12 +162,25 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source),
                     ro.verbose};
   c.options.smoothness_chains = chains;
+  // The assessment's refits (ro.compute_std) at the first attempt's estimate, made while its fit
+  // test's doubled-mesh solve runs (AttemptsContext::alongside_fit), kept if that estimate stands.
+  IntervalInputs early;
+  if (ro.compute_std)
+    c.alongside_fit = [&](const VectorXd& q) {
+      try {
+        early = assessment_refits(p, obj, c.options, q, 1);  // one core: the other solves the doubled mesh
+      } catch (const io::Interrupted&) {
+        throw;
+      } catch (const std::exception&) {
+        early = {};  // made again, if needed, in the assessment
+      }
+    };
   run_attempts(c, r);
   r.estimate = r.summary.q;
   // The fit test's outputs at the estimate (the chosen attempt's), kept for the assessment and fit.csv.
   if (r.fit.predicted.rows() == p.data.z.rows() && r.fit.predicted.cols() == p.data.z.cols() && r.fit.predicted.allFinite())
     r.predicted = r.fit.predicted;
-  if (ro.compute_std) assess_estimate(p, obj, c.options, r);
+  if (ro.compute_std) assess_estimate(p, obj, c.options, r, early.estimate.size() != 0 ? &early : nullptr);
   estimate_modes(p, r);
   r.counters = obj.counters();
   r.counters.Accumulate(c.extra);

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
 #include "test_support.h"
 
@@ -239,4 +241,29 @@ TEST(Fisher, AShareInAnUnseenDirectionAboveTheStdFlagsTheParameter) {
   EXPECT_TRUE(b.identifiable[1]) << b.reason[1];
   EXPECT_NEAR(b.std[1], 1e-3, 1e-8);
   EXPECT_TRUE(b.identifiable[2]);
+}
+
+// The half-record refit is made while the first attempt's fit test solves the doubled mesh (on one
+// core: test_fit's `meanwhile`), and kept when that estimate stands. It must be the refit the
+// assessment would make afterwards: the same estimate, bit for bit, as assessment_refits from the
+// final estimate with the run's options on the default threads.
+TEST(Interval, TheRefitMadeAlongsideTheFitTestIsTheAssessmentsOwn) {
+  auto sc = scoleid::io::load_scenario("paper-beam-2");
+  for (auto& s : sc.sensors) s.noise_std = 0.02 * 0.018;
+  auto [p, r] = test_support::quiet_run(sc);
+  ASSERT_TRUE(r.summary.converged());
+  ASSERT_EQ(r.attempts.size(), 1u);  // the first attempt stood: its refit was made alongside
+  ASSERT_EQ(r.half_record_estimate.size(), r.estimate.size());
+  Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  const auto& id = p->scenario.identification;
+  const OptimizerOptions oo = optimizer_options(id, r.method, p->params->size(), std::nullopt, p->scenario.source);
+  const IntervalInputs again = assessment_refits(*p, obj, oo, r.estimate);
+  for (int i = 0; i < r.estimate.size(); ++i) EXPECT_EQ(r.half_record_estimate[i], again.half_record_estimate[i]) << r.names[i];
+  EXPECT_EQ(r.half_record_converged, again.half_record_converged);
+  // The fit test runs `meanwhile` when it solves the doubled mesh, and gives the same test.
+  bool ran = false;
+  const FitTest f = test_fit(*p, obj, r.estimate, nullptr, [&] { ran = true; });
+  EXPECT_TRUE(ran);
+  EXPECT_EQ(f.within_noise_and_discretisation, r.fit.within_noise_and_discretisation);
+  EXPECT_EQ(f.message, r.fit.message);
 }

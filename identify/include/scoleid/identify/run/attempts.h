@@ -6,6 +6,7 @@
 // more from the starting point (the other start of a sectional family, then the cautious horizon
 // continuation, run/strategy.h). The best attempt (converged and explaining the data, else
 // explaining it, else the lowest cost over the whole record; better_attempt) is the result.
+#include <cmath>
 #include <functional>
 
 #include "scoleid/identify/run/identify_run.h"
@@ -23,7 +24,14 @@ struct AttemptsContext {
   // estimate it has just tested (a ladder level that ends the attempt, the discrepancy path's
   // plateau at its chosen weight), and each asks a forward solve on the mesh and one on the
   // doubled mesh at a quarter of the step.
-  FitTest fit_at(const VectorXd& q);
+  // What the test at q does on this thread while its doubled mesh is solved (test_fit's `meanwhile`;
+  // nothing when the test at q is already kept): at an attempt's end, the attempt's whole-record
+  // cost (attempt_cost); at one likely to stand, alongside_fit(q) too.
+  enum class Alongside { Nothing, Cost, CostAndRefits };
+  FitTest fit_at(const VectorXd& q, Alongside alongside = Alongside::Nothing);
+  // The cost over the whole record at q (one state solve; INFINITY where it cannot be evaluated),
+  // the last one kept.
+  double attempt_cost(const VectorXd& q);
   // The coarse-to-fine ladder's screen (docs/theory.md §7.6): the fit test at q with the last
   // discretisation estimate made (fit_at's), so only the identifier's model is solved. A level it
   // fails is not explained by the mesh's error as last estimated, and the ladder goes on; a level
@@ -32,6 +40,13 @@ struct AttemptsContext {
   FitTest fit_screen(const VectorXd& q);
   VectorXd fit_q{};  // fit_at's last q and its test
   FitTest fit{};
+  // Work on an estimate that is likely to stand, done while the fit test's doubled mesh is solved:
+  // the first attempt's, when it converged and no restart is taken unless its fit fails (no
+  // sectional family: those always get the smoothed restart). The run sets it to the assessment's
+  // refits.
+  std::function<void(const VectorXd&)> alongside_fit;
+  VectorXd cost_q{};  // attempt_cost's last q and its value
+  double cost = INFINITY;
 };
 
 // Fills r.summary, r.fit, r.attempts, r.chosen_attempt and the smoothness fields; r.summary.cost is

@@ -140,9 +140,11 @@ double model_error(const Problem& problem);
 // The fit test at q (one forward solve on the identifier's model, one on twice its elements at
 // a quarter of its step for the discretisation estimate, side by side; skipped if that model
 // cannot be built). With `discretisation` (samples × sensors) that estimate is taken as given and
-// only the identifier's model is solved.
+// only the identifier's model is solved. `meanwhile` (when set, and the doubled mesh is solved) runs
+// on this thread once the identifier's own solve is done, while the doubled mesh's goes on: work
+// for one core that would otherwise wait.
 FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q,
-                 const MatrixXd* discretisation = nullptr);
+                 const MatrixXd* discretisation = nullptr, const std::function<void()>& meanwhile = {});
 
 // The fit table: per sensor <name>_measured, <name>_predicted (Y, samples × sensors) and
 // <name>_residual (predicted − measured) at the sample times.
