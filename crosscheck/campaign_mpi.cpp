@@ -120,7 +120,7 @@ struct Coordinator {
   }
 
   // Rank 0's own share of the work.
-  void work(int kill_after) {
+  void work(int kill_after, int sweep_threads) {
     int finished = 0;
     for (;;) {
       CampaignTask t;
@@ -141,7 +141,7 @@ struct Coordinator {
         truth_started(c, t.index, 0);
       }
       const auto a = std::chrono::steady_clock::now();
-      const json r = execute_task(c, store, t, die);
+      const json r = execute_task(c, store, t, die, sweep_threads);
       const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
       std::lock_guard<std::mutex> lock(m);
       record(t, r, sec, 0);
@@ -151,7 +151,7 @@ struct Coordinator {
 };
 
 // A rank other than 0: ask, run, report, until told "done".
-void worker(const Campaign& c, const CampaignStore& store, int kill_after) {
+void worker(const Campaign& c, const CampaignStore& store, int kill_after, int sweep_threads) {
   json msg = json::object();
   int finished = 0;
   for (;;) {
@@ -175,7 +175,7 @@ void worker(const Campaign& c, const CampaignStore& store, int kill_after) {
     const CampaignTask t{reply[0] == 0 ? CampaignTask::Kind::Truth : CampaignTask::Kind::Case, static_cast<std::size_t>(reply[1])};
     const bool die = kill_after >= 0 && t.kind == CampaignTask::Kind::Case && finished == kill_after;
     const auto a = std::chrono::steady_clock::now();
-    const json r = execute_task(c, store, t, die);
+    const json r = execute_task(c, store, t, die, sweep_threads);
     const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
     finished += t.kind == CampaignTask::Kind::Case ? 1 : 0;
     msg = json{{"kind", reply[0]}, {"index", reply[1]}, {"result", r}, {"seconds", sec}};
@@ -190,6 +190,9 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
+  // Several ranks share the machine's cores: each identifies on one thread per sweep (the same
+  // numbers as two; ObjectiveOptions::sweep_threads).
+  const int sweep_threads = size > 1 ? 1 : 0;
   int code = 0;
   try {
     // Every rank reads the file (the same checks, the same cases); rank 0 alone speaks.
@@ -252,7 +255,7 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
           }
         });
         try {
-          co.work(kill_after);
+          co.work(kill_after, sweep_threads);
         } catch (const io::Interrupted& e) {
           std::fprintf(stderr, "\nscole-crosscheck: rank 0: %s\n", interrupted_line(e).c_str());
           co.abort_code = e.exit_code();
@@ -265,12 +268,12 @@ int run_campaign_mpi(const std::string& file, CampaignRunOptions opt) {
       } else if (size > 1) {
         co.serve(size);  // no threads in this MPI: rank 0 only coordinates
       } else {
-        co.work(kill_after);
+        co.work(kill_after, sweep_threads);
       }
       co.sum.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - co.t0).count();
       code = finish_campaign(*c, *store, co.sum, opt);
     } else {
-      worker(*c, *store, kill_after);
+      worker(*c, *store, kill_after, sweep_threads);
     }
     MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
   } catch (const io::Interrupted& e) {

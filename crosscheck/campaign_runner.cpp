@@ -132,7 +132,7 @@ CampaignSchedule make_schedule(const Campaign& c, const CampaignStore& store) {
 
 namespace {
 
-json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, bool die_midway) {
+json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, bool die_midway, int sweep_threads) {
   const CampaignCase& kc = c.cases.at(k);
   json row;
   try {
@@ -142,6 +142,7 @@ json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, 
     io::Scenario sc = c.points[kc.point].scenario;
     for (auto& s : sc.sensors) s.noise_std = 0.0;
     auto p = identify::make_problem(sc, csv);
+    if (sweep_threads > 0) p->objective_options.sweep_threads = sweep_threads;
     if (kc.seed >= 0) add_noise(*p, c.noise_relative, case_noise_seed(c, kc));
     if (die_midway) std::_Exit(137);  // the restart test: killed with the case half done
     row = identify_row(std::move(p));
@@ -159,8 +160,8 @@ json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, 
 
 }  // namespace
 
-json execute_task(const Campaign& c, const CampaignStore& store, const CampaignTask& task, bool die_midway) {
-  if (task.kind == CampaignTask::Kind::Case) return execute_case(c, store, task.index, die_midway);
+json execute_task(const Campaign& c, const CampaignStore& store, const CampaignTask& task, bool die_midway, int sweep_threads) {
+  if (task.kind == CampaignTask::Kind::Case) return execute_case(c, store, task.index, die_midway, sweep_threads);
   try {
     const auto& pt = c.points.at(task.index);
     run_truth_levels(pt.scenario, {pt.scenario.truth.segments}, store.truth_root(task.index), true, false);

@@ -75,8 +75,11 @@ CampaignSchedule make_schedule(const Campaign& c, const CampaignStore& store);
 // Runs one task in this process. A case returns its result row (campaign.h's case JSON, with
 // "failed": message if its truth is missing or the identification threw); a truth returns {} or
 // {"failed": message}. io::Interrupted propagates. `die_midway` (the restart test only): the
-// process exits abruptly with the case half done, as if killed.
-nlohmann::json execute_task(const Campaign& c, const CampaignStore& store, const CampaignTask& task, bool die_midway = false);
+// process exits abruptly with the case half done, as if killed. `sweep_threads` > 0 sets the
+// identifier's threads per sweep (ObjectiveOptions::sweep_threads; the numbers do not depend on
+// it): 1 where several ranks share the machine's cores.
+nlohmann::json execute_task(const Campaign& c, const CampaignStore& store, const CampaignTask& task, bool die_midway = false,
+                            int sweep_threads = 0);
 
 // One line of progress for a finished case ("p000-s0003: q1 -3.1e-04 ±... covered").
 std::string case_line(const Campaign& c, std::size_t k, const nlohmann::json& result);
