@@ -501,16 +501,22 @@ std::vector<std::string> experiments_output_files(const ExperimentsSpec& spec) {
 void write_experiments_outputs(io::RunDirectory& dir, ExperimentsProblem& ep, const ExperimentsResult& r) {
   std::vector<std::pair<int, double>> cost;
   for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
+  std::vector<io::DataTable> tables(ep.runs.size());
+  std::vector<FitPlot> plots;
   for (std::size_t i = 0; i < ep.runs.size(); ++i) {
     Problem& p = *ep.runs[i];
     const std::string base = "fit-" + ep.spec.runs[i].name;
     Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
-    const io::DataTable tab = fit_table(p.data, obj.predict(r.estimate));
-    io::write_csv(dir.path(base + ".csv"), tab);
+    tables[i] = fit_table(p.data, obj.predict(r.estimate));
+    io::write_csv(dir.path(base + ".csv"), tables[i]);
     io::write_text_atomic(dir.path(base + ".gp"), fit_plot_script(p.data.names, cost, base + ".csv", base + ".png"));
-    if (render_gnuplot(dir.staging(), base + ".gp") == RenderStatus::Failed)
-      std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s.png\n", base.c_str());
+    plots.push_back(FitPlot{&tables[i], p.data.names, cost, base + ".png", {}});
   }
+  // Every run's plot side by side, each from a raw float64 copy of its table.
+  const std::vector<RenderStatus> rendered = render_fit_plots(dir.staging(), plots);
+  for (std::size_t i = 0; i < rendered.size(); ++i)
+    if (rendered[i] == RenderStatus::Failed)
+      std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s\n", plots[i].png.c_str());
   if (ep.modes) {
     ModalMisfit modal(ep.modes_structure->model(), *ep.modes_params, *ep.modes);
     const auto matches = modal.matches(r.estimate);

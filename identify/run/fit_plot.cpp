@@ -1,6 +1,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -105,6 +106,33 @@ std::vector<RenderStatus> render_gnuplot(const std::string& dir, const std::vect
   std::vector<RenderStatus> out;
   for (const auto& r : io::run_programs(argvs, dir)) out.push_back(status_of(r));
   return out;
+}
+
+std::vector<RenderStatus> render_fit_plots(const std::string& dir, const std::vector<FitPlot>& plots,
+                                           const std::vector<std::string>& scripts) {
+  std::vector<std::string> all, temporary;
+  // The copies and their scripts go whatever happens (an interrupt propagates from the render).
+  struct Cleanup {
+    const std::vector<std::string>& files;
+    ~Cleanup() {
+      std::error_code ec;
+      for (const auto& f : files) std::filesystem::remove(f, ec);
+    }
+  } cleanup{temporary};
+  for (std::size_t i = 0; i < plots.size(); ++i) {
+    const FitPlot& fp = plots[i];
+    const std::string stem = ".fit-plot-" + std::to_string(i);
+    const std::string data = (std::filesystem::path(dir) / (stem + ".f64")).string(),
+                      script = (std::filesystem::path(dir) / (stem + ".gp")).string();
+    temporary.insert(temporary.end(), {data, script});
+    write_plot_binary(data, *fp.table);
+    std::ofstream out(script, std::ios::trunc);
+    out << fit_plot_script(fp.sensors, fp.cost, stem + ".f64", fp.png, fp.notes, static_cast<int>(fp.table->columns.size()) + 1);
+    if (!out) throw std::runtime_error("cannot write " + script);
+    all.push_back(stem + ".gp");
+  }
+  all.insert(all.end(), scripts.begin(), scripts.end());
+  return render_gnuplot(dir, all);
 }
 
 }  // namespace scoleid::identify

@@ -2,7 +2,6 @@
 // (identify_run.h; the file format: docs/theory.md §10).
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <tuple>
 
 #include "scoleid/identify/inverse/spectral_start.h"
@@ -437,14 +436,7 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   notes.units = sensor_units(p);
   std::tie(notes.zoom_from, notes.zoom_to) = zoom_window(p.data);
   io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost, "fit.csv", "fit.png", notes));
-  // fit.png is drawn from the same table as raw float64 (write_plot_binary: the same numbers, read
-  // without parsing text) by a copy of fit.gp that reads it; both are removed before the commit.
-  const std::string plot_data = ".fit-plot.f64", plot_script = ".fit-plot.gp";
-  const auto staged = [&](const std::string& name) { return (std::filesystem::path(dir.staging()) / name).string(); };
-  write_plot_binary(staged(plot_data), tab);
-  io::write_text_atomic(staged(plot_script), fit_plot_script(p.data.names, cost, plot_data, "fit.png", notes,
-                                                             static_cast<int>(tab.columns.size()) + 1));
-  std::vector<std::string> scripts{plot_script};
+  std::vector<std::string> scripts;
   // spectrum.csv / spectrum.gp / spectrum.png: measured and predicted power spectral densities.
   const Spectrum sm = power_spectrum(p.data.t, p.data.z), sp = power_spectrum(p.data.t, predicted);
   if (!sm.f.empty() && sm.psd.rows() == sp.psd.rows()) {
@@ -464,11 +456,11 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
     io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title));
     scripts.push_back("spectrum.gp");
   }
-  // fit.png and spectrum.png rendered side by side.
-  const std::vector<RenderStatus> rendered = render_gnuplot(dir.staging(), scripts);
-  std::filesystem::remove(staged(plot_data));
-  std::filesystem::remove(staged(plot_script));
-  for (std::size_t i = 0; i < scripts.size(); ++i)
+  // fit.png (from a raw float64 copy of fit.csv: the same numbers, no text to parse) and
+  // spectrum.png rendered side by side.
+  const std::vector<RenderStatus> rendered =
+      render_fit_plots(dir.staging(), {FitPlot{&tab, p.data.names, cost, "fit.png", notes}}, scripts);
+  for (std::size_t i = 0; i < rendered.size(); ++i)
     render(i == 0 ? "fit.png" : "spectrum.png", rendered[i]);
   io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -88,11 +89,20 @@ TEST(FitPlot, TheBinaryCopyDrawsTheSamePictureAsTheCsv) {
   scoleid::io::write_csv((dir / "fit.csv").string(), tab);
   write_plot_binary((dir / "fit.f64").string(), tab);
   EXPECT_EQ(fs::file_size(dir / "fit.f64"), tab.t.size() * (tab.columns.size() + 1) * sizeof(double));
+  fs::remove(dir / "fit.f64");
   const std::vector<std::pair<int, double>> cost = {{0, 1.0}, {1, 0.1}};
   std::ofstream(dir / "csv.gp") << fit_plot_script(sensors, cost, "fit.csv", "csv.png");
-  std::ofstream(dir / "bin.gp") << fit_plot_script(sensors, cost, "fit.f64", "bin.png", {}, static_cast<int>(tab.columns.size()) + 1);
   ASSERT_EQ(render_gnuplot(dir.string(), "csv.gp"), RenderStatus::Rendered);
-  ASSERT_EQ(render_gnuplot(dir.string(), "bin.gp"), RenderStatus::Rendered);
+  // render_fit_plots: the binary copy and its script, drawn beside another script, then removed.
+  std::ofstream(dir / "again.gp") << fit_plot_script(sensors, cost, "fit.csv", "again.png");
+  const auto st = render_fit_plots(dir.string(), {FitPlot{&tab, sensors, cost, "bin.png", {}}}, {"again.gp"});
+  ASSERT_EQ(st.size(), 2u);
+  EXPECT_EQ(st[0], RenderStatus::Rendered);
+  EXPECT_EQ(st[1], RenderStatus::Rendered);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"again.gp", "again.png", "bin.png", "csv.gp", "csv.png", "fit.csv"}));
   auto bytes = [](const fs::path& f) {
     std::ifstream in(f, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), {});

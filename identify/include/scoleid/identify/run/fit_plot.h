@@ -49,6 +49,21 @@ std::string spectrum_plot_script(const std::vector<std::string>& sensors, const 
                                  const std::string& csv = "spectrum.csv", const std::string& png = "spectrum.png");
 
 enum class RenderStatus { Rendered, NoGnuplot, Failed };
+
+// One fit.png to draw: the table (fit_table's columns), its sensors, cost history and annotations.
+struct FitPlot {
+  const io::DataTable* table = nullptr;
+  std::vector<std::string> sensors;
+  std::vector<std::pair<int, double>> cost;
+  std::string png;
+  FitPlotAnnotations notes;
+};
+// Draws every plot in `dir` from a raw float64 copy of its table (write_plot_binary) by a script
+// that reads it, and runs `scripts` (names in `dir`) too, all side by side; the copies and their
+// scripts are removed afterwards. Statuses in order: the plots, then `scripts`.
+std::vector<RenderStatus> render_fit_plots(const std::string& dir, const std::vector<FitPlot>& plots,
+                                           const std::vector<std::string>& scripts = {});
+
 // Runs `gnuplot SCRIPT` in `dir`. Throws io::Interrupted if the program is interrupted meanwhile.
 RenderStatus render_gnuplot(const std::string& dir, const std::string& script);
 // The same for several scripts at once, one gnuplot each (the plots render side by side).
