@@ -109,56 +109,144 @@ bool BandedCholesky::factorize() {
   return true;
 }
 
+namespace {
+
+// The band's full rows i ∈ [b, nb) of the two sweeps for a bandwidth B known at compile time:
+// row i's entries L_{i,i−B} … L_{i,i−1} at L[i (B+1) + m], m = 0 … B−1, the diagonal's inverse in
+// inv. The same operations in the same order as the generic loops (BandedCholesky::solve_in_place).
+template <int B>
+void band_forward(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from, int nb) {
+  for (int i = from; i < nb; ++i) {
+    const double* Li = L + static_cast<std::size_t>(i) * (B + 1);
+    for (int j = 0; j < columns; ++j) {
+      double* x = X + j * ld + (i - B);
+      double s = x[B];
+      for (int m = 0; m < B; ++m) s -= Li[m] * x[m];
+      x[B] = s * inv[i];
+    }
+  }
+}
+
+template <int B>
+void band_backward(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from, int nb) {
+  for (int i = nb - 1; i >= from; --i) {
+    const double* Li = L + static_cast<std::size_t>(i) * (B + 1);
+    for (int j = 0; j < columns; ++j) {
+      double* x = X + j * ld + (i - B);
+      const double y = (x[B] *= inv[i]);
+      for (int m = 0; m < B; ++m) x[m] -= Li[m] * y;
+    }
+  }
+}
+
+}  // namespace
+
 void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
 
 void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld) const {
   if (columns > 1 && ld < n_) throw std::invalid_argument("BandedCholesky::solve_in_place: leading dimension below n");
   if (inv_diag_.size() != static_cast<std::size_t>(n_)) throw std::logic_error("BandedCholesky: solve before a successful factorize");
+  // Many columns go in groups: a group's rows near row i stay in the first-level cache.
+  if (columns > kColumnGroup) {
+    for (int j = 0; j < columns; j += kColumnGroup)
+      solve_in_place(X + static_cast<std::ptrdiff_t>(j) * ld, std::min(kColumnGroup, columns - j), ld);
+    return;
+  }
   // Both sweeps read L by rows, which are contiguous in storage: L y = r by dot products with
   // row i, Lᵀ x = y by axpys with row i (column-oriented back substitution). Each row is applied
   // to every column before the next row: one column is a chain of dependent operations (row i
-  // needs row i − 1), several columns are independent chains the processor overlaps. Every
-  // column sees the same operations in the same order, so a column's result does not depend on
-  // how many are solved together.
+  // needs row i − 1), several columns are independent chains the processor overlaps. The band's
+  // full rows (i ≥ b) go through loops with the bandwidth a compile-time constant (b ≤ 8: no loop
+  // control inside a row); the first b rows, the border rows and wider bands through the generic
+  // loops, four columns at a time (one load of each entry of L for four), the remainder one at a
+  // time. Every column sees the same operations in the same order, so a column's result does not
+  // depend on how many are solved together, nor on which loop solved it.
   const int w = b_ + 1;
   const double* L = data_.data();
   const double* inv = inv_diag_.data();
+  const int blocked = columns - columns % 4;  // columns [0, blocked) go four at a time
   auto col = [X, ld](int j) { return X + static_cast<std::ptrdiff_t>(j) * ld; };
-  for (int i = 0; i < nb_; ++i) {
-    const int k0 = std::max(0, i - b_);
-    const double* Li = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
-    for (int j = 0; j < columns; ++j) {
+  // L y = r, row i of the band (entries k ∈ [k0, i)) or of the border (k ∈ [0, i)) at Li[k].
+  auto forward_row = [&](int i, int k0, const double* Li) {
+    for (int j = 0; j < blocked; j += 4) {
+      double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
+      double s0 = x0[i], s1 = x1[i], s2 = x2[i], s3 = x3[i];
+      for (int k = k0; k < i; ++k) {
+        const double l = Li[k];
+        s0 -= l * x0[k];
+        s1 -= l * x1[k];
+        s2 -= l * x2[k];
+        s3 -= l * x3[k];
+      }
+      x0[i] = s0 * inv[i];
+      x1[i] = s1 * inv[i];
+      x2[i] = s2 * inv[i];
+      x3[i] = s3 * inv[i];
+    }
+    for (int j = blocked; j < columns; ++j) {
       double* x = col(j);
       double s = x[i];
-      for (int k = k0; k < i; ++k) s -= Li[k - k0] * x[k];
+      for (int k = k0; k < i; ++k) s -= Li[k] * x[k];
       x[i] = s * inv[i];
     }
-  }
-  for (int i = nb_; i < n_; ++i) {
-    const double* Li = L + offset(i, 0);
-    for (int j = 0; j < columns; ++j) {
-      double* x = col(j);
-      double s = x[i];
-      for (int k = 0; k < i; ++k) s -= Li[k] * x[k];
-      x[i] = s * inv[i];
+  };
+  // Lᵀ x = y, row i's entries k ∈ [k0, i) at Li[k] taken out of the rows above it.
+  auto backward_row = [&](int i, int k0, const double* Li) {
+    for (int j = 0; j < blocked; j += 4) {
+      double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
+      const double y0 = (x0[i] *= inv[i]), y1 = (x1[i] *= inv[i]), y2 = (x2[i] *= inv[i]), y3 = (x3[i] *= inv[i]);
+      for (int k = k0; k < i; ++k) {
+        const double l = Li[k];
+        x0[k] -= l * y0;
+        x1[k] -= l * y1;
+        x2[k] -= l * y2;
+        x3[k] -= l * y3;
+      }
     }
-  }
-  for (int i = n_ - 1; i >= nb_; --i) {
-    const double* Li = L + offset(i, 0);
-    for (int j = 0; j < columns; ++j) {
-      double* x = col(j);
-      const double xi = (x[i] *= inv[i]);
-      for (int k = 0; k < i; ++k) x[k] -= Li[k] * xi;
-    }
-  }
-  for (int i = nb_ - 1; i >= 0; --i) {
-    const int k0 = std::max(0, i - b_);
-    const double* Lk = L + static_cast<std::size_t>(i) * w + (k0 - i + b_);
-    for (int j = 0; j < columns; ++j) {
+    for (int j = blocked; j < columns; ++j) {
       double* x = col(j);
       const double xi = (x[i] *= inv[i]);
-      for (int k = k0; k < i; ++k) x[k] -= Lk[k - k0] * xi;
+      for (int k = k0; k < i; ++k) x[k] -= Li[k] * xi;
     }
+  };
+  auto band_row = [&](int i, int k0) { return L + static_cast<std::size_t>(i) * w + (k0 - i + b_) - k0; };
+  // The band's first b rows (shorter than b) and, for a bandwidth without a kernel of its own, all.
+  const int full_from = b_ >= 1 && b_ <= kMaxUnrolledBand ? std::min(b_, nb_) : nb_;
+  for (int i = 0; i < full_from; ++i) forward_row(i, std::max(0, i - b_), band_row(i, std::max(0, i - b_)));
+  if (full_from < nb_) band_forward_dispatch(L, inv, X, columns, ld, full_from);
+  for (int i = nb_; i < n_; ++i) forward_row(i, 0, L + offset(i, 0));
+  for (int i = n_ - 1; i >= nb_; --i) backward_row(i, 0, L + offset(i, 0));
+  if (full_from < nb_) band_backward_dispatch(L, inv, X, columns, ld, full_from);
+  for (int i = full_from - 1; i >= 0; --i) backward_row(i, std::max(0, i - b_), band_row(i, std::max(0, i - b_)));
+}
+
+void BandedCholesky::band_forward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld,
+                                           int from) const {
+  switch (b_) {
+    case 1: band_forward<1>(L, inv, X, columns, ld, from, nb_); break;
+    case 2: band_forward<2>(L, inv, X, columns, ld, from, nb_); break;
+    case 3: band_forward<3>(L, inv, X, columns, ld, from, nb_); break;
+    case 4: band_forward<4>(L, inv, X, columns, ld, from, nb_); break;
+    case 5: band_forward<5>(L, inv, X, columns, ld, from, nb_); break;
+    case 6: band_forward<6>(L, inv, X, columns, ld, from, nb_); break;
+    case 7: band_forward<7>(L, inv, X, columns, ld, from, nb_); break;
+    case 8: band_forward<8>(L, inv, X, columns, ld, from, nb_); break;
+    default: throw std::logic_error("BandedCholesky: no kernel for this bandwidth");
+  }
+}
+
+void BandedCholesky::band_backward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld,
+                                            int from) const {
+  switch (b_) {
+    case 1: band_backward<1>(L, inv, X, columns, ld, from, nb_); break;
+    case 2: band_backward<2>(L, inv, X, columns, ld, from, nb_); break;
+    case 3: band_backward<3>(L, inv, X, columns, ld, from, nb_); break;
+    case 4: band_backward<4>(L, inv, X, columns, ld, from, nb_); break;
+    case 5: band_backward<5>(L, inv, X, columns, ld, from, nb_); break;
+    case 6: band_backward<6>(L, inv, X, columns, ld, from, nb_); break;
+    case 7: band_backward<7>(L, inv, X, columns, ld, from, nb_); break;
+    case 8: band_backward<8>(L, inv, X, columns, ld, from, nb_); break;
+    default: throw std::logic_error("BandedCholesky: no kernel for this bandwidth");
   }
 }
 

@@ -67,7 +67,7 @@ std::vector<double> segment_ends(const std::vector<double>& breakpoints, double 
 
 EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
                              NewtonMatrix& newton, ButcherTable table)
-    : M_(M), D_rows_(D), K_rows_(K), mass_(mass), newton_(newton), tab_(std::move(table)) {
+    : M_(M), products_(D, K), mass_(mass), newton_(newton), tab_(std::move(table)) {
   explicit_first_ = tab_.explicit_first_stage();
   stiffly_accurate_ = tab_.stiffly_accurate();
   for (int i = 0; i < tab_.stages; ++i)
@@ -139,16 +139,12 @@ public:
     F.setZero();
     forcing_(tf, F.data());
     ++cnt_.stage_forcings;
-    a.col(0) = F;
-    a.col(0).noalias() -= st_.D_rows_ * v.col(0);
-    a.col(0).noalias() -= st_.K_rows_ * x.col(0);
+    st_.products_.subtract(v.data(), x.data(), F.data(), a.data(), 1);
     st_.mass_.solve_in_place(a.col(0).data());
     ++cnt_.linear_solves;
     if (m_ > 1) {
       tangent_forcing(tf, x.col(0).data(), v.col(0).data(), a.col(0).data());
-      a.rightCols(P_) = G.leftCols(P_);
-      a.rightCols(P_).noalias() -= st_.D_rows_ * v.rightCols(P_);
-      a.rightCols(P_).noalias() -= st_.K_rows_ * x.rightCols(P_);
+      st_.products_.subtract(v.col(1).data(), x.col(1).data(), G.data(), a.col(1).data(), P_);
       st_.mass_.solve_in_place(a.col(1).data(), P_, n_);
       cnt_.linear_solves += P_;
     }
@@ -267,18 +263,14 @@ private:
     F.setZero();
     forcing_(ti, F.data());
     ++cnt_.stage_forcings;
-    Ai.col(0) = F;
-    Ai.col(0).noalias() -= st_.D_rows_ * vt.col(0);
-    Ai.col(0).noalias() -= st_.K_rows_ * w.col(0);
+    st_.products_.subtract(vt.data(), w.data(), F.data(), Ai.data(), 1);
     S.solve_in_place(Ai.col(0).data());
     ++cnt_.linear_solves;
     Vs[si].col(0) = vt.col(0) + g * Ai.col(0);
     if (m_ > 1) {
       X0 = w.col(0) + (g * g) * Ai.col(0);
       tangent_forcing(ti, X0.data(), Vs[si].col(0).data(), Ai.col(0).data());
-      Ai.rightCols(P_) = G.leftCols(P_);
-      Ai.rightCols(P_).noalias() -= st_.D_rows_ * vt.rightCols(P_);
-      Ai.rightCols(P_).noalias() -= st_.K_rows_ * w.rightCols(P_);
+      st_.products_.subtract(vt.col(1).data(), w.col(1).data(), G.data(), Ai.col(1).data(), P_);
       S.solve_in_place(Ai.col(1).data(), P_, n_);
       cnt_.linear_solves += P_;
       Vs[si].rightCols(P_) = vt.rightCols(P_) + g * Ai.rightCols(P_);

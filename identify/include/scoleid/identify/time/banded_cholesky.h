@@ -54,6 +54,12 @@ public:
   void solve_in_place(double* X, int columns, std::ptrdiff_t ld) const;
 
 private:
+  // The band's full rows [from, nb) of the forward and the backward sweep with the bandwidth a
+  // compile-time constant (b ≤ kMaxUnrolledBand; banded_cholesky.cpp).
+  static constexpr int kMaxUnrolledBand = 8;
+  static constexpr int kColumnGroup = 16;  // columns solved together (the rest in further groups)
+  void band_forward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from) const;
+  void band_backward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from) const;
   int n_ = 0, b_ = 0, nb_ = 0;  // nb_: rows in the band part (n − border)
   std::vector<double> data_;
   std::vector<double> inv_diag_;  // 1 / L_ii, set by factorize (a product in the sweeps, not a division)

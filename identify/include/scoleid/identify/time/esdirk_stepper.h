@@ -36,6 +36,7 @@
 
 #include "scoleid/identify/time/banded_cholesky.h"
 #include "scoleid/identify/time/newton_matrix.h"
+#include "scoleid/identify/time/stage_products.h"
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/identify/time/trajectory.h"
 
@@ -125,10 +126,9 @@ private:
   class Sweep;  // one integration's workspace and steps (esdirk_stepper.cpp)
 
   const SparseMatrix& M_;
-  // D and K copied by rows at construction (the Newton factors and `mass` are the caller's and must
-  // stay those of the same M, D, K): their products with the stage vectors are then sums per row
-  // (independent multiply-adds) instead of column scatters, whose stores depend on each other.
-  Eigen::SparseMatrix<double, Eigen::RowMajor> D_rows_, K_rows_;
+  // D and K copied at construction (the Newton factors and `mass` are the caller's and must stay
+  // those of the same M, D, K).
+  StageProducts products_;
   const BandedCholesky& mass_;
   NewtonMatrix& newton_;
   ButcherTable tab_;
