@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace scoleid::identify {
 
@@ -139,6 +140,22 @@ void band_backward(const double* L, const double* inv, double* X, int columns, s
   }
 }
 
+// f(std::integral_constant<int, b>) for b = 1 … kMaxUnrolledBand (the callers check the range).
+template <class F>
+void with_bandwidth(int b, F&& f) {
+  switch (b) {
+    case 1: f(std::integral_constant<int, 1>{}); break;
+    case 2: f(std::integral_constant<int, 2>{}); break;
+    case 3: f(std::integral_constant<int, 3>{}); break;
+    case 4: f(std::integral_constant<int, 4>{}); break;
+    case 5: f(std::integral_constant<int, 5>{}); break;
+    case 6: f(std::integral_constant<int, 6>{}); break;
+    case 7: f(std::integral_constant<int, 7>{}); break;
+    case 8: f(std::integral_constant<int, 8>{}); break;
+    default: throw std::logic_error("BandedCholesky: no kernel for this bandwidth");
+  }
+}
+
 }  // namespace
 
 void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
@@ -213,41 +230,14 @@ void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld) c
   // The band's first b rows (shorter than b) and, for a bandwidth without a kernel of its own, all.
   const int full_from = b_ >= 1 && b_ <= kMaxUnrolledBand ? std::min(b_, nb_) : nb_;
   for (int i = 0; i < full_from; ++i) forward_row(i, std::max(0, i - b_), band_row(i, std::max(0, i - b_)));
-  if (full_from < nb_) band_forward_dispatch(L, inv, X, columns, ld, full_from);
+  if (full_from < nb_)
+    with_bandwidth(b_, [&](auto B) { band_forward<decltype(B)::value>(L, inv, X, columns, ld, full_from, nb_); });
   for (int i = nb_; i < n_; ++i) forward_row(i, 0, L + offset(i, 0));
   for (int i = n_ - 1; i >= nb_; --i) backward_row(i, 0, L + offset(i, 0));
-  if (full_from < nb_) band_backward_dispatch(L, inv, X, columns, ld, full_from);
+  if (full_from < nb_)
+    with_bandwidth(b_, [&](auto B) { band_backward<decltype(B)::value>(L, inv, X, columns, ld, full_from, nb_); });
   for (int i = full_from - 1; i >= 0; --i) backward_row(i, std::max(0, i - b_), band_row(i, std::max(0, i - b_)));
 }
 
-void BandedCholesky::band_forward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld,
-                                           int from) const {
-  switch (b_) {
-    case 1: band_forward<1>(L, inv, X, columns, ld, from, nb_); break;
-    case 2: band_forward<2>(L, inv, X, columns, ld, from, nb_); break;
-    case 3: band_forward<3>(L, inv, X, columns, ld, from, nb_); break;
-    case 4: band_forward<4>(L, inv, X, columns, ld, from, nb_); break;
-    case 5: band_forward<5>(L, inv, X, columns, ld, from, nb_); break;
-    case 6: band_forward<6>(L, inv, X, columns, ld, from, nb_); break;
-    case 7: band_forward<7>(L, inv, X, columns, ld, from, nb_); break;
-    case 8: band_forward<8>(L, inv, X, columns, ld, from, nb_); break;
-    default: throw std::logic_error("BandedCholesky: no kernel for this bandwidth");
-  }
-}
-
-void BandedCholesky::band_backward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld,
-                                            int from) const {
-  switch (b_) {
-    case 1: band_backward<1>(L, inv, X, columns, ld, from, nb_); break;
-    case 2: band_backward<2>(L, inv, X, columns, ld, from, nb_); break;
-    case 3: band_backward<3>(L, inv, X, columns, ld, from, nb_); break;
-    case 4: band_backward<4>(L, inv, X, columns, ld, from, nb_); break;
-    case 5: band_backward<5>(L, inv, X, columns, ld, from, nb_); break;
-    case 6: band_backward<6>(L, inv, X, columns, ld, from, nb_); break;
-    case 7: band_backward<7>(L, inv, X, columns, ld, from, nb_); break;
-    case 8: band_backward<8>(L, inv, X, columns, ld, from, nb_); break;
-    default: throw std::logic_error("BandedCholesky: no kernel for this bandwidth");
-  }
-}
 
 }  // namespace scoleid::identify
