@@ -1010,6 +1010,18 @@ std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solve
 }
 
 double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
+  if (!profile && last_gn_.q.size() == q.size() && last_gn_.q == q && last_gn_.T == T_) {
+    gradient = last_gn_.g;
+    H = last_gn_.H;
+    return last_gn_.J;
+  }
+  last_gn_ = {};
+  const double J = gauss_newton_solve(q, gradient, H, profile);
+  if (!profile) last_gn_ = {q, T_, J, gradient, H};
+  return J;
+}
+
+double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();

@@ -181,6 +181,10 @@ public:
   // J and g (and what the step needs) at x on the current horizon; false outside the model's
   // domain. `with_profile`: the strategy may keep the misfit profile of this evaluation.
   virtual bool evaluate(const VectorXd& x, Point& p, bool with_profile) = 0;
+  // A trial point: at least J (and the profile when asked); `complete` adds the rest once the
+  // point is accepted. By default the trial is evaluated in full.
+  virtual bool evaluate_trial(const VectorXd& x, Point& p, bool with_profile) { return evaluate(x, p, with_profile); }
+  virtual void complete(const VectorXd&, Point&) {}
   virtual void start(const Point&) {}
   // The step from (x, p) inside `radius`; `lambda_floor` the Levenberg floor on a short horizon.
   virtual TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double lambda_floor) = 0;
@@ -246,7 +250,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       }
       Point trial;
       const bool profile = continuation && !full();
-      const bool ok = s.evaluate(x + st.delta, trial, profile) && trial.J < cur.J;
+      const bool ok = s.evaluate_trial(x + st.delta, trial, profile) && trial.J < cur.J;
       const double rho = ok && st.predicted > 0 ? (cur.J - trial.J) / st.predicted : -1.0;
       radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
       if (!ok) {
@@ -267,6 +271,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
       x += delta;
       cur = std::move(trial);
+      s.complete(x, cur);
       ++k;
       // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
       // with its cost on the horizon the next step is taken on.
@@ -293,10 +298,34 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
 // profile comes with the state solve); the Levenberg step of gauss_newton_step.h. With a
 // smoothness prior (§7.8) its value, gradient and (constant) matrix are added to the data's: the
 // Gauss–Newton model of the whole cost.
+//
+// With many parameters (more than kMatrixOnAcceptance) the matrix's P tangents cost many state
+// solves (at 64 sections about 20), so a trial point on the whole record gets its cost alone (one
+// state solve) and the gradient and matrix only once it is accepted: a rejected trial, and the
+// trials of an extrapolation, then cost a state solve each. (With few parameters the tangents
+// ride along with the state solve almost for free, and an accepted point would pay for a second
+// state solve.)
+constexpr Eigen::Index kMatrixOnAcceptance = 16;
 class ExplicitStep final : public StepStrategy {
 public:
   ExplicitStep(Run& r, Eigen::Index P)
-      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)) {}
+      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)), lazy_(P > kMatrixOnAcceptance) {}
+  bool evaluate_trial(const VectorXd& xx, Point& p, bool with_profile) override {
+    if (!lazy_ || with_profile) return evaluate(xx, p, with_profile);
+    try {
+      p.J = r_.obj.cost(xx.array().exp()) + prior_.value(xx);
+      p.g.resize(0);  // completed on acceptance
+      return std::isfinite(p.J);
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  void complete(const VectorXd& xx, Point& p) override {
+    if (p.g.size() == xx.size()) return;
+    if (!evaluate(xx, p, false)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at an accepted point");
+  }
   bool evaluate(const VectorXd& xx, Point& p, bool with_profile) override {
     try {
       const VectorXd q = xx.array().exp();
@@ -336,7 +365,8 @@ public:
     }
     if (!(best > 1.0)) return;
     Point far;
-    if (evaluate(x + best * st.delta, far, profile) && far.J < trial.J) {
+    far.J = Jb;  // a lazy trial's whole evaluation: its cost, just taken
+    if ((lazy_ && !profile ? std::isfinite(Jb) : evaluate(x + best * st.delta, far, profile)) && far.J < trial.J) {
       delta = best * st.delta;
       trial = std::move(far);
       radius = std::max(radius, std::min(delta.norm(), r_.opt.max_trust_radius));
@@ -355,6 +385,7 @@ private:
   const Smoothness& prior_;
   const MatrixXd prior_matrix_;
   Misfit::MisfitProfile prof_;
+  const bool lazy_;
 };
 
 // The gradient methods' search direction in x = log q: the paper's fixed-weight update, steepest

@@ -455,18 +455,23 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   //    started coarse to fine stops at J = 0.099 where the plain run reaches 4e-8), when the residual
   //    exceeds noise and discretisation (a local minimum of a sectional profile may still fit within
   //    a declared model error) or the run used up its iterations;
-  //  - the smoothed estimate of a sectional family, always (when restarts are allowed at all; it
-  //    does not count against their number): a sectional profile has local minima
+  //  - the smoothed estimate of a sectional family, always without a smoothness prior (when
+  //    restarts are allowed at all; it does not count against their number): a sectional profile has local minima
   //    that fit within the noise (beam-ei8 with noise 1e-4 m stops in a sawtooth 7-19 std off whose
   //    J is 2 % above the minimum near the truth — decisive between the two points, which share the
   //    noise, but within the noise's own spread of J, so no fit test can see it); coarse to fine
-  //    from the estimate smoothed along its sections reaches the lower one;
+  //    from the estimate smoothed along its sections reaches the lower one. A prior in force
+  //    penalises exactly that sawtooth (each section's step from its neighbours), so with one
+  //    this restart is not run;
   //  - the spectral start (spectral_start.h), after any failure of the runs so far, when the
   //    record's dominant spectral peak and the model's at the starting point differ by more than 1 %:
   //    from the start moved so that the model's frequencies match the record's;
   //  - the cautious continuation, after any failure of the runs so far: stopped without converging
   //    (the iteration limit, a stall on a short horizon) or converged where the model does not
   //    explain the data.
+  // A discrepancy principle that is not met, where the optimiser converged and the model explains
+  // the data, is no such failure: a restart keeps the chosen weight and would refit the same
+  // minimum; the run stays unconverged (RunResult::converged) and says why.
   // The best attempt is kept (better_attempt); where two converged attempts fit alike but differ,
   // the assessment flags the parameters they disagree on (assessment.cpp, the other-minimum test).
   std::vector<std::string> strategies;
@@ -474,17 +479,19 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   strategies.insert(strategies.end(), {"spectral", "cautious-continuation"});
   int done = 0;
   SpectralStart spectral;
+  auto failed = [&r]() { return !(r.summary.converged() && r.fit.explains_data); };
   for (const std::string& how : strategies) {
     if (done >= p.scenario.identification.restarts) break;
     bool wanted = false;
     // (not after a level that explained the data: a blocked profile is no sawtooth to smooth)
     if (how == "smoothed")
-      wanted = r.summary.q.allFinite() && r.summary.termination != OptimizerSummary::Termination::DataExplained;
+      wanted = r.summary.q.allFinite() && r.summary.termination != OptimizerSummary::Termination::DataExplained &&
+               !(r.smoothness_weight > 0.0);
     else if (how == "spectral") {
-      if (!r.converged()) spectral = spectral_start_of(c, r.initial);
-      wanted = !r.converged() && spectral.q.size() == r.initial.size();
+      if (failed()) spectral = spectral_start_of(c, r.initial);
+      wanted = failed() && spectral.q.size() == r.initial.size();
     }
-    else if (how == "cautious-continuation") wanted = !r.converged();
+    else if (how == "cautious-continuation") wanted = failed();
     else
       wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
     if (!wanted) continue;

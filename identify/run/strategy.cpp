@@ -8,7 +8,9 @@ namespace scoleid::identify {
 io::Method resolve_method(io::Method requested, int parameters, bool smoothness_prior, bool matrix_free_products) {
   if (requested != io::Method::Auto) return requested;
   if (parameters <= kExplicitGaussNewtonParameters) return io::Method::GaussNewton;
-  if (smoothness_prior) return matrix_free_products ? io::Method::GaussNewtonKrylov : io::Method::GaussNewton;
+  if (smoothness_prior)
+    return matrix_free_products && parameters > kExplicitGaussNewtonWithPrior ? io::Method::GaussNewtonKrylov
+                                                                              : io::Method::GaussNewton;
   return io::Method::Lbfgs;
 }
 

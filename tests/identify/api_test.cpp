@@ -117,7 +117,11 @@ TEST(Strategy, AutoResolvesByParametersPriorAndProducts) {
   const int limit = identify::kExplicitGaussNewtonParameters;
   EXPECT_EQ(identify::resolve_method(Method::Auto, limit, false, true), Method::GaussNewton);
   EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, false, true), Method::Lbfgs);
-  EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, true, true), Method::GaussNewtonKrylov);
+  const int with_prior = identify::kExplicitGaussNewtonWithPrior;
+  EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, true, true), Method::GaussNewton);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, with_prior, true, true), Method::GaussNewton);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, with_prior + 1, true, true), Method::GaussNewtonKrylov);
+  EXPECT_EQ(identify::resolve_method(Method::Auto, with_prior + 1, true, false), Method::GaussNewton);
   EXPECT_EQ(identify::resolve_method(Method::Auto, limit + 1, true, false), Method::GaussNewton);
   for (Method m : {Method::GaussNewton, Method::GaussNewtonKrylov, Method::Lbfgs, Method::SteepestDescent})
     EXPECT_EQ(identify::resolve_method(m, 64, true, false), m) << "a method given is kept";

@@ -11,6 +11,8 @@
 #include <random>
 #include <tuple>
 
+#include "scoleid/identify/inverse/optimizers.h"
+#include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/identify_run.h"
 
 using namespace scoleid::identify;
@@ -169,6 +171,52 @@ TEST(SmoothnessPrior, DiscrepancyWeightIsTheLargestWithinTheNoiseAndHalvesTheSec
   EXPECT_LT(rms_error(b), 0.7 * rms_error(a));
 }
 
+// The last Gauss–Newton evaluation is kept (objective.h): asked again at the same q on the same
+// horizon (an optimiser run going on from where the previous one stopped) it is returned as it was,
+// without a solve; another point, another horizon or a profile asked for are solved.
+TEST(GaussNewton, TheLastEvaluationIsReturnedAgainOnlyForTheSamePointAndHorizon) {
+  const Case c = ei8(false);
+  Objective o(c.p->model(), *c.p->params, c.p->signals, c.data, c.p->objective_options);
+  const VectorXd q = c.p->params->initial() * 1.05;
+  VectorXd g1, g2, g3;
+  MatrixXd H1, H2, H3;
+  const double J1 = o.gauss_newton(q, g1, H1);
+  o.reset_counters();
+  const double J2 = o.gauss_newton(q, g2, H2);
+  EXPECT_EQ(o.counters().forward_solves, 0);
+  EXPECT_EQ(o.counters().sensitivity_solves, 0);
+  EXPECT_EQ(J2, J1);
+  EXPECT_TRUE(g2 == g1 && H2 == H1);
+  // Another point: solved, and its numbers differ.
+  VectorXd q2 = q;
+  q2[0] *= 1.01;
+  o.gauss_newton(q2, g3, H3);
+  EXPECT_EQ(o.counters().forward_solves, 1);
+  EXPECT_GT(o.counters().sensitivity_solves, 0);
+  EXPECT_NE(g3[0], g1[0]);
+  // Back at q: solved again (only the last evaluation is kept), the same numbers bit for bit.
+  o.reset_counters();
+  EXPECT_EQ(o.gauss_newton(q, g2, H2), J1);
+  EXPECT_EQ(o.counters().forward_solves, 1);
+  EXPECT_TRUE(g2 == g1 && H2 == H1);
+  // A shorter horizon is another cost: solved; and the whole record's again after it.
+  o.set_horizon(0.5 * (o.data_start() + o.data_end()));
+  o.reset_counters();
+  const double Jh = o.gauss_newton(q, g3, H3);
+  EXPECT_EQ(o.counters().forward_solves, 1);
+  EXPECT_NE(Jh, J1);
+  o.set_horizon(o.data_end());
+  o.reset_counters();
+  EXPECT_EQ(o.gauss_newton(q, g2, H2), J1);
+  EXPECT_EQ(o.counters().forward_solves, 1);
+  // With a profile asked for: solved (the profile is not kept).
+  Misfit::MisfitProfile prof;
+  o.reset_counters();
+  EXPECT_EQ(o.gauss_newton(q, g2, H2, &prof), J1);
+  EXPECT_EQ(o.counters().forward_solves, 1);
+  EXPECT_FALSE(prof.t.empty());
+}
+
 TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {
   // The prior enters the explicit Gauss–Newton matrix as β LᵀL, the matrix-free product as β LᵀL v
   // and the gradient methods' cost and gradient as its value and β LᵀL x: on the same cost (EI on 8
@@ -209,6 +257,43 @@ TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {
     EXPECT_NEAR(a.summary.cost, b.summary.cost, cost_gains * stall * b.summary.cost) << method;
     EXPECT_NEAR(a.summary.prior_cost, b.summary.prior_cost, prior_tol * b.summary.prior_cost) << method;
   }
+}
+
+// With more than 16 parameters explicit Gauss–Newton takes a trial point's cost alone and the
+// matrix only where a point is accepted (optimizers.cpp, ExplicitStep): EI on 24 sections with the
+// prior (β = 10⁻², 4 sensors, 1 % noise) costs at most P tangent columns per accepted point plus
+// the start, and reaches the minimiser the matrix-free method reaches from the same start.
+TEST(SmoothnessPrior, ManyParametersTakeTheMatrixOnlyAtAcceptedPoints) {
+  auto sc = sections_scenario("1e-2", 24, 4, 0.01);
+  sc.identification.elements = 24;
+  auto p = make_problem(sc, std::nullopt);
+  std::map<std::string, OptimizerSummary> out;
+  for (const auto method : {scoleid::io::Method::GaussNewton, scoleid::io::Method::GaussNewtonKrylov}) {
+    Objective o(p->model(), *p->params, p->signals, p->data, p->objective_options);
+    OptimizerOptions oo;
+    oo.method = method;
+    oo.max_iterations = 200;
+    oo.smoothness_weight = 1e-2;
+    oo.smoothness_chains = section_families(p->params->names());
+    ASSERT_EQ(oo.smoothness_chains.size(), 1u);
+    const OptimizerSummary s = minimize(o, p->params->initial(), oo);
+    const auto& k = o.counters();
+    std::printf("%-20s %s; %ld state solves, %ld tangent columns\n", scoleid::io::to_string(method),
+                s.BriefReport().c_str(), k.forward_solves, k.sensitivity_solves);
+    EXPECT_TRUE(s.converged()) << s.BriefReport();
+    if (method == scoleid::io::Method::GaussNewton) {
+      EXPECT_LE(k.sensitivity_solves, 24L * (s.iterations_done + 1));
+      EXPECT_GE(k.forward_solves, s.iterations_done + 1);
+    }
+    out[scoleid::io::to_string(method)] = s;
+  }
+  const auto& a = out["gauss-newton"];
+  const auto& b = out["gauss-newton-krylov"];
+  const double stall = 1.0 / static_cast<double>(p->data.z.size());
+  const double dq = (a.q.array() / b.q.array() - 1.0).abs().maxCoeff();
+  std::printf("largest relative difference of the estimates %.3e; costs %.8e and %.8e\n", dq, a.cost, b.cost);
+  EXPECT_LT(dq, 1e-2);
+  EXPECT_LE(a.cost, b.cost * (1.0 + stall));  // the explicit step at least as far down
 }
 
 // The noise's share of the cost (docs/theory.md §7.8): for unit white noise n at the samples, ∫ñ²

@@ -130,7 +130,9 @@ public:
   // velocity or acceleration sensors, stepped together by esdirk), whatever the number of parameters.
   double cost_and_gradient(const VectorXd& q, VectorXd& gradient) override;
   // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
-  // the state is integrated over the whole data span and its misfit profile returned.
+  // the state is integrated over the whole data span and its misfit profile returned. The last
+  // evaluation without a profile is kept: asked again at the same q on the same horizon (an
+  // optimiser run continuing from where the previous one ended), it is returned without a solve.
   double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr) override;
   // The misfit profile over the whole data span at q (one forward solve).
   MisfitProfile misfit_profile(const VectorXd& q) override;
@@ -300,6 +302,16 @@ private:
     MatrixXd G;
   };
   KeptSensitivities kept_;
+  // The last Gauss–Newton evaluation without a profile (gauss_newton): q (empty: none), horizon, J, g, H.
+  struct LastGaussNewton {
+    VectorXd q;
+    double T = 0.0;
+    double J = 0.0;
+    VectorXd g;
+    MatrixXd H;
+  };
+  LastGaussNewton last_gn_;
+  double gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile);
   // Whether output sensitivities are interpolated in output space (no acceleration sensors) and
   // fit the memory budget: the Gauss–Newton sweep then keeps them.
   bool keeps_sensitivities() const;

@@ -13,7 +13,8 @@
 //   too (gauss-newton; gauss-newton-krylov adds its product).
 //   gauss-newton      trust-region Gauss–Newton (Levenberg) on x from forward sensitivities;
 //                     see gauss_newton_step.h for the step and the radius, and below for the
-//                     horizon continuation.
+//                     horizon continuation. With more than 16 parameters a trial point on the
+//                     whole record gets its cost alone and the matrix only once accepted.
 //   gauss-newton-krylov  inexact trust-region Gauss–Newton: the step from truncated conjugate
 //                     gradients (Steihaug) on matrix-free products H v (objective.h,
 //                     gauss_newton_product: one tangent and one costate solve each), stopped by the
