@@ -28,9 +28,9 @@ inline constexpr int kExplicitGaussNewtonParameters = 16;
 // With a smoothness prior, the explicit matrix up to this many parameters. Its P tangents are
 // stepped in one sweep (sharing the state's factorisation and stage loops) and cost about a tenth
 // of a matrix-free product each (a tangent and a costate solve of their own): measured on a beam
-// of 64 elements with 64 EI sections, the whole matrix 1.07 s against 0.16 s per product. The
-// truncated CG needs more than P/10 products per step there (the prior's differences spread the
-// spectrum), and its steps stop short: the explicit step is both cheaper and exact.
+// of 64 elements with 64 EI sections, the whole matrix 1.07 s against 0.16 s per product; the
+// truncated CG's late steps there took 4–5 s each (docs/theory.md §7.7), and stopped short of the
+// minimum: the explicit step is both cheaper and exact.
 inline constexpr int kExplicitGaussNewtonWithPrior = 64;
 
 // `requested` with auto resolved (above).
