@@ -182,9 +182,9 @@ public:
   // domain. `with_profile`: the strategy may keep the misfit profile of this evaluation.
   virtual bool evaluate(const VectorXd& x, Point& p, bool with_profile) = 0;
   // A trial point: at least J (and the profile when asked); `complete` adds the rest once the
-  // point is accepted. By default the trial is evaluated in full.
+  // point is accepted (false: it cannot be evaluated there). By default the trial is evaluated in full.
   virtual bool evaluate_trial(const VectorXd& x, Point& p, bool with_profile) { return evaluate(x, p, with_profile); }
-  virtual void complete(const VectorXd&, Point&) {}
+  virtual bool complete(const VectorXd&, Point&) { return true; }
   virtual void start(const Point&) {}
   // The step from (x, p) inside `radius`; `lambda_floor` the Levenberg floor on a short horizon.
   virtual TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double lambda_floor) = 0;
@@ -250,9 +250,17 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       }
       Point trial;
       const bool profile = continuation && !full();
-      const bool ok = s.evaluate_trial(x + st.delta, trial, profile) && trial.J < cur.J;
+      bool ok = s.evaluate_trial(x + st.delta, trial, profile) && trial.J < cur.J;
       const double rho = ok && st.predicted > 0 ? (cur.J - trial.J) / st.predicted : -1.0;
       radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
+      VectorXd delta = st.delta;
+      if (ok && rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
+      // (a point whose cost alone was taken and whose gradient or matrix cannot be evaluated is
+      // rejected like one whose cost cannot)
+      if (ok && !s.complete(x + delta, trial)) {
+        ok = false;
+        radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
+      }
       if (!ok) {
         if (radius < r.opt.step_tolerance) {
           if (extend(doubled())) {
@@ -265,13 +273,10 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
         }
         continue;
       }
-      VectorXd delta = st.delta;
-      if (rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
       const double step = delta.cwiseAbs().maxCoeff();
       const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
       x += delta;
       cur = std::move(trial);
-      s.complete(x, cur);
       ++k;
       // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
       // with its cost on the horizon the next step is taken on.
@@ -322,9 +327,8 @@ public:
       return false;
     }
   }
-  void complete(const VectorXd& xx, Point& p) override {
-    if (p.g.size() == xx.size()) return;
-    if (!evaluate(xx, p, false)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at an accepted point");
+  bool complete(const VectorXd& xx, Point& p) override {
+    return p.g.size() == xx.size() || evaluate(xx, p, false);
   }
   bool evaluate(const VectorXd& xx, Point& p, bool with_profile) override {
     try {

@@ -42,9 +42,9 @@ struct AttemptsContext {
   FitTest fit{};
   // Work on an estimate that is likely to stand, done while the fit test's doubled mesh is solved:
   // the first attempt's, when it converged and no restart is taken unless its fit fails (no
-  // sectional family: those always get the smoothed restart). The run sets it to the assessment's
+  // sectional family: without a prior those always get the smoothed restart). The run sets it to the assessment's
   // refits.
-  std::function<void(const VectorXd&)> alongside_fit;
+  std::function<void(const VectorXd&)> alongside_fit{};
   VectorXd cost_q{};  // attempt_cost's last q and its value
   double cost = INFINITY;
 };
