@@ -1021,6 +1021,39 @@ double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   return J;
 }
 
+double Objective::step_matrix_step() const {
+  const SolverOptions& so = options_.solver;
+  if (so.integrator != SolverOptions::Integrator::Esdirk || !(so.step > 0.0) || !(options_.step_matrix_coarsening > 1.0))
+    return so.step;
+  const double sample = (data_.t.back() - data_.t.front()) / static_cast<double>(data_.t.size() - 1);
+  return std::max(so.step, std::min(options_.step_matrix_coarsening * so.step, sample));
+}
+
+double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
+  const double hm = step_matrix_step();
+  if (!(hm > options_.solver.step)) return gauss_newton(q, gradient, H);
+  if (last_step_.q.size() == q.size() && last_step_.q == q && last_step_.T == T_) {
+    gradient = last_step_.g;
+    H = last_step_.H;
+    return last_step_.J;
+  }
+  last_step_ = {};
+  if (!step_matrix_) {
+    ObjectiveOptions o = options_;
+    o.solver.step = hm;
+    o.step_matrix_coarsening = 1.0;
+    step_matrix_ = std::make_unique<Objective>(model_, params_, inputs_, data_, o);
+  }
+  const double J = cost_and_gradient(q, gradient);
+  step_matrix_->set_horizon(T_);
+  step_matrix_->reset_counters();
+  VectorXd g_coarse;
+  step_matrix_->gauss_newton(q, g_coarse, H);
+  counters_.Accumulate(step_matrix_->counters());
+  last_step_ = {q, T_, J, gradient, H};
+  return J;
+}
+
 double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);

@@ -335,7 +335,10 @@ public:
       const VectorXd q = xx.array().exp();
       VectorXd g;
       MatrixXd H;
-      p.J = r_.obj.gauss_newton(q, g, H, with_profile ? &prof_ : nullptr) + prior_.value(xx);
+      // (lazy: J and g on the model's step, the matrix perhaps on a coarser one; misfit.h)
+      p.J = (lazy_ && !with_profile ? r_.obj.gradient_and_step_matrix(q, g, H)
+                                    : r_.obj.gauss_newton(q, g, H, with_profile ? &prof_ : nullptr)) +
+            prior_.value(xx);
       p.g = q.cwiseProduct(g) + prior_.apply(xx);
       p.H = q.asDiagonal() * H * q.asDiagonal() + prior_matrix_;
       return std::isfinite(p.J) && p.g.allFinite() && p.H.allFinite();

@@ -217,6 +217,61 @@ TEST(GaussNewton, TheLastEvaluationIsReturnedAgainOnlyForTheSamePointAndHorizon)
   EXPECT_FALSE(prof.t.empty());
 }
 
+// The step matrix (objective.h, docs/theory.md §7.2): J and g are the costate's on the solver's
+// step, bit for bit; H is that of the same objective on the coarsened step (its tangents' time
+// error only), close to the fine matrix; kept like gauss_newton's; the same as gauss_newton where
+// no coarser step applies.
+TEST(GaussNewton, TheStepMatrixIsTheCoarserStepsWithTheModelsCostAndGradient) {
+  const auto sc = sections_scenario("0", 24, 4, 0.01);
+  const auto p = make_problem(sc, std::nullopt);
+  const ObjectiveOptions fine_options = p->objective_options;
+  ASSERT_GT(fine_options.solver.step, 0.0);
+  Objective o(p->model(), *p->params, p->signals, p->data, fine_options);
+  const double hm = o.step_matrix_step();
+  EXPECT_GT(hm, fine_options.solver.step);
+  EXPECT_LE(hm, fine_options.step_matrix_coarsening * fine_options.solver.step * (1.0 + 1e-12));
+  const VectorXd q = p->params->initial() * 1.05;
+  VectorXd g, g_ref, g_fine, g_coarse;
+  MatrixXd H, H_fine, H_coarse;
+  const double J = o.gradient_and_step_matrix(q, g, H);
+  {
+    Objective ref(p->model(), *p->params, p->signals, p->data, fine_options);
+    EXPECT_EQ(ref.cost_and_gradient(q, g_ref), J);
+    EXPECT_TRUE(g == g_ref);
+    ref.gauss_newton(q, g_fine, H_fine);
+  }
+  ObjectiveOptions coarse_options = fine_options;
+  coarse_options.solver.step = hm;
+  Objective coarse(p->model(), *p->params, p->signals, p->data, coarse_options);
+  coarse.gauss_newton(q, g_coarse, H_coarse);
+  EXPECT_TRUE(H == H_coarse);
+  const double dH = (H - H_fine).norm() / H_fine.norm();
+  std::printf("step %.3g s, matrix step %.3g s: |H - H_fine| / |H_fine| = %.2e\n", fine_options.solver.step, hm, dH);
+  EXPECT_GT(dH, 0.0);
+  EXPECT_LT(dH, 1e-2);
+  // Kept: the same point and horizon cost nothing.
+  o.reset_counters();
+  VectorXd g2;
+  MatrixXd H2;
+  EXPECT_EQ(o.gradient_and_step_matrix(q, g2, H2), J);
+  EXPECT_EQ(o.counters().forward_solves + o.counters().sensitivity_solves + o.counters().costate_solves, 0);
+  EXPECT_TRUE(g2 == g && H2 == H);
+  // On a shorter horizon: solved there, both parts on that horizon.
+  o.set_horizon(0.5 * (o.data_start() + o.data_end()));
+  const double Jh = o.gradient_and_step_matrix(q, g2, H2);
+  coarse.set_horizon(o.horizon());
+  coarse.gauss_newton(q, g_coarse, H_coarse);
+  EXPECT_LT(Jh, J);
+  EXPECT_TRUE(H2 == H_coarse);
+  // No coarsening: gauss_newton itself.
+  ObjectiveOptions same = fine_options;
+  same.step_matrix_coarsening = 1.0;
+  Objective plain(p->model(), *p->params, p->signals, p->data, same);
+  EXPECT_EQ(plain.step_matrix_step(), fine_options.solver.step);
+  EXPECT_EQ(plain.gradient_and_step_matrix(q, g2, H2), plain.gauss_newton(q, g_fine, H_fine));
+  EXPECT_TRUE(H2 == H_fine);
+}
+
 TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {
   // The prior enters the explicit Gauss–Newton matrix as β LᵀL, the matrix-free product as β LᵀL v
   // and the gradient methods' cost and gradient as its value and β LᵀL x: on the same cost (EI on 8

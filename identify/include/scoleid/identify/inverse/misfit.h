@@ -40,6 +40,12 @@ public:
   virtual double cost_and_gradient(const VectorXd& q, VectorXd& gradient) = 0;
   // J, g and the Gauss–Newton matrix H (with `profile`: the misfit profile over the whole record).
   virtual double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr) = 0;
+  // J, g and a Gauss–Newton matrix for the optimiser's step alone (not for uncertainty): by default
+  // gauss_newton's; a misfit may take it on a coarser discretisation than J and g, which moves the
+  // steps but not the minimum they lead to.
+  virtual double gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
+    return gauss_newton(q, gradient, H);
+  }
   virtual MisfitProfile misfit_profile(const VectorXd& q) = 0;
   // H v without forming H, where the misfit offers it.
   virtual VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v) = 0;

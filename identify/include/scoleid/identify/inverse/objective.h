@@ -38,6 +38,7 @@
 // relative mean-square misfit of the data on [t0, t_i] (used to choose the horizon, optimizers.h).
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,11 @@ inline constexpr double kSensitivityBlockBytes = 128.0 * 1024 * 1024;
 // misfit streams it (time/checkpoints.h, docs/theory.md §7.9); esdirk only.
 inline constexpr double kTrajectoryBytes = 32.0 * 1024 * 1024;
 
+// The default coarsening of the step matrix's time step (ObjectiveOptions::step_matrix_coarsening).
+// The matrix only shapes the steps; its tangents' time error grows as (ω h)^p, and four times the
+// step keeps it a few 10⁻³ of the matrix on a 64-section beam (docs/theory.md §7.2).
+inline constexpr double kStepMatrixCoarsening = 4.0;
+
 struct ObjectiveOptions {
   SolverOptions solver;
   double sensitivity_block_bytes = kSensitivityBlockBytes;
@@ -81,6 +87,11 @@ struct ObjectiveOptions {
   // the state on its own thread (docs/theory.md §7.9). 0 = automatic (two when the machine has
   // two hardware threads), 1 = one thread (callers that already run objectives side by side).
   int sweep_threads = 0;
+  // The optimiser's step matrix (gradient_and_step_matrix, docs/theory.md §7.2): tangents on this
+  // many times the solver's step (esdirk, fixed step; never beyond the data's mean sample
+  // interval), J and g on the solver's own. 1 = the same step (gradient_and_step_matrix is then
+  // gauss_newton).
+  double step_matrix_coarsening = kStepMatrixCoarsening;
 };
 
 struct ObjectiveCounters {
@@ -134,6 +145,14 @@ public:
   // evaluation without a profile is kept: asked again at the same q on the same horizon (an
   // optimiser run continuing from where the previous one ended), it is returned without a solve.
   double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr) override;
+  // J and g = ∂J/∂q by the costate on the solver's step, H from P tangents on the coarser step of
+  // options.step_matrix_coarsening (a copy of this objective at that step, on the same horizon):
+  // the matrix shapes the optimiser's steps, J and g fix its minimum (docs/theory.md §7.2). Where
+  // the coarser step is not longer (no fixed esdirk step, or capped at the sample interval), this is
+  // gauss_newton. The last evaluation is kept like gauss_newton's.
+  double gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) override;
+  // The time step of gradient_and_step_matrix's tangents (the solver's where no coarser one applies).
+  double step_matrix_step() const;
   // The misfit profile over the whole data span at q (one forward solve).
   MisfitProfile misfit_profile(const VectorXd& q) override;
   // ∂J/∂q by central differences with relative step h (2P forward solves).
@@ -311,6 +330,8 @@ private:
     MatrixXd H;
   };
   LastGaussNewton last_gn_;
+  LastGaussNewton last_step_;  // gradient_and_step_matrix's, when its matrix is coarser
+  std::unique_ptr<Objective> step_matrix_;  // this objective at step_matrix_step() (made on first use)
   double gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile);
   // Whether output sensitivities are interpolated in output space (no acceleration sensors) and
   // fit the memory budget: the Gauss–Newton sweep then keeps them.
