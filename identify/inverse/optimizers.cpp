@@ -116,7 +116,7 @@ struct Run {
     sum.cost = J;
   }
   void record(int k, double J, const VectorXd& q, const VectorXd& gx) {
-    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : 0.0, obj.horizon()};
+    IterationRecord r{k, J, q, gx.size() ? gx.cwiseAbs().maxCoeff() : NAN, obj.horizon()};  // (NaN: not evaluated)
     sum.iterations.push_back(r);
     if (cb) cb(r);
   }
@@ -255,9 +255,13 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
       VectorXd delta = st.delta;
       if (ok && rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
-      // (a point whose cost alone was taken and whose gradient or matrix cannot be evaluated is
-      // rejected like one whose cost cannot)
-      if (ok && !s.complete(x + delta, trial)) {
+      // A point whose cost alone was taken gets its gradient and matrix now, unless the run ends on
+      // it (a stalled or vanishing step on the whole record: nothing is taken from there; a run
+      // that goes on from it evaluates it then). One whose gradient or matrix cannot be evaluated
+      // is rejected like one whose cost cannot.
+      const bool ends_here = full() && (cur.J - trial.J <= r.gauss_newton_stall() * cur.J ||
+                                        delta.cwiseAbs().maxCoeff() < r.opt.step_tolerance);
+      if (ok && !ends_here && !s.complete(x + delta, trial)) {
         ok = false;
         radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
       }

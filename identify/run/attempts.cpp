@@ -152,26 +152,32 @@ double fit_floor(AttemptsContext& c, const VectorXd& q) {
 
 // The smoothness weight by the discrepancy principle (docs/theory.md §7.8): β from 1 down by
 // factors of 10, each solve from the previous estimate, until the data misfit is within the noise's
-// expected misfit plus the fit test's floor at the first weight's estimate. That β (the largest
-// meeting it) and its estimate are kept; where none can (the misfit levels off above the target),
-// the weight reached when it levels off. The stated noise levels are needed.
+// expected misfit plus the fit test's floor — at the start when its fit already explains the data
+// (`start_explained`: the ladder's last level, whose fit test is taken), else at the first weight's
+// estimate. That β (the largest meeting it) and its estimate are kept; where none can (the misfit
+// levels off above the target), the weight reached when it levels off. The stated noise levels are
+// needed.
 constexpr double kSmallestWeight = 1e-10;  // the path's last weight
-OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorXd& start, OptimizerOptions oo) {
+OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorXd& start, bool start_explained,
+                                  OptimizerOptions oo) {
   const Problem& p = run.c.problem;
   double expected = r.smoothness_expected_misfit = noise_misfit(p, run.c.objective);
   VectorXd q = start;
   OptimizerSummary chosen;
   bool have = false, floor_added = false;
+  auto add_floor = [&](const VectorXd& at) {
+    if (floor_added || !at.allFinite()) return;
+    floor_added = true;
+    r.smoothness_expected_misfit = expected += fit_floor(run.c, at);
+    if (run.c.verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
+  };
+  if (start_explained) add_floor(start);
   double previous_misfit = NAN, previous_drop = NAN;
   for (double beta = 1.0; beta >= kSmallestWeight; beta /= 10.0) {
     oo.smoothness_weight = beta;
     OptimizerSummary s = run.minimize_from(q, oo);
     const double misfit = s.cost - s.prior_cost;
-    if (!floor_added && s.q.allFinite()) {
-      floor_added = true;
-      r.smoothness_expected_misfit = expected += fit_floor(run.c, s.q);
-      if (run.c.verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
-    }
+    add_floor(s.q);
     r.smoothness_path.push_back({beta, misfit, s.prior_cost, s.iterations_done, s.converged()});
     if (run.c.verbose)
       std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
@@ -340,7 +346,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     r.smoothness_weight = smoothness;
   } else {
     run.header();
-    r.summary = discrepancy_path(run, r, start, c.options);
+    r.summary = discrepancy_path(run, r, start, from_ladder && !levels.empty() && levels.back().explained, c.options);
     c.options.smoothness_weight = r.smoothness_weight;  // restarts keep the chosen prior
   }
   using A = AttemptsContext::Alongside;

@@ -99,7 +99,7 @@ struct IterationRecord {
   int k = 0;
   double cost = 0.0;
   VectorXd q;
-  double gradient_norm = 0.0;  // ‖∂J/∂log q‖∞
+  double gradient_norm = 0.0;  // ‖∂J/∂log q‖∞; NaN where not evaluated (a run's last point whose gradient nothing needed)
   double horizon = 0.0;        // end of the data the cost was taken over
 };
 
