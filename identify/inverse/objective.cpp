@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "scoleid/identify/inverse/coefficient_quadrature.h"
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::identify {
 
@@ -1029,27 +1030,46 @@ double Objective::step_matrix_step() const {
   return std::max(so.step, std::min(options_.step_matrix_coarsening * so.step, sample));
 }
 
+bool Objective::has_separate_step_matrix() const { return step_matrix_step() > options_.solver.step; }
+
+void Objective::step_matrix(const VectorXd& q, MatrixXd& H) {
+  VectorXd g;
+  if (!has_separate_step_matrix()) {
+    gauss_newton(q, g, H);
+    return;
+  }
+  if (!step_matrix_) {
+    ObjectiveOptions o = options_;
+    o.solver.step = step_matrix_step();
+    o.step_matrix_coarsening = 1.0;
+    step_matrix_ = std::make_unique<Objective>(model_, params_, inputs_, data_, o);
+  }
+  step_matrix_->set_horizon(T_);
+  step_matrix_->reset_counters();
+  try {
+    step_matrix_->gauss_newton(q, g, H);  // (its last evaluation kept: the same q again costs nothing)
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    // The longer step fails where the model's may not (an extreme trial point): the model's own.
+    counters_.Accumulate(step_matrix_->counters());
+    gauss_newton(q, g, H);
+    return;
+  }
+  step_matrix_->kept_ = {};  // (its output sensitivities serve nothing: the matrix is for steps alone)
+  counters_.Accumulate(step_matrix_->counters());
+}
+
 double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
-  const double hm = step_matrix_step();
-  if (!(hm > options_.solver.step)) return gauss_newton(q, gradient, H);
+  if (!has_separate_step_matrix()) return gauss_newton(q, gradient, H);
   if (last_step_.q.size() == q.size() && last_step_.q == q && last_step_.T == T_) {
     gradient = last_step_.g;
     H = last_step_.H;
     return last_step_.J;
   }
   last_step_ = {};
-  if (!step_matrix_) {
-    ObjectiveOptions o = options_;
-    o.solver.step = hm;
-    o.step_matrix_coarsening = 1.0;
-    step_matrix_ = std::make_unique<Objective>(model_, params_, inputs_, data_, o);
-  }
   const double J = cost_and_gradient(q, gradient);
-  step_matrix_->set_horizon(T_);
-  step_matrix_->reset_counters();
-  VectorXd g_coarse;
-  step_matrix_->gauss_newton(q, g_coarse, H);
-  counters_.Accumulate(step_matrix_->counters());
+  step_matrix(q, H);
   last_step_ = {q, T_, J, gradient, H};
   return J;
 }

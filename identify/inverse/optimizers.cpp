@@ -204,6 +204,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
   auto fail_start = [&]() {
     r.failed("cost cannot be evaluated at the starting point");
+    r.sum.cost = NAN;  // (no cost: not a zero one)
     r.sum.q = x.array().exp();
   };
   obj.set_horizon(t_end);
@@ -259,8 +260,9 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       // it (a stalled or vanishing step on the whole record: nothing is taken from there; a run
       // that goes on from it evaluates it then). One whose gradient or matrix cannot be evaluated
       // is rejected like one whose cost cannot.
-      const bool ends_here = full() && (cur.J - trial.J <= r.gauss_newton_stall() * cur.J ||
-                                        delta.cwiseAbs().maxCoeff() < r.opt.step_tolerance);
+      const double step = delta.cwiseAbs().maxCoeff();
+      const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
+      const bool ends_here = full() && (stalled || step < r.opt.step_tolerance);  // (the test below)
       if (ok && !ends_here && !s.complete(x + delta, trial)) {
         ok = false;
         radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
@@ -277,8 +279,6 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
         }
         continue;
       }
-      const double step = delta.cwiseAbs().maxCoeff();
-      const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
       x += delta;
       cur = std::move(trial);
       ++k;
@@ -310,19 +310,28 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
 //
 // With many parameters (more than kMatrixOnAcceptance) the matrix's P tangents cost many state
 // solves (at 64 sections about 20), so a trial point on the whole record gets its cost alone (one
-// state solve) and the gradient and matrix only once it is accepted: a rejected trial, and the
-// trials of an extrapolation, then cost a state solve each. (With few parameters the tangents
-// ride along with the state solve almost for free, and an accepted point would pay for a second
-// state solve.)
+// state solve; with a step matrix of its own, §7.2, its cost and gradient: a state and a costate
+// solve) and the matrix only once it is accepted: a rejected trial, and the trials of an
+// extrapolation, then cost a state solve or two each. (With few parameters the tangents ride along
+// with the state solve almost for free, and an accepted point would pay for a second state solve.)
 constexpr Eigen::Index kMatrixOnAcceptance = 16;
 class ExplicitStep final : public StepStrategy {
 public:
   ExplicitStep(Run& r, Eigen::Index P)
-      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)), lazy_(P > kMatrixOnAcceptance) {}
+      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)), lazy_(P > kMatrixOnAcceptance),
+        separate_(lazy_ && r.obj.has_separate_step_matrix()) {}
   bool evaluate_trial(const VectorXd& xx, Point& p, bool with_profile) override {
     if (!lazy_ || with_profile) return evaluate(xx, p, with_profile);
     try {
-      p.J = r_.obj.cost(xx.array().exp()) + prior_.value(xx);
+      const VectorXd q = xx.array().exp();
+      p.H.resize(0, 0);  // completed on acceptance
+      if (separate_) {
+        VectorXd g;
+        p.J = r_.obj.cost_and_gradient(q, g) + prior_.value(xx);
+        p.g = q.cwiseProduct(g) + prior_.apply(xx);
+        return std::isfinite(p.J) && p.g.allFinite();
+      }
+      p.J = r_.obj.cost(q) + prior_.value(xx);
       p.g.resize(0);  // completed on acceptance
       return std::isfinite(p.J);
     } catch (const io::Interrupted&) {
@@ -332,7 +341,19 @@ public:
     }
   }
   bool complete(const VectorXd& xx, Point& p) override {
-    return p.g.size() == xx.size() || evaluate(xx, p, false);
+    if (p.g.size() != xx.size()) return evaluate(xx, p, false);
+    if (p.H.rows() == xx.size()) return true;
+    try {
+      const VectorXd q = xx.array().exp();
+      MatrixXd H;
+      r_.obj.step_matrix(q, H);
+      p.H = q.asDiagonal() * H * q.asDiagonal() + prior_matrix_;
+      return p.H.allFinite();
+    } catch (const io::Interrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      return false;
+    }
   }
   bool evaluate(const VectorXd& xx, Point& p, bool with_profile) override {
     try {
@@ -397,6 +418,7 @@ private:
   const MatrixXd prior_matrix_;
   Misfit::MisfitProfile prof_;
   const bool lazy_;
+  const bool separate_;  // lazy, and the step matrix an evaluation of its own (misfit.h)
 };
 
 // The gradient methods' search direction in x = log q: the paper's fixed-weight update, steepest
@@ -474,6 +496,7 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   }
   if (!start_ok || !r.eval_grad(x, J, gx)) {
     r.failed("cost cannot be evaluated at the starting point");
+    r.sum.cost = NAN;  // (no cost: not a zero one)
     r.sum.q = x.array().exp();
     obj.set_horizon(t_end);
     return;

@@ -186,6 +186,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     chosen = s;
     r.smoothness_weight = beta;
     have = true;
+    if (!std::isfinite(misfit)) break;  // a run that failed (no cost): nothing to judge, not met
     if (misfit <= expected) {
       r.smoothness_met = true;
       break;

@@ -273,35 +273,45 @@ TEST(GaussNewton, TheStepMatrixIsTheCoarserStepsWithTheModelsCostAndGradient) {
 }
 
 // A run with many parameters that ends on an accepted step (here a coarse stall threshold: a step
-// gaining less than 1e-3 of J ends it) takes no gradient and matrix at that last point: its
-// record's gradient norm is NaN and the matrices counted are the start's and every earlier
-// accepted point's. A run going on from there evaluates the point itself, bit for bit what it
-// would have been.
+// gaining less than 1e-3 of J ends it) takes no matrix at that last point: the matrices counted are
+// the start's and every earlier accepted point's. Its gradient came with the trial where the step
+// matrix is an evaluation of its own (objective.h: the trial's cost and gradient by the costate);
+// where it is not, the trial took the cost alone and the record's gradient norm is NaN. A run going
+// on from there evaluates the point itself, the same numbers as a fresh objective's.
 TEST(GaussNewton, ARunEndingOnAStepTakesNoMatrixThere) {
   const auto sc = sections_scenario("0", 24, 4, 0.01);
   const auto p = make_problem(sc, std::nullopt);
-  Objective o(p->model(), *p->params, p->signals, p->data, p->objective_options);
-  OptimizerOptions oo;
-  oo.method = scoleid::io::Method::GaussNewton;
-  oo.continuation = false;
-  oo.cost_stall = 1e-3;
-  const OptimizerSummary s = minimize(o, p->params->initial() * 1.1, oo);
-  ASSERT_EQ(s.termination, OptimizerSummary::Termination::CostStalled) << s.BriefReport();
-  ASSERT_GE(s.iterations_done, 1);
-  EXPECT_TRUE(std::isnan(s.iterations.back().gradient_norm));
-  for (std::size_t i = 0; i + 1 < s.iterations.size(); ++i) EXPECT_TRUE(std::isfinite(s.iterations[i].gradient_norm));
-  EXPECT_EQ(o.counters().sensitivity_solves, 24L * s.iterations_done);
-  // Going on from the last point: evaluated there, the same numbers as a fresh objective's.
-  OptimizerOptions more = oo;
-  more.max_iterations = 0;
-  o.reset_counters();
-  const OptimizerSummary t = minimize(o, s.q, more);
-  EXPECT_EQ(o.counters().sensitivity_solves, 24L);
-  Objective fresh(p->model(), *p->params, p->signals, p->data, p->objective_options);
-  VectorXd g;
-  MatrixXd H;
-  fresh.gradient_and_step_matrix(s.q, g, H);
-  EXPECT_EQ(t.iterations.front().gradient_norm, s.q.cwiseProduct(g).cwiseAbs().maxCoeff());
+  for (const double coarsening : {kStepMatrixCoarsening, 1.0}) {
+    ObjectiveOptions oo_obj = p->objective_options;
+    oo_obj.step_matrix_coarsening = coarsening;
+    Objective o(p->model(), *p->params, p->signals, p->data, oo_obj);
+    ASSERT_EQ(o.has_separate_step_matrix(), coarsening > 1.0);
+    OptimizerOptions oo;
+    oo.method = scoleid::io::Method::GaussNewton;
+    oo.continuation = false;
+    oo.cost_stall = 1e-3;
+    const OptimizerSummary s = minimize(o, p->params->initial() * 1.1, oo);
+    std::printf("coarsening %g: %s; %ld tangent columns\n", coarsening, s.BriefReport().c_str(), o.counters().sensitivity_solves);
+    ASSERT_EQ(s.termination, OptimizerSummary::Termination::CostStalled) << s.BriefReport();
+    ASSERT_GE(s.iterations_done, 1);
+    EXPECT_EQ(std::isnan(s.iterations.back().gradient_norm), !o.has_separate_step_matrix());
+    for (std::size_t i = 0; i + 1 < s.iterations.size(); ++i) EXPECT_TRUE(std::isfinite(s.iterations[i].gradient_norm));
+    EXPECT_EQ(o.counters().sensitivity_solves, 24L * s.iterations_done);
+    // Going on from the last point: evaluated there, the same numbers as a fresh objective's.
+    OptimizerOptions more = oo;
+    more.max_iterations = 0;
+    o.reset_counters();
+    const OptimizerSummary t = minimize(o, s.q, more);
+    EXPECT_EQ(o.counters().sensitivity_solves, 24L);
+    Objective fresh(p->model(), *p->params, p->signals, p->data, oo_obj);
+    VectorXd g;
+    MatrixXd H;
+    fresh.gradient_and_step_matrix(s.q, g, H);
+    EXPECT_EQ(t.iterations.front().gradient_norm, s.q.cwiseProduct(g).cwiseAbs().maxCoeff());
+    if (o.has_separate_step_matrix()) {
+      EXPECT_EQ(s.iterations.back().gradient_norm, t.iterations.front().gradient_norm);  // the trial's: the same costate
+    }
+  }
 }
 
 TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {

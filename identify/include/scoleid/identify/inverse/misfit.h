@@ -46,6 +46,13 @@ public:
   virtual double gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
     return gauss_newton(q, gradient, H);
   }
+  // Whether that matrix is an evaluation of its own (then cost_and_gradient gives J and g, and
+  // step_matrix the matrix, at the cost of the two apart), and the matrix alone.
+  virtual bool has_separate_step_matrix() const { return false; }
+  virtual void step_matrix(const VectorXd& q, MatrixXd& H) {
+    VectorXd g;
+    gauss_newton(q, g, H);
+  }
   virtual MisfitProfile misfit_profile(const VectorXd& q) = 0;
   // H v without forming H, where the misfit offers it.
   virtual VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v) = 0;

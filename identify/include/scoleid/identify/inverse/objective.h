@@ -153,6 +153,10 @@ public:
   double gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) override;
   // The time step of gradient_and_step_matrix's tangents (the solver's where no coarser one applies).
   double step_matrix_step() const;
+  // step_matrix_step() is longer than the solver's: the matrix is its own evaluation.
+  bool has_separate_step_matrix() const override;
+  // gradient_and_step_matrix's H alone (gauss_newton's where it is not separate).
+  void step_matrix(const VectorXd& q, MatrixXd& H) override;
   // The misfit profile over the whole data span at q (one forward solve).
   MisfitProfile misfit_profile(const VectorXd& q) override;
   // ∂J/∂q by central differences with relative step h (2P forward solves).
