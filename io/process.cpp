@@ -4,9 +4,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <stdexcept>
+#include <thread>
 
 #include "scoleid/io/interrupt.h"
 
@@ -81,36 +83,42 @@ void end_children(std::vector<Child>& children) {
 
 }  // namespace
 
-std::vector<ProcessResult> run_programs(const std::vector<std::vector<std::string>>& argvs, const std::string& cwd) {
-  std::vector<Child> children;
+std::vector<ProcessResult> run_programs(const std::vector<std::vector<std::string>>& argvs, const std::string& cwd,
+                                        std::size_t max_running) {
+  const std::size_t cap = max_running > 0 ? max_running : std::max(1u, std::thread::hardware_concurrency());
   std::vector<ProcessResult> results(argvs.size());
-  try {
-    for (const auto& argv : argvs) children.push_back(start_child(argv, cwd));
-    for (std::size_t i = 0; i < children.size(); ++i) {
-      Child& c = children[i];
-      results[i].started = c.started;
-      int status = 0;
-      for (;;) {
-        const pid_t w = ::waitpid(c.pid, &status, 0);
-        if (w == c.pid) break;
-        if (w < 0 && errno == EINTR) {
-          if (interrupt_signal() != 0) {
-            end_children(children);
-            check_interrupt();
+  for (std::size_t first = 0; first < argvs.size(); first += cap) {
+    const std::size_t end = std::min(argvs.size(), first + cap);
+    std::vector<Child> children;
+    try {
+      for (std::size_t i = first; i < end; ++i) children.push_back(start_child(argvs[i], cwd));
+      for (std::size_t i = 0; i < children.size(); ++i) {
+        Child& c = children[i];
+        ProcessResult& res = results[first + i];
+        res.started = c.started;
+        int status = 0;
+        for (;;) {
+          const pid_t w = ::waitpid(c.pid, &status, 0);
+          if (w == c.pid) break;
+          if (w < 0 && errno == EINTR) {
+            if (interrupt_signal() != 0) {
+              end_children(children);
+              check_interrupt();
+            }
+            continue;
           }
-          continue;
+          throw std::runtime_error("run_program: waitpid failed");
         }
-        throw std::runtime_error("run_program: waitpid failed");
+        c.pid = -1;
+        if (WIFEXITED(status)) res.exit_code = WEXITSTATUS(status);
+        if (WIFSIGNALED(status)) res.signal = WTERMSIG(status);
       }
-      c.pid = -1;
-      if (WIFEXITED(status)) results[i].exit_code = WEXITSTATUS(status);
-      if (WIFSIGNALED(status)) results[i].signal = WTERMSIG(status);
+    } catch (...) {
+      end_children(children);
+      throw;
     }
-  } catch (...) {
-    end_children(children);
-    throw;
+    check_interrupt();
   }
-  check_interrupt();
   return results;
 }
 
