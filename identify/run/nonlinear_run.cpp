@@ -74,7 +74,10 @@ struct NonlinearRun {
   void progress(const IterationRecord& rec) const {
     io::check_interrupt();
     if (!verbose) return;
-    std::printf("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
+    if (std::isfinite(rec.gradient_norm))
+      std::printf("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
+    else  // (a run's last point, whose gradient nothing needed: optimizers.h)
+      std::printf("%4d  J = %.6e  |g| not taken  horizon %.4g", rec.k, rec.cost, rec.horizon);
     for (std::size_t i = 0; i < r.names.size(); ++i) std::printf("  %s = %.7g", r.names[i].c_str(), rec.q[static_cast<Eigen::Index>(i)]);
     std::printf("\n");
     std::fflush(stdout);
