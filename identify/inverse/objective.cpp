@@ -1011,11 +1011,7 @@ std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solve
 }
 
 double Objective::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
-  if (!profile && last_gn_.q.size() == q.size() && last_gn_.q == q && last_gn_.T == T_) {
-    gradient = last_gn_.g;
-    H = last_gn_.H;
-    return last_gn_.J;
-  }
+  if (double J = 0.0; !profile && last_gn_.recall(q, T_, J, gradient, H)) return J;
   last_gn_ = {};
   const double J = gauss_newton_solve(q, gradient, H, profile);
   if (!profile) last_gn_ = {q, T_, J, gradient, H};
@@ -1062,11 +1058,7 @@ void Objective::step_matrix(const VectorXd& q, MatrixXd& H) {
 
 double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient, MatrixXd& H) {
   if (!has_separate_step_matrix()) return gauss_newton(q, gradient, H);
-  if (last_step_.q.size() == q.size() && last_step_.q == q && last_step_.T == T_) {
-    gradient = last_step_.g;
-    H = last_step_.H;
-    return last_step_.J;
-  }
+  if (double J = 0.0; last_step_.recall(q, T_, J, gradient, H)) return J;
   last_step_ = {};
   const double J = cost_and_gradient(q, gradient);
   step_matrix(q, H);

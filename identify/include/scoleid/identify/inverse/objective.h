@@ -332,6 +332,14 @@ private:
     double J = 0.0;
     VectorXd g;
     MatrixXd H;
+    // Kept for this q and horizon: g and H copied out, J returned.
+    bool recall(const VectorXd& at, double horizon, double& J_out, VectorXd& g_out, MatrixXd& H_out) const {
+      if (q.size() != at.size() || q != at || T != horizon) return false;
+      J_out = J;
+      g_out = g;
+      H_out = H;
+      return true;
+    }
   };
   LastGaussNewton last_gn_;
   LastGaussNewton last_step_;  // gradient_and_step_matrix's, when its matrix is coarser
