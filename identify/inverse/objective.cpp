@@ -59,19 +59,48 @@ void sample_output_rows(const std::vector<double>& times, std::size_t& next, boo
   }
 }
 
-// One Gauss point of weight wt in the Gauss–Newton sums (§7.1): with residual r, output
-// sensitivities CS (sensors × P) and the sensors' weights R,
+// The Gauss–Newton sums (§7.1) over Gauss points of weight wt, with residual r, output
+// sensitivities CS (sensors × P) and the sensors' weights R (>= 0):
 //   J += ½ wt rᵀ R r,   g += wt (CS)ᵀ R r,   H += wt (CS)ᵀ R (CS).
-void add_gauss_newton_point(double wt, const Eigen::VectorXd& r, const Eigen::Ref<const Eigen::MatrixXd>& CS,
-                            const Eigen::Ref<const Eigen::VectorXd>& R, double& J, Eigen::VectorXd& gradient,
-                            Eigen::MatrixXd& H) {
-  const Eigen::MatrixXd RCS = R.asDiagonal() * CS;
-  double e = 0.0;
-  for (Eigen::Index j = 0; j < r.size(); ++j) e += R[j] * r[j] * r[j];
-  J += 0.5 * wt * e;
-  gradient += wt * RCS.transpose() * r;
-  H += wt * CS.transpose() * RCS;
-}
+// J and g point by point; for H the points' scaled rows √(wt R) CS are gathered (transposed,
+// P × rows) and taken in one symmetric rank update per kGaussNewtonBlock points (half of H's
+// products, in blocks the matrix kernel runs at speed); `finish` flushes the last block and fills
+// H's upper triangle.
+class GaussNewtonSums {
+public:
+  static constexpr int kGaussNewtonBlock = 32;
+  GaussNewtonSums(Eigen::Index P, const Eigen::Ref<const Eigen::VectorXd>& R, double& J, Eigen::VectorXd& gradient,
+                  Eigen::MatrixXd& H)
+      : R_(R), J_(J), g_(gradient), H_(H), rows_(P, kGaussNewtonBlock * R.size()) {}
+  void add(double wt, const Eigen::VectorXd& r, const Eigen::Ref<const Eigen::MatrixXd>& CS) {
+    const Eigen::Index ns = r.size();
+    double e = 0.0;
+    for (Eigen::Index j = 0; j < ns; ++j) e += R_[j] * r[j] * r[j];
+    J_ += 0.5 * wt * e;
+    RCS_ = R_.asDiagonal() * CS;
+    g_ += wt * RCS_.transpose() * r;
+    if (used_ + ns > rows_.cols()) flush();
+    for (Eigen::Index j = 0; j < ns; ++j) rows_.col(used_ + j) = std::sqrt(wt * R_[j]) * CS.row(j).transpose();
+    used_ += ns;
+  }
+  void finish() {
+    flush();
+    H_.triangularView<Eigen::StrictlyUpper>() = H_.transpose();
+  }
+
+private:
+  void flush() {
+    if (used_ == 0) return;
+    H_.selfadjointView<Eigen::Lower>().rankUpdate(rows_.leftCols(used_));
+    used_ = 0;
+  }
+  const Eigen::Ref<const Eigen::VectorXd> R_;
+  double& J_;
+  Eigen::VectorXd& g_;
+  Eigen::MatrixXd& H_;
+  Eigen::MatrixXd rows_, RCS_;
+  Eigen::Index used_ = 0;
+};
 
 // 3-point Gauss–Legendre on [0, 1]
 constexpr double kGx[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
@@ -810,6 +839,7 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   const double J = L > 0 ? gradient_checkpointed(s, solver, L, gc) : gradient_stored(s, solver, gc);
   gradient = s.dcdq.transpose() * gc;
   ++counters_.gradient_evaluations;
+  last_gradient_ = {q, T_, J, gradient, MatrixXd()};
   return J;
 }
 
@@ -1060,7 +1090,9 @@ double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient
   if (!has_separate_step_matrix()) return gauss_newton(q, gradient, H);
   if (double J = 0.0; last_step_.recall(q, T_, J, gradient, H)) return J;
   last_step_ = {};
-  const double J = cost_and_gradient(q, gradient);
+  MatrixXd none;
+  double J = 0.0;
+  if (!last_gradient_.recall(q, T_, J, gradient, none)) J = cost_and_gradient(q, gradient);
   step_matrix(q, H);
   last_step_ = {q, T_, J, gradient, H};
   return J;
@@ -1120,14 +1152,16 @@ double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, Matr
   H = MatrixXd::Zero(P, P);
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   double J = 0.0;
+  GaussNewtonSums sums(P, Rv, J, gradient, H);
   Eigen::Index row = 0;
   for_each_gauss_point(grid, [&](double t, double wt) {
     u.eval(t, x.data(), v.data());
     data_.eval(t, z.data());
     const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-    add_gauss_newton_point(wt, r, CSall.middleRows(row, ns), Rv, J, gradient, H);
+    sums.add(wt, r, CSall.middleRows(row, ns));
     row += ns;
   });
+  sums.finish();
   if (profile) *profile = misfit_profile(s, solver, u);
   counters_.quadrature_seconds += since(tq);
   return J;
@@ -1281,6 +1315,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
   double J = 0.0, quadrature = 0.0;
+  GaussNewtonSums gn(P, Rv, J, gradient, H);
   // The misfit profile (over the whole record) from the state's column in windows.
   std::unique_ptr<ProfileSums> sums;
   std::unique_ptr<WindowedSink> profile_sink;
@@ -1320,7 +1355,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
           Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
           data_.eval(t, z.data());
           const VectorXd r = Ys.col(0) - z;
-          add_gauss_newton_point(wt, r, Ys.rightCols(P), Rv, J, gradient, H);
+          gn.add(wt, r, Ys.rightCols(P));
         });
         quadrature += since(tq);
       }
@@ -1361,7 +1396,7 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
             svi = Vs.col(1 + i);
             CS.col(i) = tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, svi);
           }
-          add_gauss_newton_point(wt, r, CS, Rv, J, gradient, H);
+          gn.add(wt, r, CS);
         });
         quadrature += since(tq);
       }
@@ -1379,6 +1414,9 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
     };
     solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum);
   }
+  const auto tf = Clock::now();
+  gn.finish();
+  quadrature += since(tf);
   if (profile) {
     profile_sink->finish();  // (its windows' time is in `quadrature`)
     *profile = std::move(sums->prof);

@@ -26,6 +26,7 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   if (!(continuation_misfit > 0)) return bad("continuation_misfit must be > 0");
   if (!(short_horizon_floor >= 0)) return bad("short_horizon_floor must be >= 0");
   if (!(cost_stall >= 0)) return bad("cost_stall must be >= 0");
+  if (!(matrix_reuse >= 0)) return bad("matrix_reuse must be >= 0");
   if (!(continuation_min_fraction > 0 && continuation_min_fraction <= 1)) return bad("continuation_min_fraction must be in (0, 1]");
   return true;
 }
@@ -173,6 +174,7 @@ struct Point {
   double Jd = 0.0;  // the data's share (what the matrix-free strategy tracks)
   VectorXd g;       // ∂J/∂x
   MatrixXd H;       // the Gauss–Newton matrix in x (explicit strategy only)
+  bool matrix_kept = false;  // H is another point's (OptimizerOptions::matrix_reuse, start_matrix)
 };
 
 class StepStrategy {
@@ -186,6 +188,9 @@ public:
   virtual bool evaluate_trial(const VectorXd& x, Point& p, bool with_profile) { return evaluate(x, p, with_profile); }
   virtual bool complete(const VectorXd&, Point&) { return true; }
   virtual void start(const Point&) {}
+  // The data's matrix that holds at the run's last point p (OptimizerSummary::end_matrix): its own,
+  // else `held` (the matrix of the point before, when the step from it held); empty by default.
+  virtual MatrixXd end_matrix(const Point&, const MatrixXd& /*held*/) const { return {}; }
   // The step from (x, p) inside `radius`; `lambda_floor` the Levenberg floor on a short horizon.
   virtual TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double lambda_floor) = 0;
   // After an accepted step whose decrease beat the prediction by `rho`: a longer step along it.
@@ -223,6 +228,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   s.start(cur);
   double radius = r.opt.trust_radius;
   int k = 0;
+  MatrixXd held;  // the point before's matrix, when the step from it held (matrix_reuse)
   r.sum.termination = T::MaxIterations;
   // On a short horizon a termination test lengthens the horizon instead; true if it did.
   auto extend = [&](double T_new) {
@@ -245,6 +251,12 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       // deviation (δᵀFδ ≈ N ΔJ / J with F ≈ H N / 2J), so below a thousandth of it the step left
       // is within 0.03 std of the minimum: end the run without paying for the trial's solve.
       if (full() && !st.on_boundary && st.predicted <= 1e-3 * r.gauss_newton_stall() * cur.J) {
+        if (cur.matrix_kept) {  // (a kept matrix's prediction: the point's own decides)
+          cur.H.resize(0, 0);
+          cur.matrix_kept = false;
+          if (!s.complete(x, cur)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at the current point");
+          continue;
+        }
         r.sum.termination = T::CostStalled;
         r.sum.message = "the Gauss-Newton step left predicts a decrease below 1e-3 of the stall threshold: at the minimum";
         break;
@@ -253,6 +265,15 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       const bool profile = continuation && !full();
       bool ok = s.evaluate_trial(x + st.delta, trial, profile) && trial.J < cur.J;
       const double rho = ok && st.predicted > 0 ? (cur.J - trial.J) / st.predicted : -1.0;
+      // A kept matrix that fails — a step it shaped is rejected, or gains less than the stall
+      // threshold — is replaced by the point's own before anything is concluded from it: the
+      // trial is dropped and the step taken again.
+      if (cur.matrix_kept && (!ok || cur.J - trial.J <= r.gauss_newton_stall() * cur.J)) {
+        cur.H.resize(0, 0);
+        cur.matrix_kept = false;
+        if (!s.complete(x, cur)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at the current point");
+        continue;
+      }
       radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
       VectorXd delta = st.delta;
       if (ok && rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
@@ -263,6 +284,9 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       const double step = delta.cwiseAbs().maxCoeff();
       const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
       const bool ends_here = full() && (stalled || step < r.opt.step_tolerance);  // (the test below)
+      // The step decreased the cost as the model predicted (OptimizerOptions::matrix_reuse): where
+      // the run ends on it, the matrix it was taken with still holds there (end_matrix).
+      const bool model_held = ok && r.opt.matrix_reuse > 0 && std::abs(rho - 1.0) <= r.opt.matrix_reuse && delta == st.delta;
       if (ok && !ends_here && !s.complete(x + delta, trial)) {
         ok = false;
         radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
@@ -280,6 +304,10 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
         continue;
       }
       x += delta;
+      if (model_held)
+        held = std::move(cur.H);
+      else
+        held.resize(0, 0);
       cur = std::move(trial);
       ++k;
       // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
@@ -300,6 +328,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   }
   r.conclude(k, x, cur.J);
   r.sum.prior_cost = s.prior_cost(x, cur);
+  if (full()) r.sum.end_matrix = s.end_matrix(cur, held);
   obj.set_horizon(t_end);
 }
 
@@ -318,8 +347,9 @@ constexpr Eigen::Index kMatrixOnAcceptance = 16;
 class ExplicitStep final : public StepStrategy {
 public:
   ExplicitStep(Run& r, Eigen::Index P)
-      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)), lazy_(P > kMatrixOnAcceptance),
-        separate_(lazy_ && r.obj.has_separate_step_matrix()) {}
+      : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)),
+        start_matrix_(r.opt.start_matrix.rows() == P && r.opt.start_matrix.cols() == P ? r.opt.start_matrix : MatrixXd()),
+        lazy_(P > kMatrixOnAcceptance), separate_(lazy_ && r.obj.has_separate_step_matrix()) {}
   bool evaluate_trial(const VectorXd& xx, Point& p, bool with_profile) override {
     if (!lazy_ || with_profile) return evaluate(xx, p, with_profile);
     try {
@@ -361,6 +391,17 @@ public:
       VectorXd g;
       MatrixXd H;
       // (lazy: J and g on the model's step, the matrix perhaps on a coarser one; misfit.h)
+      // (a continuing run's first point: the previous run's matrix, OptimizerOptions::start_matrix)
+      if (start_matrix_.rows() == xx.size() && separate_ && !with_profile) {
+        p.J = r_.obj.cost_and_gradient(q, g) + prior_.value(xx);
+        p.g = q.cwiseProduct(g) + prior_.apply(xx);
+        p.H = start_matrix_ + prior_matrix_;
+        p.matrix_kept = true;
+        start_matrix_.resize(0, 0);
+        return std::isfinite(p.J) && p.g.allFinite() && p.H.allFinite();
+      }
+      start_matrix_.resize(0, 0);
+      p.matrix_kept = false;
       p.J = (lazy_ && !with_profile ? r_.obj.gradient_and_step_matrix(q, g, H)
                                     : r_.obj.gauss_newton(q, g, H, with_profile ? &prof_ : nullptr)) +
             prior_.value(xx);
@@ -411,11 +452,17 @@ public:
     return "no decrease along the damped Gauss-Newton direction: at the minimum to integration accuracy";
   }
   double prior_cost(const VectorXd& x, const Point&) const override { return prior_.value(x); }
+  MatrixXd end_matrix(const Point& p, const MatrixXd& held) const override {
+    const MatrixXd& H = p.H.rows() == prior_matrix_.rows() ? p.H : held;
+    if (!lazy_ || H.rows() != prior_matrix_.rows()) return {};
+    return H - prior_matrix_;
+  }
 
 private:
   Run& r_;
   const Smoothness& prior_;
   const MatrixXd prior_matrix_;
+  MatrixXd start_matrix_;  // OptimizerOptions::start_matrix until the first evaluation
   Misfit::MisfitProfile prof_;
   const bool lazy_;
   const bool separate_;  // lazy, and the step matrix an evaluation of its own (misfit.h)
@@ -664,6 +711,24 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
 }
 
 }  // namespace
+
+void evaluate_start(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options) {
+  if (options.method != io::Method::GaussNewton || !q0.allFinite() || !(q0.array() > 0).all()) return;
+  const VectorXd q = q0.array().log().exp();  // (the run's q: it works in log q)
+  objective.set_horizon(objective.data_end());
+  VectorXd g;
+  MatrixXd H;
+  try {
+    if (q.size() > kMatrixOnAcceptance)
+      objective.gradient_and_step_matrix(q, g, H);
+    else
+      objective.gauss_newton(q, g, H);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    // (the run meets it)
+  }
+}
 
 OptimizerSummary minimize(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options,
                           const std::function<void(const IterationRecord&)>& on_iteration) {

@@ -3,6 +3,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <optional>
 
 #include "scoleid/identify/inverse/spectral_start.h"
 #include "scoleid/identify/inverse/tied_parameterization.h"
@@ -16,13 +18,14 @@ namespace {
 bool same_point(const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && (a.array() == b.array()).all(); }
 }  // namespace
 
-FitTest AttemptsContext::fit_at(const VectorXd& q, Alongside alongside) {
+FitTest AttemptsContext::fit_at(const VectorXd& q, Alongside alongside, const std::function<void()>& also) {
   if (!same_point(fit_q, q)) {
     std::function<void()> meanwhile;
-    if (alongside != Alongside::Nothing)
-      meanwhile = [this, &q, alongside] {
-        attempt_cost(q);
+    if (alongside != Alongside::Nothing || also)
+      meanwhile = [this, &q, alongside, &also] {
+        if (alongside != Alongside::Nothing) attempt_cost(q);
         if (alongside == Alongside::CostAndRefits && alongside_fit) alongside_fit(q);
+        if (also) also();
       };
     fit = test_fit(problem, objective, q, nullptr, meanwhile);
     fit_q = q;
@@ -45,10 +48,12 @@ double AttemptsContext::attempt_cost(const VectorXd& q) {
   return cost;
 }
 
-FitTest AttemptsContext::fit_screen(const VectorXd& q) {
-  if (fit.discretisation.size() == 0 || same_point(fit_q, q)) return fit_at(q);
+FitTest AttemptsContext::fit_screen(const VectorXd& q, const std::function<void()>& if_not,
+                                    const std::function<void()>& if_explained) {
+  if (same_point(fit_q, q)) return fit;
+  if (fit.discretisation.size() == 0) return fit_at(q, Alongside::Nothing, if_not);
   const FitTest screened = test_fit(problem, objective, q, &fit.discretisation);
-  return screened.within_noise_and_discretisation ? fit_at(q) : screened;
+  return screened.within_noise_and_discretisation ? fit_at(q, Alongside::Nothing, if_explained) : screened;
 }
 
 namespace {
@@ -183,6 +188,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
       std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
                   to_string(s.termination));
     if (s.q.allFinite()) q = s.q;
+    oo.start_matrix = std::move(s.end_matrix);  // the next weight's run starts where this one ended
     chosen = s;
     r.smoothness_weight = beta;
     have = true;
@@ -200,7 +206,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     const double drop = previous_misfit - misfit;
     if (std::isfinite(previous_drop) && drop < previous_drop &&
         misfit - drop * std::log10(beta / kSmallestWeight) > expected &&
-        run.c.fit_at(q).within_noise_and_discretisation) {
+        run.c.fit_at(q, AttemptsContext::Alongside::Cost).within_noise_and_discretisation) {  // (the attempt's cost, if it ends here)
       if (run.c.verbose)
         std::printf("the data misfit levels off above the noise's: the discrepancy cannot be met, weight %.0e kept\n",
                     beta);
@@ -226,39 +232,67 @@ struct Ladder {
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
 };
-Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& families, const VectorXd& start) {
+// One level of the ladder solved from `from` (the full parameterization's q): its summary, the
+// expanded estimate, its step.
+struct LevelSolve {
+  int blocks = 0;
+  OptimizerSummary summary;
+  VectorXd q;
+  double step = 0.0;
+};
+LevelSolve solve_level(AttemptsContext& c, const std::vector<std::vector<int>>& families, int B, const VectorXd& from) {
   const Problem& p = c.problem;
+  auto [group, gnames] = block_grouping(p.params->names(), families, B);
+  TiedParameterization tied(*p.params, from, group, gnames);
+  ObjectiveOptions lo = p.objective_options;
+  // (BDF chooses its own steps: the level keeps the full run's options.)
+  if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
+      lo.solver.integrator != SolverOptions::Integrator::Bdf)
+    if (const IdentifierStep is = identifier_integration(p.scenario, p.model(), tied, p.signals); is.step > lo.solver.step) {
+      lo.solver.step = is.step;
+      lo.solver.dirk_table = is.dirk_table;
+    }
+  Objective level(p.model(), tied, p.signals, p.data, lo);
+  OptimizerOptions ol = c.options;
+  ol.method = resolve_method(io::Method::Auto, tied.size(), true, level.has_matrix_free_products());
+  ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
+  ol.smoothness_chains.clear();
+  ol.continuation = p.scenario.identification.continuation_misfit > 0;
+  LevelSolve out;
+  out.blocks = B;
+  out.step = lo.solver.step;
+  out.summary = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
+  c.extra.Accumulate(level.counters());
+  out.q = out.summary.q.allFinite() ? tied.expand(out.summary.q) : from;
+  return out;
+}
+
+// The ladder's levels in turn. While a level's fit test solves the doubled mesh, this thread goes on
+// with what likely follows (fit_screen): the next level after the first (whose test has no screen),
+// the attempt's first point (`first_point`) after a level the screen passed; work that turns out
+// not to follow is dropped (its solves stay in the counters).
+Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& families, const VectorXd& start,
+                      const std::function<void(const VectorXd&)>& first_point) {
   std::size_t N = 0;
   for (const auto& f : families) N = std::max(N, f.size());
   Ladder out;
   out.q = start;
   out.label = "coarse-to-fine over";
+  std::optional<LevelSolve> next;
   for (int B = 1; B < static_cast<int>(N); B *= 2) {
-    auto [group, gnames] = block_grouping(p.params->names(), families, B);
-    TiedParameterization tied(*p.params, out.q, group, gnames);
-    ObjectiveOptions lo = p.objective_options;
-    // (BDF chooses its own steps: the level keeps the full run's options.)
-    if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
-        lo.solver.integrator != SolverOptions::Integrator::Bdf)
-      if (const IdentifierStep is = identifier_integration(p.scenario, p.model(), tied, p.signals); is.step > lo.solver.step) {
-        lo.solver.step = is.step;
-        lo.solver.dirk_table = is.dirk_table;
-      }
-    Objective level(p.model(), tied, p.signals, p.data, lo);
-    OptimizerOptions ol = c.options;
-    ol.method = resolve_method(io::Method::Auto, tied.size(), true, level.has_matrix_free_products());
-    ol.smoothness_weight = 0.0;  // the tied levels are smooth by construction
-    ol.smoothness_chains.clear();
-    ol.continuation = p.scenario.identification.continuation_misfit > 0;
-    const OptimizerSummary sl = minimize(level, tied.initial(), ol, [&](const IterationRecord&) { io::check_interrupt(); });
-    c.extra.Accumulate(level.counters());
+    LevelSolve level = next && next->blocks == B ? std::move(*next) : solve_level(c, families, B, out.q);
+    next.reset();
+    const OptimizerSummary& sl = level.summary;
     out.iterations += sl.iterations_done;
-    if (sl.q.allFinite()) out.q = tied.expand(sl.q);
+    out.q = level.q;
     out.label += " " + std::to_string(B);
-    const bool explained = sl.q.allFinite() && c.fit_screen(out.q).within_noise_and_discretisation;
-    out.levels.push_back({B, lo.solver.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
+    std::function<void()> if_not, if_explained;
+    if (2 * B < static_cast<int>(N)) if_not = [&] { next = solve_level(c, families, 2 * B, out.q); };
+    if (first_point) if_explained = [&] { first_point(out.q); };
+    const bool explained = sl.q.allFinite() && c.fit_screen(out.q, if_not, if_explained).within_noise_and_discretisation;
+    out.levels.push_back({B, level.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
     if (c.verbose)
-      std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", lo.solver.step,
+      std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", level.step,
                   sl.BriefReport().c_str(), explained ? "; the fit is within noise and discretisation" : "");
     if (explained) break;
   }
@@ -327,7 +361,11 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   std::vector<RunResult::Attempt::Level> levels;
   if (from_ladder) {
     if (c.verbose) std::printf("%zu sections: coarse to fine from the start\n", longest(families));
-    Ladder lad = coarse_to_fine(c, families, r.initial);
+    // With a prior the attempt goes on from an explained level on the full parameterization.
+    std::function<void(const VectorXd&)> first_point;
+    if (c.problem.scenario.identification.smoothness != 0.0)
+      first_point = [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); };
+    Ladder lad = coarse_to_fine(c, families, r.initial, first_point);
     start = lad.q;
     label = lad.label;
     iterations = lad.iterations;
@@ -403,7 +441,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
   if (how == "coarse-to-fine") {
-    Ladder lad = coarse_to_fine(c, families, r.initial);
+    Ladder lad = coarse_to_fine(c, families, r.initial, [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); });
     iterations += lad.iterations;
     label = lad.label;
     levels = std::move(lad.levels);
@@ -414,7 +452,8 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     run.header();
     s = run.minimize_from(r.initial, c.options);
   } else if (how == "smoothed") {
-    Ladder lad = coarse_to_fine(c, families, smoothed(r.summary.q, families));
+    Ladder lad = coarse_to_fine(c, families, smoothed(r.summary.q, families),
+                                [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); });
     iterations += lad.iterations;
     label = "smoothed estimate, " + lad.label;
     levels = std::move(lad.levels);

@@ -290,6 +290,7 @@ TEST(GaussNewton, ARunEndingOnAStepTakesNoMatrixThere) {
     oo.method = scoleid::io::Method::GaussNewton;
     oo.continuation = false;
     oo.cost_stall = 1e-3;
+    oo.matrix_reuse = 0.0;  // a matrix at every accepted point but the last (the next test keeps some)
     const OptimizerSummary s = minimize(o, p->params->initial() * 1.1, oo);
     std::printf("coarsening %g: %s; %ld tangent columns\n", coarsening, s.BriefReport().c_str(), o.counters().sensitivity_solves);
     ASSERT_EQ(s.termination, OptimizerSummary::Termination::CostStalled) << s.BriefReport();
@@ -312,6 +313,73 @@ TEST(GaussNewton, ARunEndingOnAStepTakesNoMatrixThere) {
       EXPECT_EQ(s.iterations.back().gradient_norm, t.iterations.front().gradient_norm);  // the trial's: the same costate
     }
   }
+}
+
+// The discrepancy path's hand-over (OptimizerOptions::matrix_reuse, start_matrix; docs/theory.md
+// §7.2): a run with many parameters that ends on a step whose decrease was the predicted one hands
+// the matrix of that step on; the next weight's run from its end starts on it without evaluating
+// one and reaches the minimum a run evaluating its own start reaches. Given the very matrix the
+// run would evaluate, the same run bit for bit; given a poor one (a thousand times too stiff: steps
+// too short to gain anything), the start's own matrix is taken before anything is concluded.
+TEST(GaussNewton, TheNextWeightsRunStartsOnTheMatrixTheLastOneEndedWith) {
+  const auto sc = sections_scenario("0", 24, 8, 0.01);
+  const auto p = make_problem(sc, std::nullopt);
+  const long points = p->data.z.size();
+  OptimizerOptions oo;
+  oo.method = scoleid::io::Method::GaussNewton;
+  oo.continuation = false;
+  oo.smoothness_chains = {std::vector<int>(24)};
+  for (int k = 0; k < 24; ++k) oo.smoothness_chains[0][static_cast<std::size_t>(k)] = k;
+  oo.smoothness_weight = 1.0;
+  Objective o(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  const OptimizerSummary first = minimize(o, p->params->initial() * 1.1, oo);
+  std::printf("beta 1: %s; end matrix %s\n", first.BriefReport().c_str(), first.end_matrix.size() ? "handed on" : "none");
+  ASSERT_EQ(first.termination, OptimizerSummary::Termination::CostStalled);
+  ASSERT_EQ(first.end_matrix.rows(), 24);
+  // The next weight, from the end: on the handed matrix, and on its own.
+  OptimizerOptions next = oo;
+  next.smoothness_weight = 0.1;
+  auto run_from = [&](const MatrixXd& start_matrix, long& columns, int max_iterations = 200) {
+    Objective fresh(p->model(), *p->params, p->signals, p->data, p->objective_options);
+    OptimizerOptions n = next;
+    n.start_matrix = start_matrix;
+    n.max_iterations = max_iterations;
+    const OptimizerSummary s = minimize(fresh, first.q, n);
+    columns = fresh.counters().sensitivity_solves;
+    return s;
+  };
+  long c_handed = 0, c_own = 0, c_poor = 0, c_start = 0;
+  const OptimizerSummary handed = run_from(first.end_matrix, c_handed), own = run_from(MatrixXd(), c_own);
+  const OptimizerSummary poor = run_from(1e3 * first.end_matrix, c_poor);
+  std::printf("beta 0.1 on the handed matrix: %s, %ld tangent columns; on its own: %s, %ld; on a poor one: %s, %ld\n",
+              handed.BriefReport().c_str(), c_handed, own.BriefReport().c_str(), c_own, poor.BriefReport().c_str(), c_poor);
+  run_from(first.end_matrix, c_start, 0);
+  EXPECT_EQ(c_start, 0);  // the start took its cost and gradient only
+  for (const auto* s : {&handed, &poor}) {
+    EXPECT_TRUE(s->converged()) << s->BriefReport();
+    EXPECT_NEAR(s->cost, own.cost, 2.0 * own.cost / static_cast<double>(points));
+    EXPECT_LT((s->q.array() / own.q.array() - 1.0).abs().maxCoeff(), 1e-2);
+  }
+  EXPECT_EQ(c_handed % 24, 0);
+  EXPECT_GE(c_poor, 24);  // the poor matrix was replaced
+  // The matrix the run would evaluate at its start: the same run bit for bit, one matrix fewer.
+  const VectorXd qx = first.q.array().log().exp();  // the optimiser's q (it works in log q)
+  VectorXd g;
+  MatrixXd H;
+  Objective at_start(p->model(), *p->params, p->signals, p->data, p->objective_options);
+  at_start.gradient_and_step_matrix(qx, g, H);
+  long c_same = 0;
+  const OptimizerSummary same = run_from(qx.asDiagonal() * H * qx.asDiagonal(), c_same);
+  EXPECT_EQ(c_same, c_own - 24);
+  ASSERT_EQ(same.iterations.size(), own.iterations.size());
+  for (std::size_t i = 0; i < own.iterations.size(); ++i) {
+    EXPECT_EQ(same.iterations[i].cost, own.iterations[i].cost) << i;
+    EXPECT_TRUE(same.iterations[i].q == own.iterations[i].q) << i;
+  }
+  // A matrix of another size is not taken.
+  long c_wrong = 0;
+  run_from(MatrixXd::Identity(5, 5), c_wrong, 0);
+  EXPECT_EQ(c_wrong, 24);
 }
 
 TEST(SmoothnessPrior, EveryOptimiserReachesTheSameMinimiser) {
@@ -370,6 +438,7 @@ TEST(SmoothnessPrior, ManyParametersTakeTheMatrixOnlyAtAcceptedPoints) {
     OptimizerOptions oo;
     oo.method = method;
     oo.max_iterations = 200;
+    oo.matrix_reuse = 0.0;  // every accepted point's own matrix (TheMatrixIsKeptWhileTheModelHolds keeps some)
     oo.smoothness_weight = 1e-2;
     oo.smoothness_chains = section_families(p->params->names());
     ASSERT_EQ(oo.smoothness_chains.size(), 1u);

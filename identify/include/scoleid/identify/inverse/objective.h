@@ -343,6 +343,10 @@ private:
   };
   LastGaussNewton last_gn_;
   LastGaussNewton last_step_;  // gradient_and_step_matrix's, when its matrix is coarser
+  // cost_and_gradient's last J and g (H empty): gradient_and_step_matrix takes them at the same q and
+  // horizon (an optimiser's accepted trial point, then the start of the next run from it).
+  // cost_and_gradient itself always solves.
+  LastGaussNewton last_gradient_;
   std::unique_ptr<Objective> step_matrix_;  // this objective at step_matrix_step() (made on first use)
   double gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile);
   // Whether output sensitivities are interpolated in output space (no acceleration sensors) and

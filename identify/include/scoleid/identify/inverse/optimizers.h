@@ -87,6 +87,17 @@ struct OptimizerOptions {
   double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
   // gauss-newton-krylov: CG iterations per step (each one matrix-free product: two solves)
   int max_krylov_iterations = 50;
+  // gauss-newton with many parameters (the matrix evaluated on acceptance, a step matrix of its
+  // own; docs/theory.md §7.2): a run that ends on a step whose decrease matched the Gauss–Newton
+  // model's prediction within this fraction (|ρ − 1| <= matrix_reuse) hands the matrix that step
+  // was taken with on as OptimizerSummary::end_matrix (0: never).
+  double matrix_reuse = 0.1;
+  // A run continuing from another's end point on the same objective (the discrepancy path's next
+  // weight): that run's end_matrix, the data's matrix taken at the start instead of evaluating one
+  // (empty or another size: evaluated). Should a step it shapes fail (rejected, or gaining less
+  // than the stall threshold), the start's own matrix is evaluated and the step taken again.
+  // Used by gauss-newton with many parameters only.
+  MatrixXd start_matrix;
   // Smoothness prior on x = log q (every method; docs/theory.md §7.8):
   //   ½ β Σ_chains Σ_j (x_{c_{j+1}} − x_{c_j})²
   // over chains of neighbouring sections (e.g. the indices of EI_1 … EI_N). β = 0: off.
@@ -122,6 +133,10 @@ struct OptimizerSummary {
   double cost = 0.0;        // with the prior's share, if any
   double prior_cost = 0.0;  // the smoothness prior's share of cost
   long krylov_iterations = 0;  // gauss-newton-krylov: CG iterations (matrix-free products) in all
+  // gauss-newton with many parameters: the data's Gauss–Newton matrix in log q that holds at q (q's
+  // own, or that of the point before when the last step's decrease was the predicted one within
+  // matrix_reuse); empty otherwise. For OptimizerOptions::start_matrix of a run from q.
+  MatrixXd end_matrix;
   std::vector<IterationRecord> iterations;
   int iterations_done = 0;
   double wall_seconds = 0.0;
@@ -134,6 +149,12 @@ struct OptimizerSummary {
 };
 
 const char* to_string(OptimizerSummary::Termination t);
+
+// What minimize's first point evaluates at q0 on the whole record (Gauss–Newton: the matrix, or
+// with many parameters the gradient and step matrix; nothing for the other methods), so that the
+// objective keeps it for a run from q0 that follows (its last evaluation is kept: objective.h).
+// For a caller with a thread idle meanwhile; a point that cannot be evaluated is left to the run.
+void evaluate_start(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options);
 
 // `on_iteration` is called after every accepted iterate (and for k = 0), for progress output.
 OptimizerSummary minimize(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options,

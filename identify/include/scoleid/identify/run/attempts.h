@@ -27,8 +27,9 @@ struct AttemptsContext {
   // What the test at q does on this thread while its doubled mesh is solved (test_fit's `meanwhile`;
   // nothing when the test at q is already kept): at an attempt's end, the attempt's whole-record
   // cost (attempt_cost); at one likely to stand, alongside_fit(q) too.
+  // `also`: more work for this thread meanwhile (after the alongside's), when the test is taken.
   enum class Alongside { Nothing, Cost, CostAndRefits };
-  FitTest fit_at(const VectorXd& q, Alongside alongside = Alongside::Nothing);
+  FitTest fit_at(const VectorXd& q, Alongside alongside = Alongside::Nothing, const std::function<void()>& also = {});
   // The cost over the whole record at q (one state solve; INFINITY where it cannot be evaluated),
   // the last one kept.
   double attempt_cost(const VectorXd& q);
@@ -36,8 +37,11 @@ struct AttemptsContext {
   // discretisation estimate made (fit_at's), so only the identifier's model is solved. A level it
   // fails is not explained by the mesh's error as last estimated, and the ladder goes on; a level
   // it passes is tested again with its own estimate (fit_at) before the ladder may stop there.
-  // Without an earlier estimate it is fit_at.
-  FitTest fit_screen(const VectorXd& q);
+  // Without an earlier estimate it is fit_at. While a doubled mesh is solved this thread does what
+  // likely follows (docs/theory.md §7.6): `if_not` (the next level) where there was no screen,
+  // `if_explained` (the attempt's first point) where the screen passed.
+  FitTest fit_screen(const VectorXd& q, const std::function<void()>& if_not = {},
+                     const std::function<void()>& if_explained = {});
   VectorXd fit_q{};  // fit_at's last q and its test
   FitTest fit{};
   // Work on an estimate that is likely to stand, done while the fit test's doubled mesh is solved:
