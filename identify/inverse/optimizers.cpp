@@ -26,7 +26,6 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   if (!(continuation_misfit > 0)) return bad("continuation_misfit must be > 0");
   if (!(short_horizon_floor >= 0)) return bad("short_horizon_floor must be >= 0");
   if (!(cost_stall >= 0)) return bad("cost_stall must be >= 0");
-  if (!(matrix_reuse >= 0)) return bad("matrix_reuse must be >= 0");
   if (!(continuation_min_fraction > 0 && continuation_min_fraction <= 1)) return bad("continuation_min_fraction must be in (0, 1]");
   return true;
 }
@@ -174,7 +173,7 @@ struct Point {
   double Jd = 0.0;  // the data's share (what the matrix-free strategy tracks)
   VectorXd g;       // ∂J/∂x
   MatrixXd H;       // the Gauss–Newton matrix in x (explicit strategy only)
-  bool matrix_kept = false;  // H is another point's (OptimizerOptions::matrix_reuse, start_matrix)
+  bool matrix_kept = false;  // H is another point's (OptimizerOptions::start_matrix)
 };
 
 class StepStrategy {
@@ -189,7 +188,7 @@ public:
   virtual bool complete(const VectorXd&, Point&) { return true; }
   virtual void start(const Point&) {}
   // The data's matrix that holds at the run's last point p (OptimizerSummary::end_matrix): its own,
-  // else `held` (the matrix of the point before, when the step from it held); empty by default.
+  // else `held` (that of the point before, when the run ended on the step from it); empty by default.
   virtual MatrixXd end_matrix(const Point&, const MatrixXd& /*held*/) const { return {}; }
   // The step from (x, p) inside `radius`; `lambda_floor` the Levenberg floor on a short horizon.
   virtual TrustRegionStep step(const VectorXd& x, const Point& p, double radius, double lambda_floor) = 0;
@@ -228,7 +227,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   s.start(cur);
   double radius = r.opt.trust_radius;
   int k = 0;
-  MatrixXd held;  // the point before's matrix, when the step from it held (matrix_reuse)
+  MatrixXd held;  // the point before's matrix, when the run ends on the step from it
   r.sum.termination = T::MaxIterations;
   // On a short horizon a termination test lengthens the horizon instead; true if it did.
   auto extend = [&](double T_new) {
@@ -284,9 +283,6 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
       const double step = delta.cwiseAbs().maxCoeff();
       const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
       const bool ends_here = full() && (stalled || step < r.opt.step_tolerance);  // (the test below)
-      // The step decreased the cost as the model predicted (OptimizerOptions::matrix_reuse): where
-      // the run ends on it, the matrix it was taken with still holds there (end_matrix).
-      const bool model_held = ok && r.opt.matrix_reuse > 0 && std::abs(rho - 1.0) <= r.opt.matrix_reuse && delta == st.delta;
       if (ok && !ends_here && !s.complete(x + delta, trial)) {
         ok = false;
         radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
@@ -304,10 +300,10 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
         continue;
       }
       x += delta;
-      if (model_held)
-        held = std::move(cur.H);
-      else
-        held.resize(0, 0);
+      // A run ending on this step moved less than the stall threshold's worth (about one standard
+      // deviation, §7.4) or less than the step tolerance: the matrix it was taken with holds at its
+      // end (end_matrix).
+      if (ends_here) held = std::move(cur.H);
       cur = std::move(trial);
       ++k;
       // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded

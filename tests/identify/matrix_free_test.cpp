@@ -290,7 +290,6 @@ TEST(GaussNewton, ARunEndingOnAStepTakesNoMatrixThere) {
     oo.method = scoleid::io::Method::GaussNewton;
     oo.continuation = false;
     oo.cost_stall = 1e-3;
-    oo.matrix_reuse = 0.0;  // a matrix at every accepted point but the last (the next test keeps some)
     const OptimizerSummary s = minimize(o, p->params->initial() * 1.1, oo);
     std::printf("coarsening %g: %s; %ld tangent columns\n", coarsening, s.BriefReport().c_str(), o.counters().sensitivity_solves);
     ASSERT_EQ(s.termination, OptimizerSummary::Termination::CostStalled) << s.BriefReport();
@@ -315,9 +314,9 @@ TEST(GaussNewton, ARunEndingOnAStepTakesNoMatrixThere) {
   }
 }
 
-// The discrepancy path's hand-over (OptimizerOptions::matrix_reuse, start_matrix; docs/theory.md
-// §7.2): a run with many parameters that ends on a step whose decrease was the predicted one hands
-// the matrix of that step on; the next weight's run from its end starts on it without evaluating
+// The discrepancy path's hand-over (OptimizerSummary::end_matrix, OptimizerOptions::start_matrix;
+// docs/theory.md §7.2): a run with many parameters that ends on a step (a stall) hands the matrix of
+// that step on; the next weight's run from its end starts on it without evaluating
 // one and reaches the minimum a run evaluating its own start reaches. Given the very matrix the
 // run would evaluate, the same run bit for bit; given a poor one (a thousand times too stiff: steps
 // too short to gain anything), the start's own matrix is taken before anything is concluded.
@@ -438,7 +437,6 @@ TEST(SmoothnessPrior, ManyParametersTakeTheMatrixOnlyAtAcceptedPoints) {
     OptimizerOptions oo;
     oo.method = method;
     oo.max_iterations = 200;
-    oo.matrix_reuse = 0.0;  // every accepted point's own matrix (TheMatrixIsKeptWhileTheModelHolds keeps some)
     oo.smoothness_weight = 1e-2;
     oo.smoothness_chains = section_families(p->params->names());
     ASSERT_EQ(oo.smoothness_chains.size(), 1u);

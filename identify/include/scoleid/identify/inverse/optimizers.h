@@ -87,11 +87,6 @@ struct OptimizerOptions {
   double short_horizon_floor = 0.1;          // λ >= this · J on a horizon shorter than the record
   // gauss-newton-krylov: CG iterations per step (each one matrix-free product: two solves)
   int max_krylov_iterations = 50;
-  // gauss-newton with many parameters (the matrix evaluated on acceptance, a step matrix of its
-  // own; docs/theory.md §7.2): a run that ends on a step whose decrease matched the Gauss–Newton
-  // model's prediction within this fraction (|ρ − 1| <= matrix_reuse) hands the matrix that step
-  // was taken with on as OptimizerSummary::end_matrix (0: never).
-  double matrix_reuse = 0.1;
   // A run continuing from another's end point on the same objective (the discrepancy path's next
   // weight): that run's end_matrix, the data's matrix taken at the start instead of evaluating one
   // (empty or another size: evaluated). Should a step it shapes fail (rejected, or gaining less
@@ -134,8 +129,9 @@ struct OptimizerSummary {
   double prior_cost = 0.0;  // the smoothness prior's share of cost
   long krylov_iterations = 0;  // gauss-newton-krylov: CG iterations (matrix-free products) in all
   // gauss-newton with many parameters: the data's Gauss–Newton matrix in log q that holds at q (q's
-  // own, or that of the point before when the last step's decrease was the predicted one within
-  // matrix_reuse); empty otherwise. For OptimizerOptions::start_matrix of a run from q.
+  // own, or that of the point before when the run ended on a step that gained less than the stall
+  // threshold or moved less than the step tolerance); empty otherwise (a run that failed, a short
+  // horizon). For OptimizerOptions::start_matrix of a run from q (docs/theory.md §7.2).
   MatrixXd end_matrix;
   std::vector<IterationRecord> iterations;
   int iterations_done = 0;
