@@ -94,7 +94,7 @@ private:
     H_.selfadjointView<Eigen::Lower>().rankUpdate(rows_.leftCols(used_));
     used_ = 0;
   }
-  const Eigen::Ref<const Eigen::VectorXd> R_;
+  const Eigen::VectorXd R_;
   double& J_;
   Eigen::VectorXd& g_;
   Eigen::MatrixXd& H_;
@@ -843,6 +843,12 @@ double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
   return J;
 }
 
+double Objective::recalled_cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
+  MatrixXd none;
+  if (double J = 0.0; last_gradient_.recall(q, T_, J, gradient, none)) return J;
+  return cost_and_gradient(q, gradient);
+}
+
 double Objective::gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc) {
   const bool rates = C1_.size() != 0;
   // Checkpointed (docs/theory.md §7.9): the forward run keeps its outputs and every L-th point.
@@ -1090,9 +1096,7 @@ double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient
   if (!has_separate_step_matrix()) return gauss_newton(q, gradient, H);
   if (double J = 0.0; last_step_.recall(q, T_, J, gradient, H)) return J;
   last_step_ = {};
-  MatrixXd none;
-  double J = 0.0;
-  if (!last_gradient_.recall(q, T_, J, gradient, none)) J = cost_and_gradient(q, gradient);
+  const double J = recalled_cost_and_gradient(q, gradient);
   step_matrix(q, H);
   last_step_ = {q, T_, J, gradient, H};
   return J;

@@ -324,7 +324,7 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   }
   r.conclude(k, x, cur.J);
   r.sum.prior_cost = s.prior_cost(x, cur);
-  if (full()) r.sum.end_matrix = s.end_matrix(cur, held);
+  if (full() && r.sum.termination != T::LineSearchFailed) r.sum.end_matrix = s.end_matrix(cur, held);
   obj.set_horizon(t_end);
 }
 
@@ -344,7 +344,9 @@ class ExplicitStep final : public StepStrategy {
 public:
   ExplicitStep(Run& r, Eigen::Index P)
       : r_(r), prior_(r.prior), prior_matrix_(prior_.matrix(P)),
-        start_matrix_(r.opt.start_matrix.rows() == P && r.opt.start_matrix.cols() == P ? r.opt.start_matrix : MatrixXd()),
+        start_matrix_(r.opt.start_matrix.rows() == P && r.opt.start_matrix.cols() == P && r.opt.start_matrix.allFinite()
+                          ? r.opt.start_matrix
+                          : MatrixXd()),
         lazy_(P > kMatrixOnAcceptance), separate_(lazy_ && r.obj.has_separate_step_matrix()) {}
   bool evaluate_trial(const VectorXd& xx, Point& p, bool with_profile) override {
     if (!lazy_ || with_profile) return evaluate(xx, p, with_profile);
@@ -388,8 +390,8 @@ public:
       MatrixXd H;
       // (lazy: J and g on the model's step, the matrix perhaps on a coarser one; misfit.h)
       // (a continuing run's first point: the previous run's matrix, OptimizerOptions::start_matrix)
-      if (start_matrix_.rows() == xx.size() && separate_ && !with_profile) {
-        p.J = r_.obj.cost_and_gradient(q, g) + prior_.value(xx);
+      if (start_matrix_.rows() == xx.size() && separate_ && !with_profile && r_.obj.horizon() >= r_.obj.data_end()) {
+        p.J = r_.obj.recalled_cost_and_gradient(q, g) + prior_.value(xx);
         p.g = q.cwiseProduct(g) + prior_.apply(xx);
         p.H = start_matrix_ + prior_matrix_;
         p.matrix_kept = true;
@@ -450,7 +452,7 @@ public:
   double prior_cost(const VectorXd& x, const Point&) const override { return prior_.value(x); }
   MatrixXd end_matrix(const Point& p, const MatrixXd& held) const override {
     const MatrixXd& H = p.H.rows() == prior_matrix_.rows() ? p.H : held;
-    if (!lazy_ || H.rows() != prior_matrix_.rows()) return {};
+    if (!lazy_ || H.rows() != prior_matrix_.rows() || !H.allFinite()) return {};
     return H - prior_matrix_;
   }
 
@@ -710,7 +712,8 @@ void gauss_newton_krylov(Run& r, VectorXd x) {
 
 void evaluate_start(Misfit& objective, const VectorXd& q0, const OptimizerOptions& options) {
   if (options.method != io::Method::GaussNewton || !q0.allFinite() || !(q0.array() > 0).all()) return;
-  const VectorXd q = q0.array().log().exp();  // (the run's q: it works in log q)
+  const VectorXd x = q0.array().log();  // (the run's q, as minimize makes it: it works in log q)
+  const VectorXd q = x.array().exp();
   objective.set_horizon(objective.data_end());
   VectorXd g;
   MatrixXd H;

@@ -188,7 +188,8 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
       std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
                   to_string(s.termination));
     if (s.q.allFinite()) q = s.q;
-    oo.start_matrix = std::move(s.end_matrix);  // the next weight's run starts where this one ended
+    // The next weight's run starts where this one ended, on the matrix it ended with.
+    oo.start_matrix = s.q.allFinite() ? std::move(s.end_matrix) : MatrixXd();
     chosen = s;
     r.smoothness_weight = beta;
     have = true;
@@ -240,11 +241,14 @@ struct LevelSolve {
   VectorXd q;
   double step = 0.0;
 };
-LevelSolve solve_level(AttemptsContext& c, const std::vector<std::vector<int>>& families, int B, const VectorXd& from) {
+// `sweep_threads` as ObjectiveOptions' (1 beside another solve; the numbers do not depend on it).
+LevelSolve solve_level(AttemptsContext& c, const std::vector<std::vector<int>>& families, int B, const VectorXd& from,
+                       int sweep_threads = 0) {
   const Problem& p = c.problem;
   auto [group, gnames] = block_grouping(p.params->names(), families, B);
   TiedParameterization tied(*p.params, from, group, gnames);
   ObjectiveOptions lo = p.objective_options;
+  if (sweep_threads > 0) lo.sweep_threads = sweep_threads;
   // (BDF chooses its own steps: the level keeps the full run's options.)
   if (!(p.scenario.identification.time_step > 0) && lo.solver.step > 0 &&
       lo.solver.integrator != SolverOptions::Integrator::Bdf)
@@ -287,7 +291,17 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     out.q = level.q;
     out.label += " " + std::to_string(B);
     std::function<void()> if_not, if_explained;
-    if (2 * B < static_cast<int>(N)) if_not = [&] { next = solve_level(c, families, 2 * B, out.q); };
+    // (A speculative level that fails is solved again if it is needed: its error is the ladder's then.)
+    if (2 * B < static_cast<int>(N))
+      if_not = [&] {
+        try {
+          next = solve_level(c, families, 2 * B, out.q, 1);
+        } catch (const io::Interrupted&) {
+          throw;
+        } catch (const std::exception&) {
+          next.reset();
+        }
+      };
     if (first_point) if_explained = [&] { first_point(out.q); };
     const bool explained = sl.q.allFinite() && c.fit_screen(out.q, if_not, if_explained).within_noise_and_discretisation;
     out.levels.push_back({B, level.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});

@@ -354,6 +354,20 @@ TEST(GaussNewton, TheNextWeightsRunStartsOnTheMatrixTheLastOneEndedWith) {
               handed.BriefReport().c_str(), c_handed, own.BriefReport().c_str(), c_own, poor.BriefReport().c_str(), c_poor);
   run_from(first.end_matrix, c_start, 0);
   EXPECT_EQ(c_start, 0);  // the start took its cost and gradient only
+  {
+    // On the same objective the start's cost and gradient are the last trial's, kept
+    // (recalled_cost_and_gradient) where the run's q, exp(log q), is the point that trial took.
+    OptimizerOptions n = next;
+    n.start_matrix = first.end_matrix;
+    n.max_iterations = 0;
+    o.reset_counters();
+    const OptimizerSummary s0 = minimize(o, first.q, n);
+    const VectorXd x = first.q.array().log();
+    const bool same_point = (VectorXd(x.array().exp()).array() == first.q.array()).all();
+    EXPECT_EQ(o.counters().gradient_evaluations, same_point ? 0 : 1);
+    EXPECT_EQ(o.counters().sensitivity_solves, 0);
+    EXPECT_EQ(s0.cost - s0.prior_cost, first.cost - first.prior_cost);
+  }
   for (const auto* s : {&handed, &poor}) {
     EXPECT_TRUE(s->converged()) << s->BriefReport();
     EXPECT_NEAR(s->cost, own.cost, 2.0 * own.cost / static_cast<double>(points));

@@ -38,6 +38,9 @@ public:
 
   virtual double cost(const VectorXd& q) = 0;
   virtual double cost_and_gradient(const VectorXd& q, VectorXd& gradient) = 0;
+  // cost_and_gradient, or its last evaluation where the objective keeps it for q and the horizon
+  // (Objective: an optimiser's accepted trial, asked again where the next run starts from it).
+  virtual double recalled_cost_and_gradient(const VectorXd& q, VectorXd& gradient) { return cost_and_gradient(q, gradient); }
   // J, g and the Gauss–Newton matrix H (with `profile`: the misfit profile over the whole record).
   virtual double gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile = nullptr) = 0;
   // J, g and a Gauss–Newton matrix for the optimiser's step alone (not for uncertainty): by default

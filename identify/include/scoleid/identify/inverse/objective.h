@@ -140,6 +140,7 @@ public:
   // J and ∂J/∂q by the costate: one forward and one backward solve (two backward equations with
   // velocity or acceleration sensors, stepped together by esdirk), whatever the number of parameters.
   double cost_and_gradient(const VectorXd& q, VectorXd& gradient) override;
+  double recalled_cost_and_gradient(const VectorXd& q, VectorXd& gradient) override;
   // J, g = ∂J/∂q and the Gauss–Newton matrix H from P forward-sensitivity solves. With `profile`
   // the state is integrated over the whole data span and its misfit profile returned. The last
   // evaluation without a profile is kept: asked again at the same q on the same horizon (an
