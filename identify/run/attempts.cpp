@@ -233,6 +233,12 @@ struct Ladder {
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
 };
+// The ladder's `first_point` where a run of the attempt's options follows from the level's estimate:
+// that run's first evaluation (evaluate_start), kept by the objective.
+std::function<void(const VectorXd&)> run_from_level(AttemptsContext& c) {
+  return [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); };
+}
+
 // One level of the ladder solved from `from` (the full parameterization's q): its summary, the
 // expanded estimate, its step.
 struct LevelSolve {
@@ -378,7 +384,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
     // With a prior the attempt goes on from an explained level on the full parameterization.
     std::function<void(const VectorXd&)> first_point;
     if (c.problem.scenario.identification.smoothness != 0.0)
-      first_point = [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); };
+      first_point = run_from_level(c);
     Ladder lad = coarse_to_fine(c, families, r.initial, first_point);
     start = lad.q;
     label = lad.label;
@@ -455,7 +461,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
   if (how == "coarse-to-fine") {
-    Ladder lad = coarse_to_fine(c, families, r.initial, [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); });
+    Ladder lad = coarse_to_fine(c, families, r.initial, run_from_level(c));
     iterations += lad.iterations;
     label = lad.label;
     levels = std::move(lad.levels);
@@ -467,7 +473,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     s = run.minimize_from(r.initial, c.options);
   } else if (how == "smoothed") {
     Ladder lad = coarse_to_fine(c, families, smoothed(r.summary.q, families),
-                                [&c](const VectorXd& q) { evaluate_start(c.objective, q, c.options); });
+                                run_from_level(c));
     iterations += lad.iterations;
     label = "smoothed estimate, " + lad.label;
     levels = std::move(lad.levels);
