@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/objective.h"
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <cmath>
 #include <functional>
@@ -984,39 +985,69 @@ std::vector<Trajectory> Objective::solve_with_sensitivities(const SecondOrderSol
 }
 
 SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<Derivative>& d) const {
-  const int n = model_.ndof;
-  // The nonzeros of ∂M, ∂D, ∂K as one list per derivative, column by column (the order of a
-  // sparse product): a sectional parameter touches a few elements, so the list is short where
-  // the sparse product would still visit every column. The ∂b are copied too: the function does
-  // not refer to `d` once made.
-  struct Entry {
-    int row, col;
-    double value;
-    int which;  // 0: ∂M (on ü), 1: ∂D (on u̇), 2: ∂K (on u)
+  // The nonzeros of ∂M, ∂D, ∂K per derivative, row by row: a sectional parameter touches a few
+  // elements, so the rows are few where the sparse product would still visit every column. Row r
+  // takes its ∂M terms (on ü), then its ∂D terms (on u̇), then its ∂K terms (on u), each in column
+  // order: the order of the column-by-column sparse products ∂M ü, ∂D u̇, ∂K u, so G_r is the same
+  // to the last bit, with one running value per row instead of a load and a store per nonzero and
+  // no choice of operand per nonzero. The ∂b are copied too: the function does not refer to `d`.
+  struct Row {
+    int row;
+    int m_end, d_end, k_end;  // its terms: [previous k_end, m_end) on ü, [m_end, d_end) on u̇, [d_end, k_end) on u
   };
   struct Lists {
-    std::vector<std::vector<Entry>> entries;
+    std::vector<std::vector<Row>> rows;
+    std::vector<std::vector<int>> cols;
+    std::vector<std::vector<double>> values;
     std::vector<std::vector<VectorXd>> db;
     std::vector<double> f;
   };
   auto L = std::make_shared<Lists>();
-  L->entries.resize(d.size());
+  L->rows.resize(d.size());
+  L->cols.resize(d.size());
+  L->values.resize(d.size());
   L->f.resize(inputs_.size());
+  const int n = model_.ndof;
   for (std::size_t i = 0; i < d.size(); ++i) {
+    // Per row and operand, the nonzeros in column order (a column-major sparse matrix's order).
+    std::vector<std::array<std::vector<std::pair<int, double>>, 3>> by_row(static_cast<std::size_t>(n));
     const SparseMatrix* mats[3] = {&d[i].dM, &d[i].dD, &d[i].dK};
     for (int w = 0; w < 3; ++w)
       for (int k = 0; k < mats[w]->outerSize(); ++k)
         for (SparseMatrix::InnerIterator it(*mats[w], k); it; ++it)
           if (it.value() != 0.0)
-            L->entries[i].push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), it.value(), w});
+            by_row[static_cast<std::size_t>(it.row())][static_cast<std::size_t>(w)].emplace_back(static_cast<int>(it.col()),
+                                                                                                   it.value());
+    for (int r = 0; r < n; ++r) {
+      const auto& terms = by_row[static_cast<std::size_t>(r)];
+      if (terms[0].empty() && terms[1].empty() && terms[2].empty()) continue;
+      Row row{r, 0, 0, 0};
+      int* ends[3] = {&row.m_end, &row.d_end, &row.k_end};
+      for (int w = 0; w < 3; ++w) {
+        for (const auto& [c, v] : terms[static_cast<std::size_t>(w)]) {
+          L->cols[i].push_back(c);
+          L->values[i].push_back(v);
+        }
+        *ends[w] = static_cast<int>(L->cols[i].size());
+      }
+      L->rows[i].push_back(row);
+    }
     L->db.push_back(d[i].db);
   }
   return [this, n, L](double t, const double* x, const double* v, const double* a, double* Gp) {
-    const double* on[3] = {a, v, x};
     for (std::size_t k = 0; k < inputs_.size(); ++k) L->f[k] = inputs_[k](t);
-    for (std::size_t i = 0; i < L->entries.size(); ++i) {
+    for (std::size_t i = 0; i < L->rows.size(); ++i) {
       double* Gi = Gp + i * static_cast<std::size_t>(n);
-      for (const Entry& e : L->entries[i]) Gi[e.row] -= e.value * on[e.which][e.col];
+      const int* col = L->cols[i].data();
+      const double* val = L->values[i].data();
+      int e = 0;
+      for (const Row& row : L->rows[i]) {
+        double g = Gi[row.row];
+        for (; e < row.m_end; ++e) g -= val[e] * a[col[e]];
+        for (; e < row.d_end; ++e) g -= val[e] * v[col[e]];
+        for (; e < row.k_end; ++e) g -= val[e] * x[col[e]];
+        Gi[row.row] = g;
+      }
       Eigen::Map<VectorXd> Gm(Gi, n);
       for (std::size_t k = 0; k < L->f.size(); ++k)
         if (L->f[k] != 0.0) Gm += L->f[k] * L->db[i][k];
