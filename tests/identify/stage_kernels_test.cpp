@@ -1,5 +1,6 @@
 // The stage kernels of the time steppers against the plain algorithms they restate:
-//  - BandedCholesky::solve_in_place (its bandwidth-specialised loops, columns in groups) against a
+//  - BandedCholesky::solve_in_place (its bandwidth-specialised loops, columns in groups; both
+//    kernels, the interleaved vectors where the processor has them and the scalar loops) against a
 //    textbook band-and-border forward and column-oriented back substitution written here: bit for
 //    bit per column, for every bandwidth with and without a kernel of its own, with and without a
 //    border, for column counts around the groups, and to rounding against a dense solve;
@@ -72,19 +73,21 @@ TEST(BandedCholesky, EveryColumnIsTheTextbookSolveBitForBit) {
       for (int i = 0; i < n; ++i)
         for (int j = 0; j <= i; ++j)
           if (c.fits(i, j)) Ld(i, j) = c.data()[c.offset(i, j)];
-      for (int cols : {1, 3, 4, 7, 16, 17, 37}) {
-        const Eigen::Index ld = n + 5;  // a leading dimension beyond n
-        MatrixXd R = MatrixXd::Random(ld, cols);
-        MatrixXd X = R;
-        c.solve_in_place(X.data(), cols, ld);
-        const MatrixXd dense = MatrixXd(S).ldlt().solve(R.topRows(n));
-        for (int j = 0; j < cols; ++j) {
-          const VectorXd ref = textbook_solve(Ld, b, n - border, R.col(j).head(n));
-          EXPECT_TRUE(X.col(j).head(n) == ref) << "b " << b << " border " << border << " columns " << cols << " column " << j;
-          EXPECT_TRUE(X.col(j).tail(5) == R.col(j).tail(5)) << "rows beyond n untouched";
-          EXPECT_LT((X.col(j).head(n) - dense.col(j)).norm(), 1e-12 * dense.col(j).norm());
+      for (int cols : {1, 2, 3, 4, 5, 7, 16, 17, 33, 37})
+        for (auto kernel : {BandedCholesky::Kernel::Automatic, BandedCholesky::Kernel::Scalar}) {
+          const Eigen::Index ld = n + 5;  // a leading dimension beyond n
+          MatrixXd R = MatrixXd::Random(ld, cols);
+          MatrixXd X = R;
+          c.solve_in_place(X.data(), cols, ld, kernel);
+          const MatrixXd dense = MatrixXd(S).ldlt().solve(R.topRows(n));
+          for (int j = 0; j < cols; ++j) {
+            const VectorXd ref = textbook_solve(Ld, b, n - border, R.col(j).head(n));
+            EXPECT_TRUE(X.col(j).head(n) == ref) << "b " << b << " border " << border << " columns " << cols << " column " << j
+                                                 << (kernel == BandedCholesky::Kernel::Scalar ? " (scalar)" : "");
+            EXPECT_TRUE(X.col(j).tail(5) == R.col(j).tail(5)) << "rows beyond n untouched";
+            EXPECT_LT((X.col(j).head(n) - dense.col(j)).norm(), 1e-12 * dense.col(j).norm());
+          }
         }
-      }
     }
 }
 

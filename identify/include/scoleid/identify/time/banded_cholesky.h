@@ -51,15 +51,21 @@ public:
   void solve_in_place(double* x) const;
   // Solves A X = R in place for `columns` columns stored column-major with leading dimension ld
   // (X holds R on entry); each column's result is bit for bit that of the one-column solve.
-  void solve_in_place(double* X, int columns, std::ptrdiff_t ld) const;
+  //
+  // Two kernels, with the same operations in the same order for every column (so the same results
+  // to the last bit): Automatic takes the interleaved one where the processor has 256-bit vectors
+  // (AVX) — the columns copied into rows of four side by side, one vector operation for four
+  // columns (a lone column padded: it still gains, its sweep compiled without aliasing between
+  // factor and right-hand side) — and the scalar loops elsewhere; Scalar always takes the scalar
+  // loops (for comparison and tests).
+  enum class Kernel { Automatic, Scalar };
+  void solve_in_place(double* X, int columns, std::ptrdiff_t ld, Kernel kernel = Kernel::Automatic) const;
 
 private:
-  // The band's full rows [from, nb) of the forward and the backward sweep with the bandwidth a
-  // compile-time constant (b ≤ kMaxUnrolledBand; banded_cholesky.cpp).
+  // The band's full rows go through loops with the bandwidth a compile-time constant up to this
+  // one (banded_cholesky.cpp).
   static constexpr int kMaxUnrolledBand = 8;
-  static constexpr int kColumnGroup = 16;  // columns solved together (the rest in further groups)
-  void band_forward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from) const;
-  void band_backward_dispatch(const double* L, const double* inv, double* X, int columns, std::ptrdiff_t ld, int from) const;
+  static constexpr int kColumnGroup = 16;  // columns solved together at most (more: in equal groups)
   int n_ = 0, b_ = 0, nb_ = 0;  // nb_: rows in the band part (n − border)
   std::vector<double> data_;
   std::vector<double> inv_diag_;  // 1 / L_ii, set by factorize (a product in the sweeps, not a division)
