@@ -163,6 +163,12 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   noise_share();
   if (!options_.weights.empty()) {
     if (static_cast<int>(options_.weights.size()) != ns) throw std::invalid_argument("Objective: one weight per sensor");
+    // (A weight is a sensor's share of J: zero leaves the sensor out; a negative one would make J
+    // and the Gauss–Newton matrix indefinite.)
+    for (std::size_t k = 0; k < options_.weights.size(); ++k)
+      if (!(options_.weights[k] >= 0.0 && std::isfinite(options_.weights[k])))
+        throw std::invalid_argument("Objective: the weight of sensor '" + data_.names[k] + "' is " +
+                                    std::to_string(options_.weights[k]) + "; weights must be finite and >= 0");
     R_ = options_.weights;
   } else {
     default_weights();

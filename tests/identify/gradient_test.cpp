@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 #include "test_support.h"
 #include "scoleid/identify/inverse/cvodes_adjoint.h"
@@ -196,6 +197,41 @@ TEST(Gradient, VelocitySensorsGaussNewtonIsTheGradientOfTheDiscreteCost) {
   // H is symmetric positive definite (three parameters the data see).
   EXPECT_LT((H - H.transpose()).norm(), 1e-12 * H.norm());
   EXPECT_GT(H.ldlt().vectorD().minCoeff(), 0.0);
+}
+
+// Stated weights are a sensor's share of J: zero leaves the sensor out (J is then the other
+// sensors' alone), a negative, infinite or NaN one is refused by name.
+TEST(Objective, WeightsAreFiniteAndNonNegative) {
+  Case e = make_case(scoleid::test::test_scenario("gradient_test/grad-velocity-beam"), false);
+  const Problem& p = *e.p;
+  const int ns = p.data.sensors();
+  ASSERT_GE(ns, 2);
+  const VectorXd q = p.params->initial();
+  auto objective_with = [&](std::vector<double> w) {
+    ObjectiveOptions o = p.objective_options;
+    o.weights = std::move(w);
+    return std::make_unique<Objective>(p.model(), *p.params, p.signals, p.data, o);
+  };
+  std::vector<double> ones(static_cast<std::size_t>(ns), 1.0), first_only(static_cast<std::size_t>(ns), 0.0);
+  first_only[0] = 1.0;
+  double J_each = 0.0;
+  for (int k = 0; k < ns; ++k) {
+    std::vector<double> w(static_cast<std::size_t>(ns), 0.0);
+    w[static_cast<std::size_t>(k)] = 1.0;
+    J_each += objective_with(w)->cost(q);
+  }
+  EXPECT_NEAR(objective_with(ones)->cost(q), J_each, 1e-12 * J_each) << "J is the sum of the sensors' shares";
+  EXPECT_GT(objective_with(first_only)->cost(q), 0.0);
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    std::vector<double> w = ones;
+    w[1] = bad;
+    try {
+      objective_with(w);
+      ADD_FAILURE() << "weight " << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(p.data.names[1]), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Gradient, VelocityAndAccelerationSensorsBeam) { check_rates(kRatesBeam, {3e-4, 1e-6, true}); }
