@@ -166,9 +166,13 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
     // (A weight is a sensor's share of J: zero leaves the sensor out; a negative one would make J
     // and the Gauss–Newton matrix indefinite.)
     for (std::size_t k = 0; k < options_.weights.size(); ++k)
-      if (!(options_.weights[k] >= 0.0 && std::isfinite(options_.weights[k])))
-        throw std::invalid_argument("Objective: the weight of sensor '" + data_.names[k] + "' is " +
-                                    std::to_string(options_.weights[k]) + "; weights must be finite and >= 0");
+      if (!(options_.weights[k] >= 0.0 && std::isfinite(options_.weights[k]))) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%.6g", options_.weights[k]);
+        const std::string name = k < data_.names.size() ? "'" + data_.names[k] + "'" : "#" + std::to_string(k + 1);
+        throw std::invalid_argument("Objective: the weight of sensor " + name + " is " + value +
+                                    "; weights must be finite and >= 0");
+      }
     R_ = options_.weights;
   } else {
     default_weights();
@@ -1006,17 +1010,17 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
     std::vector<std::vector<int>> cols;
     std::vector<std::vector<double>> values;
     std::vector<std::vector<VectorXd>> db;
-    std::vector<double> f;
   };
   auto L = std::make_shared<Lists>();
   L->rows.resize(d.size());
   L->cols.resize(d.size());
   L->values.resize(d.size());
-  L->f.resize(inputs_.size());
   const int n = model_.ndof;
+  // Per row and operand, the nonzeros in column order (a column-major sparse matrix's order).
+  std::vector<std::array<std::vector<std::pair<int, double>>, 3>> by_row(static_cast<std::size_t>(n));
   for (std::size_t i = 0; i < d.size(); ++i) {
-    // Per row and operand, the nonzeros in column order (a column-major sparse matrix's order).
-    std::vector<std::array<std::vector<std::pair<int, double>>, 3>> by_row(static_cast<std::size_t>(n));
+    for (auto& row : by_row)
+      for (auto& terms : row) terms.clear();
     const SparseMatrix* mats[3] = {&d[i].dM, &d[i].dD, &d[i].dK};
     for (int w = 0; w < 3; ++w)
       for (int k = 0; k < mats[w]->outerSize(); ++k)
@@ -1040,8 +1044,11 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
     }
     L->db.push_back(d[i].db);
   }
+  // (The inputs' values go into this thread's scratch: copies of the function may run on two threads.)
   return [this, n, L](double t, const double* x, const double* v, const double* a, double* Gp) {
-    for (std::size_t k = 0; k < inputs_.size(); ++k) L->f[k] = inputs_[k](t);
+    thread_local std::vector<double> f;
+    f.resize(inputs_.size());
+    for (std::size_t k = 0; k < inputs_.size(); ++k) f[k] = inputs_[k](t);
     for (std::size_t i = 0; i < L->rows.size(); ++i) {
       double* Gi = Gp + i * static_cast<std::size_t>(n);
       const int* col = L->cols[i].data();
@@ -1055,8 +1062,8 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
         Gi[row.row] = g;
       }
       Eigen::Map<VectorXd> Gm(Gi, n);
-      for (std::size_t k = 0; k < L->f.size(); ++k)
-        if (L->f[k] != 0.0) Gm += L->f[k] * L->db[i][k];
+      for (std::size_t k = 0; k < f.size(); ++k)
+        if (f[k] != 0.0) Gm += f[k] * L->db[i][k];
     }
   };
 }

@@ -140,14 +140,14 @@ void band_backward(const double* L, const double* inv, double* X, int columns, s
   }
 }
 
-#if defined(__x86_64__) || defined(__i386__)
+#if defined(__x86_64__)
 // Several columns interleaved: the group's values of row i side by side (T[i·W + j], W a multiple
 // of four), so that one operation of the sweep serves four columns at once (a four-wide vector;
 // the compiler maps it to the machine's vector registers). Every column still sees the scalar
 // sweep's operations in the scalar sweep's order — r_i, then − L_ik y_k for k ascending, then
 // × 1/L_ii; in the backward sweep y_i × 1/L_ii, then − L_ik x_i into each row k above — so the
 // results are bit for bit those of the one-column solve. (No fused multiply-add: a product and a
-// difference each rounded, as in the scalar code.)
+// difference each rounded, as in the scalar code: the build says -ffp-contract=off.)
 typedef double Vec4 __attribute__((vector_size(32), aligned(8)));
 
 // NV vectors (4 NV columns) per row; band rows [0, nb) hold j ∈ [max(0, i − b), i] at
@@ -288,18 +288,22 @@ void with_bandwidth(int b, F&& f) {
 void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
 
 void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld, Kernel kernel) const {
+  if (columns <= 0) return;
   if (columns > 1 && ld < n_) throw std::invalid_argument("BandedCholesky::solve_in_place: leading dimension below n");
   if (inv_diag_.size() != static_cast<std::size_t>(n_)) throw std::logic_error("BandedCholesky: solve before a successful factorize");
-  // Many columns go in groups: a group's rows near row i stay in the first-level cache.
-  // (Groups of equal size, a multiple of four: 33 columns go as 12 + 12 + 9, not 16 + 16 + 1.)
+  // Many columns go in groups: a group's rows near row i stay in the first-level cache. The groups
+  // share the columns' fours (vectors of the interleaved kernel) as evenly as they can: 33 columns
+  // (9 fours) go as 12 + 12 + 9, 49 (13 fours) as 16 + 12 + 12 + 9, never with a lone column.
   if (columns > kColumnGroup) {
-    const int groups = (columns + kColumnGroup - 1) / kColumnGroup;
-    const int size = ((columns + groups - 1) / groups + 3) / 4 * 4;
-    for (int j = 0; j < columns; j += size)
-      solve_in_place(X + static_cast<std::ptrdiff_t>(j) * ld, std::min(size, columns - j), ld, kernel);
+    const int fours = (columns + 3) / 4, groups = (fours + kColumnGroup / 4 - 1) / (kColumnGroup / 4);
+    for (int g = 0, j = 0; g < groups && j < columns; ++g) {
+      const int size = std::min(4 * (fours / groups + (g < fours % groups ? 1 : 0)), columns - j);
+      solve_in_place(X + static_cast<std::ptrdiff_t>(j) * ld, size, ld, kernel);
+      j += size;
+    }
     return;
   }
-#if defined(__x86_64__) || defined(__i386__)
+#if defined(__x86_64__)
   static const bool vectors = __builtin_cpu_supports("avx");  // (the interleaved kernel's instructions)
   if (kernel == Kernel::Automatic && vectors) {
     // Interleaved (solve_group above): copied in, solved four columns to an operation, copied out.

@@ -73,7 +73,12 @@ TEST(BandedCholesky, EveryColumnIsTheTextbookSolveBitForBit) {
       for (int i = 0; i < n; ++i)
         for (int j = 0; j <= i; ++j)
           if (c.fits(i, j)) Ld(i, j) = c.data()[c.offset(i, j)];
-      for (int cols : {1, 2, 3, 4, 5, 7, 16, 17, 33, 37})
+      {  // no columns: nothing is touched
+        MatrixXd R = MatrixXd::Random(n, 4), X = R;
+        c.solve_in_place(X.data(), 0, n);
+        EXPECT_TRUE(X == R);
+      }
+      for (int cols : {1, 2, 3, 4, 5, 7, 16, 17, 33, 37, 49})
         for (auto kernel : {BandedCholesky::Kernel::Automatic, BandedCholesky::Kernel::Scalar}) {
           const Eigen::Index ld = n + 5;  // a leading dimension beyond n
           MatrixXd R = MatrixXd::Random(ld, cols);

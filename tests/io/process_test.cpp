@@ -57,6 +57,8 @@ TEST_F(ProcessTest, NeverMoreRunningThanTheCap) {
     EXPECT_EQ(starts, 7);
     EXPECT_EQ(running, 0);
     EXPECT_LE(most, static_cast<int>(cap)) << "cap " << cap;
-    if (cap > 1) EXPECT_GT(most, 1) << "cap " << cap;  // side by side
+    if (cap > 1) {
+      EXPECT_GT(most, 1) << "cap " << cap;  // side by side
+    }
   }
 }

@@ -55,9 +55,9 @@ public:
   // Two kernels, with the same operations in the same order for every column (so the same results
   // to the last bit): Automatic takes the interleaved one where the processor has 256-bit vectors
   // (AVX) — the columns copied into rows of four side by side, one vector operation for four
-  // columns (a lone column padded: it still gains, its sweep compiled without aliasing between
-  // factor and right-hand side) — and the scalar loops elsewhere; Scalar always takes the scalar
-  // loops (for comparison and tests).
+  // columns (a lone column padded to four: measured, it still gains) — and the scalar loops
+  // elsewhere; Scalar always takes the scalar loops (for comparison and tests). No columns: nothing
+  // is done.
   enum class Kernel { Automatic, Scalar };
   void solve_in_place(double* X, int columns, std::ptrdiff_t ld, Kernel kernel = Kernel::Automatic) const;
 
@@ -65,7 +65,7 @@ private:
   // The band's full rows go through loops with the bandwidth a compile-time constant up to this
   // one (banded_cholesky.cpp).
   static constexpr int kMaxUnrolledBand = 8;
-  static constexpr int kColumnGroup = 16;  // columns solved together at most (more: in equal groups)
+  static constexpr int kColumnGroup = 16;  // columns solved together at most (more: in even groups)
   int n_ = 0, b_ = 0, nb_ = 0;  // nb_: rows in the band part (n − border)
   std::vector<double> data_;
   std::vector<double> inv_diag_;  // 1 / L_ii, set by factorize (a product in the sweeps, not a division)
