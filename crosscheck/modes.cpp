@@ -141,6 +141,13 @@ std::vector<double> analytic_hz(const io::Scenario& sc, int count, std::string& 
     return (b.left == l && b.right == r) || (b.left == r && b.right == l);
   };
   const bool tip = b.tip_mass > 0 || b.tip_inertia > 0;
+  if (!b.supports.empty() || !b.attachments.empty()) {
+    // Supports and attachments: the exact transfer-matrix solution (analytic_beam.h).
+    what = "Euler-Bernoulli with supports and attachments (transfer matrix, undamped)";
+    std::vector<double> hz;
+    for (double w : an::point_element_omegas(b, count)) hz.push_back(w / kTwoPi);
+    return hz;
+  }
   if (is(EndCondition::Clamped, EndCondition::Free) && b.left == EndCondition::Clamped) {
     bl = tip ? an::beta_L_tip_mass(b.tip_mass / (rA * L), b.tip_inertia / (rA * L * L * L), count)
              : an::beta_L(an::Support::ClampedFree, count);

@@ -109,6 +109,14 @@ void print_problem(const identify::Problem& problem, bool from_file) {
                                        : (" [" + x.from_unit + ", " + x.unit_stated_by + "] x " + io::format_value(x.scale) +
                                           " -> [" + x.to_unit + "]").c_str());
   for (const auto& st : c.stepped_inputs) {
+    if (st.cubic) {
+      std::fprintf(stderr,
+                   "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g) and is read "
+                   "cubically between samples (interpolation: cubic), which overshoots at each jump; interpolation: linear "
+                   "keeps each jump within its sample\n",
+                   st.name.c_str(), st.jump, st.at);
+      continue;
+    }
     if (st.pulse_samples > 0) {  // an impact: its samples are what was measured; no advice to replace them
       std::fprintf(stderr,
                    "scole-identify: note: input '%s' from the data is a pulse over %d samples (largest change %g within one "

@@ -5,10 +5,31 @@ namespace scoleid::io {
 
 namespace {
 
+ParameterInfo point_element_info(const std::string& group, const PointElement& e, const std::string& field) {
+  const std::string where = group == "supports" ? "the " + e.name + " support" : "attachment '" + e.name + "'";
+  if (field == "mass") return {point_element_parameter(group, e, "mass"), "mass of " + where, "mass"};
+  if (field == "inertia") return {point_element_parameter(group, e, "inertia"), "rotary inertia of " + where, "mass·length²"};
+  if (field == "k_w") return {point_element_parameter(group, e, "k_w"), "translational spring to ground of " + where, "force/length"};
+  if (field == "k_theta") return {point_element_parameter(group, e, "k_theta"), "rotational spring to ground of " + where, "force·length/rad"};
+  if (field == "c_w") return {point_element_parameter(group, e, "c_w"), "translational dashpot to ground of " + where, "force·time/length"};
+  return {point_element_parameter(group, e, "c_theta"), "rotational dashpot to ground of " + where, "force·length·time/rad"};
+}
+
 std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
   auto& b = sc.beam;
-  return {{"beam.length", &b.length}, {"beam.rho_A", &b.rho_A}, {"beam.zeta", &b.zeta}, {"beam.c_kv", &b.c_kv},
+  std::vector<std::pair<std::string, double*>> v = {{"beam.length", &b.length}, {"beam.rho_A", &b.rho_A}, {"beam.zeta", &b.zeta}, {"beam.c_kv", &b.c_kv},
           {"beam.tip_mass", &b.tip_mass}, {"beam.tip_inertia", &b.tip_inertia}};
+  // Point elements: beam.supports.left.k_theta, beam.attachments.clamp.location, .mass, ...
+  for (auto* group : {&b.supports, &b.attachments}) {
+    const std::string prefix = group == &b.supports ? "beam.supports." : "beam.attachments.";
+    for (auto& e : *group) {
+      if (group == &b.attachments) v.emplace_back(prefix + e.name + ".location", &e.location);
+      for (const auto& [key, member] : point_element_fields())
+        if (group == &b.attachments || (std::string(key) != "mass" && std::string(key) != "inertia"))
+          v.emplace_back(prefix + e.name + "." + key, &(e.*member));
+    }
+  }
+  return v;
 }
 
 std::vector<ParameterRow> parameters(const Scenario& sc) {
@@ -24,6 +45,18 @@ std::vector<ParameterRow> parameters(const Scenario& sc) {
     for (std::size_t k = 0; k < sc.beam.EI.size(); ++k)
       r.push_back({{"EI_" + std::to_string(k + 1), "bending stiffness of section " + std::to_string(k + 1), "force·length²"},
                    [k](Scenario& s) -> double& { return s.beam.EI[k]; }});
+  }
+  // Every quantity a point element holds (> 0) is a parameter: supports.left.k_theta,
+  // attachments.clamp.mass (docs/theory.md §2.5).
+  for (const bool supports : {true, false}) {
+    const auto& group = supports ? sc.beam.supports : sc.beam.attachments;
+    for (std::size_t i = 0; i < group.size(); ++i)
+      for (const auto& [key, member] : point_element_fields()) {
+        if (!(group[i].*member > 0.0)) continue;
+        const auto m = member;
+        r.push_back({point_element_info(supports ? "supports" : "attachments", group[i], key),
+                     [supports, i, m](Scenario& s) -> double& { return (supports ? s.beam.supports : s.beam.attachments)[i].*m; }});
+      }
   }
   return r;
 }

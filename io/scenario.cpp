@@ -20,6 +20,15 @@
 
 namespace scoleid::io {
 
+std::vector<std::pair<const char*, double PointElement::*>> point_element_fields() {
+  return {{"mass", &PointElement::mass}, {"inertia", &PointElement::inertia}, {"k_w", &PointElement::k_w},
+          {"k_theta", &PointElement::k_theta}, {"c_w", &PointElement::c_w}, {"c_theta", &PointElement::c_theta}};
+}
+
+std::string point_element_parameter(const std::string& group, const PointElement& e, const char* field) {
+  return group + "." + e.name + "." + field;
+}
+
 const char* to_string(EndCondition e) {
   switch (e) {
     case EndCondition::Pinned: return "pinned";
@@ -336,6 +345,93 @@ void check_offset(const std::string& source, const std::string& field, double v,
                format_value(v));
 }
 
+// A point element's quantities from its map (the fields present; the others keep e's values).
+void parse_point_element_fields(Reader& r, PointElement& e, bool with_mass) {
+  for (const auto& [key, member] : point_element_fields()) {
+    const bool mass_like = std::string(key) == "mass" || std::string(key) == "inertia";
+    if (mass_like && !with_mass) continue;
+    e.*member = r.nonneg(key, e.*member);
+  }
+}
+
+// supports: {left: {...}, right: {...}}. In truth.overrides, the fields given replace the scenario's.
+void parse_supports(const YAML::Node& n, const std::string& source, const std::string& path, BeamSpec& b, bool base) {
+  Reader r(n, source, path);
+  for (const char* end : {"left", "right"}) {
+    if (!r.has(end)) continue;
+    Reader f(r.child(end), source, r.field(end));
+    auto it = std::find_if(b.supports.begin(), b.supports.end(), [&](const PointElement& e) { return e.name == end; });
+    if (it == b.supports.end()) {
+      if (!base)
+        fail_field(source, r.field(end), "overrides a support the scenario does not have (give it in beam.supports)", "'" + std::string(end) + "'");
+      b.supports.push_back(PointElement{end});
+      it = b.supports.end() - 1;
+    }
+    parse_point_element_fields(f, *it, false);
+  }
+}
+
+// attachments: [{name, location, mass, inertia, k_w, k_theta, c_w, c_theta}]. In
+// truth.overrides, each entry names an attachment of the scenario and replaces the fields it gives.
+void parse_attachments(const YAML::Node& n, const std::string& source, const std::string& path, BeamSpec& b, bool base) {
+  if (!n.IsSequence()) fail_field(source, path, "must be a list", Reader::kind(n));
+  if (base) b.attachments.clear();
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string item = path + "[" + std::to_string(i) + "]";
+    Reader r(n[i], source, item);
+    if (!r.has("name")) fail_field(source, r.field("name"), "is required (it names the attachment's parameters, attachments.NAME.mass)", "nothing");
+    const std::string name = r.str("name", "");
+    if (!valid_name(name) || name.find('.') != std::string::npos)
+      fail_field(source, r.field("name"), "must be 1-64 characters from [A-Za-z0-9_-]", "'" + name + "'");
+    if (!names.insert(name).second) fail_field(source, r.field("name"), "must be unique", "'" + name + "'");
+    PointElement* e = nullptr;
+    if (base) {
+      b.attachments.push_back(PointElement{name});
+      e = &b.attachments.back();
+    } else {
+      for (auto& a : b.attachments)
+        if (a.name == name) e = &a;
+      if (!e) fail_field(source, r.field("name"), "overrides an attachment the scenario does not have", "'" + name + "'");
+    }
+    if (base && !r.has("location")) fail_field(source, r.field("location"), "is required", "nothing");
+    e->location = r.num("location", e->location);
+    parse_point_element_fields(r, *e, true);
+  }
+}
+
+// Each point element on the beam, with only what the ends leave free to act on, plausible masses
+// and something to hold; the supports' stations are the ends of the length in force.
+void check_point_elements(const std::string& source, const std::string& path, BeamSpec& b) {
+  const double m = b.rho_A * b.length, L = b.length;
+  for (auto& s : b.supports) s.location = s.name == "left" ? 0.0 : L;
+  auto end_at = [&](double x) -> const EndCondition* { return x == 0.0 ? &b.left : x == L ? &b.right : nullptr; };
+  auto check = [&](const std::string& f, const PointElement& e) {
+    if (!(e.location >= 0.0 && e.location <= L))
+      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(L) + "]", format_value(e.location));
+    bool holds = false;
+    for (const auto& [key, member] : point_element_fields()) holds = holds || e.*member > 0.0;
+    if (!holds) fail_field(source, f, "holds nothing: give one of mass, inertia, k_w, k_theta, c_w, c_theta > 0", "all 0");
+    check_attached_mass(source, f + ".mass", e.mass, m, true);
+    check_attached_inertia(source, f + ".inertia", e.inertia, m, L);
+    if (const EndCondition* ec = end_at(e.location)) {
+      const std::string end = e.location == 0.0 ? "left" : "right";
+      if (*ec != EndCondition::Free && (e.k_w > 0.0 || e.c_w > 0.0))
+        fail_field(source, f + (e.k_w > 0.0 ? ".k_w" : ".c_w"),
+                   "acts on the " + end + " end's displacement, which the " + to_string(*ec) +
+                       " end holds (an elastic end is `" + end + ": free` with its springs)",
+                   format_value(e.k_w > 0.0 ? e.k_w : e.c_w));
+      if (*ec == EndCondition::Clamped && (e.k_theta > 0.0 || e.c_theta > 0.0))
+        fail_field(source, f + (e.k_theta > 0.0 ? ".k_theta" : ".c_theta"),
+                   "acts on the " + end + " end's slope, which the clamped end holds (a compliant clamp is `" + end +
+                       ": pinned` with supports." + end + ".k_theta)",
+                   format_value(e.k_theta > 0.0 ? e.k_theta : e.c_theta));
+    }
+  };
+  for (const auto& s : b.supports) check(path + ".supports." + s.name, s);
+  for (std::size_t i = 0; i < b.attachments.size(); ++i) check(path + ".attachments[" + std::to_string(i) + "]", b.attachments[i]);
+}
+
 // `path` is the section's dotted name in messages.
 void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, const std::string& path = "beam") {
   Reader r(n, source, path);
@@ -357,6 +453,10 @@ void parse_beam(const YAML::Node& n, const std::string& source, BeamSpec& b, con
   b.tip_inertia = r.nonneg("tip_inertia", b.tip_inertia);
   check_attached_mass(source, r.field("tip_mass"), b.tip_mass, b.rho_A * b.length, true);
   check_attached_inertia(source, r.field("tip_inertia"), b.tip_inertia, b.rho_A * b.length, b.length);
+  const bool base = path == "beam";
+  if (r.has("supports")) parse_supports(r.child("supports"), source, r.field("supports"), b, base);
+  if (r.has("attachments")) parse_attachments(r.child("attachments"), source, r.field("attachments"), b, base);
+  check_point_elements(source, path, b);
   if (b.left == EndCondition::Free && b.right == EndCondition::Free) {
     // free-free is allowed (rigid modes), nothing to check here
   }
@@ -471,6 +571,7 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     in.direction = parse_direction(r, "direction");
     in.unit = r.str("unit", "");
     in.signal_from = r.choice_of("signal_from", in.signal_from);
+    in.interpolation = r.choice_of("interpolation", in.interpolation);
     in.signal = parse_signal(r.child("signal"), sc.source, r.field("signal"));
     in.column = r.str("column", "");
     in.column_unit = r.str("column_unit", "");
@@ -871,9 +972,31 @@ nlohmann::json to_json(const Scenario& s) {
   if (!s.data.time_column.empty() || !s.data.time_unit.empty())
     j["data"] = {{"time_column", s.data.time_column}, {"time_unit", s.data.time_unit}};
   auto beam = [](const BeamSpec& b) {
-    return json{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
+    json j{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
                 {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta}, {"c_kv", b.c_kv},
                 {"tip_mass", b.tip_mass}, {"tip_inertia", b.tip_inertia}};
+    auto fields = [](const PointElement& e, bool with_mass) {
+      json f = json::object();
+      for (const auto& [key, member] : point_element_fields())
+        if (with_mass || (std::string(key) != "mass" && std::string(key) != "inertia")) f[key] = e.*member;
+      return f;
+    };
+    if (!b.supports.empty()) {
+      json s = json::object();
+      for (const auto& e : b.supports) s[e.name] = fields(e, false);
+      j["supports"] = s;
+    }
+    if (!b.attachments.empty()) {
+      json a = json::array();
+      for (const auto& e : b.attachments) {
+        json f = fields(e, true);
+        f["name"] = e.name;
+        f["location"] = e.location;
+        a.push_back(f);
+      }
+      j["attachments"] = a;
+    }
+    return j;
   };
   auto scole = [&](const ScoleSpec& c) {
     return json{{"length", c.length}, {"rho_A", c.rho_A}, {"EI_roll", c.EI_roll}, {"EI_pitch", c.EI_pitch},
@@ -917,6 +1040,7 @@ nlohmann::json to_json(const Scenario& s) {
                            {"direction", in.direction},
                            {"unit", in.unit},
                            {"signal_from", to_string(in.signal_from)},
+                           {"interpolation", to_string(in.interpolation)},
                            {"signal", signal_json(in.signal)}});
     if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
     if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;

@@ -40,18 +40,68 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
 
   std::vector<JointSpring> joints;
   std::vector<AnchorSpring> anchors;
+  std::vector<PointSpring> points;
+  // Point elements (supports, attachments; docs/theory.md §2.5, §9.1): each rides on the bar that
+  // holds its station (bar i on [i h, (i+1) h], s = L on the last bar).
+  std::vector<io::PointElement> elements = beam.supports;
+  elements.insert(elements.end(), beam.attachments.begin(), beam.attachments.end());
+  const auto bar_of = [&](double s, double& x) {
+    const int i = std::min(n - 1, std::max(0, static_cast<int>(std::floor(s / h))));
+    x = s - i * h;
+    return i;
+  };
+  // An end's rotational spring-dashpot in series with the end cell's joint spring k0 (and damper
+  // c0): the two springs carry one moment, k = kθ k0 / (kθ + k0); the dashpots take the rotation
+  // the springs share out, c = cθ (k/kθ)² + c0 (k/k0)² (exact as the cell's mass → 0).
+  double k_theta_end[2] = {0.0, 0.0}, c_theta_end[2] = {0.0, 0.0};
+  std::vector<std::pair<int, io::PointElement>> interior_rotation;
+  for (const auto& e : elements) {
+    double x = 0.0;
+    const int i = bar_of(e.location, x);
+    if (e.k_w > 0.0 || e.c_w > 0.0) points.push_back({MobilizedBodyIndex(), Vec3(x, 0, 0), e.k_w, e.c_w});
+    if (e.k_theta > 0.0 || e.c_theta > 0.0) {
+      const int end = e.location == 0.0 ? 0 : e.location == length_ ? 1 : -1;
+      if (end >= 0 && e.k_theta > 0.0) {
+        k_theta_end[end] += e.k_theta;
+        c_theta_end[end] += e.c_theta;
+      } else {
+        interior_rotation.push_back({i, e});  // an anchor on its bar (O(h): the bar's angle is the mean slope)
+      }
+    }
+  }
+  std::vector<int> point_bar;
+  for (const auto& e : elements) {
+    double x = 0.0;
+    if (e.k_w > 0.0 || e.c_w > 0.0) point_bar.push_back(bar_of(e.location, x));
+  }
+  const auto series = [](double kt, double ct, double k0, double c0, double& k, double& c) {
+    k = kt * k0 / (kt + k0);
+    c = ct * (k / kt) * (k / kt) + c0 * (k / k0) * (k / k0);
+  };
   MobilizedBody parent = matter_.Ground();
   // A tip mass without rotary inertia rides on the last bar's end; with rotary inertia it is a
   // body of its own on a Pin at s = L with the end-cell spring (2EI/h): the last bar's slope is
   // w_s at L - h/2, and only the end cell's compliance carries it to L (O(h^2), not O(h)).
   const bool tip_body = beam.tip_inertia > 0.0;
   for (int i = 0; i < n; ++i) {
-    MassProperties mp = bar;
-    if (i == n - 1 && beam.tip_mass > 0.0 && !tip_body) {
-      const double M = m + beam.tip_mass;
-      const Vec3 com = (m * Vec3(h / 2, 0, 0) + beam.tip_mass * Vec3(h, 0, 0)) / M;
-      mp = MassProperties(M, com, bar.getInertia() + Inertia(Vec3(h, 0, 0), beam.tip_mass));
+    // The bar, a tip mass without rotary inertia at its end, and the point elements' masses at
+    // their stations with their rotary inertias (about the origin: the point's share plus J).
+    double M = m;
+    Vec3 moment = m * Vec3(h / 2, 0, 0);
+    Inertia inertia = bar.getInertia();
+    bool added = false;
+    const auto add_point = [&](double mass, double J, double x) {
+      added = true;
+      M += mass;
+      moment += mass * Vec3(x, 0, 0);
+      inertia += Inertia(Vec3(x, 0, 0), mass) + Inertia(Vec3(0, J, J));
+    };
+    if (i == n - 1 && beam.tip_mass > 0.0 && !tip_body) add_point(beam.tip_mass, 0.0, h);
+    for (const auto& e : elements) {
+      double x = 0.0;
+      if ((e.mass > 0.0 || e.inertia > 0.0) && bar_of(e.location, x) == i) add_point(e.mass, e.inertia, x);
     }
+    const MassProperties mp = added ? MassProperties(M, moment / M, inertia) : bar;
     Body::Rigid body(mp);
     // Geometry for the visualizer only (a cylinder's axis is its y).
     body.addDecoration(Transform(Rotation(-Pi / 2, ZAxis), Vec3(h / 2, 0, 0)),
@@ -67,6 +117,12 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     if (i > 0) joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
     if (i == 0 && beam.left == io::EndCondition::Clamped)
       joints.push_back({seg.getMobilizedBodyIndex(), 0, lumping_.stiffness[0], lumping_.damping[0]});
+    if (i == 0 && k_theta_end[0] > 0.0) {
+      double k = 0.0, c = 0.0;
+      series(k_theta_end[0], c_theta_end[0], lumping_.stiffness[0], lumping_.damping[0], k, c);
+      if (beam.left == io::EndCondition::Pinned) joints.push_back({seg.getMobilizedBodyIndex(), 0, k, c});
+      else anchors.push_back({seg.getMobilizedBodyIndex(), k, c});  // free: the Planar body's angle
+    }
     if (beam.zeta > 0.0) anchors.push_back({seg.getMobilizedBodyIndex(), 0.0, chen_russell(i * h, (i + 1) * h)});
     segment_bodies_.push_back(seg.getMobilizedBodyIndex());
     parent = seg;
@@ -80,6 +136,16 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     joints.push_back({tip.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
     tip_body_ = tip.getMobilizedBodyIndex();
   }
+  if (k_theta_end[1] > 0.0) {
+    // On the tip body (its angle is the end slope), else in series with the last cell.
+    double k = k_theta_end[1], c = c_theta_end[1];
+    if (!tip_body) series(k_theta_end[1], c_theta_end[1], lumping_.stiffness[static_cast<std::size_t>(n)],
+                          lumping_.damping[static_cast<std::size_t>(n)], k, c);
+    anchors.push_back({tip_body ? tip_body_ : parent.getMobilizedBodyIndex(), k, c});
+  }
+  for (const auto& [i, e] : interior_rotation)
+    anchors.push_back({segment_bodies_[static_cast<std::size_t>(i)], e.k_theta, e.c_theta});
+  for (std::size_t k = 0; k < points.size(); ++k) points[k].body = segment_bodies_[static_cast<std::size_t>(point_bar[k])];
   if (beam.right != io::EndCondition::Free) {
     Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));
     if (beam.right == io::EndCondition::Clamped) {
@@ -88,7 +154,7 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     }
   }
   joint_springs_ = joints;
-  Force::Custom(forces_, new JointForces(matter_, std::move(joints), std::move(anchors)));
+  Force::Custom(forces_, new JointForces(matter_, std::move(joints), std::move(anchors), {}, std::move(points)));
 }
 
 }  // namespace scoleid::model

@@ -7,8 +7,10 @@ namespace scoleid::model {
 using namespace SimTK;
 
 JointForces::JointForces(const SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
-                         std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative)
-    : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)), relative_(std::move(relative)) {}
+                         std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative,
+                         std::vector<PointSpring> points)
+    : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)), relative_(std::move(relative)),
+      points_(std::move(points)) {}
 
 namespace {
 double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB[1][0], R_GB[0][0]); }
@@ -48,6 +50,12 @@ void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces
     b.applyBodyTorque(state, torque, body_forces);
     r.applyBodyTorque(state, -torque, body_forces);
   }
+  for (const auto& p : points_) {
+    const MobilizedBody& b = matter_.getMobilizedBody(p.body);
+    const Real y = b.findStationLocationInGround(state, p.station)[1];
+    const Real v = b.findStationVelocityInGround(state, p.station)[1];
+    b.applyForceToBodyPoint(state, p.station, Vec3(0, -p.k * y - p.c * v, 0), body_forces);
+  }
 }
 
 Real JointForces::calcPotentialEnergy(const State& state) const {
@@ -59,6 +67,10 @@ Real JointForces::calcPotentialEnergy(const State& state) const {
   for (const auto& a : anchors_) {
     const Real theta = planar_angle(matter_.getMobilizedBody(a.body).getBodyRotation(state));
     e += 0.5 * a.k * theta * theta;
+  }
+  for (const auto& p : points_) {
+    const Real y = matter_.getMobilizedBody(p.body).findStationLocationInGround(state, p.station)[1];
+    e += 0.5 * p.k * y * y;
   }
   return e;
 }

@@ -1,7 +1,10 @@
 #include "scoleid/identify/fe/analytic_beam.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 
 namespace scoleid::identify::analytic {
 
@@ -60,6 +63,78 @@ std::vector<double> beta_L_tip_mass(double mu, double j, int count) {
 
 double omega(double betaL, double L, double EI, double rhoA) {
   return betaL * betaL * std::sqrt(EI / (rhoA * L * L * L * L));
+}
+
+namespace {
+
+using Z = std::array<std::array<double, 2>, 4>;  // z for each of the left end's two unknowns
+
+// The 2 × 2 determinant of the right end's conditions at ω (see the header).
+double end_determinant(const io::BeamSpec& b, const std::vector<io::PointElement>& elems, double w) {
+  const double EI = b.EI[0], beta = std::pow(b.rho_A * w * w / EI, 0.25);
+  Z z{};
+  // The left end: z's columns are the unknowns the end condition leaves.
+  using io::EndCondition;
+  const int free_rows[3][2] = {{1, 3}, {2, 3}, {0, 1}};  // pinned (w_s, Q), clamped (M, Q), free (w, w_s)
+  const int* rows = free_rows[b.left == EndCondition::Pinned ? 0 : b.left == EndCondition::Clamped ? 1 : 2];
+  z[static_cast<std::size_t>(rows[0])][0] = 1.0;
+  z[static_cast<std::size_t>(rows[1])][1] = 1.0;
+  auto jump = [&](const io::PointElement& e) {
+    for (int c = 0; c < 2; ++c) {
+      z[3][c] += (e.mass * w * w - e.k_w) * z[0][c];
+      z[2][c] -= (e.inertia * w * w - e.k_theta) * z[1][c];
+    }
+  };
+  auto carry = [&](double a) {
+    if (a <= 0.0) return;
+    const double x = beta * a, ch = std::cosh(x), sh = std::sinh(x), c = std::cos(x), s = std::sin(x);
+    const double S = 0.5 * (ch + c), T = 0.5 * (sh + s), U = 0.5 * (ch - c), V = 0.5 * (sh - s);
+    const double B = beta, B2 = B * B, B3 = B2 * B;
+    const double t[4][4] = {{S, T / B, U / (EI * B2), V / (EI * B3)},
+                            {B * V, S, T / (EI * B), U / (EI * B2)},
+                            {EI * B2 * U, EI * B * V, S, T / B},
+                            {EI * B3 * T, EI * B2 * U, B * V, S}};
+    Z out{};
+    for (int i = 0; i < 4; ++i)
+      for (int c = 0; c < 2; ++c)
+        for (int k = 0; k < 4; ++k) out[static_cast<std::size_t>(i)][c] += t[i][k] * z[static_cast<std::size_t>(k)][c];
+    z = out;
+  };
+  double at = 0.0;
+  for (const auto& e : elems) {
+    carry(e.location - at);
+    at = std::max(at, e.location);
+    jump(e);
+  }
+  carry(b.length - at);
+  const int end_rows[3][2] = {{0, 2}, {0, 1}, {2, 3}};  // pinned (w, M), clamped (w, w_s), free (M, Q)
+  const int* r = end_rows[b.right == EndCondition::Pinned ? 0 : b.right == EndCondition::Clamped ? 1 : 2];
+  const auto& a = z[static_cast<std::size_t>(r[0])];
+  const auto& c = z[static_cast<std::size_t>(r[1])];
+  // Scaled by cosh βL so that the function stays O(1) at large arguments.
+  return (a[0] * c[1] - a[1] * c[0]) / std::cosh(beta * b.length);
+}
+
+}  // namespace
+
+std::vector<double> point_element_omegas(const io::BeamSpec& b, int count) {
+  if (b.EI.size() != 1) throw std::invalid_argument("point_element_omegas: a uniform beam (one EI)");
+  std::vector<io::PointElement> elems = b.supports;
+  elems.insert(elems.end(), b.attachments.begin(), b.attachments.end());
+  if (b.tip_mass > 0.0 || b.tip_inertia > 0.0) {
+    io::PointElement tip{"tip", b.length};
+    tip.mass = b.tip_mass;
+    tip.inertia = b.tip_inertia;
+    elems.push_back(tip);
+  }
+  std::stable_sort(elems.begin(), elems.end(), [](const auto& x, const auto& y) { return x.location < y.location; });
+  // β L from a thousandth of the first pinned–pinned value in steps of a thousandth of π: the
+  // roots of an Euler–Bernoulli beam lie about π apart in β L.
+  const double L = b.length, scale = std::sqrt(b.EI[0] / (b.rho_A * L * L * L * L));
+  const auto f = [&](double bl) { return end_determinant(b, elems, bl * bl * scale); };
+  std::vector<double> bl = roots(f, count, 1e-3 * kPi);
+  for (double& x : bl) x = x * x * scale;
+  return bl;
 }
 
 double ss_static_point_load(double x, double a, double P, double L, double EI) {

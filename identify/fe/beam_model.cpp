@@ -141,6 +141,16 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("EI_" + std::to_string(s + 1));
   for (int s = 0; s < sections; ++s) m.coefficient_names.push_back("d_" + std::to_string(s + 1));
   m.coefficient_names.push_back("c_kv");
+  // The point elements' quantities, one coefficient each after c_kv (docs/theory.md §2.5).
+  for (const bool supports : {true, false})
+    for (const auto& e : supports ? beam.supports : beam.attachments)
+      for (const auto& [key, member] : io::point_element_fields())
+        if (e.*member > 0.0) {
+          fe.points.push_back({io::point_element_parameter(supports ? "supports" : "attachments", e, key), e.location,
+                               std::string(key), e.*member});
+          m.coefficient_names.push_back(fe.points.back().name);
+        }
+  m.ncoef += static_cast<int>(fe.points.size());
   m.dof_group.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < nfull; ++i) {
     const int r = fe.full_to_reduced[static_cast<std::size_t>(i)];
@@ -205,6 +215,23 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     if (rt >= 0 && beam.tip_inertia > 0.0) tip.emplace_back(rt, rt, beam.tip_inertia);
     if (!tip.empty()) m.mass.push_back({to_sparse(tip), -1});
   }
+  // A point element at s: m N Nᵀ and J N′N′ᵀ in M, k_w N Nᵀ and k_θ N′N′ᵀ in K, c_w N Nᵀ and
+  // c_θ N′N′ᵀ in D, N (N′) the displacement (slope) row at s (docs/theory.md §2.5). Each row lies
+  // on one element's DOFs, so the operators keep the mesh's pattern.
+  for (std::size_t k = 0; k < fe.points.size(); ++k) {
+    const auto& p = fe.points[k];
+    const bool slope = p.field == "inertia" || p.field == "k_theta" || p.field == "c_theta";
+    const Eigen::RowVectorXd row = slope ? fe.rotation_row(p.location) : fe.displacement_row(p.location);
+    std::vector<Trip> t;
+    for (int a = 0; a < n; ++a)
+      if (row[a] != 0.0)
+        for (int b = 0; b < n; ++b)
+          if (row[b] != 0.0) t.emplace_back(a, b, row[a] * row[b]);
+    OperatorTerm term{to_sparse(t), fe.coef_point(static_cast<int>(k))};
+    if (p.field == "mass" || p.field == "inertia") m.mass.push_back(std::move(term));
+    else if (p.field == "k_w" || p.field == "k_theta") m.stiffness.push_back(std::move(term));
+    else m.damping.push_back(std::move(term));
+  }
 
   add_beam_inputs(fe, beam, inputs, source);
   add_beam_sensors(fe, beam, sensors, source);
@@ -220,6 +247,7 @@ VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<dou
     c[fe.coef_chen_russell(s)] = 2.0 * zeta * std::sqrt(rho_A * ei);
   }
   c[fe.coef_kelvin_voigt()] = c_kv;
+  for (std::size_t k = 0; k < fe.points.size(); ++k) c[fe.coef_point(static_cast<int>(k))] = fe.points[k].value;
   return c;
 }
 
@@ -264,6 +292,11 @@ ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) 
   sp.quantities.push_back("c_kv");
   sp.value.push_back(beam.c_kv);
   sp.true_value.push_back(true);
+  for (const auto& p : fe.points) {
+    sp.quantities.push_back(p.name);
+    sp.value.push_back(p.value);
+    sp.true_value.push_back(true);
+  }
   sp.groups.push_back(ei);
   sp.rho_A = 0;
   sp.q3_quantity = N + 2;
@@ -272,8 +305,11 @@ ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) 
   sp.ncoef = fe.model.ncoef;
   // φ = [ρA, EI_1..EI_N, ζ, c_kv] → c = [ρA, EI_1..EI_N, d_1..d_N, c_kv], d_k = 2ζ√(ρA EI_k)
   // (Chen–Russell), c_kv as is (Kelvin–Voigt); docs/theory.md §2.2.
-  sp.coefficients = [N](const std::vector<ParameterSpace::Cd>& f) {
-    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(2 + 2 * N));
+  // The point elements' quantities follow c_kv in both.
+  const int P = static_cast<int>(fe.points.size());
+  sp.coefficients = [N, P](const std::vector<ParameterSpace::Cd>& f) {
+    std::vector<ParameterSpace::Cd> c(static_cast<std::size_t>(2 + 2 * N + P));
+    for (int k = 0; k < P; ++k) c[static_cast<std::size_t>(2 + 2 * N + k)] = f[static_cast<std::size_t>(N + 3 + k)];
     c[0] = f[0];
     for (int k = 0; k < N; ++k) {
       c[static_cast<std::size_t>(1 + k)] = f[static_cast<std::size_t>(1 + k)];

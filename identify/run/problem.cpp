@@ -577,27 +577,53 @@ std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col,
   return v;
 }
 
-// An input driven by its column (piecewise linear), with its largest jump within one sample.
+// A pulse over at most this many samples (above a tenth of its peak) is an impact.
+constexpr int kImpactSamples = 8;
+bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable& tab, const std::vector<double>& f);
+
+// An input driven by its column, read between samples as inputs[i].interpolation says (auto:
+// cubic unless the column jumps, then piecewise linear), with its largest jump within one sample.
 void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
   const auto& in = p.scenario.inputs[i];
   const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, io::to_string(in.kind), in.unit, in.column_unit);
-  p.signals[i] = io::Signal::table(tab.t, f);
   p.columns.inputs_from_data.push_back(in.name);
+  const bool stepped = add_stepped_input(p, in, tab, f);
+  const bool cubic = in.interpolation == io::Interpolation::Cubic || (in.interpolation == io::Interpolation::Auto && !stepped);
+  p.signals[i] = cubic ? io::Signal::cubic_table(tab.t, f) : io::Signal::table(tab.t, f);
+  if (stepped) p.columns.stepped_inputs.back().cubic = cubic;
+  p.columns.input_interpolation.push_back(cubic ? io::Interpolation::Cubic : io::Interpolation::Linear);
+}
+
+// Whether the column jumps by more than a quarter of its range within one sample, in a step (a
+// change more than three times either neighbour's) or an impact (a pulse over a few samples); if it
+// does, it is listed among the stepped inputs (ColumnUse), its largest jump and where.
+bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable& tab, const std::vector<double>& f) {
   const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
   ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
+  std::size_t at = 0;
   for (std::size_t k = 1; k < f.size(); ++k)
     if (std::abs(f[k] - f[k - 1]) > st.jump) {
       st.jump = std::abs(f[k] - f[k - 1]);
       st.at = tab.t[k];
       st.sample = tab.t[k] - tab.t[k - 1];
+      at = k;
     }
-  if (!(*hi > *lo && st.jump > 0.25 * (*hi - *lo))) return;
+  if (!(*hi > *lo && st.jump > 0.25 * (*hi - *lo))) return false;
   if (std::abs(f.back() - f.front()) < 0.25 * (*hi - *lo)) {
     const double peak = std::max(std::abs(*hi - f.front()), std::abs(*lo - f.front()));
     st.pulse_samples = static_cast<int>(
         std::count_if(f.begin(), f.end(), [&](double x) { return std::abs(x - f.front()) > 0.1 * peak; }));
   }
+  // A jump, or an impact over a few samples; not a smooth signal sampled a few times a period (a
+  // sampled harmonic's largest change is at most 1/cos(ω Δt) times its neighbours', under 3 down
+  // to 5 samples a period).
+  const double before = at >= 2 ? std::abs(f[at - 1] - f[at - 2]) : 0.0;
+  const double after = at + 1 < f.size() ? std::abs(f[at + 1] - f[at]) : 0.0;
+  const bool isolated = st.jump > 3.0 * std::max(before, after);
+  const bool impact = st.pulse_samples > 0 && st.pulse_samples <= kImpactSamples;
+  if (!isolated && !impact) return false;
   p.columns.stepped_inputs.push_back(st);
+  return true;
 }
 
 // The measurements from the table's sensor columns, the inputs from theirs (signal_from), and

@@ -183,7 +183,10 @@ json data_columns_json(const ColumnUse& c) {
   json stepped = json::array();
   for (const auto& st : c.stepped_inputs)
     stepped.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at}, {"switch_shift_up_to", 0.5 * st.sample},
-                       {"scenario_gives_signal", st.scenario_signal}, {"pulse_samples", st.pulse_samples}});
+                       {"scenario_gives_signal", st.scenario_signal}, {"pulse_samples", st.pulse_samples},
+                       {"interpolation", st.cubic ? "cubic" : "linear"}});
+  json interpolation = json::array();
+  for (const auto k : c.input_interpolation) interpolation.push_back(io::to_string(k));
   json sources = json::array();
   for (const auto& x : c.sources)
     sources.push_back({{"name", x.name}, {"column", x.column}, {"column_unit", x.from_unit}, {"unit_stated_by", x.unit_stated_by},
@@ -191,6 +194,7 @@ json data_columns_json(const ColumnUse& c) {
   return {{"sensors", c.sensors},
           {"sources", sources},
           {"inputs_from_data", c.inputs_from_data},
+          {"input_interpolation", interpolation},
           {"inputs_from_scenario", c.inputs_from_scenario},
           {"unused", c.unused},
           {"stepped_inputs", stepped}};

@@ -39,6 +39,14 @@ void check_kind(const std::string& yaml) {
 }  // namespace
 
 TEST(Gradient, PaperParametersWithTipBody) { check_kind(kPaper); }
+// Supports and attachments (docs/theory.md §2.5): every point-element quantity, a body between
+// nodes of the mesh.
+TEST(Gradient, SupportsAndAttachments) {
+  const std::string yaml = scoleid::test::test_scenario("gradient_test/grad-point-elements");
+  check_kind(yaml);
+  Case e = make_case(yaml, false);
+  test_support::expect_second_order(test_support::taylor_remainders(*e.obj, e.p->params->initial(), 13), 1, 5);
+}
 TEST(Gradient, PhysicalParameters) { check_kind(kPhysical); }
 TEST(Gradient, SectionalStiffnessMassAndDamping) { check_kind(kSections); }
 

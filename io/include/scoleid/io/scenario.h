@@ -9,7 +9,9 @@
 //
 //   name, description
 //   structure: beam | scole
-//   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, c_kv, tip_mass, tip_inertia }
+//   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, c_kv, tip_mass, tip_inertia,
+//                supports: { left|right: { k_w, k_theta, c_w, c_theta } },
+//                attachments: [ { name, location, mass, inertia, k_w, k_theta, c_w, c_theta } ] }
 //   scole:     see ScoleSpec
 //   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
@@ -31,6 +33,7 @@
 // rotation beyond the small-rotation bound unless truth.large_motion is set.
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -51,6 +54,23 @@ const char* to_string(EndCondition e);
 // pinned–pinned beam has damping ratio exactly zeta; d follows EI section by section), and c_kv,
 // the Kelvin–Voigt (strain-rate) coefficient in units of EI × time (N·m²·s), one value for the
 // whole beam. Both >= 0.
+// A point element at station s of a member (docs/theory.md §2.5): a rigid mass m with rotary
+// inertia J riding on the member's displacement w(s) and slope w_s(s), and springs and dashpots
+// from that point to ground, k_w, c_w on w(s) and k_theta, c_theta on w_s(s). Every quantity is a
+// named, estimable parameter when it is > 0 (point_element_quantities).
+struct PointElement {
+  std::string name;
+  double location = 0.0;
+  double mass = 0.0, inertia = 0.0;
+  double k_w = 0.0, k_theta = 0.0, c_w = 0.0, c_theta = 0.0;
+};
+// The quantities of a point element by field name (mass, inertia, k_w, k_theta, c_w, c_theta), in
+// that order.
+std::vector<std::pair<const char*, double PointElement::*>> point_element_fields();
+// The parameter name of a point element's quantity: "supports.left.k_theta",
+// "attachments.clamp.mass" (`group` is "supports" or "attachments").
+std::string point_element_parameter(const std::string& group, const PointElement& e, const char* field);
+
 struct BeamSpec {
   double length = 10.0;
   EndCondition left = EndCondition::Pinned;
@@ -61,6 +81,13 @@ struct BeamSpec {
   double c_kv = 0.0;   // Kelvin–Voigt coefficient (EI × time)
   double tip_mass = 0.0;     // rigid mass at s = length
   double tip_inertia = 0.0;  // its rotary inertia about the bending axis
+  // An end's springs and dashpots to ground (`supports: {left: {...}, right: {...}}`), acting on
+  // the degrees of freedom the end condition leaves free (a compliant clamp: `left: pinned` with
+  // supports.left.k_theta). Each PointElement's name is its end, its location the end's station.
+  std::vector<PointElement> supports;
+  // Point elements at stations of the beam (`attachments: [{name, location, ...}]`): a sensor's or
+  // a fixture's mass, a grounded spring. docs/theory.md §2.5.
+  std::vector<PointElement> attachments;
 };
 
 struct RigidBodySpec {
@@ -139,6 +166,13 @@ struct InputSpec : PointSpec {
   // same name when there is one, else by `signal`; "data" requires the column (an error if it is
   // missing); "scenario" always uses `signal`. The truth always uses `signal`.
   SignalFrom signal_from = SignalFrom::Auto;
+  // How a column that drives the input is read between its samples: "linear" (piecewise linear:
+  // a jump stays within its sample), "cubic" (the 4-point Lagrange cubic through the neighbouring
+  // samples: midway between samples a smooth force's harmonic at f keeps 1 − (π f Δt)²/2 of its
+  // amplitude read linearly, 1 − 3 (2π f Δt)⁴/128 read cubically: at 20 samples a period 1.2 %
+  // against 0.05 %), "auto" (linear for a column that jumps — a step, or an impact over a few
+  // samples — cubic otherwise).
+  Interpolation interpolation = Interpolation::Auto;
   Signal signal;
   // The data column that drives it (free text, e.g. "Hammer [N]"); "" = the column named `name`.
   std::string column;

@@ -12,6 +12,7 @@
 //   Site        inputs[].at, sensors[].at            the body a sensor or input is on (§3.5, §4)
 //   InputKind   inputs[].kind                        what an input applies: a force or a moment
 //   SignalFrom  inputs[].signal_from                 what drives an input with a data file (§9)
+//   Interpolation inputs[].interpolation             how an input's column is read between samples
 //
 // Adding a value: one enumerator and one row of its table, here; the reader, --help and the JSON
 // writers follow, and a switch over the type that misses it is a compiler warning. A sensor kind
@@ -36,6 +37,7 @@ enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSi
 enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
 enum class InputKind { Force, Moment };
 enum class SignalFrom { Auto, Data, Scenario };
+enum class Interpolation { Auto, Linear, Cubic };
 
 // Each type's names, in declaration order (the first is the default where a field has one).
 template <class E>
@@ -97,6 +99,11 @@ template <>
 struct Names<SignalFrom> {
   static constexpr std::array<std::pair<SignalFrom, const char*>, 3> rows{
       {{SignalFrom::Auto, "auto"}, {SignalFrom::Data, "data"}, {SignalFrom::Scenario, "scenario"}}};
+};
+template <>
+struct Names<Interpolation> {
+  static constexpr std::array<std::pair<Interpolation, const char*>, 3> rows{
+      {{Interpolation::Auto, "auto"}, {Interpolation::Linear, "linear"}, {Interpolation::Cubic, "cubic"}}};
 };
 
 // A site along which a location is measured: the beam or the mast (a station s ∈ [0, L]).

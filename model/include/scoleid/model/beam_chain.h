@@ -21,6 +21,13 @@
 //         clamped: the same plus an AnchorSpring on the last segment; free: nothing.
 // A tip mass sits at s = L; with rotary inertia it is a body on a Pin at s = L carrying the
 // end-cell spring 2EI/h (the free-end Hencky treatment, which keeps the tip rotation O(h^2)).
+// Point elements (supports and attachments, docs/theory.md §2.5) ride on the bar holding their
+// station: a mass at its point of the bar, a rotary inertia added to the bar's; a grounded
+// translational spring-dashpot a PointSpring at that point (joint_forces.h). A rotational one at an
+// end acts in series with the end cell's joint spring (the Pin's spring at the left end, an
+// AnchorSpring on the last bar or on the tip body at the right); at an interior station it is an
+// AnchorSpring on its bar, whose angle is the bar's mean slope (O(h), where the element's own
+// rotation is the slope at its station).
 // Valid for small rotations in the sense of the PDE; the chain itself is geometrically exact.
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/structure.h"

@@ -4,7 +4,8 @@
 // Each JointSpring acts on one mobility (a joint rotation q with speed u = qdot, as for Pin and
 // Gimbal mobilizers): generalized force f = -k q - c u, potential energy 1/2 k q^2. Mobility
 // forces are internal: they act equally and oppositely on the two bodies of the joint, so they
-// conserve the system's linear and angular momentum. An AnchorSpring ties a planar body's
+// conserve the system's linear and angular momentum. A PointSpring ties a body's station to
+// ground along y. An AnchorSpring ties a planar body's
 // absolute rotation about ground z to zero (a clamped end that is not the chain's root):
 // torque -k theta - c omega_z on the body. A RelativeDamper damps a body's angular velocity
 // relative to a reference body, per axis of the reference frame: torque -R_GR diag(c) R_GR^T
@@ -25,6 +26,16 @@ struct AnchorSpring {
   double c = 0.0;
 };
 
+// A translational spring-dashpot from a body's station to ground along ground y (a planar
+// structure's grounded spring at a point, docs/theory.md §2.5): force (0, -k y - c v_y, 0) at the
+// station, y and v_y its ground position and velocity along y; potential energy 1/2 k y^2.
+struct PointSpring {
+  SimTK::MobilizedBodyIndex body;
+  SimTK::Vec3 station{0.0};  // in the body's frame
+  double k = 0.0;
+  double c = 0.0;
+};
+
 struct RelativeDamper {
   SimTK::MobilizedBodyIndex body, reference;
   SimTK::Vec3 c{0.0};  // about the reference frame's x, y, z axes
@@ -33,7 +44,8 @@ struct RelativeDamper {
 class JointForces : public SimTK::Force::Custom::Implementation {
 public:
   JointForces(const SimTK::SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
-              std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative = {});
+              std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative = {},
+              std::vector<PointSpring> points = {});
   void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
                  SimTK::Vector_<SimTK::Vec3>& particle_forces,
                  SimTK::Vector& mobility_forces) const override;
@@ -51,6 +63,7 @@ private:
   std::vector<JointSpring> joints_;
   std::vector<AnchorSpring> anchors_;
   std::vector<RelativeDamper> relative_;
+  std::vector<PointSpring> points_;
 };
 
 }  // namespace scoleid::model

@@ -19,6 +19,8 @@
 // modal series: w(x,t) = Σ_k (2P / (ρA L ω_k²)) sin(kπa/L) sin(kπx/L) (1 − cos ω_k t).
 #include <vector>
 
+#include "scoleid/io/scenario.h"
+
 namespace scoleid::identify::analytic {
 
 enum class Support { PinnedPinned, ClampedFree, FreeFree, ClampedClamped };
@@ -27,6 +29,17 @@ std::vector<double> beta_L(Support s, int count);
 std::vector<double> beta_L_tip_mass(double mu, double j, int count);
 // ω_k from β_k L
 double omega(double betaL, double L, double EI, double rhoA);
+
+// The first `count` nonzero natural frequencies ω [rad/s] of a uniform beam (one EI) with any end
+// conditions, its tip body and its point elements (supports, attachments: masses, rotary inertias
+// and springs; dashpots and ζ, c_kv ignored), exactly: the field z = (w, w_s, EI w_ss, EI w_sss)
+// carried along each stretch between stations by the transfer matrix of the uniform beam at ω
+// (Krylov–Duncan functions of β x, β⁴ = ρA ω²/EI), with the jumps a point element makes at its
+// station (docs/theory.md §2.5):
+//   [EI w_sss] = (m ω² − k_w) w(s_p),   [EI w_ss] = −(J ω² − k_θ) w_s(s_p),
+// the left end's two free unknowns carried to the right end, whose two conditions vanish at a
+// natural frequency. Roots by scanning for sign changes of the 2 × 2 determinant and bisection.
+std::vector<double> point_element_omegas(const io::BeamSpec& beam, int count);
 
 double ss_static_point_load(double x, double a, double P, double L, double EI);
 double cantilever_static_tip_load(double x, double P, double L, double EI);

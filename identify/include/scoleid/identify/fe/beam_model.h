@@ -12,8 +12,9 @@
 //
 // Hermite cubic elements on a uniform mesh; EI piecewise constant on N equal sections;
 // ends pinned (w = 0), clamped (w = w_s = 0) or free (natural conditions); optional rigid tip
-// mass and rotary inertia at s = L. Constrained DOFs are eliminated.
-// Coefficients: c = [ρA, EI_1..EI_N, d_1..d_N, c_kv]. Operators: M = ρA M_1 (+ tip body),
+// mass and rotary inertia at s = L; point elements (supports, attachments: masses, rotary
+// inertias, springs and dashpots to ground) at any station. Constrained DOFs are eliminated.
+// Coefficients: c = [ρA, EI_1..EI_N, d_1..d_N, c_kv, the point elements' quantities]. Operators: M = ρA M_1 (+ tip body),
 // K = Σ_k EI_k K_k, D = Σ_k d_k G_k + c_kv Σ_k K_k, with K_k = ∫_{section k} N″N″ᵀ ds and
 // G_k = ∫_{section k} N′N′ᵀ ds (hermite_beam.h). Loads and sensors anywhere on the beam, through
 // the shape functions (a sensor between nodes reads the interpolated field).
@@ -32,11 +33,21 @@ struct BeamFE {
   int elements = 0;
   int sections = 0;
   std::vector<int> full_to_reduced;  // 2 per node: (w, θ); -1 where constrained
+  // The point elements' quantities (supports and attachments, docs/theory.md §2.5), each > 0 and
+  // one coefficient of its own after c_kv: its parameter name, station, field and value.
+  struct PointQuantity {
+    std::string name;
+    double location = 0.0;
+    std::string field;  // mass, inertia, k_w, k_theta, c_w, c_theta
+    double value = 0.0;
+  };
+  std::vector<PointQuantity> points;
 
   int coef_rho_A() const { return 0; }
   int coef_EI(int s) const { return 1 + s; }
   int coef_chen_russell(int s) const { return 1 + sections + s; }  // d_s
   int coef_kelvin_voigt() const { return 1 + 2 * sections; }        // c_kv
+  int coef_point(int k) const { return 2 + 2 * sections + k; }      // points[k]
 
   // Rows acting on the reduced DOF vector.
   Eigen::RowVectorXd displacement_row(double s) const;
@@ -55,7 +66,7 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
 VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta, double c_kv = 0.0);
 
 // The beam's parameter space (physical_parameterization.h): φ = [ρA, EI_1..EI_N (the model's N
-// sections), ζ, c_kv], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
+// sections), ζ, c_kv, the point elements' quantities (supports.left.k_theta, attachments.clamp.mass)], the group EI (every section), the paper form q1 = EI/ρA, q2 = 1/ρA,
 // q3 = c_kv/ρA (uniform beams only; ζ is held). φ's values: the scenario's beam (sections expanded
 // to the model's; a model section's true EI is known when it lies inside one scenario section).
 ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam);

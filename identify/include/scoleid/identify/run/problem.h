@@ -49,6 +49,7 @@ struct DataContent {
 struct ColumnUse {
   std::vector<std::string> sensors;               // matched to the scenario's sensors
   std::vector<std::string> inputs_from_data;      // inputs driven by their column
+  std::vector<io::Interpolation> input_interpolation;  // how each of them is read between samples
   std::vector<std::string> inputs_from_scenario;  // inputs driven by the scenario's signal
   std::vector<std::string> unused;                // columns that matched nothing
   // Where each sensor's and data-driven input's values came from: its column, the column's unit
@@ -59,8 +60,9 @@ struct ColumnUse {
     double scale = 1.0;
   };
   std::vector<Source> sources;
-  // An input driven by its column that jumps by more than a quarter of its range within one sample:
-  // between samples the column is piecewise linear, so each jump (a step, a bang-bang switch) is
+  // An input driven by its column that jumps by more than a quarter of its range within one sample,
+  // in a step (a change more than three times its neighbours') or an impact (a pulse over at most
+  // 8 samples): between samples such a column is read piecewise linearly (interpolation auto), so each jump (a step, a bang-bang switch) is
   // spread over a sample and its centre moved by up to half a sample, which a ringing structure's
   // phase feels (docs/theory.md §11.3).
   struct SteppedInput {
@@ -70,6 +72,7 @@ struct ColumnUse {
     // A pulse (an impact): the signal ends where it began (within a quarter of its range), and
     // `pulse_samples` samples hold more than a tenth of its peak. 0 for a step.
     int pulse_samples = 0;
+    bool cubic = false;  // read cubically all the same (interpolation: cubic): it overshoots at each jump
   };
   std::vector<SteppedInput> stepped_inputs;
 };
