@@ -66,6 +66,16 @@ int run_experiments_command(const std::string& file, std::string out, std::optio
     for (const auto& x : r.experiments) std::printf(" %14s", sd(x.alone, i).c_str());
     std::printf("\n");
   }
+  if (r.interval.half_width.size() == r.estimate.size()) {
+    std::printf("\n%-10s %14s %14s   (%s)\n", "parameter", "± interval", "identifiable", r.interval.note.c_str());
+    for (std::size_t i = 0; i < r.names.size(); ++i) {
+      const double w = r.interval.half_width[static_cast<Eigen::Index>(i)];
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.4g", w);
+      std::printf("%-10s %14s %14s\n", r.names[i].c_str(), std::isfinite(w) ? buf : "-",
+                  r.ident.identifiable[i] ? "yes" : ("no: " + r.ident.reason[i]).c_str());
+    }
+  }
   std::printf("\n%-12s %-6s %10s %12s  %s\n", "experiment", "kind", "share", "data values", "fit");
   for (const auto& x : r.experiments)
     std::printf("%-12s %-6s %10.4f %12ld  %s\n", x.name.c_str(), x.kind.c_str(), x.share, x.data_values, x.fit_message.c_str());

@@ -416,16 +416,24 @@ void check_point_elements(const std::string& source, const std::string& path, Be
     check_attached_inertia(source, f + ".inertia", e.inertia, m, L);
     if (const EndCondition* ec = end_at(e.location)) {
       const std::string end = e.location == 0.0 ? "left" : "right";
-      if (*ec != EndCondition::Free && (e.k_w > 0.0 || e.c_w > 0.0))
-        fail_field(source, f + (e.k_w > 0.0 ? ".k_w" : ".c_w"),
-                   "acts on the " + end + " end's displacement, which the " + to_string(*ec) +
-                       " end holds (an elastic end is `" + end + ": free` with its springs)",
-                   format_value(e.k_w > 0.0 ? e.k_w : e.c_w));
-      if (*ec == EndCondition::Clamped && (e.k_theta > 0.0 || e.c_theta > 0.0))
-        fail_field(source, f + (e.k_theta > 0.0 ? ".k_theta" : ".c_theta"),
-                   "acts on the " + end + " end's slope, which the clamped end holds (a compliant clamp is `" + end +
-                       ": pinned` with supports." + end + ".k_theta)",
-                   format_value(e.k_theta > 0.0 ? e.k_theta : e.c_theta));
+      // What acts on a held degree of freedom would be a parameter no data can see.
+      for (const char* key : {"mass", "k_w", "c_w"}) {
+        const double v = e.*(key == std::string("mass") ? &PointElement::mass : key == std::string("k_w") ? &PointElement::k_w : &PointElement::c_w);
+        if (*ec != EndCondition::Free && v > 0.0)
+          fail_field(source, f + "." + key,
+                     "acts on the " + end + " end's displacement, which the " + to_string(*ec) +
+                         " end holds (an elastic end is `" + end + ": free` with its springs)",
+                     format_value(v));
+      }
+      for (const char* key : {"inertia", "k_theta", "c_theta"}) {
+        const double v =
+            e.*(key == std::string("inertia") ? &PointElement::inertia : key == std::string("k_theta") ? &PointElement::k_theta : &PointElement::c_theta);
+        if (*ec == EndCondition::Clamped && v > 0.0)
+          fail_field(source, f + "." + key,
+                     "acts on the " + end + " end's slope, which the clamped end holds (a compliant clamp is `" + end +
+                         ": pinned` with supports." + end + ".k_theta)",
+                     format_value(v));
+      }
     }
   };
   for (const auto& s : b.supports) check(path + ".supports." + s.name, s);

@@ -9,6 +9,19 @@ namespace scoleid::model {
 
 using namespace SimTK;
 
+double end_rotational_spring(const io::BeamSpec& beam, int end) {
+  double k = 0.0;
+  for (const auto* group : {&beam.supports, &beam.attachments})
+    for (const auto& e : *group)
+      if (e.location == (end == 0 ? 0.0 : beam.length)) k += e.k_theta;
+  return k;
+}
+
+double end_series_stiffness(const io::BeamSpec& beam, int end, double k0) {
+  const double k = end_rotational_spring(beam, end);
+  return k > 0.0 ? k * k0 / (k + k0) : 0.0;
+}
+
 BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
   length_ = beam.length;
   root_R_ = Vec3(0);

@@ -1,5 +1,7 @@
 #include "scoleid/model/sensors.h"
 
+#include "scoleid/model/beam_chain.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -52,11 +54,17 @@ void resolve_strain(const io::BeamSpec& beam, const Structure& st, const io::Sen
   const auto& seg = st.segment_bodies();
   auto joint = [&](int j) {
     ResolvedSensor::Joint jt;
+    // An end's rotational spring (supports, attachments) acts in series with the end cell's: the
+    // joint carries the series stiffness (beam_chain.h).
     if (j == 0) {
       if (beam.left == io::EndCondition::Clamped) jt = {MobilizedBodyIndex(), seg.front(), lumping.stiffness.front()};
+      else if (const double k = end_series_stiffness(beam, 0, lumping.stiffness.front()); k > 0.0)
+        jt = {MobilizedBodyIndex(), seg.front(), k};
     } else if (j == n) {
       if (st.tip_body().isValid()) jt = {seg.back(), st.tip_body(), lumping.stiffness.back()};
       else if (beam.right == io::EndCondition::Clamped) jt = {seg.back(), MobilizedBodyIndex(), lumping.stiffness.back()};
+      else if (const double k = end_series_stiffness(beam, 1, lumping.stiffness.back()); k > 0.0)
+        jt = {seg.back(), MobilizedBodyIndex(), k};
     } else {
       jt = {seg[static_cast<std::size_t>(j - 1)], seg[static_cast<std::size_t>(j)], lumping.stiffness[static_cast<std::size_t>(j)]};
     }

@@ -69,36 +69,51 @@ namespace {
 
 using Z = std::array<std::array<double, 2>, 4>;  // z for each of the left end's two unknowns
 
-// The 2 × 2 determinant of the right end's conditions at ω (see the header).
+// The 2 × 2 determinant of the right end's conditions at ω (see the header), in the scaled field
+// ẑ = (w, w_s/β, w_ss/β², w_sss/β³), whose transfer matrix over a stretch a is [[S T U V] [V S T U]
+// [U V S T] [T U V S]] of β a. Carried in steps of β a <= 1 with the two columns orthonormalised
+// after each (Gram–Schmidt with positive diagonal: the determinant keeps its sign and stays O(1),
+// where the plain product would lose it to cancellation between terms of size e^{2βL}).
 double end_determinant(const io::BeamSpec& b, const std::vector<io::PointElement>& elems, double w) {
   const double EI = b.EI[0], beta = std::pow(b.rho_A * w * w / EI, 0.25);
   Z z{};
-  // The left end: z's columns are the unknowns the end condition leaves.
   using io::EndCondition;
   const int free_rows[3][2] = {{1, 3}, {2, 3}, {0, 1}};  // pinned (w_s, Q), clamped (M, Q), free (w, w_s)
   const int* rows = free_rows[b.left == EndCondition::Pinned ? 0 : b.left == EndCondition::Clamped ? 1 : 2];
   z[static_cast<std::size_t>(rows[0])][0] = 1.0;
   z[static_cast<std::size_t>(rows[1])][1] = 1.0;
+  auto orthonormalise = [&] {
+    double n0 = 0.0, d = 0.0, n1 = 0.0;
+    for (int i = 0; i < 4; ++i) n0 += z[static_cast<std::size_t>(i)][0] * z[static_cast<std::size_t>(i)][0];
+    n0 = std::sqrt(n0);
+    for (auto& r : z) r[0] /= n0;
+    for (const auto& r : z) d += r[0] * r[1];
+    for (auto& r : z) r[1] -= d * r[0];
+    for (const auto& r : z) n1 += r[1] * r[1];
+    n1 = std::sqrt(n1);
+    for (auto& r : z) r[1] /= n1;
+  };
   auto jump = [&](const io::PointElement& e) {
     for (int c = 0; c < 2; ++c) {
-      z[3][c] += (e.mass * w * w - e.k_w) * z[0][c];
-      z[2][c] -= (e.inertia * w * w - e.k_theta) * z[1][c];
+      z[3][c] += (e.mass * w * w - e.k_w) / (EI * beta * beta * beta) * z[0][c];
+      z[2][c] -= (e.inertia * w * w - e.k_theta) / (EI * beta) * z[1][c];
     }
   };
   auto carry = [&](double a) {
     if (a <= 0.0) return;
-    const double x = beta * a, ch = std::cosh(x), sh = std::sinh(x), c = std::cos(x), s = std::sin(x);
+    const int steps = std::max(1, static_cast<int>(std::ceil(beta * a)));
+    const double x = beta * a / steps, ch = std::cosh(x), sh = std::sinh(x), c = std::cos(x), s = std::sin(x);
     const double S = 0.5 * (ch + c), T = 0.5 * (sh + s), U = 0.5 * (ch - c), V = 0.5 * (sh - s);
-    const double B = beta, B2 = B * B, B3 = B2 * B;
-    const double t[4][4] = {{S, T / B, U / (EI * B2), V / (EI * B3)},
-                            {B * V, S, T / (EI * B), U / (EI * B2)},
-                            {EI * B2 * U, EI * B * V, S, T / B},
-                            {EI * B3 * T, EI * B2 * U, B * V, S}};
-    Z out{};
-    for (int i = 0; i < 4; ++i)
-      for (int c = 0; c < 2; ++c)
-        for (int k = 0; k < 4; ++k) out[static_cast<std::size_t>(i)][c] += t[i][k] * z[static_cast<std::size_t>(k)][c];
-    z = out;
+    const double t[4][4] = {{S, T, U, V}, {V, S, T, U}, {U, V, S, T}, {T, U, V, S}};
+    for (int k = 0; k < steps; ++k) {
+      Z out{};
+      for (int i = 0; i < 4; ++i)
+        for (int col = 0; col < 2; ++col)
+          for (int m = 0; m < 4; ++m)
+            out[static_cast<std::size_t>(i)][col] += t[i][m] * z[static_cast<std::size_t>(m)][col];
+      z = out;
+      orthonormalise();
+    }
   };
   double at = 0.0;
   for (const auto& e : elems) {
@@ -111,8 +126,7 @@ double end_determinant(const io::BeamSpec& b, const std::vector<io::PointElement
   const int* r = end_rows[b.right == EndCondition::Pinned ? 0 : b.right == EndCondition::Clamped ? 1 : 2];
   const auto& a = z[static_cast<std::size_t>(r[0])];
   const auto& c = z[static_cast<std::size_t>(r[1])];
-  // Scaled by cosh βL so that the function stays O(1) at large arguments.
-  return (a[0] * c[1] - a[1] * c[0]) / std::cosh(beta * b.length);
+  return a[0] * c[1] - a[1] * c[0];
 }
 
 }  // namespace

@@ -220,6 +220,9 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   // on one element's DOFs, so the operators keep the mesh's pattern.
   for (std::size_t k = 0; k < fe.points.size(); ++k) {
     const auto& p = fe.points[k];
+    if (!(p.location >= 0.0 && p.location <= beam.length))  // a station moved by identification.uncertain
+      fail_field(source, "beam." + p.name.substr(0, p.name.rfind('.')) + ".location",
+                 "must lie on the beam [0, " + format_value(beam.length) + "]", format_value(p.location));
     const bool slope = p.field == "inertia" || p.field == "k_theta" || p.field == "c_theta";
     const Eigen::RowVectorXd row = slope ? fe.rotation_row(p.location) : fe.displacement_row(p.location);
     std::vector<Trip> t;
@@ -236,6 +239,14 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   add_beam_inputs(fe, beam, inputs, source);
   add_beam_sensors(fe, beam, sensors, source);
   return fe;
+}
+
+double point_value(const BeamFE::PointQuantity& p, const io::BeamSpec& beam) {
+  for (const bool supports : {true, false})
+    for (const auto& e : supports ? beam.supports : beam.attachments)
+      for (const auto& [key, member] : io::point_element_fields())
+        if (io::point_element_parameter(supports ? "supports" : "attachments", e, key) == p.name) return e.*member;
+  return std::nan("");
 }
 
 VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta, double c_kv) {
@@ -292,10 +303,13 @@ ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) 
   sp.quantities.push_back("c_kv");
   sp.value.push_back(beam.c_kv);
   sp.true_value.push_back(true);
+  // The point elements' values in `beam` (a truth's may differ from the mesh's scenario; a
+  // quantity it lacks has no true value).
   for (const auto& p : fe.points) {
+    const double v = point_value(p, beam);
     sp.quantities.push_back(p.name);
-    sp.value.push_back(p.value);
-    sp.true_value.push_back(true);
+    sp.value.push_back(std::isnan(v) ? p.value : v);
+    sp.true_value.push_back(!std::isnan(v));
   }
   sp.groups.push_back(ei);
   sp.rho_A = 0;

@@ -1,5 +1,6 @@
 #include "scoleid/identify/fe/structure.h"
 
+#include <cmath>
 #include <functional>
 #include <map>
 
@@ -22,7 +23,10 @@ public:
     return std::make_unique<PhysicalParameterization>(beam_parameter_space(fe_, sc.beam), sc.identification, sc.source);
   }
   VectorXd coefficients(const io::Scenario& sc) const override {
-    return beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta, sc.beam.c_kv);
+    VectorXd c = beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta, sc.beam.c_kv);
+    for (std::size_t k = 0; k < fe_.points.size(); ++k)  // the point elements' values in sc (its truth's may differ)
+      if (const double v = point_value(fe_.points[k], sc.beam); !std::isnan(v)) c[fe_.coef_point(static_cast<int>(k))] = v;
+    return c;
   }
 
 private:

@@ -18,7 +18,7 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
   const bool refit = in.half_record_estimate.size() == P;
   if (refit) u.half_record_delta = in.estimate - in.half_record_estimate;
   if (smoothing) u.smoothing_delta = in.estimate - in.smoothing_estimate;
-  if (!refit) u.note = "no half-record refit: interval not assessed";
+  if (!refit && in.refit_applies) u.note = "no half-record refit: interval not assessed";
   else if (!in.half_record_converged) u.note = "the half-record refit did not converge: its shift is where it stopped";
   if (smoothing && !in.smoothing_converged)
     u.note += std::string(u.note.empty() ? "" : "; ") + "the refit at a tenth of the smoothness weight did not converge: its shift is where it stopped";
@@ -31,8 +31,8 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
     u.noise[i] = 2.0 * sd;
     u.residual[i] = 2.0 * res;
     u.noise_and_residual[i] = 2.0 * std::hypot(sd, res);
-    if (!refit) continue;
-    u.half_record_shift[i] = std::abs(in.estimate[i] - in.half_record_estimate[i]);
+    if (!refit && in.refit_applies) continue;
+    u.half_record_shift[i] = refit ? std::abs(in.estimate[i] - in.half_record_estimate[i]) : 0.0;
     u.half_width[i] = u.noise_and_residual[i] + u.half_record_shift[i] + c + u.smoothing_shift[i];
     u.too_wide[static_cast<std::size_t>(i)] = !(u.half_width[i] <= 0.5 * std::abs(in.estimate[i]));
   }

@@ -327,6 +327,28 @@ FisherInformation modal_experiment(ModalMisfit& modal, const io::ModalData& mode
   return fi;
 }
 
+// Measured modes alone: the interval from the noise (the file's stds) and residual terms of the
+// Fisher information (no half-record refit applies to a mode set; docs/theory.md §8.2), a parameter
+// whose interval exceeds half its value flagged as the time-domain assessment flags it.
+void modal_interval(ExperimentsResult& r, const ExperimentsProblem& ep) {
+  IntervalInputs in;
+  in.estimate = r.estimate;
+  in.refit_applies = false;
+  r.interval = uncertainty_interval(r.ident, in);
+  r.interval.note = "measured modes alone: noise (the file's stds) and residual terms only, no half-record refit";
+  if (!ep.modes_scenario->identification.uncertain.empty())
+    r.interval.note += "; the modes scenario's identification.uncertain is not in it";
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    if (!r.ident.identifiable[i] || !r.interval.too_wide[i]) continue;
+    r.ident.identifiable[i] = false;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "uncertainty interval ±%.3g is %.3g of the estimate: above 0.5 (the modes determine it only with others)",
+                  r.interval.half_width[e], r.interval.half_width[e] / std::abs(r.estimate[e]));
+    r.ident.reason[i] = buf;
+  }
+}
+
 }  // namespace
 
 ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo) {
@@ -419,6 +441,7 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
     if (r.weighting == "relative")
       r.std_note = "some noise levels are not stated: the runs are weighed by their relative misfit, not by the likelihood, "
                    "so the std (the Cramér-Rao bound with noise levels from the residual) may be optimistic";
+    if (ep.runs.empty() && ep.modes) modal_interval(r, ep);
   }
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
@@ -460,9 +483,27 @@ nlohmann::json ExperimentsResult::to_json() const {
   out["identifiability"] = ident_json(ident);
   if (!ident.identifiable.empty()) {
     out["identifiability"]["std_note"] = std_note;
-    out["identifiability"]["interval"] =
-        "not assessed in a joint run (no half-record refit, no consider terms): std and resolution are the Fisher "
-        "information's of all experiments together";
+    if (interval.half_width.size() == estimate.size()) {
+      json iv = json::object();
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        const auto e = static_cast<Eigen::Index>(i);
+        const double w = interval.half_width[e];
+        json x{{"half_width", finite(w)},
+               {"low", std::isfinite(w) ? json(estimate[e] - w) : json(nullptr)},
+               {"high", std::isfinite(w) ? json(estimate[e] + w) : json(nullptr)},
+               {"noise_2std", finite(interval.noise[e])},
+               {"residual_2resolution", finite(interval.residual[e])}};
+        if (const auto t = truth.find(names[i]); t != truth.end() && std::isfinite(w))
+          x["covers_truth"] = std::abs(estimate[e] - t->second) <= w;
+        iv[names[i]] = x;
+      }
+      out["identifiability"]["interval"] = iv;
+      out["identifiability"]["interval_note"] = interval.note;
+    } else {
+      out["identifiability"]["interval"] =
+          "not assessed in a joint run with time records (no half-record refit, no consider terms): std and resolution "
+          "are the Fisher information's of all experiments together";
+    }
   }
   json ex = json::array();
   for (const auto& e : experiments) {

@@ -614,12 +614,13 @@ bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable&
     st.pulse_samples = static_cast<int>(
         std::count_if(f.begin(), f.end(), [&](double x) { return std::abs(x - f.front()) > 0.1 * peak; }));
   }
-  // A jump, or an impact over a few samples; not a smooth signal sampled a few times a period (a
-  // sampled harmonic's largest change is at most 1/cos(ω Δt) times its neighbours', under 3 down
-  // to 5 samples a period).
+  // A jump (a change with a neighbour under a third of it: a step, one caught mid-way, a switch),
+  // or an impact over a few samples; not a smooth signal sampled a few times a period (a sampled
+  // harmonic's largest change has both neighbours at cos(ω Δt) of it, over a third above 5.1
+  // samples a period).
   const double before = at >= 2 ? std::abs(f[at - 1] - f[at - 2]) : 0.0;
   const double after = at + 1 < f.size() ? std::abs(f[at + 1] - f[at]) : 0.0;
-  const bool isolated = st.jump > 3.0 * std::max(before, after);
+  const bool isolated = st.jump > 3.0 * std::min(before, after);
   const bool impact = st.pulse_samples > 0 && st.pulse_samples <= kImpactSamples;
   if (!isolated && !impact) return false;
   p.columns.stepped_inputs.push_back(st);

@@ -84,6 +84,14 @@ TEST(StrainGauge, TheChainsGaugesConvergeOntoTheFiniteElementCurvatureAtSecondOr
 
 TEST(StrainGauge, EIRhoAAndZetaFromTwoGaugesOnTheEightySegmentTruth) { expect_identified_from_the_truth(strip()); }
 
+TEST(StrainGauge, AGaugeAtACompliantClampReadsTheRootMoment) {
+  // The end joint carries the clamp's spring in series with the end cell's (beam_chain.h): a gauge
+  // inside the first segment reads k_θ w_s(0) at the root, converging like the clamped strip's.
+  expect_second_order_convergence(
+      io::parse_scenario(scoleid::test::test_scenario("strain_gauge_test/strain-compliant-clamp"), "compliant clamp"),
+      "scoleid-strain-compliant-clamp");
+}
+
 TEST(RelativeDisplacementGauge, TheChainReadsTheDifferenceOfItsTwoStationsDisplacements) {
   // The same truth with displacement sensors at each gauge's two stations: a gauge must read
   // w(s) − w(r) of the chain to rounding (both read-outs are the same station positions).

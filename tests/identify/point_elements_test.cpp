@@ -61,9 +61,11 @@ TEST(PointElements, TransferMatrixMeetsTheClosedForms) {
   // Clamped–free, and with a tip body (Blevins' equation, analytic_beam.h).
   b.left = io::EndCondition::Clamped;
   b.right = io::EndCondition::Free;
-  auto w = an::point_element_omegas(b, 4);
-  auto bl = an::beta_L(an::Support::ClampedFree, 4);
-  for (int k = 0; k < 4; ++k) EXPECT_LT(rel(w[k], an::omega(bl[k], L, EI, rA)), 1e-12) << "mode " << k + 1;
+  // Twenty modes (β L up to 61: the unscaled transfer product would have lost them to cancellation).
+  auto w = an::point_element_omegas(b, 20);
+  auto bl = an::beta_L(an::Support::ClampedFree, 20);
+  ASSERT_EQ(w.size(), 20u);
+  for (int k = 0; k < 20; ++k) EXPECT_LT(rel(w[k], an::omega(bl[k], L, EI, rA)), 1e-12) << "mode " << k + 1;
   b.tip_mass = 0.7 * rA * L;
   b.tip_inertia = 0.05 * rA * L * L * L;
   w = an::point_element_omegas(b, 4);
@@ -187,6 +189,8 @@ TEST(PointElements, BadInputNamesTheField) {
   refused("supports: {left: {k_theta: 5}}", "beam.supports.left.k_theta", "left: clamped, right: free");
   refused("supports: {left: {k_w: 5}}", "beam.supports.left.k_w");
   refused("attachments: [{name: a, location: 0, k_w: 5}]", "beam.attachments[0].k_w");
+  refused("attachments: [{name: a, location: 0, mass: 0.1}]", "beam.attachments[0].mass");  // on the held w(0)
+  refused("attachments: [{name: a, location: 1, inertia: 0.1}]", "beam.attachments[0].inertia", "left: pinned, right: clamped");
   refused("supports: {middle: {k_w: 5}}", "beam.supports.middle");
   refused("supports: {left: {mass: 5}}", "beam.supports.left.mass");
   refused("attachments: [{name: a, location: 1.5, mass: 0.1}]", "beam.attachments[0].location");
@@ -207,6 +211,28 @@ TEST(PointElements, BadInputNamesTheField) {
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("supports.left.k_theta"), std::string::npos) << e.what();
   }
+}
+
+TEST(PointElements, TrueValuesAndCoefficientsComeFromTheScenarioGiven) {
+  // The model's mesh built from the scenario; its parameterisation and coefficients asked with the
+  // truth's (truth.overrides): the truth's values, not the mesh's.
+  const std::string y = std::string(kBench) +
+                        "identification: {estimate: [EI, attachments.clamp.mass], elements: 8}\n"
+                        "truth:\n  overrides:\n    beam:\n      attachments: [{name: clamp, mass: 0.07}]\n";
+  const io::Scenario sc = io::parse_scenario(y, "override");
+  const io::Scenario t = io::truth_scenario(sc);
+  const auto st = identify::make_structure(sc, 8);
+  EXPECT_DOUBLE_EQ(st->parameterize(t)->truth()[1], 0.07);
+  EXPECT_DOUBLE_EQ(st->parameterize(sc)->truth()[1], 0.06);
+  const auto c = st->coefficients(t), c0 = st->coefficients(sc);
+  int changed = 0;
+  for (Eigen::Index i = 0; i < c.size(); ++i)
+    if (c[i] != c0[i]) {
+      ++changed;
+      EXPECT_DOUBLE_EQ(c[i], 0.07);
+      EXPECT_DOUBLE_EQ(c0[i], 0.06);
+    }
+  EXPECT_EQ(changed, 1);
 }
 
 TEST(PointElements, TruthOverridesReplaceFieldsByName) {

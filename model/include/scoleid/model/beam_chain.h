@@ -34,6 +34,11 @@
 
 namespace scoleid::model {
 
+// The rotational springs of the point elements at an end (0: s = 0, 1: s = L), summed, and the
+// joint stiffness they make in series with the end cell's k0 (0 when there are none).
+double end_rotational_spring(const io::BeamSpec& beam, int end);
+double end_series_stiffness(const io::BeamSpec& beam, int end, double k0);
+
 class BeamChain : public Structure {
 public:
   BeamChain(const io::BeamSpec& beam, int segments);

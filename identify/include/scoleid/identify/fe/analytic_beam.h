@@ -38,7 +38,10 @@ double omega(double betaL, double L, double EI, double rhoA);
 // station (docs/theory.md §2.5):
 //   [EI w_sss] = (m ω² − k_w) w(s_p),   [EI w_ss] = −(J ω² − k_θ) w_s(s_p),
 // the left end's two free unknowns carried to the right end, whose two conditions vanish at a
-// natural frequency. Roots by scanning for sign changes of the 2 × 2 determinant and bisection.
+// natural frequency. Carried in the scaled field (w, w_s/β, w_ss/β², w_sss/β³) in steps of β x <= 1,
+// the two columns orthonormalised after each step (the determinant keeps its sign; unscaled, its
+// terms of size e^{2βL} cancel and the high modes are lost). Roots by scanning for sign changes of
+// the 2 × 2 determinant and bisection.
 std::vector<double> point_element_omegas(const io::BeamSpec& beam, int count);
 
 double ss_static_point_load(double x, double a, double P, double L, double EI);

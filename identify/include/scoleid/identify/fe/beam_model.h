@@ -61,6 +61,9 @@ struct BeamFE {
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
                   const std::vector<io::SensorSpec>& sensors, const std::string& source);
 
+// A point quantity's value in `beam` (found by its parameter name), or NaN if `beam` lacks it.
+double point_value(const BeamFE::PointQuantity& p, const io::BeamSpec& beam);
+
 // Coefficients c for a physical state (ρA, EI per section, ζ, c_kv); EI holds one value or one
 // per model section.
 VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<double>& EI, double zeta, double c_kv = 0.0);

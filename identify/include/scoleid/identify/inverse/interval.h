@@ -48,6 +48,9 @@ struct IntervalInputs {
   VectorXd estimate;
   VectorXd half_record_estimate;       // empty: no refit (then the term is NaN and the interval too)
   bool half_record_converged = true;
+  // false for data without a time axis (measured modes): no half-record refit applies, and the
+  // interval is the noise and residual terms and the consider terms alone.
+  bool refit_applies = true;
   std::vector<ConsiderTerm> consider;
   VectorXd smoothing_estimate;         // the refit at a tenth of the prior's weight; empty: no prior
   bool smoothing_converged = true;

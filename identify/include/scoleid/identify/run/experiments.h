@@ -40,6 +40,7 @@
 
 #include "scoleid/identify/inverse/fit_test.h"
 #include "scoleid/identify/inverse/identifiability.h"
+#include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/modal_data.h"
@@ -98,6 +99,10 @@ struct ExperimentsResult {
   std::vector<Experiment> experiments;
   Identifiability ident;  // joint
   std::string std_note;   // why the std may be weaker than stated ("" if it is not)
+  // Measured modes alone (no time record): the uncertainty interval 2·√(std² + resolution²) from
+  // the joint Fisher information (docs/theory.md §8.2; no half-record refit applies to a mode
+  // set), a parameter whose interval exceeds half its value flagged in `ident`. Empty otherwise.
+  UncertaintyInterval interval;
   double wall_seconds = 0;
   bool converged() const;
   nlohmann::json to_json() const;

@@ -61,7 +61,7 @@ struct ColumnUse {
   };
   std::vector<Source> sources;
   // An input driven by its column that jumps by more than a quarter of its range within one sample,
-  // in a step (a change more than three times its neighbours') or an impact (a pulse over at most
+  // in a step (a change more than three times one of its neighbours') or an impact (a pulse over at most
   // 8 samples): between samples such a column is read piecewise linearly (interpolation auto), so each jump (a step, a bang-bang switch) is
   // spread over a sample and its centre moved by up to half a sample, which a ringing structure's
   // phase feels (docs/theory.md §11.3).
