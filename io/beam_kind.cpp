@@ -24,9 +24,16 @@ std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
     const std::string prefix = group == &b.supports ? "beam.supports." : "beam.attachments.";
     for (auto& e : *group) {
       if (group == &b.attachments) v.emplace_back(prefix + e.name + ".location", &e.location);
-      for (const auto& [key, member] : point_element_fields())
-        if (group == &b.attachments || (std::string(key) != "mass" && std::string(key) != "inertia"))
-          v.emplace_back(prefix + e.name + "." + key, &(e.*member));
+      // A support's fields that act on what its end holds are no numbers of the model.
+      const EndCondition end = e.name == "left" ? b.left : b.right;
+      for (const auto& [key, member] : point_element_fields()) {
+        const std::string k = key;
+        const bool on_w = k == "mass" || k == "k_w" || k == "c_w";
+        if (group == &b.supports && (k == "mass" || k == "inertia" || end == EndCondition::Clamped ||
+                                     (on_w && end == EndCondition::Pinned)))
+          continue;
+        v.emplace_back(prefix + e.name + "." + key, &(e.*member));
+      }
     }
   }
   return v;

@@ -112,7 +112,9 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     if (i == n - 1 && beam.tip_mass > 0.0 && !tip_body) add_point(beam.tip_mass, 0.0, h);
     for (const auto& e : elements) {
       double x = 0.0;
-      if ((e.mass > 0.0 || e.inertia > 0.0) && bar_of(e.location, x) == i) add_point(e.mass, e.inertia, x);
+      // At s = L with a tip body, a rotary inertia rides the tip body (its angle is the end slope).
+      const double J = tip_body && e.location == length_ ? 0.0 : e.inertia;
+      if ((e.mass > 0.0 || J > 0.0) && bar_of(e.location, x) == i) add_point(e.mass, J, x);
     }
     const MassProperties mp = added ? MassProperties(M, moment / M, inertia) : bar;
     Body::Rigid body(mp);
@@ -141,10 +143,11 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     parent = seg;
   }
   if (tip_body) {
+    double J = beam.tip_inertia;
+    for (const auto& e : elements)
+      if (e.location == length_) J += e.inertia;
     const MobilizedBody::Pin tip(parent, Transform(Vec3(h, 0, 0)),
-                                 Body::Rigid(MassProperties(beam.tip_mass, Vec3(0),
-                                                            Inertia(Vec3(0, beam.tip_inertia, beam.tip_inertia)))),
-                                 Transform());
+                                 Body::Rigid(MassProperties(beam.tip_mass, Vec3(0), Inertia(Vec3(0, J, J)))), Transform());
     const auto j = static_cast<std::size_t>(n);
     joints.push_back({tip.getMobilizedBodyIndex(), 0, lumping_.stiffness[j], lumping_.damping[j]});
     tip_body_ = tip.getMobilizedBodyIndex();
@@ -156,8 +159,9 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
                           lumping_.damping[static_cast<std::size_t>(n)], k, c);
     anchors.push_back({tip_body ? tip_body_ : parent.getMobilizedBodyIndex(), k, c});
   }
-  for (const auto& [i, e] : interior_rotation)
-    anchors.push_back({segment_bodies_[static_cast<std::size_t>(i)], e.k_theta, e.c_theta});
+  for (const auto& [i, e] : interior_rotation)  // a dashpot alone at s = L acts on the tip body where there is one
+    anchors.push_back({tip_body && e.location == length_ ? tip_body_ : segment_bodies_[static_cast<std::size_t>(i)], e.k_theta,
+                       e.c_theta});
   for (std::size_t k = 0; k < points.size(); ++k) points[k].body = segment_bodies_[static_cast<std::size_t>(point_bar[k])];
   if (beam.right != io::EndCondition::Free) {
     Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));
