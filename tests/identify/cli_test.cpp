@@ -219,6 +219,22 @@ TEST(ScoleIdentifyCli, NanStiffness) {
   expect_yaml_error(good_with("EI: 23000", "EI: .nan"), {"beam.EI", ".nan"});
 }
 
+// Supports and attachments (docs/theory.md §2.5): one line naming the file, the field and the
+// value, exit 2, nothing written; an estimate naming a quantity no element holds lists those that do.
+TEST(ScoleIdentifyCli, SupportsAndAttachmentsBadInput) {
+  expect_yaml_error(good_with("zeta: 0}", "zeta: 0, supports: {left: {k_theta: 500}}}"),
+                    {"beam.supports.left.k_theta", "clamped end holds", "got 500"});
+  expect_yaml_error(good_with("zeta: 0}", "zeta: 0, attachments: [{name: acc, location: 11, mass: 0.1}]}"),
+                    {"beam.attachments[0].location", "got 11"});
+  expect_yaml_error(good_with("zeta: 0}", "zeta: 0, attachments: [{name: acc, location: 5, mass: -2}]}"),
+                    {"beam.attachments[0].mass", "got -2"});
+  const std::string pinned = scoleid::test::replaced(
+      good_with("left: clamped, right: free, rho_A: 67, EI: 23000, zeta: 0}",
+                "left: pinned, right: free, rho_A: 67, EI: 23000, zeta: 0, supports: {left: {k_theta: 5.0e5}}}"),
+      "estimate: [q1, q2]", "estimate: [q1, q2, supports.left.k_w]");
+  expect_yaml_error(pinned, {"identification.estimate[2]", "supports.left.k_theta", "supports.left.k_w"});
+}
+
 TEST(ScoleIdentifyCli, SensorOutsideBeam) {
   expect_yaml_error(good_with("kind: displacement, location: 10", "kind: displacement, location: 12"),
                     {"sensors[0].location", "got 12"});
