@@ -17,6 +17,7 @@
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/input_file.h"
+#include "scoleid/io/interrupt.h"
 
 namespace scoleid::crosscheck {
 
@@ -110,8 +111,25 @@ void make_points(Campaign& c, const std::string& path) {
   if (combos * c.scenarios.size() * static_cast<std::size_t>(c.seeds + 1) > kMaxCases)
     bad(path, "noise.seeds", "gives more than " + std::to_string(kMaxCases) + " cases with the grid's " +
                                  std::to_string(combos * c.scenarios.size()) + " points", std::to_string(c.seeds));
+  // Each grid value first on its own (the other paths at their first value): a bad value is
+  // refused in a moment, not after the points before it in the grid's order (a grid of 10⁵ points
+  // takes minutes to check whole).
+  for (const auto& s : c.scenarios)
+    for (std::size_t a = 0; a < c.grid.size(); ++a)
+      for (std::size_t k = 1; k < c.grid[a].second.size(); ++k) {
+        io::check_interrupt();
+        std::vector<std::string> overlays{c.overlay};
+        std::string label = s;
+        for (std::size_t b = 0; b < c.grid.size(); ++b) {
+          const std::string& v = c.grid[b].second[b == a ? k : 0];
+          overlays.push_back(path_overlay(c.grid[b].first, v));
+          label += " " + c.grid[b].first + "=" + v;
+        }
+        checked_scenario(overlaid_scenario_yaml(s, path, "scenarios", overlays), path + " (" + label + ")");
+      }
   for (const auto& s : c.scenarios)
     for (std::size_t g = 0; g < combos; ++g) {
+      io::check_interrupt();  // checking 10⁵ points takes minutes
       std::vector<std::string> overlays{c.overlay};
       std::string label = s;
       std::size_t rest = g;
@@ -171,7 +189,9 @@ Campaign load_checked(const std::string& path) {
   c.path = path;
   YAML::Node root;
   try {
-    root = YAML::Load(io::read_text_file(path, "campaign file"));
+    const std::string text = io::read_text_file(path, "campaign file");
+    io::check_yaml_nesting(text, "campaign file '" + path + "'");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw io::InputError("campaign file '" + path + "': malformed YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }

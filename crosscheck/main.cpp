@@ -121,6 +121,13 @@ void check_suite_out(const fs::path& out) {
     const std::string n = e.path().filename().string();
     if (std::find(ours.begin(), ours.end(), n) == ours.end() && n.find(".tmp.") == std::string::npos) foreign.push_back(n);
   }
+  // results/ holds one <family>.json per family run: anything else there is not the suite's either.
+  if (fs::is_directory(out / "results", ec))
+    for (const auto& e : fs::directory_iterator(out / "results", ec)) {
+      const std::string n = e.path().filename().string();
+      if (!(e.is_regular_file() && e.path().extension() == ".json") && n.find(".tmp.") == std::string::npos)
+        foreign.push_back("results/" + n);
+    }
   if (!foreign.empty()) {
     std::sort(foreign.begin(), foreign.end());
     std::string list;

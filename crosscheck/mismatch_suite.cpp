@@ -91,7 +91,9 @@ static SuiteFile load_suite_file_checked(const std::string& path) {
   f.path = path;
   YAML::Node root;
   try {
-    root = YAML::Load(io::read_text_file(path, "suite file"));
+    const std::string text = io::read_text_file(path, "suite file");
+    io::check_yaml_nesting(text, "suite file '" + path + "'");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw io::InputError("suite file '" + path + "': malformed YAML: " + e.msg);
   }

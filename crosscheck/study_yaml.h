@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
 
 namespace scoleid::crosscheck::study {
 
@@ -24,11 +25,8 @@ inline std::string text_of(const YAML::Node& n) {
 
 inline double number_of(const YAML::Node& n, const std::string& file, const std::string& field) {
   double v = std::nan("");
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    bad(file, field, "must be a number", n.IsScalar() ? "'" + n.Scalar() + "'" : text_of(n));
-  }
+  if (!n.IsScalar() || !io::parse_decimal(n.Scalar(), v))
+    bad(file, field, "must be a decimal number", n.IsScalar() ? "'" + n.Scalar() + "'" : text_of(n));
   if (!std::isfinite(v)) bad(file, field, "must be finite", n.Scalar());
   return v;
 }

@@ -36,6 +36,13 @@ std::string Identification::verdict() const {
                   r.summary.message.empty() ? "" : ": ", io::one_line(r.summary.message).c_str());
     return buf;
   }
+  if (r.determines_nothing()) {
+    std::snprintf(buf, sizeof buf,
+                  "the data determine none of the %zu estimated parameters (each is NOT IDENTIFIABLE; its row says why): "
+                  "the estimate is not the data's",
+                  r.ident.identifiable.size());
+    return buf;
+  }
   if (!r.converged()) {  // the discrepancy principle found no weight (docs/theory.md §7.8)
     std::snprintf(buf, sizeof buf,
                   "no smoothness weight fits the data within the noise band (discrepancy principle not met down to %g)",
@@ -148,7 +155,10 @@ void Identification::write(const std::string& dir) const {
 
 std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data) {
   io::validate_scenario(scenario);
-  if (data.table) return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.name + " (metadata)");
+  if (data.table) {
+    io::check_table(*data.table);  // a table built in memory passes the checks a file's does
+    return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.name + " (metadata)");
+  }
   return identify::make_problem(scenario, data.csv);
 }
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "scoleid/io/program.h"
 #include "scoleid/identify.h"
@@ -14,6 +15,7 @@
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/mat_file.h"
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
 
@@ -143,16 +145,18 @@ void print_problem(const identify::Problem& problem, bool from_file) {
   }
 }
 
-// --export-model FILE: a .json whose directory exists (checked before any work).
-void check_export_path(const std::string& path) {
+// --export-model FILE: a .json or .mat file, no input of the run and outside --out, in a
+// writable directory (checked before any work; io/output_paths.h).
+void check_export_path(const std::string& path, const std::string& scenario, const std::string& data, const std::string& out) {
   if (path.empty()) return;
   const std::filesystem::path p(path);
   if (p.extension() != ".json" && p.extension() != ".mat")
     throw io::InputError("command line: --export-model must name a .json or .mat file, got '" + path + "'");
   if (p.extension() == ".mat" && !io::mat_files_supported())
     throw io::InputError("command line: --export-model '" + path + "': this build writes no .mat files (libmatio was not found); use .json");
-  if (p.has_parent_path() && !std::filesystem::is_directory(p.parent_path()))
-    throw io::InputError("command line: --export-model '" + path + "': directory '" + p.parent_path().string() + "' does not exist");
+  // A data file's metadata (truth.json beside truth.csv) is read too.
+  const std::string meta = data.empty() ? std::string() : std::filesystem::path(data).replace_extension(".json").string();
+  io::check_output_file("--export-model", path, {scenario, data, meta}, out);
 }
 
 }  // namespace
@@ -231,7 +235,11 @@ int main(int argc, char** argv) {
     if (out.empty()) out = "run/" + sc.name;
     // The output directory is checked (and its staging area made) before any work.
     io::RunDirectory run_dir(out, Identification::output_files(), "scole-identify");
-    check_export_path(export_model);
+    check_export_path(export_model, scenario, data, out);
+    // The exported model is written beside its place during the run and put there after the
+    // outputs: a run that fails or is interrupted leaves neither.
+    std::optional<io::StagedFile> staged_model;
+    if (!export_model.empty()) staged_model.emplace(export_model, "command line: --export-model");
     const auto problem = prepare(sc, data.empty() ? DataSource::synthetic() : DataSource::file(data));
     // (Checked again by the run; here so that the refusal is the only line on stderr.)
     if (const auto& w = sc.identification.steepest_weights; !w.empty() && static_cast<int>(w.size()) != problem->params->size())
@@ -241,8 +249,9 @@ int main(int argc, char** argv) {
     print_problem(*problem, !data.empty());
     const Identification id = identify_parameters(problem, options);
     id.write(run_dir);
+    if (staged_model) id.export_model(staged_model->path());
     run_dir.commit();
-    if (!export_model.empty()) id.export_model(export_model);
+    if (staged_model) staged_model->commit();
     std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with gnuplot)\n", out.c_str());
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());

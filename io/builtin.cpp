@@ -4,6 +4,7 @@
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/scenario.h"
+#include "scoleid/io/validation.h"
 
 namespace scoleid::io {
 
@@ -28,7 +29,7 @@ std::string builtin_scenario_text(const std::string& name) {
   if (!yaml.empty()) return yaml;
   std::string names;
   for (const auto& n : builtin_scenario_names()) names += (names.empty() ? "" : ", ") + n;
-  throw InputError("--print-scenario: '" + name + "' is not a built-in scenario (" + names + ")");
+  throw InputError("'" + shorten(name) + "' is not a built-in scenario (" + names + ")");
 }
 
 std::string builtin_scenario_yaml(const std::string& name) {

@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
 #include "scoleid/io/signal.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/interrupt.h"
@@ -93,7 +94,10 @@ DataTable read_csv(const std::string& path, const CsvOptions& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError("data file '" + path + "': is a directory");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("data file '" + path + "': cannot be opened");
+  if (!in) {
+    check_interrupt();  // a signal while blocked opening a FIFO
+    throw InputError("data file '" + path + "': cannot be opened");
+  }
   return read_csv_stream(in, path, options);
 }
 
@@ -127,8 +131,10 @@ std::string header_line(std::istream& in, const std::string& path, std::size_t& 
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     break;
   }
-  if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos)
+  if (lineno == 0 || line.find_first_not_of(" \t\r") == std::string::npos) {
+    check_interrupt();  // a read interrupted by a signal ends like an empty file
     throw InputError("data file '" + path + "': empty, expected a header line (time column first)");
+  }
   // Lines ended by CR alone (classic Mac) arrive as one line: say so rather than misread it. A CR
   // followed by anything but another CR is inside the line (CR CR LF endings are read as before).
   for (std::size_t i = 0; i + 1 < line.size(); ++i)
@@ -171,9 +177,7 @@ std::size_t read_header(const std::vector<std::string>& header, const CsvOptions
 bool parse_number(std::string f, bool decimal_comma, double& v) {
   if (f.empty()) return false;
   if (decimal_comma) std::replace(f.begin(), f.end(), ',', '.');
-  char* end = nullptr;
-  v = std::strtod(f.c_str(), &end);
-  return end && *end == '\0';
+  return scoleid::io::parse_number(std::string_view(f), v);
 }
 
 // t into seconds from the time column's unit.
@@ -236,10 +240,52 @@ DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOp
       }
     }
   }
+  check_interrupt();  // a read cut short by a signal is no short file
   if (tab.t.size() < 2)
     throw InputError("data file '" + path + "': needs at least 2 data rows, got " + std::to_string(tab.t.size()));
   time_in_seconds(tab);
   return tab;
+}
+
+void check_table(const DataTable& tab) {
+  const std::string src = "data '" + one_line(shorten(tab.source)) + "'";
+  const std::size_t n = tab.t.size();
+  if (n < 2) throw InputError(src + ": needs at least 2 samples, got " + std::to_string(n));
+  if (n > static_cast<std::size_t>(limits::kMaxSamples))
+    throw InputError(src + ": " + std::to_string(n) + " samples, more than " + format_value(limits::kMaxSamples) +
+                     " (the limit of one record)");
+  if (tab.columns.size() != tab.names.size())
+    throw InputError(src + ": " + std::to_string(tab.names.size()) + " column names for " + std::to_string(tab.columns.size()) +
+                     " columns");
+  if (tab.names.empty()) throw InputError(src + ": no data columns beside the time");
+  std::set<std::string> seen;
+  for (const auto& name : tab.names) {
+    if (name.empty()) throw InputError(src + ": a column has an empty name");
+    if (name == tab.time_name || name == "t")
+      throw InputError(src + ": column '" + one_line(shorten(name)) + "' has the time column's name");
+    if (!seen.insert(name).second) throw InputError(src + ": duplicate column '" + one_line(shorten(name)) + "'");
+  }
+  auto bad = [&](const std::string& col, std::size_t k, const std::string& what, double v) {
+    throw InputError(src + ": " + col + ", sample " + std::to_string(k + 1) + (col == "time" ? "" : " (t = " + format_value(tab.t[k]) + " s)") +
+                     ": " + what + ", got " + format_value(v));
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    const double v = tab.t[k];
+    if (!std::isfinite(v)) bad("time", k, "must be finite", v);
+    if (!(std::abs(v) <= limits::kMaxMagnitude)) bad("time", k, "magnitude must be at most " + format_value(limits::kMaxMagnitude), v);
+    if (k > 0 && !(v > tab.t[k - 1]))
+      bad("time", k, "must be strictly increasing (after " + format_value(tab.t[k - 1]) + ")", v);
+  }
+  for (std::size_t j = 0; j < tab.names.size(); ++j) {
+    const std::string col = "column '" + one_line(shorten(tab.names[j])) + "'";
+    if (tab.columns[j].size() != n)
+      throw InputError(src + ": " + col + " has " + std::to_string(tab.columns[j].size()) + " values for " + std::to_string(n) + " times");
+    for (std::size_t k = 0; k < n; ++k) {
+      const double v = tab.columns[j][k];
+      if (!std::isfinite(v)) bad(col, k, "must be finite", v);
+      if (!(std::abs(v) <= limits::kMaxMagnitude)) bad(col, k, "magnitude must be at most " + format_value(limits::kMaxMagnitude), v);
+    }
+  }
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {
@@ -397,6 +443,12 @@ TruthMeta truth_meta_from_json(const nlohmann::json& j, const std::string& sourc
       if (!v.is_number()) fail_field(source, "true_parameters." + one_line(k), "must be a number", json_kind(v));
       const double x = v.get<double>();
       if (!std::isfinite(x) || !(x >= 0)) fail_field(source, "true_parameters." + one_line(k), "must be a finite number >= 0", format_value(x));
+      // The range every number of a scenario has (limits.h): a true value beyond it is no truth.
+      if (x != 0 && !(x >= limits::kMinMagnitude && x <= limits::kMaxMagnitude))
+        fail_field(source, "true_parameters." + one_line(k),
+                   "must be 0 or of magnitude within [" + format_value(limits::kMinMagnitude) + ", " +
+                       format_value(limits::kMaxMagnitude) + "], as every number of a scenario",
+                   format_value(x));
       m.true_parameters[k] = x;
     }
   }

@@ -21,6 +21,7 @@
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/validation.h"
 
 namespace {
@@ -48,8 +49,9 @@ void print_info(const io::DataFileInfo& info) {
   int k = 0;
   for (const auto& c : info.channels) {
     const std::string node = c.node > 0 ? std::to_string(c.node) + c.direction : c.direction;
-    std::printf("%-4d %-28s %-10s %-14s %9zu %12.6g %12.6g%s %-6s %s\n", ++k, c.name.c_str(),
-                c.unit.empty() ? "-" : c.unit.c_str(), c.quantity.empty() ? "-" : c.quantity.c_str(), c.samples, c.start,
+    std::printf("%-4d %-28s %-10s %-14s %9zu %12.6g %12.6g%s %-6s %s\n", ++k, io::one_line(io::shorten(c.name, 60)).c_str(),
+                c.unit.empty() ? "-" : io::one_line(io::shorten(c.unit, 20)).c_str(),
+                c.quantity.empty() ? "-" : io::one_line(io::shorten(c.quantity, 40)).c_str(), c.samples, c.start,
                 c.step, c.even ? " " : "~", node.empty() ? "-" : node.c_str(), c.function.c_str());
   }
   for (const auto& n : info.notes) std::printf("  %s\n", n.c_str());
@@ -57,6 +59,15 @@ void print_info(const io::DataFileInfo& info) {
 
 // OUT.csv and OUT.json (written to temporary files and renamed: both or neither).
 void convert(const std::string& file, const std::string& out, const io::CsvOptions& options, bool quiet) {
+  // Neither output may be the input, a directory, or in a directory that cannot be written.
+  {
+    std::filesystem::path m(out);
+    if (m.extension() == ".json")
+      throw io::InputError("command line: --out '" + out + "': names the column description; give the CSV's name (OUT.json is written beside it)");
+    m.replace_extension(".json");
+    io::check_output_file("--out", out, {file});
+    io::check_output_file("--out", m.string(), {file});
+  }
   io::DataTable tab = io::read_data(file, options);
   const io::DataFileInfo info = io::describe_data(file, options);
   json cols = json::array();
@@ -70,10 +81,7 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
       }
     cols.push_back(c);
   }
-  const std::filesystem::path csv(out);
-  if (csv.has_parent_path() && !std::filesystem::is_directory(csv.parent_path()))
-    throw io::InputError("command line: --out '" + out + "': directory '" + csv.parent_path().string() + "' does not exist");
-  std::filesystem::path meta = csv;
+  std::filesystem::path meta(out);
   meta.replace_extension(".json");
   if (std::filesystem::exists(meta)) {  // never over another program's JSON (a truth.json beside truth.csv)
     nlohmann::json old;

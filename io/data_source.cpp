@@ -167,11 +167,24 @@ DataTable uff_table(const uff::File& file) {
     } else {
       const double span = std::abs(tab.t.back() - tab.t.front());
       bool same = t.size() == tab.t.size();
-      for (std::size_t k = 0; same && k < t.size(); ++k) same = std::abs(t[k] - tab.t[k]) <= 1e-9 * span;
+      std::size_t differ = 0;
+      for (std::size_t k = 0; k < std::min(t.size(), tab.t.size()); ++k)
+        if (!(std::abs(t[k] - tab.t[k]) <= 1e-9 * span)) {
+          same = false;
+          differ = k;
+          break;
+        }
+      auto grid = [](const std::vector<double>& g) {
+        return std::to_string(g.size()) + " points from " + format_value(g.empty() ? 0.0 : g.front()) + " s" +
+               (g.size() > 1 ? " every " + format_value((g.back() - g.front()) / static_cast<double>(g.size() - 1)) + " s" : "");
+      };
       if (!same)
-        throw InputError(record_of(file, f) + ": its time grid (" + std::to_string(t.size()) + " points from " + format_value(t.empty() ? 0.0 : t.front()) +
-                         " s) differs from the first time response's (" + std::to_string(tab.t.size()) + " points from " +
-                         format_value(tab.t.front()) + " s): the channels of one record share one time grid");
+        throw InputError(record_of(file, f) + ": its time grid (" + grid(t) + ") differs from the first time response's (" +
+                         grid(tab.t) + ")" +
+                         (t.size() == tab.t.size() ? ": point " + std::to_string(differ + 1) + " is at " + format_value(t[differ]) +
+                                                         " s against " + format_value(tab.t[differ]) + " s"
+                                                   : "") +
+                         "; the channels of one record share one time grid");
     }
     for (double v : f.re)
       if (!std::isfinite(v) || !(std::abs(v) <= limits::kMaxMagnitude))

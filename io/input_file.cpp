@@ -48,7 +48,9 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& sourc
     for (const auto& s : path) p += (p.empty() || s == "[]" ? "" : ".") + s;
     return p;
   };
-  const json::parser_callback_t cb = [&](int, json::parse_event_t event, json& parsed) {
+  const json::parser_callback_t cb = [&](int depth, json::parse_event_t event, json& parsed) {
+    // Deeper than any file of ours: refused before the nesting reaches code that recurses over it.
+    if (depth > kMaxNesting) throw InputError(one_line(source + ": nested deeper than " + std::to_string(kMaxNesting) + " levels"));
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:
@@ -123,6 +125,37 @@ void check_node(const YAML::Node& n, const std::string& source, const std::strin
   }
 }
 }  // namespace
+
+void check_yaml_nesting(const std::string& text, const std::string& source) {
+  int depth = 0;
+  std::size_t line = 1;
+  char quote = 0;
+  bool comment = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      comment = false;
+      if (quote == '\'') quote = 0;  // (a single-quoted scalar may span lines; a rough end is enough here)
+      continue;
+    }
+    if (comment) continue;
+    if (quote) {
+      if (c == '\\' && quote == '"') ++i;
+      else if (c == quote) quote = 0;
+      continue;
+    }
+    if (c == '"' || c == '\'') quote = c;
+    else if (c == '#' && (i == 0 || text[i - 1] == ' ' || text[i - 1] == '\t')) comment = true;
+    else if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting)
+        throw InputError(one_line(source + ": line " + std::to_string(line) + ": nested deeper than " +
+                                  std::to_string(kMaxNesting) + " levels"));
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
 
 void check_yaml_document(const YAML::Node& root, const std::string& source, bool allow_null) {
   std::set<std::size_t> seen;

@@ -10,6 +10,7 @@
 
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/validation.h"
 
@@ -154,9 +155,7 @@ ModalData read_modal_data_text(const std::string& text, const std::string& sourc
       double v = 0.0;
       bool ok = !f[j].empty();
       if (ok) {
-        char* end = nullptr;
-        v = std::strtod(f[j].c_str(), &end);
-        ok = end && *end == '\0';
+        ok = parse_number(f[j], v);
       }
       if (!ok) rd.fail(lineno, col, "not a number, got '" + f[j] + "'");
       check_value(col, v, [&](const std::string& c, const std::string& req, const std::string&) {

@@ -28,7 +28,13 @@ int guarded_main(const char* program, const std::function<int()>& run) {
 
 bool print_builtin_scenarios(const std::string& print_name, bool list) {
   if (!print_name.empty()) {
-    std::fputs(builtin_scenario_text(print_name).c_str(), stdout);
+    std::string text;
+    try {
+      text = builtin_scenario_text(print_name);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--print-scenario: ") + e.what());
+    }
+    std::fputs(text.c_str(), stdout);
     return true;
   }
   if (list) {

@@ -1,6 +1,7 @@
 #include "scoleid/io/run_directory.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <stdio.h>
 #include <unistd.h>
@@ -16,6 +17,12 @@
 namespace scoleid::io {
 
 namespace fs = std::filesystem;
+
+namespace {
+bool is_lock_name(const std::string& n) { return n.size() > 6 && n[0] == '.' && n.compare(n.size() - 5, 5, ".lock") == 0; }
+// The lock of directory d: d's parent/.NAME.lock.
+fs::path lock_of(const fs::path& d) { return d.parent_path() / ("." + d.filename().string() + ".lock"); }
+}  // namespace
 
 RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> owned, const std::string& program)
     : program_(program), owned_(std::move(owned)) {
@@ -33,15 +40,40 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
     throw InputError("output directory '" + target + "': is a symbolic link" +
                      (fs::exists(t, ec) ? std::string() : std::string(" to nothing")) +
                      "; give the directory itself");
+  fs::create_directories(parent, ec);
+  if (ec || !fs::is_directory(parent))
+    throw InputError("output directory '" + target + "': its parent cannot be created (" +
+                     (ec ? ec.message() : std::string("not a directory")) + ")");
+  lock(t);
+  try {
+    check_target(t, target, program);
+  } catch (...) {
+    release_lock();
+    throw;
+  }
+}
+
+void RunDirectory::check_target(const fs::path& t, const std::string& target, const std::string& program) {
+  std::error_code ec;
+  const fs::path parent = t.parent_path();
   const auto st = fs::status(t, ec);
   if (fs::exists(st)) {
     if (!fs::is_directory(st)) throw InputError("output directory '" + target + "': exists and is not a directory");
+    // The run replaces the directory: one the user may not write is not replaced either.
+    if (::access(t.c_str(), W_OK | X_OK) != 0)
+      throw InputError("output directory '" + target + "': is not writable (" + std::strerror(errno) + ")");
     std::vector<std::string> foreign;
     for (const auto& e : fs::directory_iterator(t, ec)) {
       const std::string n = e.path().filename().string();
       if (std::find(owned_.begin(), owned_.end(), n) != owned_.end() && (e.is_regular_file() || e.is_directory()))
         continue;
       if (n.find(".tmp.") != std::string::npos) continue;  // temporary file of an older version
+      if (is_lock_name(n)) {
+        if (lock_held(e.path()))
+          throw InputError("output directory '" + target + "': another run (" + lock_holder(e.path()) + ") is writing '" +
+                           n.substr(1, n.size() - 6) + "' inside it; wait for it to finish or choose another directory");
+        continue;  // left by a run that was killed
+      }
       foreign.push_back(n);
     }
     if (ec) throw InputError("output directory '" + target + "': cannot be read (" + ec.message() + ")");
@@ -54,10 +86,6 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
                        list + "); give a new or empty directory, or one holding only an earlier run's outputs");
     }
   }
-  fs::create_directories(parent, ec);
-  if (ec || !fs::is_directory(parent))
-    throw InputError("output directory '" + target + "': its parent cannot be created (" +
-                     (ec ? ec.message() : std::string("not a directory")) + ")");
   std::string tmpl = (parent / ("." + t.filename().string() + ".staging-XXXXXX")).string();
   std::vector<char> buf(tmpl.begin(), tmpl.end());
   buf.push_back('\0');
@@ -72,9 +100,70 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
 }
 
 RunDirectory::~RunDirectory() {
-  if (committed_ || staging_.empty()) return;
   std::error_code ec;
-  fs::remove_all(staging_, ec);
+  if (!committed_ && !staging_.empty()) fs::remove_all(staging_, ec);
+  release_lock();
+}
+
+void RunDirectory::release_lock() {
+  if (lock_fd_ < 0) return;
+  ::unlink(lock_path_.c_str());  // while held: a run that opened it meanwhile finds the path gone and retries
+  ::close(lock_fd_);
+  lock_fd_ = -1;
+}
+
+
+bool RunDirectory::lock_held(const fs::path& lock) {
+  const int fd = ::open(lock.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);
+  return held;
+}
+
+std::string RunDirectory::lock_holder(const fs::path& lock) {
+  std::string who;
+  if (FILE* f = std::fopen(lock.c_str(), "r")) {
+    char buf[256] = {0};
+    if (std::fgets(buf, sizeof buf, f)) who = buf;
+    std::fclose(f);
+  }
+  while (!who.empty() && (who.back() == '\n' || who.back() == '\r')) who.pop_back();
+  return who.empty() ? std::string("another program") : who;
+}
+
+void RunDirectory::lock(const fs::path& t) {
+  lock_path_ = lock_of(t).string();
+  // open + flock, then make sure the path still names the locked file (a finishing run unlinks
+  // its lock while holding it; a waiter that opened the old file retries on the new one).
+  for (int attempt = 0;; ++attempt) {
+    const int fd = ::open(lock_path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0)
+      throw InputError("output directory '" + target_ + "': cannot write in '" + t.parent_path().string() + "' (" +
+                       std::strerror(errno) + ")");
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd);
+      throw InputError("output directory '" + target_ + "': another run (" + lock_holder(lock_path_) +
+                       ") is writing it; wait for it to finish or choose another directory");
+    }
+    struct stat a {}, b {};
+    if (::fstat(fd, &a) == 0 && ::stat(lock_path_.c_str(), &b) == 0 && a.st_ino == b.st_ino && a.st_dev == b.st_dev) {
+      lock_fd_ = fd;
+      break;
+    }
+    ::close(fd);
+    if (attempt > 100) throw InputError("output directory '" + target_ + "': its lock '" + lock_path_ + "' keeps changing");
+  }
+  const std::string who = program_ + " (pid " + std::to_string(::getpid()) + ")\n";
+  if (::ftruncate(lock_fd_, 0) == 0 && ::write(lock_fd_, who.data(), who.size()) < 0) {
+  }
+  // Nor inside a directory another run is writing (its commit would replace this run's outputs).
+  for (fs::path d = t.parent_path(); d.has_relative_path() && d.has_filename(); d = d.parent_path()) {
+    const fs::path l = lock_of(d);
+    if (lock_held(l))
+      throw InputError("output directory '" + target_ + "': lies inside '" + d.string() + "', which another run (" +
+                       lock_holder(l) + ") is writing; wait for it to finish or choose another directory");
+  }
 }
 
 std::string RunDirectory::path(const std::string& name) const { return (fs::path(staging_) / name).string(); }

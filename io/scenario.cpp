@@ -15,6 +15,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/number.h"
 #include "scoleid/io/validation.h"
 #include "structure_kinds.h"
 
@@ -58,6 +59,10 @@ public:
   bool has(const std::string& key) {
     seen_.insert(key);
     return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
+  }
+  // The field holds exactly this text (a keyword such as "auto" where a number may stand).
+  bool is_scalar(const std::string& key, const std::string& text) {
+    return has(key) && node_[key].IsScalar() && node_[key].Scalar() == text;
   }
   YAML::Node child(const std::string& key) {
     seen_.insert(key);
@@ -173,13 +178,7 @@ public:
         low == "-inf" || low == "+inf")
       fail_field(source_, f, "must be a finite number", "'" + text + "'");
     double v = 0.0;
-    try {
-      std::size_t used = 0;
-      v = std::stod(text, &used);
-      if (used != text.size()) throw std::invalid_argument("trailing");
-    } catch (const std::exception&) {
-      fail_field(source_, f, "must be a number", "'" + text + "'");
-    }
+    if (!parse_decimal(text, v)) fail_field(source_, f, "must be a decimal number", "'" + text + "'");
     if (!std::isfinite(v)) fail_field(source_, f, "must be a finite number", "'" + text + "'");
     check_magnitude(source_, f, v);
     return v;
@@ -706,7 +705,9 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.time_step = r.nonneg("time_step", id.time_step);
   id.step_rule = r.choice_of("step_rule", id.step_rule);
   id.rtol = r.positive("rtol", id.rtol);
-  if (r.has("model_error")) id.model_error = r.nonneg("model_error", 0.0);
+  // "auto" (what identify.json's settings echo for the default) or a fraction.
+  if (r.has("model_error"))
+    id.model_error = r.is_scalar("model_error", "auto") ? -1.0 : r.nonneg("model_error", 0.0);
   if (id.model_error > 1.0)
     fail_field(source, "identification.model_error",
                "must be at most 1 (a fraction of each sensor's RMS signal: above 1 the fit test accepts a model that explains "
@@ -819,6 +820,7 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source) {
   check_utf8(yaml_text, source);
+  check_yaml_nesting(yaml_text, source);
   YAML::Node root;
   try {
     // (An empty document, as after a trailing `---`, is no second scenario.)
@@ -847,6 +849,13 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
       if (!system) fail_field(source, "units", "must be SI or slug-ft-s", "'" + u + "'");
       sc.units = *system;
     }
+    // The section of the other structure would be read and then ignored: refused instead.
+    if (r.has("beam") && sc.structure != Structure::Beam)
+      fail_field(source, "beam", "describes a beam, but the scenario's structure is " + std::string(to_string(sc.structure)) +
+                                     " (remove the section, or set structure: beam)", "a beam section");
+    if (r.has("scole") && sc.structure != Structure::Scole)
+      fail_field(source, "scole", "describes SCOLE, but the scenario's structure is " + std::string(to_string(sc.structure)) +
+                                      " (remove the section, or set structure: scole)", "a scole section");
     if (r.has("beam")) parse_beam(r.child("beam"), source, sc.beam);
     if (r.has("scole")) parse_scole(r.child("scole"), source, sc.scole);
     {
@@ -880,11 +889,18 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
         if (!b) fail_field(source, field, "names no switch of this scenario (switches: scole.bending_rotary_inertia)", "'" + u.field + "'");
         if (*b == u.alternative)
           fail_field(source, field, "must name the alternative to the model's setting", u.alternative ? "true" : "false");
-      } else if (!numeric_field(sc, u.field)) {
+      } else if (const double* v = numeric_field(sc, u.field); !v) {
         std::string known;
         for (const auto& p : field_paths(sc))
           if (p != "scole.bending_rotary_inertia") known += (known.empty() ? "" : ", ") + p;
         fail_field(source, field, "names no number of this scenario (known: " + known + ")", "'" + u.field + "'");
+      } else if (!signed_field(u.field) && *v > 0 && !(u.tolerance < *v)) {
+        // The interval's consider term is a first-order shift: a tolerance as large as the value
+        // of a quantity that cannot be negative says the quantity is unknown, not uncertain.
+        fail_field(source, field,
+                   "must be smaller than the value it is a tolerance of (" + format_value(*v) +
+                       "): a quantity known no better than that is unknown (estimate it instead)",
+                   format_value(u.tolerance));
       }
     }
   } catch (const YAML::Exception& e) {

@@ -918,8 +918,12 @@ File read_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(one_line("UFF file '" + path + "': is a directory"));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(one_line("UFF file '" + path + "': cannot be opened"));
+  if (!in) {
+    check_interrupt();  // a signal while blocked opening a FIFO
+    throw InputError(one_line("UFF file '" + path + "': cannot be opened"));
+  }
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  check_interrupt();
   if (in.bad()) throw InputError(one_line("UFF file '" + path + "': cannot be read"));
   return parse(bytes, path);
 }

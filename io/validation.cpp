@@ -25,7 +25,7 @@ void check_name(const std::string& source, const std::string& field, const std::
   fail_field(source, field,
              "must be 1-" + std::to_string(limits::kMaxNameLength) +
                  " characters from [A-Za-z0-9_.-], starting with a letter, digit or '_', and not 't'",
-             "'" + one_line(name) + "'");
+             "'" + one_line(shorten(name)) + "'");
 }
 
 std::size_t first_invalid_utf8(const std::string& s) {
@@ -145,6 +145,15 @@ void validate_scenario(const Scenario& sc) {
   if (!(sc.truth.accuracy >= 1e-14 && sc.truth.accuracy < 1))
     fail_field(src, "truth.accuracy", "must be in [1e-14, 1) (a smaller error per step is below double precision)",
                format_value(sc.truth.accuracy));
+  // A servo lag longer than the record leaves the actuators still throughout: no actuator at all.
+  if (sc.structure == Structure::Scole) {
+    const double lag = sc.truth.overrides.empty() ? sc.scole.actuator_lag : truth_scenario(sc).scole.actuator_lag;
+    if (!(lag < sc.simulation.duration))
+      fail_field(src, sc.scole.actuator_lag == lag ? "scole.actuator_lag" : "truth.overrides.scole.actuator_lag",
+                 "must be shorter than simulation.duration (" + format_value(sc.simulation.duration) +
+                     "): the actuators would not move within the record",
+                 format_value(lag));
+  }
   const auto& id = sc.identification;
   if (id.elements < 1 || id.elements > limits::kMaxElements)
     fail_field(src, "identification.elements", "must be an integer in [1, " + std::to_string(limits::kMaxElements) + "]",

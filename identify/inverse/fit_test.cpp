@@ -17,6 +17,7 @@ FitTest fit_test(const FitTestInputs& in) {
   // Sums over sensors of s², a² and the strict a² (without m), each relative to the sensor's mean
   // square signal, as the cost weighs them.
   double S = 0.0, A = 0.0, A_strict = 0.0, band_var = 0.0;
+  int moving = 0;  // sensors with a signal
   bool finite = N >= 3;
   for (Eigen::Index k = 0; k < ns; ++k) {
     SensorFit s;
@@ -67,6 +68,7 @@ FitTest fit_test(const FitTestInputs& in) {
     band_var += std::pow(band2 / 3.0 / scale, 2);
     A += (allowed2 - band2) / scale;
     A_strict += (strict2 - band2) / scale;
+    if (s.rms_signal > 0) ++moving;  // each adds m² to the allowance's sum
     f.sensors.push_back(s);
   }
   A += 3.0 * std::sqrt(band_var);
@@ -74,6 +76,8 @@ FitTest fit_test(const FitTestInputs& in) {
   f.explains_data = finite && S <= A;
   f.within_noise_and_discretisation = finite && S <= A_strict;
   f.ratio = A > 0 ? std::sqrt(S / A) : (S > 0 ? INFINITY : 0.0);
+  // The least model error with which the sum passes: S <= A_strict + moving·m².
+  f.model_error_needed = S <= A_strict ? 0.0 : moving > 0 ? std::sqrt((S - A_strict) / moving) : INFINITY;
   char buf[512];
   if (N < 3) {
     f.message = "fewer than 3 samples: the fit cannot be tested";
@@ -87,7 +91,12 @@ FitTest fit_test(const FitTestInputs& in) {
       if (s.rms_signal > 0 && (!worst || beyond(s) > beyond(*worst))) worst = &s;
     char dbuf[40] = "not estimated";
     if (disc && worst) std::snprintf(dbuf, sizeof dbuf, "%.3g %%", 100.0 * worst->discretisation / worst->rms_signal);
-    if (f.explains_data || !worst)
+    if ((f.explains_data || !worst) && !f.within_noise_and_discretisation && in.model_error > 0)
+      std::snprintf(buf, sizeof buf,
+                    "passes only with the model-error allowance of %.3g %% (identification.model_error): the residual needs at "
+                    "least %.3g %%, beyond what noise and discretisation allow",
+                    100.0 * in.model_error, 100.0 * f.model_error_needed);
+    else if (f.explains_data || !worst)
       std::snprintf(buf, sizeof buf, "the systematic residual is %.2f of what noise, discretisation and the declared model error allow",
                     f.ratio);
     else

@@ -17,6 +17,8 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
@@ -66,9 +68,8 @@ bool name_of(const std::string& name, const std::string& extra, bool alnum_first
 // A finite number.
 double number(const YAML::Node& n, const std::string& file, const std::string& field) {
   const std::string text = scalar(n, file, field);
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v)) bad(file, field, "must be a finite number", text);
+  double v = 0.0;
+  if (!io::parse_decimal(text, v) || !std::isfinite(v)) bad(file, field, "must be a finite decimal number", text);
   return v;
 }
 
@@ -114,7 +115,9 @@ ExperimentsSpec load_experiments(const std::string& path) {
   if (!fs::is_regular_file(path)) bad(path, "file", "does not exist or is not a file", path);
   YAML::Node root;
   try {
-    root = YAML::Load(io::read_text_file(path, "experiments file"));
+    const std::string text = io::read_text_file(path, "experiments file");
+    io::check_yaml_nesting(text, "experiments file '" + path + "'");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     bad(path, "yaml", "is not valid YAML", io::one_line(e.what()));
   }
@@ -132,11 +135,11 @@ ExperimentsSpec load_experiments(const std::string& path) {
                                  std::to_string(io::limits::kMaxNameLength) + ")", io::one_line(s.name.substr(0, 80)));
   if (root["description"]) s.description = scalar(root["description"], path, "description");
   if (root["threads"]) {
-    try {
-      s.threads = root["threads"].as<int>();
-    } catch (const YAML::Exception&) {
-      bad(path, "threads", "must be an integer in [0, 1024]", scalar(root["threads"], path, "threads"));
-    }
+    const std::string t = scalar(root["threads"], path, "threads");
+    double v = -1.0;
+    if (!io::parse_decimal(t, v) || v != std::floor(v) || !(v >= 0 && v <= 1024))
+      bad(path, "threads", "must be an integer in [0, 1024]", t);
+    s.threads = static_cast<int>(v);
     // The command line's bound (--threads): more threads than that is no machine's.
     if (s.threads < 0 || s.threads > 1024)
       bad(path, "threads", "must be an integer in [0, 1024] (0 = the machine's threads)", std::to_string(s.threads));
@@ -164,6 +167,11 @@ ExperimentsSpec load_experiments(const std::string& path) {
       if (!r["scenario"]) bad(path, f + ".scenario", "is required (a built-in name or a YAML file)", "missing");
       run.scenario = resolve(scalar(r["scenario"], path, f + ".scenario"), path);
       if (r["data"]) run.data = relative_path(scalar(r["data"], path, f + ".data"), path);
+      // One record fitted twice would count its information twice (intervals half as wide).
+      for (std::size_t k = 0; k < s.runs.size() && run.data; ++k)
+        if (s.runs[k].data && io::same_file(*s.runs[k].data, *run.data))
+          bad(path, f + ".data", "is the record of runs[" + std::to_string(k) + "] (" + s.runs[k].name +
+                                     ") too: one record counted twice would halve the intervals", *run.data);
       s.runs.push_back(run);
     }
   }
@@ -212,6 +220,9 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     if (!sc.identification.band.empty())
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           "sets identification.band, which a joint run does not take (its Fisher sum counts independent samples)", r.scenario);
+    if (!sc.identification.uncertain.empty())
+      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+          "sets identification.uncertain, which a joint run does not take (its interval has no consider terms)", r.scenario);
     if (sc.identification.model != io::Model::Linear)
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",
@@ -224,6 +235,10 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     ep->modes_scenario = std::make_unique<io::Scenario>(spec.modes_scenario.empty() ? ep->runs.front()->scenario
                                                                                       : io::load_scenario(spec.modes_scenario));
     io::validate_scenario(*ep->modes_scenario);
+    if (!spec.modes_scenario.empty() && !ep->modes_scenario->identification.uncertain.empty())
+      bad(spec.source, "modes.scenario",
+          "sets identification.uncertain, which measured modes do not take (their interval has no consider terms)",
+          spec.modes_scenario);
     ep->modes_structure = make_structure(*ep->modes_scenario, ep->modes_scenario->identification.elements);
     ep->modes_params = ep->modes_structure->parameterize(*ep->modes_scenario);
     same_parameters(*ep->modes_params, "modes.scenario");
@@ -336,8 +351,6 @@ void modal_interval(ExperimentsResult& r, const ExperimentsProblem& ep) {
   in.refit_applies = false;
   r.interval = uncertainty_interval(r.ident, in);
   r.interval.note = "measured modes alone: noise (the file's stds) and residual terms only, no half-record refit";
-  if (!ep.modes_scenario->identification.uncertain.empty())
-    r.interval.note += "; the modes scenario's identification.uncertain is not in it";
   for (std::size_t i = 0; i < r.names.size(); ++i) {
     const auto e = static_cast<Eigen::Index>(i);
     if (!r.ident.identifiable[i] || !r.interval.too_wide[i]) continue;

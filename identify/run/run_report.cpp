@@ -78,7 +78,7 @@ json fit_test_json(const FitTest& fit) {
                     {"allowed", sf.allowed}, {"explained", sf.explained}});
   return {{"explains_data", fit.explains_data},
           {"within_noise_and_discretisation", fit.within_noise_and_discretisation},
-          {"model_error", fit.model_error}, {"ratio", fit.ratio},
+          {"model_error", fit.model_error}, {"model_error_needed", finite_or_null(fit.model_error_needed)}, {"ratio", fit.ratio},
           {"message", fit.message}, {"sensors", sens}};
 }
 
@@ -372,7 +372,12 @@ namespace {
 std::string plot_title(const RunResult& r) {
   std::string t = r.scenario + ": ";
   if (r.converged()) t += "converged";
-  else t += "NOT converged (" + std::string(r.summary.converged() ? "the fit test rejects the fit" : to_string(r.summary.termination)) + ")";
+  else
+    t += "NOT converged (" +
+         std::string(!r.summary.converged()   ? to_string(r.summary.termination)
+                     : r.determines_nothing() ? "the data determine no parameter"
+                                              : "the fit test rejects the fit") +
+         ")";
   for (std::size_t i = 0; i < r.names.size() && i < 4; ++i) {
     const auto e = static_cast<Eigen::Index>(i);
     char buf[96];

@@ -6,6 +6,8 @@
 // Plus the positive paths: --list-scenarios, --help, and a small identification run without
 // and then with --data (the data being the first run's measured column).
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -614,6 +616,10 @@ TEST(ScoleIdentifyHardening, ARunWithNoIdentifiableParameterSaysSo) {
   const auto j = read_json_file(out / "identify.json");
   for (const auto& p : j["parameters"]) EXPECT_FALSE(p.value("identifiable", true)) << p.dump();
   EXPECT_NE(r.err.find("none of the 2 estimated parameters is identifiable"), std::string::npos) << r.err;
+  // The estimate is the start's, not the data's: no "converged", exit 1.
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_FALSE(j["converged"].get<bool>());
+  EXPECT_NE(r.err.find("the data determine none of the 2 estimated parameters"), std::string::npos) << r.err;
 }
 
 TEST(ScoleIdentifyHardening, NegativeMaxIterationsIsRefused) {
@@ -1032,4 +1038,60 @@ TEST(ScoleIdentifyCli, ExportModelWritesThePlant) {
     for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(A[i][k].get<double>(), k == i + n / 2 ? 1.0 : 0.0);
   const Result bad = run({"--scenario", "good.yaml", "--out", "out2", "--export-model", "plant.txt"}, dir);
   expect_input_error(bad, dir / "out2", {"--export-model must name a .json or .mat file", "plant.txt"});
+}
+
+// An output file is never an input, never inside --out, never a directory, and its directory must
+// take a file: each refused before any work (exit 2, nothing written, the input unchanged).
+TEST(ScoleIdentifyHardening, ExportModelNeverOverwritesAnInputAndIsCheckedFirst) {
+  TempDir dir;
+  write_file(dir / "good.json", kGood);  // YAML is JSON's superset: a scenario named .json
+  const std::string before = slurp(dir / "good.json");
+  const Result a = run({"--scenario", "good.json", "--out", "out", "--export-model", "./good.json"}, dir);
+  expect_input_error(a, dir / "out", {"--export-model './good.json'", "is an input of this run"});
+  EXPECT_EQ(slurp(dir / "good.json"), before);
+  fs::create_directories(dir / "out0");
+  const Result b = run({"--scenario", "good.json", "--out", "out0", "--export-model", "out0/m.json"}, dir);
+  EXPECT_EQ(b.code, 2) << b.err;
+  EXPECT_NE(b.err.find("lies inside the output directory"), std::string::npos) << b.err;
+  EXPECT_TRUE(fs::is_empty(dir / "out0"));
+  fs::create_directories(dir / "m.json");
+  const Result c = run({"--scenario", "good.json", "--out", "out", "--export-model", "m.json"}, dir);
+  expect_input_error(c, dir / "out", {"--export-model 'm.json'", "is a directory"});
+  // No staging file is left beside an export that was refused or failed.
+  for (const auto& e : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << e.path();
+}
+
+// One run per output directory: a second into the same directory, or into one inside it, is
+// refused while the first holds it (here the test holds the lock as a running program would).
+TEST(ScoleIdentifyHardening, ConcurrentRunsIntoOneOrNestedOutputDirectoriesAreRefused) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const int fd = ::open((dir / ".out.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  ASSERT_EQ(::write(fd, "scole-truth (pid 1)\n", 20), 20);
+  const Result same = run({"--scenario", "good.yaml", "--out", "out", "-q"}, dir);
+  expect_input_error(same, dir / "out", {"another run (scole-truth (pid 1)) is writing it"});
+  const Result nested = run({"--scenario", "good.yaml", "--out", "out/inner", "-q"}, dir);
+  EXPECT_EQ(nested.code, 2) << nested.err;
+  EXPECT_NE(nested.err.find("lies inside"), std::string::npos) << nested.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "inner"));
+  ::close(fd);
+  const Result after = run({"--scenario", "good.yaml", "--out", "out", "-q"}, dir);
+  EXPECT_EQ(after.code, 0) << after.err;
+}
+
+// A data file that is a FIFO no one writes to: SIGTERM is an interruption (143), not bad input.
+TEST(ScoleIdentifyHardening, ASignalWhileOpeningAFifoAsDataIsAnInterruption) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path fifo = dir / "data.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  double after = 0.0;
+  const int code = run_and_signal({"--scenario", "good.yaml", "--data", fifo.string(), "--out", (dir / "out").string(), "-q"}, dir,
+                                  0.5, SIGTERM, &after);
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_LT(after, 1.0);
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }

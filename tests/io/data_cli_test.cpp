@@ -157,3 +157,27 @@ TEST(DataCli, TheColumnDescriptionBesideAConvertedFile) {
   EXPECT_NE(r.err.find("truth.json exists and is not a scole-data column description"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "truth.csv"));
 }
+
+// convert never writes over its input (however the path is spelled), nor onto a directory: each
+// refused before reading (exit 2), the input unchanged.
+TEST(DataCli, ConvertNeverOverwritesItsInputNorWritesOntoADirectory) {
+  const fs::path dir = scratch();
+  const std::string raw = "# comment\n\"time [s]\";\"P [N]\"\n0;10\n0,01;11\n";
+  scoleid::test::write_file(dir / "data.csv", raw);
+  for (const std::string out : {"data.csv", "./data.csv", "sub/../data.csv"}) {
+    fs::create_directories(dir / "sub");
+    const Result r = run({"convert", "data.csv", "--out", out}, dir);
+    EXPECT_EQ(r.code, 2) << out;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("is an input of this run"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(dir / "data.csv"), raw);
+  }
+  fs::create_directories(dir / "outdir");
+  const Result d = run({"convert", "data.csv", "--out", "outdir"}, dir);
+  EXPECT_EQ(d.code, 2);
+  EXPECT_NE(d.err.find("--out 'outdir': is a directory"), std::string::npos) << d.err;
+  const Result j = run({"convert", "data.csv", "--out", "x.json"}, dir);
+  EXPECT_EQ(j.code, 2);
+  EXPECT_NE(j.err.find("names the column description"), std::string::npos) << j.err;
+  EXPECT_FALSE(fs::exists(dir / "x.json"));
+}

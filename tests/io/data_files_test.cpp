@@ -186,3 +186,62 @@ TEST(DataFiles, BlanksAroundQuotesAndATrailingSeparator) {
   EXPECT_EQ(t.names, std::vector<std::string>{"Kraft [N]"});
   EXPECT_EQ(t.columns[0], (std::vector<double>{1.5, 2.0}));
 }
+
+// Hexadecimal is no number in a data file (strtod would read 0x1p-10 as 0.0009765625).
+TEST(DataFiles, HexadecimalCellsAreRefused) {
+  EXPECT_NE(error_of_csv("t,a\n0,1\n1,0x1p-10\n").find("line 3, column 'a': not a number, got '0x1p-10'"), std::string::npos);
+  EXPECT_NE(error_of_csv("t,a\n0,1\n0x10,1\n").find("line 3, column 't': not a number, got '0x10'"), std::string::npos);
+  EXPECT_NE(error_of_csv("t,a\n0,1\n1,1e400\n").find("line 3, column 'a': must be finite"), std::string::npos);
+}
+
+// A table built in memory (a program's, Python's) passes the checks a file's does.
+TEST(DataFiles, ATableBuiltInMemoryIsCheckedAsAFileIs) {
+  auto table = [] {
+    DataTable t;
+    t.source = "mem";
+    t.t = {0.0, 0.1, 0.2};
+    t.names = {"a"};
+    t.columns = {{1.0, 2.0, 3.0}};
+    return t;
+  };
+  auto error_of_table = [](const DataTable& t) {
+    try {
+      check_table(t);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of_table(table()), "");
+  DataTable t = table();
+  t.columns[0][1] = std::nan("");
+  EXPECT_EQ(error_of_table(t), "data 'mem': column 'a', sample 2 (t = 0.1 s): must be finite, got nan");
+  t = table();
+  t.t[2] = 0.1;
+  EXPECT_EQ(error_of_table(t), "data 'mem': time, sample 3: must be strictly increasing (after 0.1), got 0.1");
+  t = table();
+  t.t = {};
+  t.columns[0] = {};
+  EXPECT_EQ(error_of_table(t), "data 'mem': needs at least 2 samples, got 0");
+  t = table();
+  t.columns[0].pop_back();
+  EXPECT_EQ(error_of_table(t), "data 'mem': column 'a' has 2 values for 3 times");
+  t = table();
+  t.columns[0][0] = 1e300;
+  EXPECT_NE(error_of_table(t).find("magnitude must be at most"), std::string::npos);
+  t = table();
+  t.names = {"t"};
+  EXPECT_NE(error_of_table(t).find("has the time column's name"), std::string::npos);
+}
+
+TEST(DataFiles, ATrueValueBeyondTheScenarioRangeIsRefused) {
+  const auto d = temp_dir();
+  const auto p = write_file(d / "truth.json", R"({"true_parameters": {"EI": 1e308}})");
+  std::string msg;
+  try {
+    read_truth_meta(p);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("true_parameters.EI must be 0 or of magnitude within"), std::string::npos) << msg;
+}

@@ -86,3 +86,15 @@ TEST(Interruptible, ACallThatCannotCheckIsAbandonedAtTheSignalAndOtherwiseAnswer
   // An exception of the call reaches the caller.
   EXPECT_THROW(interruptible([]() -> int { throw InputError("x"); }), InputError);
 }
+
+// Nesting deeper than any file of ours is refused before anything recurses over it (a JSON of
+// 100 000 nested arrays crashed the serializer of an error message).
+TEST(InputFile, DeepNestingIsRefusedInJsonAndYaml) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_EQ(error_of([&] { parse_json_text(deep, "f.json"); }), "f.json: nested deeper than 100 levels");
+  const std::string ok = std::string(50, '[') + std::string(50, ']');
+  EXPECT_EQ(error_of([&] { parse_json_text(ok, "f.json"); }), "");
+  EXPECT_EQ(error_of([&] { check_yaml_nesting("name: x\nbeam: " + deep, "f.yaml"); }), "f.yaml: line 2: nested deeper than 100 levels");
+  // Brackets inside quotes and comments are text.
+  EXPECT_EQ(error_of([&] { check_yaml_nesting("a: '" + deep.substr(0, 200) + "' # " + deep.substr(0, 300), "f.yaml"); }), "");
+}

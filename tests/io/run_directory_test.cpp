@@ -4,6 +4,7 @@
 #include "scoleid/io/run_directory.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -181,4 +182,89 @@ TEST_F(RunDirectoryTest, KeepEarlierOutputsReplacesOnlyWhatThisRunWrote) {
   EXPECT_FALSE(fs::exists(out / "a.csv"));
   EXPECT_FALSE(fs::exists(out / "sub"));
   EXPECT_EQ(slurp(out / "b.json"), "newer b\n");
+}
+
+// One run per directory at a time, and none inside another's: the second is refused up front,
+// naming the run that holds the directory, and the lock goes with the run that held it.
+TEST_F(RunDirectoryTest, ASecondRunIntoTheSameOrANestedDirectoryIsRefusedWhileTheFirstRuns) {
+  const fs::path out = root_ / "run";
+  {
+    RunDirectory first(out.string(), owned_, "first");
+    std::string msg;
+    try {
+      RunDirectory second(out.string(), owned_, "second");
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find("another run (first (pid " + std::to_string(::getpid()) + ")) is writing it"), std::string::npos) << msg;
+    msg.clear();
+    try {
+      RunDirectory inner((out / "inner").string(), owned_, "inner");
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find("lies inside"), std::string::npos) << msg;
+    write_text_atomic(first.path("a.csv"), "t\n");
+    first.commit();
+  }
+  EXPECT_TRUE(fs::is_regular_file(out / "a.csv"));
+  // Released: the next run may use it, and no lock file is left beside it.
+  EXPECT_NO_THROW(RunDirectory again(out.string(), owned_, "again"));
+  EXPECT_EQ(leftovers("run"), std::vector<std::string>{});
+}
+
+TEST_F(RunDirectoryTest, ARunInsideTheTargetRefusesTheOuterRunAndAKilledRunsLockIsNoObstacle) {
+  const fs::path out = root_ / "run";
+  {
+    RunDirectory inner((out / "inner").string(), owned_, "inner");
+    std::string msg;
+    try {
+      RunDirectory outer(out.string(), owned_, "outer");
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find("is writing 'inner' inside it"), std::string::npos) << msg;
+  }
+  // A lock file nobody holds (a run killed with SIGKILL) is stale: ignored.
+  fs::remove_all(out);
+  fs::create_directories(out);
+  write_text_atomic((out / ".inner.lock").string(), "inner (pid 1)\n");
+  write_text_atomic((root_ / ".run.lock").string(), "someone (pid 1)\n");
+  EXPECT_NO_THROW(RunDirectory outer(out.string(), owned_, "outer"));
+}
+
+// A run holds its lock until it ends however it ends: a refusal after the lock releases it.
+TEST_F(RunDirectoryTest, ARefusedRunReleasesItsLock) {
+  const fs::path out = existing_run("foreign.txt", "mine");
+  EXPECT_THROW(RunDirectory r(out.string(), owned_, "x"), InputError);
+  EXPECT_FALSE(fs::exists(root_ / ".run.lock"));
+}
+
+// A directory the user may not write is not replaced by one they may (the commit's rename only
+// needs the parent writable). Needs a user without root's pass: run as nobody when the test is
+// root, else as the user.
+TEST_F(RunDirectoryTest, AnUnwritableTargetIsRefusedNotReplaced) {
+  const fs::path parent = root_ / "shared";
+  fs::create_directories(parent / "out");
+  fs::permissions(parent, fs::perms::all);  // 0777: anyone may create beside it
+  fs::permissions(parent / "out", fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                      fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(root_, fs::perms::all);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::geteuid() == 0 && ::setuid(65534) != 0) ::_exit(3);
+    try {
+      RunDirectory r((parent / "out").string(), owned_, "x");
+    } catch (const InputError& e) {
+      ::_exit(std::string(e.what()).find("is not writable") != std::string::npos ? 0 : 4);
+    } catch (...) {
+      ::_exit(5);
+    }
+    ::_exit(6);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no setuid, 4: another message, 6: accepted";
+  EXPECT_TRUE(fs::is_directory(parent / "out"));
 }

@@ -99,7 +99,7 @@ TEST(Scenario, ScoleDampingAndActuatorHardwareAreChecked) {
 
 TEST(Scenario, NanAndTextAreRejected) {
   EXPECT_EQ(error_of("beam: {EI: .nan}"), "scenario 'x.yaml': beam.EI must be a finite number, got '.nan'");
-  EXPECT_EQ(error_of("beam: {length: ten}"), "scenario 'x.yaml': beam.length must be a number, got 'ten'");
+  EXPECT_EQ(error_of("beam: {length: ten}"), "scenario 'x.yaml': beam.length must be a decimal number, got 'ten'");
 }
 
 TEST(Scenario, UnknownFieldIsRejected) {
@@ -413,4 +413,59 @@ TEST(Scenario, MeaninglessMagnitudesAreRefusedWithTheirReason) {
   EXPECT_NE(error_of("identification: {step_tolerance: 2}").find("identification.step_tolerance must be below 1"),
             std::string::npos);
   EXPECT_EQ(error_of("beam: {zeta: 1}\nidentification: {model_error: 1, gradient_tolerance: 0.5}"), "");
+}
+
+// Numbers are decimal: yaml-cpp and strtod would read 0x10 as 16.
+TEST(Scenario, HexadecimalNumbersAreRefused) {
+  EXPECT_EQ(error_of("identification: {elements: '0x10'}"),
+            "scenario 'x.yaml': identification.elements must be a decimal number, got '0x10'");
+  EXPECT_EQ(error_of("beam: {EI: 0x1p10}"), "scenario 'x.yaml': beam.EI must be a decimal number, got '0x1p10'");
+  EXPECT_EQ(error_of("beam: {length: 1e400}"), "scenario 'x.yaml': beam.length must be a finite number, got '1e400'");
+}
+
+// The other structure's section would be read and ignored: refused, naming it.
+TEST(Scenario, TheOtherStructuresSectionIsRefused) {
+  EXPECT_EQ(error_of("structure: scole\nbeam: {length: 10}"),
+            "scenario 'x.yaml': beam describes a beam, but the scenario's structure is scole (remove the section, or set "
+            "structure: beam), got a beam section");
+  EXPECT_NE(error_of("scole: {zeta: 0.01}").find("scole describes SCOLE, but the scenario's structure is beam"), std::string::npos);
+}
+
+// identify.json echoes the default model error as "auto"; the echo reads back.
+TEST(Scenario, ModelErrorAutoIsTheDefault) {
+  EXPECT_EQ(error_of("identification: {model_error: auto}"), "");
+  EXPECT_LT(parse_scenario("identification: {model_error: auto}", "x").identification.model_error, 0.0);
+  EXPECT_EQ(parse_scenario("identification: {model_error: 0.02}", "x").identification.model_error, 0.02);
+  EXPECT_NE(error_of("identification: {model_error: automatic}").find("identification.model_error"), std::string::npos);
+}
+
+// A tolerance as large as the quantity it qualifies (that cannot be negative) is refused.
+TEST(Scenario, AnUncertaintyAsLargeAsItsValueIsRefused) {
+  EXPECT_EQ(error_of("beam: {length: 10}\nidentification: {uncertain: {beam.length: 1e24}}"),
+            "scenario 'x.yaml': identification.uncertain.beam.length must be smaller than the value it is a tolerance of "
+            "(10): a quantity known no better than that is unknown (estimate it instead), got 1e+24");
+  EXPECT_EQ(error_of("beam: {length: 10}\nidentification: {uncertain: {beam.length: 0.1}}"), "");
+}
+
+TEST(Scenario, AnActuatorLagLongerThanTheRecordIsRefused) {
+  EXPECT_NE(error_of("structure: scole\nsimulation: {duration: 2}\ntruth: {overrides: {scole: {actuator_lag: 1e24}}}")
+                .find("truth.overrides.scole.actuator_lag must be shorter than simulation.duration (2)"),
+            std::string::npos);
+}
+
+TEST(Scenario, AnUnknownBuiltinNamesNoCommandLineOption) {
+  std::string msg;
+  try {
+    builtin_scenario_text("nope");
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_EQ(msg.rfind("'nope' is not a built-in scenario (paper-beam-1", 0), 0u) << msg;
+}
+
+// A name echoed in a refusal says how long it really is.
+TEST(Scenario, AHugeNameIsCountedWhole) {
+  const std::string name(1000000, 'a');
+  const std::string msg = error_of("sensors: [{name: " + name + ", location: 5}]");
+  EXPECT_NE(msg.find("(1000000 characters)"), std::string::npos) << msg.substr(0, 300);
 }

@@ -74,27 +74,57 @@ def truth(scenario, progress=False):
     return TruthRecord(cols, json.loads(meta))
 
 
+def _column(name, values, n=None):
+    """One column as a 1-D float array of n values; InputError for anything else."""
+    if getattr(getattr(values, "dtype", None), "kind", "") in ("m", "M"):
+        raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, values.dtype))
+    if hasattr(values, "to_numpy"):  # a pandas Series (nullable dtypes: NA becomes NaN, refused below)
+        try:
+            values = values.to_numpy(dtype=float, na_value=np.nan)
+        except (TypeError, ValueError) as e:
+            raise InputError("data: column '%s' is not numeric (%s)" % (name, e)) from None
+    a = np.asarray(values)
+    if np.iscomplexobj(a):
+        raise InputError("data: column '%s' is complex; give real values (a time record)" % name)
+    if a.dtype.kind in "mM":
+        raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, a.dtype))
+    try:
+        a = np.asarray(a, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError("data: column '%s' is not numeric (%s)" % (name, e)) from None
+    if a.ndim != 1:
+        raise InputError("data: column '%s' has shape %s; give a 1-D array%s"
+                         % (name, a.shape, "" if n is None else " of %d values" % n))
+    if n is not None and a.size != n:
+        raise InputError("data: column '%s' has %d values for %d times" % (name, a.size, n))
+    return a
+
+
 def _table(data):
     """(names, t, values[samples x columns], meta_json) of a dict or DataFrame."""
     if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a pandas DataFrame (truth.json in .attrs["meta"])
         meta = getattr(data, "attrs", {}).get("meta")
-        cols = {str(c): data[c].to_numpy(dtype=float) for c in data.columns}
+        if len(set(map(str, data.columns))) != len(data.columns):
+            raise InputError("data: the DataFrame's column names repeat")
+        if len(data.columns) == 0:
+            raise InputError("data: the DataFrame has no columns")
+        cols = {str(c): data[c] for c in data.columns}
         if "t" not in cols:
             first = str(data.columns[0])
             cols = {"t": cols.pop(first), **cols}
         data = cols
-    else:
+    elif isinstance(data, dict):
         meta = data.meta if isinstance(data, TruthRecord) else None
+    else:
+        raise InputError("data: a dict of arrays with a \"t\" entry, a pandas DataFrame or a file path, got %s"
+                         % type(data).__name__)
     if "t" not in data:
         raise InputError('data: a dict of arrays needs a "t" entry (the sample times)')
-    t = np.asarray(data["t"], dtype=float)
+    t = _column("t", data["t"])
     names = [str(k) for k in data if k != "t"]
     values = np.empty((t.size, len(names)))
-    for j, n in enumerate(names):
-        v = np.asarray(data[n], dtype=float)
-        if v.shape != t.shape:
-            raise InputError("data: column '%s' has %d values for %d times" % (n, v.size, t.size))
-        values[:, j] = v
+    for j, (k, n) in enumerate(zip([k for k in data if k != "t"], names)):
+        values[:, j] = _column(n, data[k], t.size)
     return names, t, values, json.dumps(meta) if meta is not None else ""
 
 

@@ -51,6 +51,12 @@ DataTable read_csv(const std::string& path, const CsvOptions& options = {});
 // The same on text already in memory / a stream; `path` names it in messages.
 DataTable read_csv_text(const std::string& text, const std::string& path, const CsvOptions& options = {});
 DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options = {});
+// What every record must satisfy however it arrives (a file, a program's memory, Python): at
+// least 2 and at most limits::kMaxSamples samples, times strictly increasing, one value per time
+// in every column, names non-empty, unique and not the time column's, every value finite and of
+// magnitude at most limits::kMaxMagnitude. The readers check as they read (naming the line);
+// this checks a table built elsewhere, naming the source, column and sample.
+void check_table(const DataTable& table);
 // 17 significant digits; atomic.
 void write_csv(const std::string& path, const DataTable& table);
 // The fields of one CSV line, each trimmed of blanks and double quotes ('\r' dropped); a quoted

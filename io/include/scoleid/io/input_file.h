@@ -8,6 +8,7 @@
 //   meanwhile ends the program as an interruption (io::Interrupted), not as a bad file.
 // - parse_json_text parses JSON and refuses a key repeated within one object (nlohmann keeps the
 //   last, so the first value would be dropped silently), naming the key's path.
+// - JSON and flow YAML nested deeper than kMaxNesting levels are refused before anything recurses.
 // - check_yaml_document refuses, in a parsed YAML document, a repeated key (yaml-cpp answers
 //   node[key] with the first pair, dropping the later one silently), a non-scalar key, a scalar or
 //   key that is not UTF-8 and (unless allow_null) a key written without a value; each alias's
@@ -27,11 +28,17 @@ namespace scoleid::io {
 // modal data, truth.json and the cross-check's own JSON; data records are bounded by their sample
 // count instead).
 inline constexpr std::size_t kMaxInputFileBytes = std::size_t{256} << 20;
+// JSON and YAML nested deeper than this are refused (no file of ours goes beyond 10 levels; a
+// nesting of 100 000 would exhaust the stack of code that recurses over the document).
+inline constexpr int kMaxNesting = 100;
 
 // `what` names the kind of file in the message ("scenario file", "JSON file").
 std::string read_text_file(const std::string& path, const std::string& what,
                            std::size_t max_bytes = kMaxInputFileBytes);
 nlohmann::json parse_json_text(const std::string& text, const std::string& source);
 void check_yaml_document(const YAML::Node& root, const std::string& source, bool allow_null = false);
+// Before YAML is parsed: flow collections ([ ], { }) nested deeper than kMaxNesting are refused
+// with one line naming the line (the parser's own guard answers "bad file").
+void check_yaml_nesting(const std::string& text, const std::string& source);
 
 }  // namespace scoleid::io

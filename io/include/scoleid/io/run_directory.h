@@ -8,9 +8,15 @@
 // earlier run. A run that fails, throws, or is interrupted (interrupt.h) never commits; the
 // destructor removes the staging directory and the target is left exactly as it was.
 //
+// One run at a time per directory, and none inside another's: the run holds PARENT/.NAME.lock
+// (flock; the file holds the program and pid, and is removed at the end) from the constructor to
+// the destructor, and a run whose target lies inside a directory whose lock is held, or a
+// directory holding a held lock, is refused up front (InputError naming the other run).
+//
 // The target may be new, empty, or hold an earlier run of the same program (only files from
 // `owned`; an owned name may be a file or a directory). Anything else in it is refused up front, so no user file is ever replaced. The
 // constructor also proves the parent is writable, before any work is done.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -39,7 +45,15 @@ public:
   bool committed() const { return committed_; }
 
 private:
-  std::string target_, staging_, program_;
+  void lock(const std::filesystem::path& target);
+  void release_lock();
+  // The target's contents and the staging directory (the constructor's work after the lock).
+  void check_target(const std::filesystem::path& target, const std::string& given, const std::string& program);
+  static bool lock_held(const std::filesystem::path& lock);
+  static std::string lock_holder(const std::filesystem::path& lock);
+
+  std::string target_, staging_, program_, lock_path_;
+  int lock_fd_ = -1;
   std::vector<std::string> owned_;
   bool committed_ = false;
 };

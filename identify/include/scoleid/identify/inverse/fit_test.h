@@ -76,6 +76,9 @@ struct FitTest {
   double ratio = 0;  // √(Σ s²/z² / Σ a²/z²): <= 1 when the data are explained
   std::vector<SensorFit> sensors;
   double model_error = 0;
+  // The least model error m with which the test passes (0 when noise and discretisation suffice):
+  // what a declared identification.model_error buys, stated beside it.
+  double model_error_needed = 0;
   // One line: which sensor fails by how much, or that every sensor passes.
   std::string message;
   // The discretisation estimate d (samples × sensors) the test used; empty when none was made.

@@ -16,6 +16,7 @@
 // estimate; the uncertainty interval (interval.h) from them, a refit on the first half of the
 // record, and the consider shifts of the scenario's declared uncertainties
 // (identification.uncertain).
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <optional>
@@ -94,8 +95,17 @@ struct RunResult {
   double smoothness_expected_misfit = 0.0;
   bool smoothness_met = false;
   // The optimiser stopped on a convergence test and the model explains the data (and, with the
-  // discrepancy principle, a weight met it).
-  bool converged() const { return summary.converged() && fit.explains_data && (smoothness_path.empty() || smoothness_met); }
+  // discrepancy principle, a weight met it), and the data determine at least one estimated
+  // parameter where that was assessed: a point the data leave wholly undetermined (noise far above
+  // the signal, three samples) is the start's, not the data's, however well it "fits".
+  bool converged() const {
+    return summary.converged() && fit.explains_data && (smoothness_path.empty() || smoothness_met) && !determines_nothing();
+  }
+  // Identifiability was assessed and flags every estimated parameter.
+  bool determines_nothing() const {
+    return !ident.identifiable.empty() &&
+           std::none_of(ident.identifiable.begin(), ident.identifiable.end(), [](bool b) { return b; });
+  }
   // Every attempt's iterations with its coarse-to-fine levels (summary.iterations_done is the
   // chosen run's alone).
   int iterations_all_attempts() const {
