@@ -22,6 +22,7 @@
 #include <iostream>
 
 #include "campaign_mpi.h"
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/program.h"
 #include "scoleid/crosscheck/campaign_runner.h"
 #include "scoleid/crosscheck/identify_study.h"
@@ -260,6 +261,7 @@ int run_campaign(const std::string& file, crosscheck::CampaignRunOptions opt) {
   return guarded([&] {
     const crosscheck::Campaign c = crosscheck::load_campaign(file);
     if (opt.out.empty()) opt.out = "run/campaign/" + c.name;
+    io::check_inputs_outside("--out", opt.out, {file});
     const crosscheck::CampaignStore store(c, opt.out, true);
     if (opt.progress) std::fprintf(stderr, "scole-crosscheck campaign: %s: %zu points, %zu cases, serially\n", c.name.c_str(), c.points.size(), c.cases.size());
     try {
@@ -275,6 +277,7 @@ int run_campaign(const std::string& file, crosscheck::CampaignRunOptions opt) {
 // The command line: the verbs and their options.
 struct Cli {
   std::string scenario = "paper-scole-1", out;
+  bool out_given = false;  // --out was on the command line (an empty one is refused, not defaulted)
   bool quiet = false;
   crosscheck::ModesOptions mo;
   crosscheck::TrajectoryOptions to;
@@ -430,10 +433,12 @@ std::vector<std::string> report_verb(io::RunDirectory& dir, const std::string& o
 int run_scenario_verbs(Cli& c) {
   const io::Scenario sc = io::load_scenario(c.scenario);
   io::validate_scenario(sc);
+  if (c.out_given && c.out.empty()) throw io::InputError("command line: --out is empty (give a value, or leave the option out)");
   if (c.out.empty()) c.out = "run/" + sc.name + "/crosscheck";
   std::string why;
   if (!c.mo.IsValid(&why) || !c.to.IsValid(&why) || !c.io_.IsValid(&why)) throw io::InputError("command line: " + why);
   c.to.progress = c.io_.progress = !c.quiet;
+  io::check_inputs_outside("--out", c.out, {c.scenario});
   io::RunDirectory dir(c.out, kOutputs, "scole-crosscheck");
   const bool all = c.all->parsed();
   bool converged = true;
@@ -477,5 +482,7 @@ int main(int argc, char** argv) {
     return run_campaign(c.campaign_file, c.co);
   }
   if (c.suite->parsed()) return run_suite(c.suite_only, c.suite_dir, c.suite_out, c.suite_collect, c.so, c.quiet);
+  for (CLI::App* sub : {c.modes, c.traj, c.ident, c.report, c.all})
+    if (sub && sub->parsed() && sub->count("--out") > 0) c.out_given = true;
   return guarded([&] { return run_scenario_verbs(c); });
 }

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/mat_file.h"
 #include "scoleid/io/validation.h"
 
@@ -135,6 +136,13 @@ io::MatVariable mat_of(const std::string& name, const std::vector<std::string>& 
 }  // namespace
 
 void Identification::export_model(const std::string& path) const {
+  io::check_output_file("export model", path, {});  // a file name in a directory that takes one
+  // Never over what the identification read (its scenario file, its data file).
+  for (const std::string& in : {problem_->scenario.source, problem_->data_source}) {
+    std::error_code ec;
+    if (!in.empty() && std::filesystem::is_regular_file(in, ec) && io::same_file(path, in))
+      throw io::InputError("export model: '" + io::shorten(path) + "' is an input of this identification; it would be overwritten");
+  }
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".json") return io::write_json_atomic(path, model_json());
   if (ext != ".mat") throw io::InputError("export model: '" + path + "' must end in .json or .mat");
@@ -148,6 +156,7 @@ void Identification::export_model(const std::string& path) const {
 void Identification::write(io::RunDirectory& dir) const { identify::write_outputs(dir, *problem_, result_); }
 
 void Identification::write(const std::string& dir) const {
+  io::check_inputs_outside("write", dir, {problem_->scenario.source, problem_->data_source});
   io::RunDirectory run_dir(dir, output_files(), "scoleid");
   write(run_dir);
   run_dir.commit();

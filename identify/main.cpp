@@ -29,6 +29,15 @@ int run_experiments_command(const std::string& file, std::string out, std::optio
                             int max_iterations, bool compute_std, bool verbose) {
   const identify::ExperimentsSpec spec = identify::load_experiments(file);
   if (out.empty()) out = "run/" + spec.name;
+  {
+    std::vector<std::string> inputs{file};
+    for (const auto& r : spec.runs) {
+      inputs.push_back(r.scenario);
+      if (r.data) inputs.push_back(*r.data);
+    }
+    if (spec.modes_file) inputs.push_back(*spec.modes_file);
+    io::check_inputs_outside("--out", out, inputs);
+  }
   io::RunDirectory run_dir(out, identify::experiments_output_files(spec), "scole-identify");
   auto ep = identify::make_experiments(spec);
   identify::ExperimentsOptions eo;
@@ -114,12 +123,21 @@ void print_problem(const identify::Problem& problem, bool from_file) {
   std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
                list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
                list(c.unused).c_str());
-  for (const auto& x : c.sources)
+  for (const auto& x : c.sources) {
     if (x.column != x.name || !x.from_unit.empty())
       std::fprintf(stderr, "scole-identify: %s <- column '%s'%s\n", x.name.c_str(), x.column.c_str(),
                    x.from_unit.empty() ? ""
                                        : (" [" + x.from_unit + ", " + x.unit_stated_by + "] x " + io::format_value(x.scale) +
                                           " -> [" + x.to_unit + "]").c_str());
+    if (x.conditioned)
+      std::fprintf(stderr, "scole-identify: %s conditioned: offset %s removed, times %s%s\n", x.name.c_str(),
+                   io::format_value(x.offset_removed).c_str(), io::format_value(x.factor).c_str(),
+                   x.trend_removed.second != 0.0 || x.trend_removed.first != 0.0
+                       ? (", trend " + io::format_value(x.trend_removed.first) + " + " + io::format_value(x.trend_removed.second) +
+                          " (t - mid) removed")
+                             .c_str()
+                       : "");
+  }
   for (const auto& st : c.stepped_inputs) {
     if (st.cubic) {
       std::fprintf(stderr,
@@ -234,6 +252,8 @@ int main(int argc, char** argv) {
     io::validate_scenario(sc);  // the overrides pass the same checks as the file
     if (out.empty()) out = "run/" + sc.name;
     // The output directory is checked (and its staging area made) before any work.
+    io::check_inputs_outside("--out", out,
+                             {scenario, data, data.empty() ? std::string() : std::filesystem::path(data).replace_extension(".json").string()});
     io::RunDirectory run_dir(out, Identification::output_files(), "scole-identify");
     check_export_path(export_model, scenario, data, out);
     // The exported model is written beside its place during the run and put there after the

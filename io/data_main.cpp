@@ -4,8 +4,9 @@
 //   scole-data convert FILE --out OUT.csv   the time responses as the product's CSV (t in s, then
 //                                           the channels in file order, values in the file's units)
 //                                           and OUT.json beside it describing each column
-// FILE is a Universal File (58/58b, 151, 164, 15, 2411, 55) or a CSV (DAQ dialects: comment
-// lines, any time-column name, quoted headers, ';' with decimal commas, units in brackets).
+// FILE is a Universal File (58/58b, 151, 164, 15, 2411, 55), a LabVIEW Measurement file (.lvm, one
+// segment) or a CSV (DAQ dialects: comment lines, any time-column name, quoted headers, ';' with
+// decimal commas, units in brackets).
 // Exit codes: 0 success, 2 bad usage or bad input (one line naming the file, record or line, field
 // and value; nothing written), 130/143 interrupted.
 #include <CLI/CLI.hpp>
@@ -115,15 +116,16 @@ int main(int argc, char** argv) {
   CLI::App app{
       "scole-data: measured data as labs export it. Reads Universal Files (UFF/UNV datasets 58 and 58b time\n"
       "histories and functions, 151 header, 164 units, 15/2411 nodes, 55 mode shapes) and DAQ CSV exports\n"
-      "(comment lines, any time-column name, quoted headers, ';' with decimal commas, units in brackets)."};
+      "(comment lines, any time-column name, quoted headers, ';' with decimal commas, units in brackets), and\n"
+      "LabVIEW Measurement files (.lvm text: X_Columns No/One/Multi, Tab or Comma, decimal point or comma)."};
   app.require_subcommand(1);
   std::string file, out, time_column, time_unit;
   bool as_json = false, quiet = false;
   auto* info = app.add_subcommand("info", "list the file's channels (name, unit, quantity, samples, start, step, node)");
-  info->add_option("file", file, "data file (UFF or CSV)")->required();
+  info->add_option("file", file, "data file (UFF, LabVIEW LVM or CSV)")->required();
   info->add_flag("--json", as_json, "print the listing as JSON");
   auto* conv = app.add_subcommand("convert", "write the time responses as the product's CSV and a JSON of its columns");
-  conv->add_option("file", file, "data file (UFF or CSV)")->required();
+  conv->add_option("file", file, "data file (UFF, LabVIEW LVM or CSV)")->required();
   conv->add_option("-o,--out", out, "output CSV; OUT.json is written beside it")->required();
   conv->add_flag("-q,--quiet", quiet, "no summary on stderr");
   for (auto* sub : {info, conv}) {

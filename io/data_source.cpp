@@ -1,4 +1,5 @@
 #include "scoleid/io/data_source.h"
+#include "scoleid/io/lvm.h"
 
 #include <cmath>
 #include <filesystem>
@@ -249,13 +250,25 @@ DataFileInfo describe_uff(const std::string& path) {
 
 }  // namespace
 
+bool is_lvm_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return looks_like_lvm(head);
+}
+
 DataTable read_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return uff_table(uff::read_file(path));
+  if (is_lvm_file(path)) return read_lvm(path);
   return read_csv_data(path, options);
 }
 
 DataFileInfo describe_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return describe_uff(path);
+  if (is_lvm_file(path)) return describe_lvm(path);
   return describe_csv(path, options);
 }
 

@@ -2,6 +2,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
@@ -14,11 +17,39 @@
 
 namespace scoleid::io {
 
+InputFileStream::InputFileStream(const std::string& path) : std::istream(nullptr) {
+  rdbuf(&buf_);
+  for (;;) {
+    buf_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (buf_.fd >= 0 || errno != EINTR) break;
+    check_interrupt();
+  }
+  if (buf_.fd < 0) setstate(std::ios::failbit);
+}
+
+InputFileStream::~InputFileStream() {
+  if (buf_.fd >= 0) ::close(buf_.fd);
+}
+
+InputFileStream::Buf::int_type InputFileStream::Buf::underflow() {
+  if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+  for (;;) {
+    const ssize_t n = ::read(fd, data, sizeof data);
+    if (n > 0) {
+      setg(data, data, data + n);
+      return traits_type::to_int_type(*gptr());
+    }
+    if (n == 0) return traits_type::eof();
+    if (errno != EINTR) return traits_type::eof();
+    check_interrupt();
+  }
+}
+
 std::string read_text_file(const std::string& path, const std::string& what, std::size_t max_bytes) {
   const std::string where = what + " '" + path + "'";
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(one_line(where + ": is a directory"));
-  std::ifstream in(path, std::ios::binary);
+  InputFileStream in(path);
   if (!in) {
     check_interrupt();  // a signal while blocked opening a FIFO
     throw InputError(one_line(where + ": cannot be opened"));

@@ -45,6 +45,8 @@ bool inside(const std::string& path, const std::string& dir) {
 void check_output_file(const std::string& option, const std::string& path, const std::vector<std::string>& inputs,
                        const std::string& out_dir) {
   const std::string where = "command line: " + option + " '" + shorten(path) + "'";
+  if (path.empty()) throw InputError("command line: " + option + " is empty (give a file name)");
+  if (path.find('\0') != std::string::npos) throw InputError(where + ": holds a NUL character");
   for (const auto& in : inputs) {
     std::error_code ec;
     if (in.empty() || !fs::exists(in, ec)) continue;  // a built-in scenario's name is no file
@@ -60,6 +62,22 @@ void check_output_file(const std::string& option, const std::string& path, const
   if (!fs::is_directory(dir, ec)) throw InputError(where + ": directory '" + dir.string() + "' does not exist");
   if (::access(dir.c_str(), W_OK | X_OK) != 0)
     throw InputError(where + ": directory '" + dir.string() + "' is not writable (" + std::strerror(errno) + ")");
+  // access() answers yes to root everywhere: a file made and removed proves the directory takes one.
+  const fs::path probe = dir / (".scoleid-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) throw InputError(where + ": directory '" + dir.string() + "' takes no new file (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+void check_inputs_outside(const std::string& option, const std::string& out_dir, const std::vector<std::string>& inputs) {
+  for (const auto& in : inputs) {
+    std::error_code ec;
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    if (inside(in, out_dir))
+      throw InputError("command line: " + option + " '" + shorten(out_dir) + "': holds an input of this run ('" + shorten(in) +
+                       "'), and the run replaces the directory as a whole; move the input out or choose another " + option);
+  }
 }
 
 StagedFile::StagedFile(std::string final_path, const std::string& what) : final_(std::move(final_path)) {

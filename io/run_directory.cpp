@@ -26,7 +26,7 @@ fs::path lock_of(const fs::path& d) { return d.parent_path() / ("." + d.filename
 
 RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> owned, const std::string& program)
     : program_(program), owned_(std::move(owned)) {
-  if (target.empty()) throw InputError(program + ": output directory must not be empty");
+  if (target.empty()) throw InputError("output directory must not be empty (give one, or leave the option out)");
   std::error_code ec;
   fs::path t = fs::absolute(fs::path(target), ec).lexically_normal();
   if (!t.has_filename() && t.has_parent_path()) t = t.parent_path();  // "dir/" -> "dir"

@@ -543,6 +543,46 @@ void check_location(const Scenario& sc, const std::string& field, Site at, doubl
 
 // A sensor's or input's unit and its column's must be units of its quantity, and the unit the
 // scenario's unit system gives it (no label may disagree with the numbers).
+// conditioning: {offset: none | mean | {mean_before: T} | value, scale, sign, detrend} (scenario.h).
+Conditioning parse_conditioning(Reader& parent, const std::string& source) {
+  Conditioning c;
+  if (!parent.has("conditioning")) return c;
+  const YAML::Node n = parent.child("conditioning");
+  const std::string path = parent.field("conditioning");
+  if (!n.IsMap()) fail_field(source, path, "must be a map {offset, scale, sign, detrend}", Reader::kind(n));
+  Reader r(n, source, path);
+  if (r.has("offset")) {
+    const YAML::Node o = r.child("offset");
+    if (o.IsMap()) {
+      Reader m(o, source, r.field("offset"));
+      if (!m.has("mean_before")) fail_field(source, r.field("offset"), "as a map must be {mean_before: T}", Reader::kind(o));
+      c.offset = Conditioning::Offset::MeanBefore;
+      c.offset_value = m.num("mean_before", 0.0);
+    } else if (o.IsScalar() && (o.Scalar() == "none" || o.Scalar() == "mean")) {
+      c.offset = o.Scalar() == "mean" ? Conditioning::Offset::Mean : Conditioning::Offset::None;
+    } else {
+      c.offset = Conditioning::Offset::Value;
+      c.offset_value = r.as_number(o, r.field("offset"));
+    }
+  }
+  c.scale = r.positive("scale", 1.0);
+  c.sign = r.num("sign", 1.0);
+  if (c.sign != 1.0 && c.sign != -1.0) fail_field(source, r.field("sign"), "must be 1 or -1", format_value(c.sign));
+  c.detrend = r.boolean("detrend", false);
+  return c;
+}
+
+nlohmann::json conditioning_json(const Conditioning& c) {
+  nlohmann::json j = nlohmann::json::object();
+  if (c.offset == Conditioning::Offset::Mean) j["offset"] = "mean";
+  else if (c.offset == Conditioning::Offset::MeanBefore) j["offset"] = {{"mean_before", c.offset_value}};
+  else if (c.offset == Conditioning::Offset::Value) j["offset"] = c.offset_value;
+  if (c.scale != 1.0) j["scale"] = c.scale;
+  if (c.sign != 1.0) j["sign"] = c.sign;
+  if (c.detrend) j["detrend"] = true;
+  return j;
+}
+
 void check_units(const Scenario& sc, const Reader& r, const std::string& kind, const std::string& unit,
                  const std::string& column_unit) {
   const auto q = units::quantity_of_kind(kind);
@@ -583,6 +623,7 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     in.column = r.str("column", "");
     in.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(in.kind), in.unit, in.column_unit);
+    in.conditioning = parse_conditioning(r, sc.source);
     sc.inputs.push_back(std::move(in));
   }
 }
@@ -644,6 +685,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.column = r.str("column", "");
     s.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(s.kind), s.unit, s.column_unit);
+    s.conditioning = parse_conditioning(r, sc.source);
     parse_sensor_fields(sc, r, s);
     // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
     // cannot explain, so they belong to the truth's side of a mismatch study only.
@@ -1068,6 +1110,7 @@ nlohmann::json to_json(const Scenario& s) {
                            {"signal", signal_json(in.signal)}});
     if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
     if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;
+    if (in.conditioning.stated()) j["inputs"].back()["conditioning"] = conditioning_json(in.conditioning);
   }
   j["sensors"] = json::array();
   for (const auto& se : s.sensors) {
@@ -1076,6 +1119,7 @@ nlohmann::json to_json(const Scenario& s) {
     for (const auto& [name, value] : se.fields) j["sensors"].back()[name] = value;
     if (!se.column.empty()) j["sensors"].back()["column"] = se.column;
     if (!se.column_unit.empty()) j["sensors"].back()["column_unit"] = se.column_unit;
+    if (se.conditioning.stated()) j["sensors"].back()["conditioning"] = conditioning_json(se.conditioning);
   }
   j["simulation"] = {{"duration", s.simulation.duration}, {"sample_interval", s.simulation.sample_interval},
                      {"seed", s.simulation.seed}};

@@ -18,6 +18,7 @@
 #include <system_error>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/validation.h"
@@ -917,7 +918,7 @@ File parse(const std::string& bytes, const std::string& source) {
 File read_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(one_line("UFF file '" + path + "': is a directory"));
-  std::ifstream in(path, std::ios::binary);
+  InputFileStream in(path);
   if (!in) {
     check_interrupt();  // a signal while blocked opening a FIFO
     throw InputError(one_line("UFF file '" + path + "': cannot be opened"));

@@ -63,10 +63,34 @@ std::string replace_word(const std::string& text, const std::string& word, const
   return out;
 }
 
+// Whole labels as DAQ software writes them (LabVIEW's Y_Unit_Label "Newtons", "Pounds", "Inches"),
+// read case-insensitively for their quantity: the alias table of units.h.
+struct DaqAlias {
+  const char* label;
+  std::optional<Quantity> quantity;  // nullopt: any
+  const char* unit;
+};
+constexpr DaqAlias kDaqAliases[] = {
+    {"newtons", std::nullopt, "N"},          {"newton", std::nullopt, "N"},
+    {"pounds", Quantity::Force, "lbf"},      {"pound", Quantity::Force, "lbf"},   {"lbs", Quantity::Force, "lbf"},
+    {"lbf", std::nullopt, "lbf"},            {"kilonewtons", std::nullopt, "kN"},
+    {"meters", std::nullopt, "m"},           {"metres", std::nullopt, "m"},       {"millimeters", std::nullopt, "mm"},
+    {"millimetres", std::nullopt, "mm"},     {"inches", std::nullopt, "in"},      {"inch", std::nullopt, "in"},
+    {"feet", std::nullopt, "ft"},            {"seconds", std::nullopt, "s"},      {"sec", std::nullopt, "s"},
+    {"gs", Quantity::Acceleration, "standard_free_fall"}, {"g's", Quantity::Acceleration, "standard_free_fall"},
+    {"degrees", std::nullopt, "degree"},     {"radians", std::nullopt, "rad"},
+};
+
 // The unit text as UDUNITS-2 should read it for quantity q (the header's aliases).
 std::string canonical(std::string u, Quantity q) {
   const auto b = u.find_first_not_of(" \t"), e = u.find_last_not_of(" \t");
   u = b == std::string::npos ? std::string() : u.substr(b, e - b + 1);
+  {
+    std::string low;
+    for (char c : u) low += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (const auto& a : kDaqAliases)
+      if (low == a.label && (!a.quantity || *a.quantity == q)) return a.unit;
+  }
   if (q == Quantity::Acceleration && (u == "g" || u == "G" || u == "gn" || u == "g_n")) return "standard_free_fall";
   if (q == Quantity::Strain) {
     for (const char* micro : {"µε", "με", "ue", "uε", "microstrain", "µstrain", "ustrain"})

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <string>
 
+#include "scoleid/io/output_paths.h"
 #include "scoleid/io/program.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
       throw io::InputError("command line: --visualize needs a display (DISPLAY is not set)");
     std::string why;
     if (!opt.IsValid(&why)) throw io::InputError("command line: " + why);
+    io::check_inputs_outside("--out", out, {scenario});
     io::RunDirectory run_dir(out, model::output_files(), "scole-truth");
     const model::TruthResult res = model::run_truth(sc, opt);
     model::write_truth(res, run_dir);

@@ -538,9 +538,58 @@ int column_of(const io::DataTable& tab, const std::string& name, const std::stri
 // The values of column `col` in the unit of a sensor or input of kind `kind` and unit `unit`
 // (or its unit system's): the column's unit from column_unit, else from its file. A column without
 // a stated unit is taken as it is; one with a unit needs a unit to convert into.
+// The column conditioned as the scenario says (io::Conditioning): x' = sign·scale·(x − offset), then
+// less its least-squares line with detrend; what was removed is recorded in `src`.
+void condition(std::vector<double>& v, const std::vector<double>& t, const io::Conditioning& c, const std::string& where,
+               const std::string& field, ColumnUse::Source& src) {
+  if (!c.stated()) return;
+  double offset = 0.0;
+  switch (c.offset) {
+    case io::Conditioning::Offset::None: break;
+    case io::Conditioning::Offset::Value: offset = c.offset_value; break;
+    case io::Conditioning::Offset::Mean:
+      for (double x : v) offset += x / static_cast<double>(v.size());
+      break;
+    case io::Conditioning::Offset::MeanBefore: {
+      std::size_t n = 0;
+      while (n < t.size() && t[n] < c.offset_value) ++n;
+      if (n == 0)
+        throw InputError(where + ": " + field + ".conditioning.offset.mean_before " + io::format_value(c.offset_value) +
+                         " s leaves no sample before it (the record starts at " + io::format_value(t.front()) + " s)");
+      if (n == t.size())
+        throw InputError(where + ": " + field + ".conditioning.offset.mean_before " + io::format_value(c.offset_value) +
+                         " s takes the whole record (it ends at " + io::format_value(t.back()) + " s): use offset: mean");
+      for (std::size_t k = 0; k < n; ++k) offset += v[k] / static_cast<double>(n);
+      break;
+    }
+  }
+  const double factor = c.sign * c.scale;
+  for (double& x : v) x = factor * (x - offset);
+  double slope = 0.0, mean = 0.0;
+  if (c.detrend) {
+    // Least-squares line a + b (t − t̄).
+    double tm = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      tm += t[k] / static_cast<double>(v.size());
+      mean += v[k] / static_cast<double>(v.size());
+    }
+    double stt = 0.0, sty = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      stt += (t[k] - tm) * (t[k] - tm);
+      sty += (t[k] - tm) * (v[k] - mean);
+    }
+    slope = stt > 0 ? sty / stt : 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) v[k] -= mean + slope * (t[k] - tm);
+  }
+  src.conditioned = true;
+  src.offset_removed = offset;
+  src.factor = factor;
+  src.trend_removed = {mean, slope};
+}
+
 std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col, const std::string& field,
                                   const std::string& name, const std::string& kind, const std::string& unit,
-                                  const std::string& column_unit) {
+                                  const std::string& column_unit, const io::Conditioning& conditioning) {
   const auto& sc = p.scenario;
   const std::string& column = tab.names[static_cast<std::size_t>(col)];
   ColumnUse::Source src{name, column, column_unit.empty() ? tab.unit(col) : column_unit,
@@ -555,12 +604,13 @@ std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col,
     src.unit_stated_by = "truth.json";
   }
   std::vector<double> v = tab.columns[static_cast<std::size_t>(col)];
+  const std::string where = "data file '" + tab.source + "': column '" + io::one_line(column) + "' (" + field + ", '" + name + "')";
   if (src.from_unit.empty() || !q) {
     src.unit_stated_by = src.from_unit.empty() ? "none" : src.unit_stated_by;
+    condition(v, tab.t, conditioning, where, field, src);
     p.columns.sources.push_back(src);
     return v;
   }
-  const std::string where = "data file '" + tab.source + "': column '" + io::one_line(column) + "' (" + field + ", '" + name + "')";
   if (src.to_unit.empty())
     throw InputError(where + ": is in '" + src.from_unit + "' but " + field +
                      " states no unit to convert it into: give " + field + ".unit or the scenario's units");
@@ -573,6 +623,7 @@ std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col,
   src.scale = c.scale;
   if (!c.identity())
     for (double& x : v) x = c.apply(x);
+  condition(v, tab.t, conditioning, where, field, src);
   p.columns.sources.push_back(src);
   return v;
 }
@@ -585,7 +636,8 @@ bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable&
 // cubic unless the column jumps, then piecewise linear), with its largest jump within one sample.
 void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
   const auto& in = p.scenario.inputs[i];
-  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, io::to_string(in.kind), in.unit, in.column_unit);
+  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, io::to_string(in.kind), in.unit, in.column_unit,
+                               in.conditioning);
   p.columns.inputs_from_data.push_back(in.name);
   const bool stepped = add_stepped_input(p, in, tab, f);
   const bool cubic = in.interpolation == io::Interpolation::Cubic || (in.interpolation == io::Interpolation::Auto && !stepped);
@@ -642,7 +694,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
       throw InputError("data file '" + csv + "': no column " +
                        (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
                        " (" + field + " of " + sc.source + ")");
-    const auto v = column_values(p, tab, col, field, s.name, io::to_string(s.kind), s.unit, s.column_unit);
+    const auto v = column_values(p, tab, col, field, s.name, io::to_string(s.kind), s.unit, s.column_unit, s.conditioning);
     check_lone_spike(v, tab, col, field, s.name);
     for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
     p.data.names.push_back(s.name);
@@ -681,6 +733,15 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
 IdentifierStep synthesize_data(Problem& p) {
   const auto& sc = p.scenario;
   const auto& id = sc.identification;
+  // Conditioning is for a data column; synthetic data have none to condition.
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i)
+    if (sc.inputs[i].conditioning.stated())
+      fail_field(sc.source, "inputs[" + std::to_string(i) + "].conditioning",
+                 "conditions a data column, and this run synthesises its data (give a data file)", "'" + sc.inputs[i].name + "'");
+  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
+    if (sc.sensors[j].conditioning.stated())
+      fail_field(sc.source, "sensors[" + std::to_string(j) + "].conditioning",
+                 "conditions a data column, and this run synthesises its data (give a data file)", "'" + sc.sensors[j].name + "'");
   const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
   if (data_elements < 2 * id.elements)
     fail_field(sc.source, "identification.data_elements",

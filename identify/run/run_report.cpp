@@ -188,9 +188,14 @@ json data_columns_json(const ColumnUse& c) {
   json interpolation = json::array();
   for (const auto k : c.input_interpolation) interpolation.push_back(io::to_string(k));
   json sources = json::array();
-  for (const auto& x : c.sources)
+  for (const auto& x : c.sources) {
     sources.push_back({{"name", x.name}, {"column", x.column}, {"column_unit", x.from_unit}, {"unit_stated_by", x.unit_stated_by},
                        {"unit", x.to_unit}, {"scale", x.scale}});
+    if (x.conditioned)
+      sources.back()["conditioning"] = {{"offset_removed", x.offset_removed},
+                                        {"factor", x.factor},
+                                        {"trend_removed", {{"mean", x.trend_removed.first}, {"slope", x.trend_removed.second}}}};
+  }
   return {{"sensors", c.sensors},
           {"sources", sources},
           {"inputs_from_data", c.inputs_from_data},

@@ -1095,3 +1095,40 @@ TEST(ScoleIdentifyHardening, ASignalWhileOpeningAFifoAsDataIsAnInterruption) {
   EXPECT_LT(after, 1.0);
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
+
+// An input inside --out named like one of the run's outputs would be replaced with the directory:
+// refused before any work, the input unchanged.
+TEST(ScoleIdentifyHardening, AnInputInsideTheOutputDirectoryIsRefused) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const Result first = run({"--scenario", "good.yaml", "--out", "q", "-q"}, dir);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string fit = slurp(dir / "q" / "fit.csv");
+  const Result r = run({"--scenario", "good.yaml", "--data", "q/fit.csv", "--out", "q", "-q"}, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("holds an input of this run ('q/fit.csv')"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir / "q" / "fit.csv"), fit);
+}
+
+// A FIFO whose writer sends a little and then stalls: the read blocks, and SIGTERM still ends the
+// run within a second as an interruption (std::ifstream would retry the interrupted read for ever).
+TEST(ScoleIdentifyHardening, ASignalDuringAStalledReadOfAFifoIsAnInterruption) {
+  TempDir dir;
+  write_file(dir / "good.yaml", kGood);
+  const fs::path fifo = dir / "data.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const pid_t writer = ::fork();
+  if (writer == 0) {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd >= 0 && ::write(fd, "t,P,w_tip\n0,0,0\n", 16) == 16) ::sleep(30);
+    ::_exit(0);
+  }
+  double after = 0.0;
+  const int code = run_and_signal({"--scenario", "good.yaml", "--data", fifo.string(), "--out", (dir / "out").string(), "-q"}, dir,
+                                  0.7, SIGTERM, &after);
+  ::kill(writer, SIGKILL);
+  ::waitpid(writer, nullptr, 0);
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_LT(after, 1.0);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}

@@ -469,3 +469,27 @@ TEST(Scenario, AHugeNameIsCountedWhole) {
   const std::string msg = error_of("sensors: [{name: " + name + ", location: 5}]");
   EXPECT_NE(msg.find("(1000000 characters)"), std::string::npos) << msg.substr(0, 300);
 }
+
+// conditioning: parsed, checked, and written back by to_json so that the echo reads back.
+TEST(Scenario, ConditioningParsesChecksAndRoundTrips) {
+  const std::string head = "inputs: [{name: P, location: 5, signal: {type: step, amplitude: 1}, conditioning: ";
+  const std::string tail = "}]\nsensors: [{name: w, location: 5}]";
+  const Scenario s = parse_scenario(head + "{offset: {mean_before: 0.1}, sign: -1, scale: 2, detrend: true}" + tail, "x");
+  const auto& c = s.inputs[0].conditioning;
+  EXPECT_EQ(c.offset, Conditioning::Offset::MeanBefore);
+  EXPECT_EQ(c.offset_value, 0.1);
+  EXPECT_EQ(c.sign, -1.0);
+  EXPECT_EQ(c.scale, 2.0);
+  EXPECT_TRUE(c.detrend);
+  EXPECT_EQ(to_json(s)["inputs"][0]["conditioning"],
+            nlohmann::json::parse(R"({"offset": {"mean_before": 0.1}, "sign": -1.0, "scale": 2.0, "detrend": true})"));
+  EXPECT_FALSE(to_json(s)["sensors"][0].contains("conditioning"));
+  EXPECT_EQ(parse_scenario(head + "{offset: mean}" + tail, "x").inputs[0].conditioning.offset, Conditioning::Offset::Mean);
+  EXPECT_EQ(parse_scenario(head + "{offset: -23}" + tail, "x").inputs[0].conditioning.offset_value, -23.0);
+  EXPECT_EQ(error_of(head + "{sign: 2}" + tail), "scenario 'x.yaml': inputs[0].conditioning.sign must be 1 or -1, got 2");
+  EXPECT_NE(error_of(head + "{scale: 0}" + tail).find("inputs[0].conditioning.scale must be > 0"), std::string::npos);
+  EXPECT_NE(error_of(head + "{remove_mean: true}" + tail).find("inputs[0].conditioning.remove_mean is not a known field"),
+            std::string::npos);
+  EXPECT_NE(error_of(head + "{offset: {median: 1}}" + tail).find("inputs[0].conditioning.offset as a map must be {mean_before: T}"),
+            std::string::npos);
+}

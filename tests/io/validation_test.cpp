@@ -203,3 +203,10 @@ TEST(Csv, HeaderMustBeUtf8) {
   EXPECT_THROW(read_csv_text("t,w\xFF\n0,1\n1,2\n", "x.csv"), InputError);
   EXPECT_NO_THROW(read_csv_text("t,w\n0,1\n1,2\n", "x.csv"));
 }
+
+// what() is read as a C string: a NUL inside a message (a key that holds one) would end it before
+// the field and the value.
+TEST(Validation, AnInputErrorShowsANulAndKeepsWhatFollows) {
+  const scoleid::io::InputError e(std::string("f.yaml: a\0b is not a known field, got 'x'", 41));
+  EXPECT_STREQ(e.what(), "f.yaml: a\\x00b is not a known field, got 'x'");
+}

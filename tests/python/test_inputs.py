@@ -138,3 +138,46 @@ def test_any_data_end_in_a_result_or_an_input_error(n, bad, shape, frame):
 def test_an_unknown_builtin_names_no_command_line_option():
     with pytest.raises(scoleid.InputError, match=r"^'nope' is not a built-in scenario \(paper-beam-1"):
         scoleid.builtin_scenario("nope")
+
+
+def test_numpy_scalars_in_a_scenario_dict_are_numbers_and_other_objects_input_errors():
+    base = {"name": "x", "structure": "beam",
+            "beam": {"length": 10, "left": "pinned", "right": "pinned", "rho_A": 67, "EI": 23000},
+            "inputs": [{"name": "P", "location": 5, "signal": {"type": "step", "amplitude": 10}}],
+            "sensors": [{"name": "w_mid", "location": 5}],
+            "simulation": {"duration": 1, "sample_interval": 0.01},
+            "identification": {"estimate": ["EI"], "initial": {"EI": 20000}, "elements": 10, "max_iterations": 0}}
+    plain = scoleid.identify(base, compute_std=False)
+    typed = dict(base, identification=dict(base["identification"], elements=np.int64(10), max_iterations=np.int32(0)),
+                 beam=dict(base["beam"], EI=np.float32(23000.0)))
+    assert scoleid.identify(typed, compute_std=False).estimates == plain.estimates
+    with pytest.raises(scoleid.InputError, match="a value of type object"):
+        scoleid.identify(dict(base, description=object()))
+
+
+def test_export_model_and_write_never_overwrite_the_data(tmp_path):
+    import pandas as pd
+    data = tmp_path / "d.json"  # a CSV under a .json name: read as data, and no place for the model
+    pd.DataFrame(good(100)).to_csv(data, index=False)
+    before = data.read_bytes()
+    r = identify(str(data))
+    with pytest.raises(scoleid.InputError, match="is an input of this identification"):
+        r.export_model(str(data))
+    with pytest.raises(scoleid.InputError, match="NUL character"):
+        r.export_model(str(data) + "\0.json")
+    with pytest.raises(scoleid.InputError, match="holds an input of this run"):
+        r.write(str(tmp_path))
+    assert data.read_bytes() == before
+
+
+def test_a_complex_dataframe_column_is_refused_not_cast():
+    import pandas as pd
+    d = pd.DataFrame(good())
+    d["w_mid"] = d["w_mid"] + 1j
+    with pytest.raises(scoleid.InputError, match="column 'w_mid' is complex"):
+        identify(d)
+    o = pd.DataFrame(good())
+    o["w_mid"] = list(o["w_mid"].astype(object))
+    o.loc[3, "w_mid"] = 1 + 2j
+    with pytest.raises(scoleid.InputError, match="column 'w_mid' is complex"):
+        identify(o)

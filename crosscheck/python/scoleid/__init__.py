@@ -43,10 +43,23 @@ def load_scenario(path):
         return f.read()
 
 
+def _json_value(x):
+    """A scenario dict's numpy scalars, 0-d arrays, Decimal and Fraction as the numbers they hold."""
+    import decimal
+    import fractions
+    if isinstance(x, np.generic) or (isinstance(x, np.ndarray) and x.ndim == 0):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (decimal.Decimal, fractions.Fraction)):
+        return float(x)
+    raise InputError("scenario (dict): a value of type %s is not a number, text, list or dict: %r" % (type(x).__name__, x))
+
+
 def _scenario(scenario):
     """(text, source) for _core: source "" means `text` is a built-in name or a file path."""
     if isinstance(scenario, dict):
-        return json.dumps(scenario), "scenario (dict)"
+        return json.dumps(scenario, default=_json_value), "scenario (dict)"
     if isinstance(scenario, os.PathLike):
         return os.fspath(scenario), ""
     if not isinstance(scenario, str):
@@ -78,13 +91,16 @@ def _column(name, values, n=None):
     """One column as a 1-D float array of n values; InputError for anything else."""
     if getattr(getattr(values, "dtype", None), "kind", "") in ("m", "M"):
         raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, values.dtype))
+    if getattr(getattr(values, "dtype", None), "kind", "") == "c" or (
+            getattr(values, "dtype", None) == object and any(isinstance(x, (complex, np.complexfloating)) for x in values)):
+        raise InputError("data: column '%s' is complex; give real values (a time record)" % name)
     if hasattr(values, "to_numpy"):  # a pandas Series (nullable dtypes: NA becomes NaN, refused below)
         try:
             values = values.to_numpy(dtype=float, na_value=np.nan)
         except (TypeError, ValueError) as e:
             raise InputError("data: column '%s' is not numeric (%s)" % (name, e)) from None
     a = np.asarray(values)
-    if np.iscomplexobj(a):
+    if np.iscomplexobj(a) or (a.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in a.ravel())):
         raise InputError("data: column '%s' is complex; give real values (a time record)" % name)
     if a.dtype.kind in "mM":
         raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, a.dtype))

@@ -5,6 +5,7 @@
 //       function type 1) on one time grid, each channel named by its ID line 1 (or
 //       <entity>:<node><direction>), its unit from the record; any other function (FRF, spectrum,
 //       PSD) is refused with its record and type named;
+//   a file whose first line begins "LabVIEW Measurement": a LabVIEW Measurement file (lvm.h);
 //   anything else: a CSV (data_files.h), the DAQ dialects included.
 // Values stay in their file's units; each column's unit is in DataTable::units.
 #include <string>
@@ -21,6 +22,8 @@ inline constexpr const char* kColumnsFormat = "scole-data columns 1";
 
 // Whether the file at `path` is a Universal File (by its first non-blank line, "-1").
 bool is_uff_file(const std::string& path);
+// Whether the file at `path` is a LabVIEW Measurement file (by its first line).
+bool is_lvm_file(const std::string& path);
 
 // The record as a table. InputError naming the file (and record, line, field) on anything wrong.
 DataTable read_data(const std::string& path, const CsvOptions& options = {});

@@ -14,6 +14,8 @@
 //   key that is not UTF-8 and (unless allow_null) a key written without a value; each alias's
 //   target is visited once.
 #include <cstddef>
+#include <istream>
+#include <streambuf>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +25,26 @@ class Node;
 }
 
 namespace scoleid::io {
+
+// A file opened for reading whose reads a signal can end: std::ifstream retries a read that a
+// signal interrupts (EINTR), so a read blocked on a FIFO whose writer stalls would never see
+// SIGTERM. Here open() and read() returning EINTR call check_interrupt() (which throws
+// io::Interrupted when a SIGINT/SIGTERM arrived) and otherwise retry.
+class InputFileStream : public std::istream {
+public:
+  explicit InputFileStream(const std::string& path);
+  ~InputFileStream() override;
+  InputFileStream(const InputFileStream&) = delete;
+  InputFileStream& operator=(const InputFileStream&) = delete;
+  bool is_open() const { return buf_.fd >= 0; }
+
+private:
+  struct Buf : std::streambuf {
+    int fd = -1;
+    char data[1 << 16];
+    int_type underflow() override;
+  } buf_;
+};
 
 // Input files larger than this are refused (scenarios, experiments, campaigns, suite families,
 // modal data, truth.json and the cross-check's own JSON; data records are bounded by their sample

@@ -21,6 +21,11 @@ namespace scoleid::io {
 void check_output_file(const std::string& option, const std::string& path, const std::vector<std::string>& inputs,
                        const std::string& out_dir = "");
 
+// Every existing input file that lies inside the output directory `out_dir` is refused: the run
+// replaces that directory as a whole (an input named like one of its outputs, q/fit.csv read with
+// --out q, would be overwritten). `option` names the directory's option ("--out").
+void check_inputs_outside(const std::string& option, const std::string& out_dir, const std::vector<std::string>& inputs);
+
 // True when a and b name the same file, or the same path once made absolute and normal (for paths
 // that do not exist yet).
 bool same_file(const std::string& a, const std::string& b);

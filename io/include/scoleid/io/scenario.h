@@ -158,6 +158,23 @@ struct PointSpec {
   std::string unit;
 };
 
+// How a data column is conditioned before the identifier uses it (docs/data.md "Conditioning"),
+// in the sensor's or input's own unit, after the unit conversion:
+//   x' = sign · scale · (x − offset),   then, with detrend, x' less its least-squares line,
+// offset: none | mean (the whole record's mean) | {mean_before: T} (the mean of the samples before
+// t = T: a transducer's static offset read off the pre-trigger) | a value. scale > 0 is a
+// calibration factor, sign −1 a transducer mounted (or wired) the other way round. Applies to
+// columns of a data file or table; a run that synthesises its data refuses it.
+struct Conditioning {
+  enum class Offset { None, Mean, MeanBefore, Value };
+  Offset offset = Offset::None;
+  double offset_value = 0.0;  // Value: the offset; MeanBefore: T [s]
+  double scale = 1.0;
+  double sign = 1.0;
+  bool detrend = false;
+  bool stated() const { return offset != Offset::None || scale != 1.0 || sign != 1.0 || detrend; }
+};
+
 // A point input, a force or a moment. At "actuatorK" (K = 1, 2) it is the proof mass's commanded
 // force along its slider.
 struct InputSpec : PointSpec {
@@ -178,6 +195,7 @@ struct InputSpec : PointSpec {
   std::string column;
   // The column's unit, in place of what its header or file states ("" = theirs).
   std::string column_unit;
+  Conditioning conditioning;
 };
 
 // A sensor. kind: one of the sensor kinds (io/types.h, kSensorKinds: what each reads and which
@@ -207,6 +225,7 @@ struct SensorSpec : PointSpec {
   // UFF record, or column_unit) into `unit` (or the unit system's) with UDUNITS-2 (io/units.h).
   std::string column;
   std::string column_unit;
+  Conditioning conditioning;
 };
 
 struct SimulationSpec {

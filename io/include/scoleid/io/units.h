@@ -7,6 +7,10 @@
 //   g      standard gravity (9.80665 m/s²) where an acceleration is meant (UDUNITS reads gram);
 //   lb     pound-force where a force or moment is meant (UDUNITS reads pound-mass);
 //   deg    arc degree;  µε, με, ue, microstrain  1e-6 (strain);  ε, strain  1.
+// Whole labels as DAQ software writes them are read too, in any case (LabVIEW's Y_Unit_Label):
+//   Newtons N, Kilonewtons kN, Pounds/Pound/lbs lbf (a force), Meters/Metres m, Millimeters mm,
+//   Inches in, Feet ft, Seconds/sec s, Gs/g's standard gravity (an acceleration), Degrees degree,
+//   Radians rad.
 // A conversion is affine, value_to = scale · value_from + offset (offset is 0 for every unit
 // above; temperatures are not data this product reads), with UDUNITS-2's own factors.
 //

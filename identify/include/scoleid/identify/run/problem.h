@@ -58,6 +58,12 @@ struct ColumnUse {
   struct Source {
     std::string name, column, from_unit, unit_stated_by, to_unit;
     double scale = 1.0;
+    // The scenario's conditioning (io::Conditioning), when stated: the offset subtracted (in the
+    // sensor's or input's unit), the factor sign·scale applied after it, and with detrend the
+    // line removed (its mean and slope per second about the record's mid-time).
+    bool conditioned = false;
+    double offset_removed = 0.0, factor = 1.0;
+    std::pair<double, double> trend_removed{0.0, 0.0};
   };
   std::vector<Source> sources;
   // An input driven by its column that jumps by more than a quarter of its range within one sample,
