@@ -82,25 +82,8 @@ DataTable read_csv_data(const std::string& path, const CsvOptions& options) {
 
 DataFileInfo describe_csv(const std::string& path, const CsvOptions& options) {
   const DataTable tab = read_csv_data(path, options);
-  DataFileInfo info{path, "csv", {}, {}};
-  const double n = static_cast<double>(tab.t.size());
-  const double mean_step = (tab.t.back() - tab.t.front()) / (n - 1.0);
-  bool even = true;
-  for (std::size_t k = 1; k < tab.t.size(); ++k)
-    even = even && std::abs(tab.t[k] - tab.t[k - 1] - mean_step) <= 1e-6 * mean_step;
+  DataFileInfo info = describe_table(tab, "csv");
   info.notes.push_back("time column '" + tab.time_name + "'" + (tab.time_unit.empty() ? "" : " [" + tab.time_unit + "]"));
-  for (std::size_t j = 0; j < tab.names.size(); ++j) {
-    Channel c;
-    c.name = tab.names[j];
-    c.unit = tab.unit(static_cast<int>(j));
-    c.samples = tab.t.size();
-    c.start = tab.t.front();
-    c.step = mean_step;
-    c.even = even;
-    c.function = "time response";
-    c.abscissa_unit = "s";
-    info.channels.push_back(c);
-  }
   return info;
 }
 
@@ -249,6 +232,28 @@ DataFileInfo describe_uff(const std::string& path) {
 }
 
 }  // namespace
+
+DataFileInfo describe_table(const DataTable& tab, const std::string& format) {
+  DataFileInfo info{tab.source, format, {}, {}};
+  const double n = static_cast<double>(tab.t.size());
+  const double mean_step = (tab.t.back() - tab.t.front()) / (n - 1.0);
+  bool even = true;
+  for (std::size_t k = 1; k < tab.t.size(); ++k)
+    even = even && std::abs(tab.t[k] - tab.t[k - 1] - mean_step) <= 1e-6 * mean_step;
+  for (std::size_t j = 0; j < tab.names.size(); ++j) {
+    Channel c;
+    c.name = tab.names[j];
+    c.unit = tab.unit(static_cast<int>(j));
+    c.samples = tab.t.size();
+    c.start = tab.t.front();
+    c.step = mean_step;
+    c.even = even;
+    c.function = "time response";
+    c.abscissa_unit = "s";
+    info.channels.push_back(c);
+  }
+  return info;
+}
 
 bool is_lvm_file(const std::string& path) {
   std::error_code ec;

@@ -178,20 +178,17 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
   }
   // The column names (LabVIEW writes them; a file without the row gets "Untitled", as LabVIEW's
   // own default names).
-  std::streampos data_start = in.tellg();
-  std::size_t data_line = lineno;
-  if (next(line) && trim(split(line, f.sep)[0]) == "X_Value") {
-    const auto fl = split(line, f.sep);
-    for (int i = 0; i < f.channels; ++i) {
-      const std::size_t c = value_column(f, i);
-      f.names.push_back(c < fl.size() ? to_utf8(trim(fl[c])) : std::string());
+  bool pending = false;  // the row read in place of the names is the first data row
+  if (next(line)) {
+    if (trim(split(line, f.sep)[0]) == "X_Value") {
+      const auto fl = split(line, f.sep);
+      for (int i = 0; i < f.channels; ++i) {
+        const std::size_t c = value_column(f, i);
+        f.names.push_back(c < fl.size() ? to_utf8(trim(fl[c])) : std::string());
+      }
+    } else {
+      pending = true;
     }
-    data_start = in.tellg();
-    data_line = lineno;
-  } else {
-    in.clear();
-    in.seekg(data_start);
-    lineno = data_line;
   }
   for (int i = 0; i < f.channels; ++i)
     if (static_cast<std::size_t>(i) >= f.names.size() || f.names[i].empty()) {
@@ -201,7 +198,8 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
   // The data rows, to a blank row or the end.
   std::vector<std::vector<double>> y(f.channels), x(f.x_columns == "Multi" ? f.channels : 1);
   std::vector<std::size_t> count(f.channels, 0);
-  while (next(line)) {
+  while (pending || next(line)) {
+    pending = false;
     if (trim(line).empty() || line.find_first_not_of(f.sep) == std::string::npos) {
       // A blank row ends the segment: anything after it is a further segment.
       while (next(line))
@@ -323,26 +321,10 @@ DataTable read_lvm(const std::string& path) { return parse(path).table; }
 
 DataFileInfo describe_lvm(const std::string& path) {
   const Lvm f = parse(path);
-  const DataTable& tab = f.table;
-  DataFileInfo info{path, "lvm", {}, f.notes};
-  const double n = static_cast<double>(tab.t.size());
-  const double mean_step = (tab.t.back() - tab.t.front()) / (n - 1.0);
-  bool even = true;
-  for (std::size_t k = 1; k < tab.t.size(); ++k) even = even && std::abs(tab.t[k] - tab.t[k - 1] - mean_step) <= 1e-6 * mean_step;
-  info.notes.insert(info.notes.begin(), "X_Columns " + f.x_columns + ", separator " + (f.sep == '\t' ? "Tab" : "Comma") +
-                                            ", decimal mark '" + std::string(1, f.decimal) + "'");
-  for (std::size_t j = 0; j < tab.names.size(); ++j) {
-    Channel c;
-    c.name = tab.names[j];
-    c.unit = tab.unit(static_cast<int>(j));
-    c.samples = tab.t.size();
-    c.start = tab.t.front();
-    c.step = mean_step;
-    c.even = even;
-    c.function = "time response";
-    c.abscissa_unit = "s";
-    info.channels.push_back(c);
-  }
+  DataFileInfo info = describe_table(f.table, "lvm");
+  info.notes.push_back("X_Columns " + f.x_columns + ", separator " + (f.sep == '\t' ? "Tab" : "Comma") + ", decimal mark '" +
+                       std::string(1, f.decimal) + "'");
+  info.notes.insert(info.notes.end(), f.notes.begin(), f.notes.end());
   return info;
 }
 

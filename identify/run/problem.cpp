@@ -848,6 +848,23 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
                        p.scenario.sensors[static_cast<std::size_t>(j)].name + "' " + why + ", got " + io::format_value(sd));
     fail_field(p.scenario.source, "sensors[" + std::to_string(j) + "].noise_std", why, io::format_value(sd));
   }
+  // A synthetic record whose stated noise buries the signal of every sensor: its mean square
+  // exceeds the noise's σ² by less than (σ/3)² (over N ≥ 30 samples the noise's own mean square
+  // scatters by σ²√(2/N) ≤ 0.26σ², so a signal of a third of σ is the least the record can show).
+  // Nothing is determined by such data; every start would "converge" where it is.
+  if (!csv && N >= 30) {
+    bool signal = false;
+    for (Eigen::Index j = 0; j < p.data.z.cols() && !signal; ++j) {
+      const double sd = p.noise_std[static_cast<std::size_t>(j)];
+      const double ms = p.data.z.col(j).squaredNorm() / static_cast<double>(N);
+      signal = !(sd > 0.0) || ms - sd * sd > sd * sd / 9.0;
+    }
+    if (!signal)
+      fail_field(p.scenario.source, "sensors[0].noise_std",
+                 "buries every sensor's signal: the synthetic records hold noise of the stated levels and less than a third of "
+                 "as much signal, from which no parameter can be determined",
+                 io::format_value(p.noise_std.front()));
+  }
   apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
   p.objective_options.solver.step = step.step;

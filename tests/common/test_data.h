@@ -2,6 +2,7 @@
 // The tests' data files (tests/data): scenarios the tests start from, exported lab files.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -27,6 +28,16 @@ inline std::string replaced(std::string text, const std::string& from, const std
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
+}
+
+// The message of the InputError that `f` throws; "" if it throws none.
+inline std::string input_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const io::InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // The message of the InputError that parsing scenario `yaml` (named `source`) throws; "" if it parses.

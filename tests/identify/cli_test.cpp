@@ -605,21 +605,25 @@ TEST(ScoleIdentifyHardening, AnUnmetDiscrepancyPrincipleExitsOne) {
   EXPECT_EQ(j["attempts"].size(), 1u) << j["attempts"].dump();
 }
 
-// A run whose every parameter is flagged says so in words, not only row by row: a displacement
-// sensor on a pinned support records noise alone.
+// A run whose every parameter is flagged says so in words and earns no "converged": EI on two
+// halves seen from midspan, where a profile and its mirror fit alike. A sensor on a support, whose
+// record is noise alone, is refused before any work.
 TEST(ScoleIdentifyHardening, ARunWithNoIdentifiableParameterSaysSo) {
   TempDir dir;
-  write_file(dir / "support.yaml", scoleid::test::test_scenario("cli_test/sensor-on-support"));
+  write_file(dir / "mirror.yaml", scoleid::test::test_scenario("cli_test/mirror-profile"));
   const fs::path out = dir / "out";
-  const Result r = run({"--scenario", (dir / "support.yaml").string(), "--out", out.string(), "-q"}, dir);
+  const Result r = run({"--scenario", (dir / "mirror.yaml").string(), "--out", out.string(), "-q"}, dir);
   ASSERT_TRUE(fs::exists(out / "identify.json")) << r.err;
   const auto j = read_json_file(out / "identify.json");
   for (const auto& p : j["parameters"]) EXPECT_FALSE(p.value("identifiable", true)) << p.dump();
   EXPECT_NE(r.err.find("none of the 2 estimated parameters is identifiable"), std::string::npos) << r.err;
-  // The estimate is the start's, not the data's: no "converged", exit 1.
+  // The estimate is the start's or the mirror's, not the data's: no "converged", exit 1.
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_FALSE(j["converged"].get<bool>());
   EXPECT_NE(r.err.find("the data determine none of the 2 estimated parameters"), std::string::npos) << r.err;
+  write_file(dir / "support.yaml", scoleid::test::test_scenario("cli_test/sensor-on-support"));
+  const Result s = run({"--scenario", (dir / "support.yaml").string(), "--out", (dir / "out2").string(), "-q"}, dir);
+  expect_input_error(s, dir / "out2", {"sensors[0].noise_std buries every sensor's signal"});
 }
 
 TEST(ScoleIdentifyHardening, NegativeMaxIterationsIsRefused) {

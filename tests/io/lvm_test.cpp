@@ -12,6 +12,7 @@
 #include <functional>
 
 #include "scoleid/io/data_source.h"
+#include "common/test_data.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/units.h"
 
@@ -21,14 +22,7 @@ using namespace scoleid::io;
 namespace {
 const fs::path kData = fs::path(SCOLEID_TEST_DATA_DIR) / "lvm";
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+const auto& error_of = scoleid::test::input_error_of;
 
 fs::path write_lvm(const std::string& name, const std::string& text) {
   const fs::path d = fs::temp_directory_path() / ("scoleid-lvm-" + std::to_string(::getpid()));
@@ -133,4 +127,15 @@ TEST(Lvm, WhatTheReaderDoesNotTakeIsRefusedNamingFileAndLine) {
   back.replace(back.rfind("2.5\t"), 3, "0.1");
   EXPECT_NE(error_of([&] { read_data(write_lvm("back.lvm", back).string()); }).find("time must be strictly increasing"),
             std::string::npos);
+}
+
+// A file without the X_Value row (some writers leave it out): the channels get LabVIEW's default
+// names and no data row is lost.
+TEST(Lvm, AFileWithoutTheColumnNamesKeepsEveryRow) {
+  std::string text = small_lvm("\t", ".", "One");
+  const auto at = text.find("X_Value");
+  text.erase(at, text.find('\n', at) + 1 - at);
+  const DataTable t = read_data(write_lvm("nonames.lvm", text).string());
+  EXPECT_EQ(t.names, (std::vector<std::string>{"Untitled", "Untitled 1"}));
+  EXPECT_EQ(t.t, (std::vector<double>{0.5, 1.5, 2.5}));
 }

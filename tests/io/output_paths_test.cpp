@@ -10,20 +10,14 @@
 #include <fstream>
 #include <functional>
 
+#include "common/test_data.h"
 #include "scoleid/io/error.h"
 
 namespace fs = std::filesystem;
 using namespace scoleid::io;
 
 namespace {
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+const auto& error_of = scoleid::test::input_error_of;
 
 struct Dir {
   fs::path root = fs::temp_directory_path() / ("scoleid-outpaths-" + std::to_string(::getpid()));

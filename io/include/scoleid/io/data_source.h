@@ -53,5 +53,8 @@ struct DataFileInfo {
 };
 
 DataFileInfo describe_data(const std::string& path, const CsvOptions& options = {});
+// The channels of a table read from a file of `format` (time responses on its time grid: mean
+// step, even within 1e-6 of it), without notes.
+DataFileInfo describe_table(const DataTable& table, const std::string& format);
 
 }  // namespace scoleid::io
