@@ -91,13 +91,7 @@ std::vector<std::string> split_csv_line(const std::string& line, char separator)
 }
 
 DataTable read_csv(const std::string& path, const CsvOptions& options) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError("data file '" + path + "': is a directory");
-  InputFileStream in(path);
-  if (!in) {
-    check_interrupt();  // a signal while blocked opening a FIFO
-    throw InputError("data file '" + path + "': cannot be opened");
-  }
+  InputFileStream in(path, "data file '" + path + "'");
   return read_csv_stream(in, path, options);
 }
 

@@ -1,4 +1,5 @@
 #include "scoleid/io/data_source.h"
+#include "scoleid/io/input_file.h"
 #include "scoleid/io/lvm.h"
 
 #include <cmath>
@@ -15,15 +16,7 @@
 
 namespace scoleid::io {
 
-bool is_uff_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
-  std::ifstream in(path, std::ios::binary);
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  return uff::looks_like_uff(head);
-}
+bool is_uff_file(const std::string& path) { return uff::looks_like_uff(file_head(path, 4096)); }
 
 namespace {
 
@@ -255,15 +248,7 @@ DataFileInfo describe_table(const DataTable& tab, const std::string& format) {
   return info;
 }
 
-bool is_lvm_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
-  std::ifstream in(path, std::ios::binary);
-  std::string head(64, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  return looks_like_lvm(head);
-}
+bool is_lvm_file(const std::string& path) { return looks_like_lvm(file_head(path, 64)); }
 
 DataTable read_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return uff_table(uff::read_file(path));

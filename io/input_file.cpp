@@ -17,14 +17,29 @@
 
 namespace scoleid::io {
 
-InputFileStream::InputFileStream(const std::string& path) : std::istream(nullptr) {
+InputFileStream::InputFileStream(const std::string& path, const std::string& where) : std::istream(nullptr) {
   rdbuf(&buf_);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(one_line(where + ": is a directory"));
   for (;;) {
     buf_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (buf_.fd >= 0 || errno != EINTR) break;
-    check_interrupt();
+    check_interrupt();  // a signal while blocked opening a FIFO
   }
-  if (buf_.fd < 0) setstate(std::ios::failbit);
+  if (buf_.fd < 0) {
+    check_interrupt();
+    throw InputError(one_line(where + ": cannot be opened"));
+  }
+}
+
+std::string file_head(const std::string& path, std::size_t bytes) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return {};
+  std::ifstream in(path, std::ios::binary);
+  std::string head(bytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head;
 }
 
 InputFileStream::~InputFileStream() {
@@ -47,13 +62,7 @@ InputFileStream::Buf::int_type InputFileStream::Buf::underflow() {
 
 std::string read_text_file(const std::string& path, const std::string& what, std::size_t max_bytes) {
   const std::string where = what + " '" + path + "'";
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(one_line(where + ": is a directory"));
-  InputFileStream in(path);
-  if (!in) {
-    check_interrupt();  // a signal while blocked opening a FIFO
-    throw InputError(one_line(where + ": cannot be opened"));
-  }
+  InputFileStream in(path, where);
   std::string text;
   std::vector<char> chunk(std::size_t{1} << 16);
   while (in) {

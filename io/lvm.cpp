@@ -298,13 +298,7 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
 }
 
 Lvm parse(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(one_line("LVM file '" + path + "': is a directory"));
-  InputFileStream in(path);
-  if (!in) {
-    check_interrupt();
-    throw InputError(one_line("LVM file '" + path + "': cannot be opened"));
-  }
+  InputFileStream in(path, "LVM file '" + path + "'");
   return parse_stream(in, path);
 }
 

@@ -916,13 +916,7 @@ File parse(const std::string& bytes, const std::string& source) {
 }
 
 File read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(one_line("UFF file '" + path + "': is a directory"));
-  InputFileStream in(path);
-  if (!in) {
-    check_interrupt();  // a signal while blocked opening a FIFO
-    throw InputError(one_line("UFF file '" + path + "': cannot be opened"));
-  }
+  InputFileStream in(path, "UFF file '" + path + "'");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   check_interrupt();
   if (in.bad()) throw InputError(one_line("UFF file '" + path + "': cannot be read"));

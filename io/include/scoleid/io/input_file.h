@@ -29,14 +29,15 @@ namespace scoleid::io {
 // A file opened for reading whose reads a signal can end: std::ifstream retries a read that a
 // signal interrupts (EINTR), so a read blocked on a FIFO whose writer stalls would never see
 // SIGTERM. Here open() and read() returning EINTR call check_interrupt() (which throws
-// io::Interrupted when a SIGINT/SIGTERM arrived) and otherwise retry.
+// io::Interrupted when a SIGINT/SIGTERM arrived) and otherwise retry. A directory or a file that
+// cannot be opened is an InputError "<where>: is a directory" / "<where>: cannot be opened"
+// (`where` names the file: "data file 'x.csv'").
 class InputFileStream : public std::istream {
 public:
-  explicit InputFileStream(const std::string& path);
+  InputFileStream(const std::string& path, const std::string& where);
   ~InputFileStream() override;
   InputFileStream(const InputFileStream&) = delete;
   InputFileStream& operator=(const InputFileStream&) = delete;
-  bool is_open() const { return buf_.fd >= 0; }
 
 private:
   struct Buf : std::streambuf {
@@ -57,6 +58,8 @@ inline constexpr int kMaxNesting = 100;
 // `what` names the kind of file in the message ("scenario file", "JSON file").
 std::string read_text_file(const std::string& path, const std::string& what,
                            std::size_t max_bytes = kMaxInputFileBytes);
+// The first `bytes` bytes of a regular file ("" for anything else: a FIFO is not read to sniff it).
+std::string file_head(const std::string& path, std::size_t bytes);
 nlohmann::json parse_json_text(const std::string& text, const std::string& source);
 void check_yaml_document(const YAML::Node& root, const std::string& source, bool allow_null = false);
 // Before YAML is parsed: flow collections ([ ], { }) nested deeper than kMaxNesting are refused
