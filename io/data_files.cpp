@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <set>
+#include <stdexcept>
 #include <sstream>
 #include <type_traits>
 
@@ -141,8 +142,7 @@ std::string header_line(std::istream& in, const std::string& path, std::size_t& 
 
 // The time column's index and the table's names and units from the header.
 std::size_t read_header(const std::vector<std::string>& header, const CsvOptions& options, DataTable& tab,
-                        std::size_t lineno) {
-  const std::string where = "data file '" + tab.source + "': line " + std::to_string(lineno);
+                        const std::string& where) {
   std::size_t time = 0;
   if (!options.time_column.empty()) {
     const auto it = std::find(header.begin(), header.end(), options.time_column);
@@ -175,18 +175,18 @@ bool parse_number(std::string f, bool decimal_comma, double& v) {
 }
 
 // t into seconds from the time column's unit.
-void time_in_seconds(DataTable& tab) {
+void time_in_seconds(DataTable& tab, const std::string& where) {
   if (tab.time_unit.empty() || tab.time_unit == "s") return;
   units::Conversion c;
   try {
     c = units::conversion(tab.time_unit, "s", units::Quantity::Time);
   } catch (const std::invalid_argument& e) {
-    throw InputError("data file '" + tab.source + "': time column '" + one_line(tab.time_name) + "': unit " + e.what());
+    throw InputError(where + ": time column '" + one_line(tab.time_name) + "': unit " + e.what());
   }
   for (double& x : tab.t) x = c.apply(x);
   for (std::size_t k = 1; k < tab.t.size(); ++k)
     if (!(tab.t[k] > tab.t[k - 1]))
-      throw InputError("data file '" + tab.source + "': time column '" + one_line(tab.time_name) + "': sample " + std::to_string(k + 1) +
+      throw InputError(where + ": time column '" + one_line(tab.time_name) + "': sample " + std::to_string(k + 1) +
                        " is not after the one before once converted from " + tab.time_unit + " into s (" + format_value(tab.t[k]) + ")");
 }
 
@@ -203,7 +203,7 @@ DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOp
   // Exports that end every line with the separator ("t;a;b;") have an empty last field throughout.
   const bool trailing = header.size() > 2 && header.back().empty();
   if (trailing) header.pop_back();
-  const std::size_t time = read_header(header, options, tab, lineno);
+  const std::size_t time = read_header(header, options, tab, "data file '" + path + "': line " + std::to_string(lineno));
   tab.columns.assign(tab.names.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
@@ -237,7 +237,23 @@ DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOp
   check_interrupt();  // a read cut short by a signal is no short file
   if (tab.t.size() < 2)
     throw InputError("data file '" + path + "': needs at least 2 data rows, got " + std::to_string(tab.t.size()));
-  time_in_seconds(tab);
+  time_in_seconds(tab, "data file '" + path + "'");
+  return tab;
+}
+
+DataTable table_from_columns(const std::vector<std::string>& header, const std::vector<std::vector<double>>& columns,
+                             const std::string& source, const CsvOptions& options) {
+  if (header.size() != columns.size())
+    throw std::logic_error("table_from_columns: " + std::to_string(header.size()) + " names for " + std::to_string(columns.size()) + " columns");
+  DataTable tab;
+  tab.source = source;
+  if (header.empty()) throw InputError("data '" + one_line(shorten(source)) + "': no columns");
+  const std::size_t time = read_header(header, options, tab, "data '" + one_line(shorten(source)) + "'");
+  tab.t = columns[time];
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    if (j != time) tab.columns.push_back(columns[j]);
+  check_table(tab);  // finite and increasing in the unit stated, then converted as a file's
+  time_in_seconds(tab, "data '" + one_line(shorten(source)) + "'");
   return tab;
 }
 

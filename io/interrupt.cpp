@@ -39,4 +39,8 @@ void check_interrupt() {
 
 void clear_interrupt() { g_signal = 0; }
 
+void request_interrupt(int signal) {
+  if (g_signal == 0) g_signal = signal;
+}
+
 }  // namespace scoleid::io

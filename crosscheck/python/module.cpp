@@ -12,7 +12,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <chrono>
+#include <memory>
 #include <csignal>
 #include <mutex>
 #include <cstring>
@@ -25,6 +27,8 @@
 #include "scoleid/identify.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/progress.h"
+#include "scoleid/io/builtin.h"
 #include "scoleid/io/scenario.h"
 #include "scoleid/io/validation.h"
 #include "scoleid/truth.h"
@@ -82,20 +86,22 @@ py::tuple record(const io::DataTable& tab) {
   return py::make_tuple(tab.names, t, v);
 }
 
-io::DataTable table_of(const std::vector<std::string>& names, const py::array_t<double, py::array::c_style | py::array::forcecast>& t,
-                       const py::array_t<double, py::array::c_style | py::array::forcecast>& values, const std::string& source) {
-  if (t.ndim() != 1 || values.ndim() != 2 || values.shape(0) != t.shape(0) ||
-      values.shape(1) != static_cast<py::ssize_t>(names.size()))
-    throw io::InputError(source + ": expected t of n samples and n x " + std::to_string(names.size()) + " values");
-  io::DataTable tab;
-  tab.source = source;
-  tab.names = names;
-  tab.t.assign(t.data(), t.data() + t.shape(0));
-  tab.columns.assign(names.size(), std::vector<double>(static_cast<std::size_t>(t.shape(0))));
+// A table given as a header (the time column's name among them) and its columns, read as the CSV
+// reader reads a file with that header: the time column the one named (`time_column`, else the
+// scenario's data.time_column, else "t" when there is one, else the first), units from the names'
+// bracketed suffixes and the scenario's data.time_unit, the time converted into seconds.
+io::DataTable table_of(const io::Scenario& sc, const std::vector<std::string>& header,
+                       const py::array_t<double, py::array::c_style | py::array::forcecast>& values, const std::string& time_column,
+                       const std::string& source) {
+  if (values.ndim() != 2 || values.shape(1) != static_cast<py::ssize_t>(header.size()))
+    throw io::InputError(source + ": expected samples x " + std::to_string(header.size()) + " values");
+  std::vector<std::vector<double>> columns(header.size(), std::vector<double>(static_cast<std::size_t>(values.shape(0))));
   const auto v = values.unchecked<2>();
-  for (py::ssize_t k = 0; k < t.shape(0); ++k)
-    for (std::size_t j = 0; j < names.size(); ++j) tab.columns[j][static_cast<std::size_t>(k)] = v(k, static_cast<py::ssize_t>(j));
-  return tab;
+  for (py::ssize_t k = 0; k < values.shape(0); ++k)
+    for (std::size_t j = 0; j < header.size(); ++j) columns[j][static_cast<std::size_t>(k)] = v(k, static_cast<py::ssize_t>(j));
+  io::CsvOptions o{time_column.empty() ? sc.data.time_column : time_column, sc.data.time_unit};
+  if (o.time_column.empty() && std::find(header.begin(), header.end(), "t") != header.end()) o.time_column = "t";
+  return io::table_from_columns(header, columns, source, o);
 }
 
 py::tuple truth(const std::string& yaml_text, const std::string& source, bool progress) {
@@ -112,12 +118,50 @@ py::tuple truth(const std::string& yaml_text, const std::string& source, bool pr
 
 struct IdentifyArgs {
   std::string data_file;                 // "" = not a file
-  std::optional<std::vector<std::string>> names;
-  std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> t, values;
+  std::optional<std::vector<std::string>> header;  // an in-memory table: its column names (time among them)
+  std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> values;  // samples x header
+  std::string time_column;               // the time column's name ("" = as a CSV's: see table_of)
+  std::string source = "data";           // the table's name in messages
   std::string meta_json;                 // truth.json text for an in-memory table ("" = none)
   std::optional<std::string> method;
   std::optional<int> max_iterations;
   bool compute_std = true, verbose = false;
+  py::object progress = py::none();      // called with each progress line (verbose output)
+};
+
+// Progress lines to a Python callable for the duration of a call. The callable runs with the GIL
+// held; an exception it raises ends the run (as an interrupt would) and is raised in its place.
+class PythonProgress {
+public:
+  explicit PythonProgress(py::object callback) {
+    if (callback.is_none()) return;
+    callback_ = std::move(callback);
+    sink_.emplace([this](const std::string& line) {
+      py::gil_scoped_acquire gil;
+      if (error_) return;
+      try {
+        callback_(line);
+      } catch (py::error_already_set& e) {
+        error_ = std::make_unique<py::error_already_set>(std::move(e));
+        io::request_interrupt(SIGINT);
+      }
+    });
+  }
+  ~PythonProgress() { sink_.reset(); }
+  PythonProgress(const PythonProgress&) = delete;
+  PythonProgress& operator=(const PythonProgress&) = delete;
+  // The callback's exception, if it raised one (call with the GIL held).
+  void rethrow() {
+    if (!error_) return;
+    io::clear_interrupt();
+    auto e = std::move(error_);
+    throw std::move(*e);
+  }
+
+private:
+  py::object callback_;
+  std::unique_ptr<py::error_already_set> error_;
+  std::optional<io::ProgressSink> sink_;
 };
 
 // The identification and the seconds the library call took (scenario parsing to the verdict).
@@ -136,19 +180,24 @@ py::tuple identify_call(const std::string& yaml_text, const std::string& source,
     io::validate_scenario(sc);
   }
   o.compute_std = a.compute_std;
-  o.verbose = a.verbose;
+  o.verbose = a.verbose || !a.progress.is_none();
   DataSource data = DataSource::synthetic();
   if (!a.data_file.empty()) data = DataSource::file(a.data_file);
-  if (a.names) {
+  if (a.header) {
     std::optional<io::TruthMeta> meta;
-    if (!a.meta_json.empty()) meta = io::truth_meta_from_json(nlohmann::json::parse(a.meta_json), "data (truth metadata)");
-    data = DataSource::in_memory(table_of(*a.names, *a.t, *a.values, "data"), "data", meta);
+    if (!a.meta_json.empty()) meta = io::truth_meta_from_json(nlohmann::json::parse(a.meta_json), a.source + " (truth metadata)");
+    data = DataSource::in_memory(table_of(sc, *a.header, *a.values, a.time_column, a.source), a.source, meta);
   }
   std::optional<Identification> id;
-  {
+  PythonProgress progress(a.progress);
+  try {
     LibraryCall call;
     id.emplace(identify_parameters(sc, data, o));
+  } catch (const io::Interrupted&) {
+    progress.rethrow();  // the callback's own exception, when it was the callback that ended the run
+    throw;
   }
+  progress.rethrow();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return py::make_tuple(std::move(*id), seconds);
 }
@@ -175,6 +224,16 @@ py::dict modal_model(const Identification& id) {
   d["inputs"] = m.inputs;
   d["outputs"] = m.outputs;
   return d;
+}
+
+// fit.csv's table as (names, t, values[samples x columns]).
+py::tuple fit_table(const Identification& id) {
+  io::DataTable tab;
+  {
+    LibraryCall call;
+    tab = id.fit_table();
+  }
+  return record(tab);
 }
 
 std::string crosscheck_modes(const std::string& yaml_text, const std::string& source, int count, int segments, int elements, int levels) {
@@ -223,16 +282,20 @@ PYBIND11_MODULE(_core, m) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     }
   });
+  m.attr("__version__") = SCOLEID_VERSION;
   m.def("builtin_scenarios", &io::builtin_scenario_names);
+  m.def("builtin_scenario_description", &io::builtin_scenario_description);
   m.def("builtin_scenario", &io::builtin_scenario_text);
   m.def("scenario_json", [](const std::string& text, const std::string& source) { return io::to_json(scenario_of(text, source)).dump(); });
   m.def("truth", &truth, py::arg("yaml"), py::arg("source"), py::arg("progress") = false);
   py::class_<IdentifyArgs>(m, "IdentifyArgs")
       .def(py::init<>())
       .def_readwrite("data_file", &IdentifyArgs::data_file)
-      .def_readwrite("names", &IdentifyArgs::names)
-      .def_readwrite("t", &IdentifyArgs::t)
+      .def_readwrite("header", &IdentifyArgs::header)
       .def_readwrite("values", &IdentifyArgs::values)
+      .def_readwrite("time_column", &IdentifyArgs::time_column)
+      .def_readwrite("source", &IdentifyArgs::source)
+      .def_readwrite("progress", &IdentifyArgs::progress)
       .def_readwrite("meta_json", &IdentifyArgs::meta_json)
       .def_readwrite("method", &IdentifyArgs::method)
       .def_readwrite("max_iterations", &IdentifyArgs::max_iterations)
@@ -251,6 +314,7 @@ PYBIND11_MODULE(_core, m) {
       .def("export_model", &Identification::export_model)
       .def("state_space", &state_space)
       .def("modal_model", &modal_model)
+      .def("fit_table", &fit_table)
       .def("write", [](const Identification& id, const std::string& dir) { id.write(dir); });
   m.def("identify", &identify_call, py::arg("yaml"), py::arg("source"), py::arg("args"));
   m.def("crosscheck_modes", &crosscheck_modes);

@@ -11,6 +11,7 @@
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/progress.h"
 
 namespace scoleid::identify {
 
@@ -67,27 +68,27 @@ public:
       : p_(p), phys_(physical_columns),
         columns_{"rho_A", "EI", physical_columns && p.physical(p.initial()).count("c_kv") ? "c_kv" : "zeta"} {}
   void header() const {
-    std::printf("%5s", "iter");
+    io::progress("%5s", "iter");
     const int P = std::min(p_.size(), kMaxCols);
-    for (int i = 0; i < P; ++i) std::printf(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
-    if (p_.size() > kMaxCols) std::printf(" %5s", "...");
+    for (int i = 0; i < P; ++i) io::progress(" %13s", p_.names()[static_cast<std::size_t>(i)].c_str());
+    if (p_.size() > kMaxCols) io::progress(" %5s", "...");
     if (phys_)
-      for (const char* n : columns_) std::printf(" %13s", n);
-    std::printf(" %13s %8s\n", "cost", "horizon");
+      for (const char* n : columns_) io::progress(" %13s", n);
+    io::progress(" %13s %8s\n", "cost", "horizon");
   }
   void row(const IterationRecord& r) const {
-    std::printf("%5d", r.k);
+    io::progress("%5d", r.k);
     const int P = std::min(p_.size(), kMaxCols);
-    for (int i = 0; i < P; ++i) std::printf(" %13.6g", r.q[i]);
-    if (p_.size() > kMaxCols) std::printf(" %5s", "");
+    for (int i = 0; i < P; ++i) io::progress(" %13.6g", r.q[i]);
+    if (p_.size() > kMaxCols) io::progress(" %5s", "");
     if (phys_) {
       const auto ph = p_.physical(r.q);
       for (const char* n : columns_) {
         const auto it = ph.find(n);
-        std::printf(" %13.6g", it == ph.end() ? std::nan("") : it->second);
+        io::progress(" %13.6g", it == ph.end() ? std::nan("") : it->second);
       }
     }
-    std::printf(" %13.6e %8.4g\n", r.cost, r.horizon);
+    io::progress(" %13.6e %8.4g\n", r.cost, r.horizon);
     std::fflush(stdout);
   }
 
@@ -174,7 +175,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     if (floor_added || !at.allFinite()) return;
     floor_added = true;
     r.smoothness_expected_misfit = expected += fit_floor(run.c, at);
-    if (run.c.verbose) std::printf("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
+    if (run.c.verbose) io::progress("discrepancy: noise and the fit test's floor give a data misfit of %.4e\n", expected);
   };
   if (start_explained) add_floor(start);
   double previous_misfit = NAN, previous_drop = NAN;
@@ -185,7 +186,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
     add_floor(s.q);
     r.smoothness_path.push_back({beta, misfit, s.prior_cost, s.iterations_done, s.converged()});
     if (run.c.verbose)
-      std::printf("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
+      io::progress("smoothness weight %.0e: data misfit %.4e (noise %.4e), prior %.4e, %s\n", beta, misfit, expected, s.prior_cost,
                   to_string(s.termination));
     if (s.q.allFinite()) q = s.q;
     // The next weight's run starts where this one ended, on the matrix it ended with.
@@ -209,7 +210,7 @@ OptimizerSummary discrepancy_path(const Runner& run, RunResult& r, const VectorX
         misfit - drop * std::log10(beta / kSmallestWeight) > expected &&
         run.c.fit_at(q, AttemptsContext::Alongside::Cost).within_noise_and_discretisation) {  // (the attempt's cost, if it ends here)
       if (run.c.verbose)
-        std::printf("the data misfit levels off above the noise's: the discrepancy cannot be met, weight %.0e kept\n",
+        io::progress("the data misfit levels off above the noise's: the discrepancy cannot be met, weight %.0e kept\n",
                     beta);
       break;
     }
@@ -312,7 +313,7 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
     const bool explained = sl.q.allFinite() && c.fit_screen(out.q, if_not, if_explained).within_noise_and_discretisation;
     out.levels.push_back({B, level.step, sl.cost, sl.iterations_done, to_string(sl.termination), explained});
     if (c.verbose)
-      std::printf("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", level.step,
+      io::progress("  %d block%s per family (step %.3g s): %s%s\n", B, B > 1 ? "s" : "", level.step,
                   sl.BriefReport().c_str(), explained ? "; the fit is within noise and discretisation" : "");
     if (explained) break;
   }
@@ -367,7 +368,7 @@ OptimizerSummary explained_by_level(const Runner& run, const VectorXd& q, int bl
   run.header();
   if (c.verbose) {
     run.table.row(rec);
-    std::printf("%s\n", s.message.c_str());
+    io::progress("%s\n", s.message.c_str());
   }
   return s;
 }
@@ -380,7 +381,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   int iterations = 0;
   std::vector<RunResult::Attempt::Level> levels;
   if (from_ladder) {
-    if (c.verbose) std::printf("%zu sections: coarse to fine from the start\n", longest(families));
+    if (c.verbose) io::progress("%zu sections: coarse to fine from the start\n", longest(families));
     // With a prior the attempt goes on from an explained level on the full parameterization.
     std::function<void(const VectorXd&)> first_point;
     if (c.problem.scenario.identification.smoothness != 0.0)
@@ -484,7 +485,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     label = "spectral start (" + io::format_value(ss.model_hz) + " Hz -> " + io::format_value(ss.data_hz) + " Hz), " +
             io::to_string(c.options.method);
     if (c.verbose)
-      std::printf("spectral start: the record's peak at %.6g Hz, the model's at %.6g Hz from the starting point\n", ss.data_hz,
+      io::progress("spectral start: the record's peak at %.6g Hz, the model's at %.6g Hz from the starting point\n", ss.data_hz,
                   ss.model_hz);
     run.header();
     s = run.minimize_from(ss.q, c.options);
@@ -562,18 +563,18 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
       wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
     if (!wanted) continue;
     if (c.verbose) {
-      std::printf("fit test: %s\n", r.fit.message.c_str());
+      io::progress("fit test: %s\n", r.fit.message.c_str());
       if (how == "smoothed")
-        std::printf("restart %d (smoothed): from the estimate smoothed along its sections — a sectional minimum may be local\n",
+        io::progress("restart %d (smoothed): from the estimate smoothed along its sections — a sectional minimum may be local\n",
                     done + 1);
       else
-        std::printf("restart %d (%s) from the starting point\n", done + 1, how.c_str());
+        io::progress("restart %d (%s) from the starting point\n", done + 1, how.c_str());
     }
     restart(run, r, families, how, spectral);
     if (how != "smoothed") ++done;  // a check of every sectional run, not an answer to a failure
   }
   r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record
-  if (c.verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
+  if (c.verbose) io::progress("fit test: %s\n", r.fit.message.c_str());
 }
 
 }  // namespace scoleid::identify

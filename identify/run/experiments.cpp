@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
+#include "scoleid/io/progress.h"
 
 namespace scoleid::identify {
 
@@ -405,16 +406,16 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
     bad(ep.spec.source, "method", "needs displacement sensors only in every run", io::to_string(r.method));
   const OptimizerOptions oo = optimizer_options(lead.identification, r.method, params.size(), eo.max_iterations, lead.source);
   if (eo.verbose) {
-    std::printf("%5s", "iter");
-    for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) std::printf(" %13s", r.names[i].c_str());
-    std::printf(" %13s %8s\n", "cost", "horizon");
+    io::progress("%5s", "iter");
+    for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) io::progress(" %13s", r.names[i].c_str());
+    io::progress(" %13s %8s\n", "cost", "horizon");
   }
   auto progress = [&](const IterationRecord& rec) {
     io::check_interrupt();
     if (!eo.verbose) return;
-    std::printf("%5d", rec.k);
-    for (Eigen::Index i = 0; i < rec.q.size() && i < 6; ++i) std::printf(" %13.6g", rec.q[i]);
-    std::printf(" %13.6e %8.4g\n", rec.cost, rec.horizon);
+    io::progress("%5d", rec.k);
+    for (Eigen::Index i = 0; i < rec.q.size() && i < 6; ++i) io::progress(" %13.6g", rec.q[i]);
+    io::progress(" %13.6e %8.4g\n", rec.cost, rec.horizon);
     std::fflush(stdout);
   };
   r.summary = minimize(joint, r.initial, oo, progress);

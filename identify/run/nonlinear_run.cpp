@@ -17,6 +17,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/progress.h"
 
 namespace scoleid::identify {
 
@@ -75,11 +76,11 @@ struct NonlinearRun {
     io::check_interrupt();
     if (!verbose) return;
     if (std::isfinite(rec.gradient_norm))
-      std::printf("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
+      io::progress("%4d  J = %.6e  |g| = %.3e  horizon %.4g", rec.k, rec.cost, rec.gradient_norm, rec.horizon);
     else  // (a run's last point, whose gradient nothing needed: optimizers.h)
-      std::printf("%4d  J = %.6e  |g| not taken  horizon %.4g", rec.k, rec.cost, rec.horizon);
-    for (std::size_t i = 0; i < r.names.size(); ++i) std::printf("  %s = %.7g", r.names[i].c_str(), rec.q[static_cast<Eigen::Index>(i)]);
-    std::printf("\n");
+      io::progress("%4d  J = %.6e  |g| not taken  horizon %.4g", rec.k, rec.cost, rec.horizon);
+    for (std::size_t i = 0; i < r.names.size(); ++i) io::progress("  %s = %.7g", r.names[i].c_str(), rec.q[static_cast<Eigen::Index>(i)]);
+    io::progress("\n");
     std::fflush(stdout);
   }
 
@@ -119,7 +120,7 @@ struct NonlinearRun {
     std::tie(r.summary, r.fit, r.predicted) = attempt(std::string("plain ") + io::to_string(oo.method), oo);
     if (id.restarts > 0 && r.summary.converged() && !r.fit.explains_data) {
       const OptimizerOptions oc = cautious_continuation(oo, id);
-      if (verbose) std::printf("fit test: %s\nrestart (cautious continuation)\n", r.fit.message.c_str());
+      if (verbose) io::progress("fit test: %s\nrestart (cautious continuation)\n", r.fit.message.c_str());
       auto [s, f, pred] = attempt(cautious_continuation_label(oc), oc);
       if (better_attempt(r.attempts.back(), r.attempts.front())) {
         r.chosen_attempt = 1;
@@ -129,7 +130,7 @@ struct NonlinearRun {
       }
     }
     r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;
-    if (verbose) std::printf("fit test: %s\n", r.fit.message.c_str());
+    if (verbose) io::progress("fit test: %s\n", r.fit.message.c_str());
   }
 
   // Fisher information from differenced output sensitivities (2P forward runs), each sensor's
@@ -186,7 +187,7 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
   NonlinearRun run(p, fo, ro.verbose, r);
   const OptimizerOptions oo = optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source);
   if (ro.verbose)
-    std::printf("nonlinear model: %d elastic DOFs, step %.4g s, %s\n", run.model.elastic(), fo.max_step, io::to_string(r.method));
+    io::progress("nonlinear model: %d elastic DOFs, step %.4g s, %s\n", run.model.elastic(), fo.max_step, io::to_string(r.method));
   run.attempts(oo);
   r.estimate = r.summary.q;
   if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) run.assess(oo);

@@ -433,13 +433,15 @@ void render(const char* png, RenderStatus status) {
 
 }  // namespace
 
+MatrixXd predicted_outputs(Problem& p, const RunResult& r) {
+  if (r.predicted.size() != 0) return r.predicted;
+  Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
+  return obj.predict(r.estimate);
+}
+
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   // fit.csv: measured, predicted and residual per sensor at the sample times.
-  MatrixXd predicted = r.predicted;
-  if (predicted.size() == 0) {
-    Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
-    predicted = obj.predict(r.estimate);
-  }
+  const MatrixXd predicted = predicted_outputs(p, r);
   const io::DataTable tab = fit_table(p.data, predicted);
   io::write_csv(dir.path("fit.csv"), tab);
   // fit.gp, rendered to fit.png when gnuplot is installed (the script stays for other terminals).

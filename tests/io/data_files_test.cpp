@@ -245,3 +245,33 @@ TEST(DataFiles, ATrueValueBeyondTheScenarioRangeIsRefused) {
   }
   EXPECT_NE(msg.find("true_parameters.EI must be 0 or of magnitude within"), std::string::npos) << msg;
 }
+
+// Columns held in memory with a header (a DataFrame's) are read as a CSV with that header is: the
+// time column chosen alike, the bracketed units taken alike, the time converted alike.
+TEST(DataFiles, ColumnsInMemoryAreReadAsACsvWithTheirHeader) {
+  const std::string csv = "a [g],Time [ms],b\n1,0,4\n2,0.5,5\n3,1.25,6\n";
+  const CsvOptions by_name{"Time [ms]", ""};
+  const DataTable file = read_csv_text(csv, "f.csv", by_name);
+  const DataTable mem = table_from_columns({"a [g]", "Time [ms]", "b"}, {{1, 2, 3}, {0, 0.5, 1.25}, {4, 5, 6}}, "mem", by_name);
+  EXPECT_EQ(mem.t, file.t);
+  EXPECT_EQ(mem.t, (std::vector<double>{0.0, 0.0005, 0.00125}));
+  EXPECT_EQ(mem.names, file.names);
+  EXPECT_EQ(mem.units, file.units);
+  EXPECT_EQ(mem.units, (std::vector<std::string>{"g", ""}));
+  EXPECT_EQ(mem.columns, file.columns);
+  // No time column named: the first, as in a file; a unit for an unstated time from the options.
+  const DataTable first = table_from_columns({"x", "a"}, {{0, 2, 4}, {1, 1, 1}}, "mem", {"", "ms"});
+  EXPECT_EQ(first.t, (std::vector<double>{0.0, 0.002, 0.004}));
+  auto error_of = [](const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols, const CsvOptions& o) {
+    try {
+      table_from_columns(header, cols, "mem", o);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of({"t", "a"}, {{0, 1}, {1, 2}}, {"time", ""}), "data 'mem': no time column 'time' (data.time_column); the header's first is 't'");
+  EXPECT_EQ(error_of({"t [m]", "a"}, {{0, 1}, {1, 2}}, {}), "data 'mem': time column 't [m]': unit 'm' is not a unit of time");
+  EXPECT_EQ(error_of({"t", "a"}, {{1, 0}, {1, 2}}, {}), "data 'mem': time, sample 2: must be strictly increasing (after 1), got 0");
+  EXPECT_EQ(error_of({"t", "t"}, {{0, 1}, {1, 2}}, {}), "data 'mem': duplicate column 't'");
+}

@@ -36,8 +36,8 @@ def good(n=40):
     ("time2d", r"column 't' has shape \(40, 1\)"),
     ("short", "column 'w_mid' has 39 values for 40 times"),
     ("strings", "column 'P' is not numeric"),
-    ("dates", "holds dates or time spans"),
-    ("int", "a dict of arrays"),
+    ("dates", "column 'P' holds dates"),
+    ("spans", "column 'P' holds time spans; pass time='P'"),
     ("nullable", "column 'w_mid', sample 4 .* must be finite"),
     ("too_many", "more than 5000000"),
 ])
@@ -74,8 +74,8 @@ def test_bad_data_are_input_errors_naming_the_column(case, message):
         d["P"] = ["x"] * 40
     elif case == "dates":
         d["P"] = pd.date_range("2026-01-01", periods=40, freq="s")
-    elif case == "int":
-        d = 123
+    elif case == "spans":
+        d["P"] = pd.timedelta_range(0, periods=40, freq="s")
     elif case == "nullable":
         df = pd.DataFrame(d)
         df["w_mid"] = df["w_mid"].astype("Float64")
@@ -86,6 +86,19 @@ def test_bad_data_are_input_errors_naming_the_column(case, message):
         d = {"t": np.arange(n) * 1e-5, "P": np.zeros(n), "w_mid": np.zeros(n)}
     with pytest.raises(scoleid.InputError, match=message):
         identify(d)
+
+
+def test_arguments_of_the_wrong_type_are_type_errors_that_say_what_is_expected():
+    with pytest.raises(TypeError, match="data: None, a file path, a dict of arrays or a pandas DataFrame, got int"):
+        identify(123)
+    with pytest.raises(TypeError, match="max_iterations must be an integer, got float 2.0"):
+        scoleid.identify(SCENARIO, data=good(), max_iterations=2.0)
+    with pytest.raises(TypeError, match="compute_std must be True or False"):
+        scoleid.identify(SCENARIO, data=good(), compute_std="no")
+    with pytest.raises(TypeError, match="progress must be a callable"):
+        scoleid.identify(SCENARIO, data=good(), progress="log.txt")
+    # numpy integers are integers
+    assert scoleid.identify(SCENARIO, data=good(), max_iterations=np.int64(0), compute_std=False).iterations is not None
 
 
 def test_good_data_as_a_dict_and_as_a_dataframe_identify_alike():

@@ -4,41 +4,102 @@
     rec = scoleid.truth("paper-beam-1")                  # Simbody truth: {"t": array, column: array, ...}
     idn = scoleid.identify("paper-beam-1", data=rec)     # the FE costate identifier on those arrays
     print(idn.report())                                  # the table scole-identify prints
-    plant = idn.state_space()                            # {"A", "B", "C", "D", "inputs", "outputs"}
+    idn.summary()                                        # pandas: estimate, std, low, high, identifiable
+    idn.fit                                              # pandas: measured, predicted, residual per sensor
+    plant = idn.state_space().to_scipy()                 # scipy.signal.StateSpace
 
-A scenario is a built-in name, a YAML file's path, YAML text, or a dict with the YAML's structure.
-Data are None (the scenario synthesises them), a file (CSV or Universal File), a dict of equal-length
-arrays with a "t" entry, or a pandas DataFrame (a "t" column, else its first column is time). A record's truth.json (true values,
-noise levels) travels as TruthRecord.meta, or a DataFrame's attrs["meta"].
-The numbers are those of the programs (scole-truth, scole-identify, scole-crosscheck); bad input
-raises scoleid.InputError (a ValueError) with their one-line message; Ctrl-C ends a solve under way.
+Scenarios. A built-in name (``builtin_scenarios()``), a YAML file's path, YAML text, or a dict with
+the YAML's structure (numpy scalars and arrays are taken as the numbers they hold).
+
+Data. ``None`` (the scenario synthesises its own), a file (CSV, Universal File, LabVIEW LVM: read as
+``scole-identify --data`` reads it), a dict of equal-length arrays, or a pandas DataFrame. The time
+of a table is, in this order: the column or array given as ``time=``; a DataFrame's index when it is
+named or holds floats or time spans (an unnamed integer index is row numbers, not time); the
+scenario's ``data.time_column``; a column named ``t``; the first column. Column names are read as a
+CSV header is: a bracketed suffix states the unit (``"Time [ms]"``, ``"acc_tip [g]"``,
+``"hammer [lbf]"``) and is converted exactly as the CSV reader converts it; a time-span
+(``Timedelta``) time is taken in seconds. A record's truth.json (true values, noise levels) travels
+as ``TruthRecord.meta`` or a DataFrame's ``attrs["meta"]``.
+
+Results. The numbers are those of the programs (scole-truth, scole-identify, scole-crosscheck), bit
+for bit. What the user must know of a run (nothing identifiable, not converged) is also emitted as a
+``ScoleidWarning``; progress lines go to ``progress=``, to ``sys.stdout`` with ``verbose=True``, and
+to the ``logging`` logger ``"scoleid"`` (level INFO) when it is enabled. An ``Identification``
+pickles (its numbers; see ``Identification.write``).
+
+Errors. Bad input raises ``scoleid.InputError`` (a ``ValueError``) with the programs' one-line
+message; an argument of the wrong type raises ``TypeError``; Ctrl-C ends a solve under way
+(``KeyboardInterrupt``).
+
+Threads. One library call runs at a time in a process: calls from several threads wait for one
+another (the solver's signal handling belongs to the process). The GIL is released while a call
+runs. For runs in parallel use processes (``concurrent.futures.ProcessPoolExecutor``, joblib).
 """
-import json
-import os
+import json as _json
+import logging as _logging
+import math as _math
+import operator as _operator
+import os as _os
+import re as _re
+import sys as _sys
+import warnings as _warnings
 
-import numpy as np
+import numpy as _np
 
 from . import _core
 
-InputError = _core.InputError
+__version__ = _core.__version__
 
-__all__ = ["InputError", "builtin_scenarios", "builtin_scenario", "load_scenario", "truth", "identify",
-           "Identification", "TruthRecord", "crosscheck_modes", "crosscheck_trajectories"]
+InputError = _core.InputError
+InputError.__doc__ = ("Bad input (a scenario field, a data column, a file): the programs' one-line message, naming the "
+                      "file, field and value. A ValueError.")
+
+__all__ = ["__version__", "InputError", "ScoleidWarning", "builtin_scenarios", "builtin_scenario", "load_scenario",
+           "truth", "identify", "Identification", "TruthRecord", "StateSpace", "crosscheck_modes",
+           "crosscheck_trajectories"]
+
+_log = _logging.getLogger("scoleid")
+
+
+class ScoleidWarning(UserWarning):
+    """What the user must know of a result: no parameter identifiable, a run not converged (with why)."""
 
 
 def builtin_scenarios():
-    """The built-in scenarios' names."""
-    return list(_core.builtin_scenarios())
+    """The built-in scenarios: ``{name: one-line description}``, in the order ``--list-scenarios`` prints them.
+
+    Returns:
+        dict[str, str]
+    """
+    return {n: _core.builtin_scenario_description(n) for n in _core.builtin_scenarios()}
 
 
 def builtin_scenario(name):
-    """A built-in scenario as YAML text (edit it, or pass it on as it is)."""
+    """A built-in scenario as YAML text (edit it, or pass it on as it is).
+
+    Args:
+        name (str): one of ``builtin_scenarios()``.
+    Returns:
+        str: the YAML text.
+    Raises:
+        InputError: no built-in scenario has that name.
+    """
+    if not isinstance(name, str):
+        raise TypeError("builtin_scenario: name must be a str, got %s" % type(name).__name__)
     return _core.builtin_scenario(name)
 
 
 def load_scenario(path):
-    """A scenario file's YAML text, checked as the programs check it (InputError otherwise)."""
-    _core.scenario_json(os.fspath(path), "")
+    """A scenario file's YAML text, checked as the programs check it.
+
+    Args:
+        path (str | os.PathLike): a YAML (or JSON) scenario file.
+    Returns:
+        str: the file's text.
+    Raises:
+        InputError: the file is missing or a field is invalid (the message names it).
+    """
+    _core.scenario_json(_os.fspath(path), "")
     with open(path, encoding="utf-8") as f:
         return f.read()
 
@@ -47,9 +108,9 @@ def _json_value(x):
     """A scenario dict's numpy scalars, 0-d arrays, Decimal and Fraction as the numbers they hold."""
     import decimal
     import fractions
-    if isinstance(x, np.generic) or (isinstance(x, np.ndarray) and x.ndim == 0):
+    if isinstance(x, _np.generic) or (isinstance(x, _np.ndarray) and x.ndim == 0):
         return x.item()
-    if isinstance(x, np.ndarray):
+    if isinstance(x, _np.ndarray):
         return x.tolist()
     if isinstance(x, (decimal.Decimal, fractions.Fraction)):
         return float(x)
@@ -59,53 +120,96 @@ def _json_value(x):
 def _scenario(scenario):
     """(text, source) for _core: source "" means `text` is a built-in name or a file path."""
     if isinstance(scenario, dict):
-        return json.dumps(scenario, default=_json_value), "scenario (dict)"
-    if isinstance(scenario, os.PathLike):
-        return os.fspath(scenario), ""
+        return _json.dumps(scenario, default=_json_value), "scenario (dict)"
+    if isinstance(scenario, _os.PathLike):
+        return _os.fspath(scenario), ""
     if not isinstance(scenario, str):
         raise TypeError("scenario: a built-in name, a path, YAML text or a dict, got %s" % type(scenario).__name__)
-    if "\n" in scenario or ":" in scenario and not os.path.exists(scenario):
+    if "\n" in scenario or ":" in scenario and not _os.path.exists(scenario):
         return scenario, "scenario (YAML text)"
     return scenario, ""
 
 
+def _integer(name, value):
+    """An integer argument (numpy integers too); TypeError for a float, a bool or anything else."""
+    if isinstance(value, bool):
+        raise TypeError("%s must be an integer, got bool %r" % (name, value))
+    try:
+        return _operator.index(value)
+    except TypeError:
+        raise TypeError("%s must be an integer, got %s %r" % (name, type(value).__name__, value)) from None
+
+
+def _flag(name, value):
+    if not isinstance(value, (bool, _np.bool_)):
+        raise TypeError("%s must be True or False, got %s %r" % (name, type(value).__name__, value))
+    return bool(value)
+
+
 class TruthRecord(dict):
-    """A Simbody truth: {"t": times, column: values, ...}; `meta` is its truth.json (a dict)."""
+    """A Simbody truth: ``{"t": times [s], column: values, ...}``; ``meta`` is its truth.json (a dict:
+    true parameters, each column's unit, kind and noise level)."""
 
     def __init__(self, columns, meta):
         super().__init__(columns)
         self.meta = meta
 
+    def to_dataframe(self):
+        """The record as a pandas DataFrame indexed by ``t`` (its ``attrs["meta"]`` the truth.json)."""
+        import pandas as pd
+        df = pd.DataFrame({k: v for k, v in self.items() if k != "t"}, index=pd.Index(self["t"], name="t"))
+        df.attrs["meta"] = self.meta
+        return df
+
+    def __reduce__(self):
+        return (TruthRecord, (dict(self), self.meta))
+
 
 def truth(scenario, progress=False):
-    """The Simbody truth of a scenario, as scole-truth computes it (the same numbers)."""
+    """The Simbody truth of a scenario, as ``scole-truth`` computes it (the same numbers).
+
+    Args:
+        scenario (str | os.PathLike | dict): a built-in name, a path, YAML text or a dict.
+        progress (bool): print the simulation's progress on stderr.
+    Returns:
+        TruthRecord: ``{"t": times, column: values}`` with ``meta`` (truth.json).
+    Raises:
+        InputError: an invalid scenario.
+    """
     text, source = _scenario(scenario)
-    (names, t, values), meta = _core.truth(text, source, progress)
+    (names, t, values), meta = _core.truth(text, source, _flag("progress", progress))
     cols = {"t": t}
     for j, n in enumerate(names):
-        cols[n] = np.ascontiguousarray(values[:, j])
-    return TruthRecord(cols, json.loads(meta))
+        cols[n] = _np.ascontiguousarray(values[:, j])
+    return TruthRecord(cols, _json.loads(meta))
+
+
+def _dtype_kind(values):
+    return getattr(getattr(values, "dtype", None), "kind", "")
 
 
 def _column(name, values, n=None):
     """One column as a 1-D float array of n values; InputError for anything else."""
-    if getattr(getattr(values, "dtype", None), "kind", "") in ("m", "M"):
-        raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, values.dtype))
-    if getattr(getattr(values, "dtype", None), "kind", "") == "c" or (
-            getattr(values, "dtype", None) == object and any(isinstance(x, (complex, np.complexfloating)) for x in values)):
+    if _dtype_kind(values) == "M":
+        raise InputError("data: column '%s' holds dates (%s); give the time as seconds or time spans "
+                         "(e.g. df.index - df.index[0])" % (name, values.dtype))
+    if _dtype_kind(values) == "m":
+        raise InputError("data: column '%s' holds time spans (%s); only the time may" % (name, values.dtype))
+    if _dtype_kind(values) == "c" or (
+            getattr(values, "dtype", None) == object and any(isinstance(x, (complex, _np.complexfloating)) for x in values)):
         raise InputError("data: column '%s' is complex; give real values (a time record)" % name)
-    if hasattr(values, "to_numpy"):  # a pandas Series (nullable dtypes: NA becomes NaN, refused below)
+    if hasattr(values, "to_numpy"):  # a pandas Series or Index (nullable dtypes: NA becomes NaN, refused later)
         try:
-            values = values.to_numpy(dtype=float, na_value=np.nan)
+            values = values.to_numpy(dtype=float, na_value=_np.nan)
         except (TypeError, ValueError) as e:
             raise InputError("data: column '%s' is not numeric (%s)" % (name, e)) from None
-    a = np.asarray(values)
-    if np.iscomplexobj(a) or (a.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in a.ravel())):
+    a = _np.asarray(values)
+    if _np.iscomplexobj(a) or (a.dtype == object and any(isinstance(x, (complex, _np.complexfloating)) for x in a.ravel())):
         raise InputError("data: column '%s' is complex; give real values (a time record)" % name)
     if a.dtype.kind in "mM":
         raise InputError("data: column '%s' holds dates or time spans (%s); give seconds as numbers" % (name, a.dtype))
     try:
-        a = np.asarray(a, dtype=float)
+        a = _np.asarray(a, dtype=float)
     except (TypeError, ValueError) as e:
         raise InputError("data: column '%s' is not numeric (%s)" % (name, e)) from None
     if a.ndim != 1:
@@ -116,105 +220,266 @@ def _column(name, values, n=None):
     return a
 
 
-def _table(data):
-    """(names, t, values[samples x columns], meta_json) of a dict or DataFrame."""
-    if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a pandas DataFrame (truth.json in .attrs["meta"])
+_UNIT = _re.compile(r"\[\s*([^\]]*?)\s*\]\s*$")
+
+
+def _time_column(name, values):
+    """(header name, seconds-or-stated-unit values) of the time: a Timedelta time in seconds."""
+    kind = _dtype_kind(values)
+    if kind == "M":
+        raise InputError("data: the time '%s' holds dates (%s); give seconds or time spans from the start "
+                         "(e.g. df.index - df.index[0])" % (name, values.dtype))
+    if kind != "m":
+        return name, _column(name, values)
+    m = _UNIT.search(name)
+    if m and m.group(1) not in ("", "s"):
+        raise InputError("data: the time '%s' holds time spans, which are seconds, not [%s]" % (name, m.group(1)))
+    if hasattr(values, "isna") and bool(values.isna().any()):
+        raise InputError("data: the time '%s' has missing values (NaT)" % name)
+    seconds = _np.asarray(values, dtype="timedelta64[ns]").astype(_np.int64) / 1e9
+    return (_UNIT.sub("", name).rstrip() or "t") + " [s]", seconds
+
+
+def _index_is_time(index):
+    """A DataFrame's index is its time when named, or when it holds floats or time spans."""
+    return index.name is not None or index.dtype.kind in "fmM"
+
+
+def _table(data, time):
+    """(header, values[samples x columns], time column, source, meta_json) of a dict or DataFrame."""
+    columns, time_name, source = {}, "", "data"
+    if hasattr(data, "columns") and hasattr(data, "index") and hasattr(data, "to_numpy"):  # a pandas DataFrame
+        source = "data (DataFrame)"
         meta = getattr(data, "attrs", {}).get("meta")
-        if len(set(map(str, data.columns))) != len(data.columns):
+        names = [str(c) for c in data.columns]
+        if len(set(names)) != len(names):
             raise InputError("data: the DataFrame's column names repeat")
-        if len(data.columns) == 0:
+        if len(names) == 0:
             raise InputError("data: the DataFrame has no columns")
-        cols = {str(c): data[c] for c in data.columns}
-        if "t" not in cols:
-            first = str(data.columns[0])
-            cols = {"t": cols.pop(first), **cols}
-        data = cols
+        columns = {str(c): data[c] for c in data.columns}
+        if time is None and _index_is_time(data.index):
+            name = "t" if data.index.name is None else str(data.index.name)
+            if name in columns:
+                raise InputError("data: the index '%s' and a column share a name; which is the time?" % name)
+            time_name, values = _time_column(name, data.index)
+            columns = {time_name: values, **columns}
     elif isinstance(data, dict):
+        source = "data (dict)"
         meta = data.meta if isinstance(data, TruthRecord) else None
+        if not data:
+            raise InputError("data: the dict has no columns")
+        columns = {str(k): v for k, v in data.items()}
+        if len(columns) != len(data):
+            raise InputError("data: the dict's keys repeat once written as text")
     else:
-        raise InputError("data: a dict of arrays with a \"t\" entry, a pandas DataFrame or a file path, got %s"
-                         % type(data).__name__)
-    if "t" not in data:
-        raise InputError('data: a dict of arrays needs a "t" entry (the sample times)')
-    t = _column("t", data["t"])
-    names = [str(k) for k in data if k != "t"]
-    values = np.empty((t.size, len(names)))
-    for j, (k, n) in enumerate(zip([k for k in data if k != "t"], names)):
-        values[:, j] = _column(n, data[k], t.size)
-    return names, t, values, json.dumps(meta) if meta is not None else ""
+        raise TypeError("data: None, a file path, a dict of arrays or a pandas DataFrame, got %s" % type(data).__name__)
+    if time is not None:
+        if isinstance(time, str):
+            if time not in columns:
+                raise InputError("data: time='%s' is not a column (%s)" % (time, ", ".join(list(columns)[:12])))
+            time_name, values = _time_column(time, columns.pop(time))
+        else:  # the sample times themselves
+            time_name, values = _time_column(getattr(time, "name", None) or "t", time)
+            if time_name in columns:
+                raise InputError("data: time= is named '%s', as a column is" % time_name)
+        columns = {time_name: values, **columns}
+    header = list(columns)
+    n = None
+    values = None
+    for j, name in enumerate(header):
+        v = columns[name]
+        if name != time_name:
+            if _dtype_kind(v) == "m":
+                raise InputError("data: column '%s' holds time spans; pass time='%s' to take it as the time" % (name, name))
+            v = _column(name, v, n)
+        if values is None:
+            n = len(v)
+            values = _np.empty((n, len(header)))
+        values[:, j] = v
+    return header, values, time_name, source, _json.dumps(meta) if meta is not None else ""
+
+
+class StateSpace:
+    """The identified linear FE model as a plant: x' = A x + B f, y = C x + D f, with x = (u, du/dt) the
+    FE model's degrees of freedom and their rates, f the scenario's inputs and y its sensors, in the
+    scenario's units (``input_units``, ``output_units``). ``to_scipy()`` gives a
+    ``scipy.signal.StateSpace`` (whose rows and columns follow ``inputs`` and ``outputs``)."""
+
+    def __init__(self, A, B, C, D, inputs, outputs, input_units=(), output_units=()):
+        self.A, self.B, self.C, self.D = A, B, C, D
+        self.inputs, self.outputs = list(inputs), list(outputs)
+        self.input_units, self.output_units = list(input_units), list(output_units)
+
+    def to_scipy(self):
+        """``scipy.signal.StateSpace(A, B, C, D)``, continuous time."""
+        from scipy import signal
+        return signal.StateSpace(self.A, self.B, self.C, self.D)
+
+    def __repr__(self):
+        return "<scoleid.StateSpace %d states, inputs %s, outputs %s>" % (self.A.shape[0], self.inputs, self.outputs)
+
+
+def _interval_pair(i):
+    return (i["low"], i["high"]) if isinstance(i, dict) and "low" in i else None
 
 
 class Identification:
-    """One identification: estimates with their std and intervals, the verdict it earned, the model."""
+    """One identification: estimates with their std and intervals, the verdict it earned, the model.
+
+    Built by ``identify()``. Everything is read from the run's identify.json (``to_dict()``); tables
+    come as pandas DataFrames (``summary()``, ``fit``, ``modes``). It pickles with all its numbers;
+    ``write()`` and ``export_model()`` need the solver's state and work only in the process that ran it.
+    """
 
     def __init__(self, core, library_seconds=float("nan")):
         self._core = core
-        self._json = json.loads(core.to_json())
+        self._json_text = core.to_json()
+        self._dict = _json.loads(self._json_text)
+        self._cache = {}
         #: seconds the library call took (scenario to verdict), without the Python around it
         self.library_seconds = library_seconds
+        self._plain = {"converged": core.converged, "verdict": core.verdict, "exit_code": core.exit_code,
+                       "warnings": list(core.warnings), "names": list(core.names), "report": core.report()}
 
+    # ----- pickling: the numbers travel, the solver's state does not
+    def __getstate__(self):
+        self._fit_arrays()
+        self._model_arrays()
+        return {"json_text": self._json_text, "cache": self._cache, "plain": self._plain,
+                "library_seconds": self.library_seconds}
+
+    def __setstate__(self, state):
+        self._core = None
+        self._json_text = state["json_text"]
+        self._dict = _json.loads(self._json_text)
+        self._cache = state["cache"]
+        self._plain = state["plain"]
+        self.library_seconds = state["library_seconds"]
+
+    def _need_core(self, what):
+        if self._core is None:
+            raise RuntimeError("%s needs the solver's state, which an unpickled Identification does not carry: "
+                               "call it in the process that ran identify()" % what)
+        return self._core
+
+    def _fit_arrays(self):
+        if "fit" not in self._cache:
+            self._cache["fit"] = self._need_core("fit").fit_table()
+        return self._cache["fit"]
+
+    def _model_arrays(self):
+        if "state_space" not in self._cache:
+            core = self._need_core("state_space()")
+            self._cache["state_space"] = dict(core.state_space())
+            self._cache["modal_model"] = dict(core.modal_model())
+            self._cache["model_json"] = core.model_json()
+        return self._cache
+
+    # ----- verdict
     @property
     def converged(self):
         """True only when the optimiser converged and the model explains the data (the fit test)."""
-        return self._core.converged
+        return self._plain["converged"]
 
     @property
     def verdict(self):
         """Why the run is not converged, in one line ("" when it is)."""
-        return self._core.verdict
+        return self._plain["verdict"]
 
     @property
     def exit_code(self):
-        return self._core.exit_code
+        """scole-identify's exit code for this run: 0 when converged, 1 otherwise."""
+        return self._plain["exit_code"]
 
     @property
     def warnings(self):
-        return list(self._core.warnings)
+        """What the user must know even of a converged run (list of str; also emitted as ScoleidWarning)."""
+        return list(self._plain["warnings"])
 
+    # ----- estimates
     @property
     def names(self):
-        return list(self._core.names)
+        """The estimated parameters' names (list of str), in the order of every table."""
+        return list(self._plain["names"])
 
     @property
     def estimates(self):
-        """{parameter: estimate}"""
-        return {p["name"]: p["estimate"] for p in self._json["parameters"]}
+        """``{parameter: estimate}``"""
+        return {p["name"]: p["estimate"] for p in self._dict["parameters"]}
 
     @property
     def physical(self):
-        """The structure's physical values at the estimate (EI, rho_A, zeta, ...)."""
-        return dict(self._json["physical_estimate"])
+        """The structure's physical values at the estimate (EI, rho_A, zeta, ...), as a dict."""
+        return dict(self._dict["physical_estimate"])
 
     @property
     def std(self):
-        """{parameter: standard deviation} (None where not assessed or not identifiable)."""
-        return {p["name"]: p.get("std") for p in self._json["parameters"]}
+        """``{parameter: standard deviation}`` (None where not assessed or not identifiable)."""
+        return {p["name"]: p.get("std") for p in self._dict["parameters"]}
 
     @property
     def intervals(self):
-        """{parameter: (low, high)} of the reported uncertainty interval (None where there is none)."""
-        out = {}
-        for p in self._json["parameters"]:
-            i = p.get("interval")
-            out[p["name"]] = (i["low"], i["high"]) if isinstance(i, dict) and "low" in i else None
-        return out
+        """``{parameter: (low, high)}`` of the reported uncertainty interval (None where there is none)."""
+        return {p["name"]: _interval_pair(p.get("interval")) for p in self._dict["parameters"]}
 
     @property
     def identifiable(self):
-        return {p["name"]: p.get("identifiable") for p in self._json["parameters"]}
+        """``{parameter: bool}`` (None where not assessed: ``compute_std=False``)."""
+        return {p["name"]: p.get("identifiable") for p in self._dict["parameters"]}
+
+    def summary(self):
+        """identify.json's parameters as a DataFrame indexed by name: initial, estimate, std, low, high,
+        identifiable (and truth, relative_error when the record states the true values). Missing values
+        (not assessed, not identifiable) are NaN / None.
+
+        Returns:
+            pandas.DataFrame
+        """
+        import pandas as pd
+        rows = []
+        for p in self._dict["parameters"]:
+            low, high = _interval_pair(p.get("interval")) or (None, None)
+            row = {"initial": p["initial"], "estimate": p["estimate"], "std": p.get("std"), "low": low, "high": high,
+                   "identifiable": p.get("identifiable")}
+            if "truth" in p:
+                row.update({"truth": p["truth"], "relative_error": p["relative_error"]})
+            rows.append(row)
+        df = pd.DataFrame(rows, index=pd.Index([p["name"] for p in self._dict["parameters"]], name="parameter"))
+        for c in ("initial", "estimate", "std", "low", "high", "truth", "relative_error"):
+            if c in df:
+                df[c] = df[c].astype(float)
+        return df
 
     @property
     def modes(self):
-        """The identified model's elastic modes, lowest first: dicts with frequency_hz,
-        frequency_std_hz, frequency_interval_hz, damping_ratio, damping_ratio_std,
-        damping_ratio_interval (None where not assessed; docs/theory.md §8.3)."""
-        return [dict(m) for m in self._json.get("modes", [])]
+        """The identified model's elastic modes, lowest first, as a DataFrame indexed by mode number:
+        frequency_hz, frequency_std_hz, frequency_low_hz, frequency_high_hz (the uncertainty interval),
+        damping_ratio, damping_ratio_std, damping_ratio_low, damping_ratio_high; NaN where not
+        assessed, with the reason in ``uncertainty_not_given_because`` (docs/theory.md §8.3).
+        Rigid-body modes are not listed (``modal_model()`` flags them)."""
+        import pandas as pd
+        rows = []
+        for m in self._dict.get("modes", []):
+            def num(k):
+                v = m.get(k)
+                return _math.nan if v is None else float(v)
+            f, hw, z, zhw = num("frequency_hz"), num("frequency_interval_hz"), num("damping_ratio"), num("damping_ratio_interval")
+            rows.append({"mode": m["mode"], "frequency_hz": f, "frequency_std_hz": num("frequency_std_hz"),
+                         "frequency_low_hz": f - hw, "frequency_high_hz": f + hw,
+                         "damping_ratio": z, "damping_ratio_std": num("damping_ratio_std"),
+                         "damping_ratio_low": z - zhw, "damping_ratio_high": z + zhw,
+                         "uncertainty_not_given_because": m.get("uncertainty_not_given_because", "")})
+        cols = ["frequency_hz", "frequency_std_hz", "frequency_low_hz", "frequency_high_hz", "damping_ratio",
+                "damping_ratio_std", "damping_ratio_low", "damping_ratio_high", "uncertainty_not_given_because"]
+        if not rows:
+            return pd.DataFrame(columns=cols, index=pd.Index([], name="mode"))
+        return pd.DataFrame(rows).set_index("mode")[cols]
 
     @property
     def correlation(self):
-        """The correlation matrix of the estimates as {parameter: {parameter: r}} (None where a
-        parameter has no covariance)."""
-        c = self._json.get("identifiability", {}).get("correlation")
+        """The correlation matrix of the estimates as ``{parameter: {parameter: r}}`` (None where a
+        parameter has no covariance; {} when not assessed)."""
+        c = self._dict.get("identifiability", {}).get("correlation")
         if not c:
             return {}
         names = c["parameters"]
@@ -222,36 +487,78 @@ class Identification:
 
     @property
     def iterations(self):
-        """The iteration history, as identify.json's "iterations"."""
-        return list(self._json.get("iterations", []))
+        """The iteration history, as identify.json's "iterations" (list of dict)."""
+        return list(self._dict.get("iterations", []))
 
-    def to_json(self):
-        """identify.json, as a dict."""
-        return json.loads(self._core.to_json())
+    # ----- the fit
+    @property
+    def fit(self):
+        """fit.csv as a DataFrame indexed by ``t`` [s]: per sensor ``<name>_measured``,
+        ``<name>_predicted`` and ``<name>_residual`` (predicted − measured), in the scenario's units."""
+        import pandas as pd
+        names, t, values = self._fit_arrays()
+        return pd.DataFrame(_np.array(values, copy=True), columns=list(names), index=pd.Index(_np.array(t), name="t"))
+
+    # ----- outputs
+    def to_json(self, indent=None):
+        """identify.json as JSON text (``indent`` as ``json.dumps``'s; None: as the library writes it)."""
+        return self._json_text if indent is None else _json.dumps(self._dict, indent=indent)
+
+    def to_dict(self):
+        """identify.json as a dict (a fresh copy)."""
+        return _json.loads(self._json_text)
 
     def report(self):
-        """The table scole-identify prints."""
-        return self._core.report()
+        """The table scole-identify prints (str)."""
+        return self._plain["report"]
 
     def state_space(self):
-        """{"A", "B", "C", "D", "inputs", "outputs"}: the identified linear FE model, x = (u, du/dt),
-        in the scenario's units; y = C x + D f."""
-        return dict(self._core.state_space())
+        """The identified linear FE model as a plant.
+
+        Returns:
+            StateSpace: A, B, C, D (numpy arrays), inputs, outputs and their units; ``to_scipy()``.
+        """
+        c = self._model_arrays()
+        ss, model = c["state_space"], _json.loads(c["model_json"])["state_space"]
+        return StateSpace(ss["A"], ss["B"], ss["C"], ss["D"], ss["inputs"], ss["outputs"],
+                          model.get("input_units", ()), model.get("output_units", ()))
 
     def modal_model(self):
-        """{"omega" [rad/s], "zeta", "output_shapes" (outputs x modes), "input_shapes", ...}."""
-        return dict(self._core.modal_model())
+        """The identified model's modes, all of them (rigid-body modes too), ascending.
+
+        Returns:
+            dict: ``omega`` [rad/s], ``zeta`` (NaN for a rigid-body mode), ``rigid`` (bool array: a mode
+            whose frequency is under 1e-6 of the highest, i.e. a free structure's rigid motion, at ω ~ 0),
+            ``output_shapes`` (outputs x modes: a sensor's reading per unit modal coordinate),
+            ``input_shapes`` (inputs x modes), ``inputs``, ``outputs``.
+        """
+        m = dict(self._model_arrays()["modal_model"])
+        m["rigid"] = ~_np.isfinite(_np.asarray(m["zeta"], dtype=float))
+        return m
 
     def export_model(self, path):
-        """The state space and the modal model to path.json, or path.mat (MATLAB: A, B, C, D, inputs,
-        outputs, omega, zeta, output_shapes, input_shapes), as scole-identify --export-model writes
-        them. Returns the model as a dict."""
-        self._core.export_model(os.fspath(path))
-        return json.loads(self._core.model_json())
+        """The state space and the modal model to ``path`` (.json, or .mat for MATLAB: A, B, C, D, inputs,
+        outputs, omega, zeta, output_shapes, input_shapes), as ``scole-identify --export-model`` writes
+        them.
+
+        Returns:
+            dict: the model as written to .json.
+        Raises:
+            InputError: another extension, a path that is an input of the run, a directory.
+            RuntimeError: an unpickled Identification (no solver state).
+        """
+        self._need_core("export_model()").export_model(_os.fspath(path))
+        return _json.loads(self._model_arrays()["model_json"])
 
     def write(self, directory):
-        """identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with gnuplot) into `directory`."""
-        self._core.write(os.fspath(directory))
+        """identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with
+        gnuplot) into ``directory``, as ``scole-identify --out`` writes them (all or none).
+
+        Raises:
+            InputError: the directory holds an input of the run, or another run is writing into it.
+            RuntimeError: an unpickled Identification (no solver state).
+        """
+        self._need_core("write()").write(_os.fspath(directory))
 
     def __repr__(self):
         return "<scoleid.Identification %s: %s>" % (
@@ -259,35 +566,111 @@ class Identification:
             "converged" if self.converged else "not converged (%s)" % self.verdict)
 
 
-def identify(scenario, data=None, method=None, max_iterations=None, compute_std=True, verbose=False):
-    """Identify the scenario's parameters from data, as scole-identify does (the same numbers)."""
+def _progress_sink(progress, verbose):
+    """One callable for the library's progress lines, or None when nobody listens."""
+    sinks = []
+    if progress is not None:
+        if not callable(progress):
+            raise TypeError("progress must be a callable taking one line (str), got %s" % type(progress).__name__)
+        sinks.append(progress)
+    if verbose:
+        sinks.append(lambda line: print(line, file=_sys.stdout, flush=True))
+    if _log.isEnabledFor(_logging.INFO):
+        sinks.append(_log.info)
+    if not sinks:
+        return None
+
+    def sink(line):
+        for s in sinks:
+            s(line)
+    return sink
+
+
+def identify(scenario, data=None, *, time=None, method=None, max_iterations=None, compute_std=True, verbose=False,
+             progress=None):
+    """Identify the scenario's parameters from data, as ``scole-identify`` does (the same numbers).
+
+    Args:
+        scenario (str | os.PathLike | dict): a built-in name, a scenario file, YAML text or a dict.
+        data (None | str | os.PathLike | dict | pandas.DataFrame): None: the scenario synthesises its
+            data (on a finer mesh); a file: CSV, Universal File or LabVIEW LVM; a dict of equal-length
+            arrays; a DataFrame. See the module's help for how the time and the units are found.
+        time (None | str | array): the time column's name, or the sample times themselves (seconds, or
+            time spans); None: the DataFrame's index when it is time, else as a CSV file's.
+        method (None | str): the optimiser, one of "gauss-newton", "lbfgs", ... (scole-identify --help);
+            None: the scenario's identification.method.
+        max_iterations (None | int): None: the scenario's identification.max_iterations.
+        compute_std (bool): identifiability, standard deviations and uncertainty intervals.
+        verbose (bool): print the progress (iteration table, restarts, fit test) on sys.stdout.
+        progress (None | callable): called with each progress line (str) as the run goes; an exception it
+            raises ends the run and is raised in its place.
+    Returns:
+        Identification: the estimates and the verdict. ``converged`` is True only when earned; a run that
+        is not converged, or whose parameters the data do not determine, also emits a ScoleidWarning.
+    Raises:
+        InputError: a bad scenario field, data column, unit or file (one line naming it), before any solve.
+        TypeError: an argument of the wrong type.
+        KeyboardInterrupt: Ctrl-C (or SIGTERM) during the run.
+    """
     text, source = _scenario(scenario)
     args = _core.IdentifyArgs()
     if data is None:
-        pass
-    elif isinstance(data, (str, os.PathLike)):
-        args.data_file = os.fspath(data)
+        if time is not None:
+            raise TypeError("time= applies to a table (a dict or a DataFrame), not to synthesised data")
+    elif isinstance(data, (str, _os.PathLike)):
+        if time is not None:
+            raise TypeError("time= applies to a table; a file's time column is the scenario's data.time_column")
+        args.data_file = _os.fspath(data)
     else:
-        args.names, args.t, args.values, args.meta_json = _table(data)
+        args.header, args.values, args.time_column, args.source, args.meta_json = _table(data, time)
+    if method is not None and not isinstance(method, str):
+        raise TypeError("method must be a str, got %s" % type(method).__name__)
     args.method = method
-    args.max_iterations = max_iterations
-    args.compute_std = compute_std
-    args.verbose = verbose
+    args.max_iterations = None if max_iterations is None else _integer("max_iterations", max_iterations)
+    args.compute_std = _flag("compute_std", compute_std)
+    _flag("verbose", verbose)
+    sink = _progress_sink(progress, verbose)
+    if sink is not None:
+        args.progress = sink
     core, seconds = _core.identify(text, source, args)
-    return Identification(core, seconds)
+    idn = Identification(core, seconds)
+    for w in idn.warnings:
+        _warnings.warn(w, ScoleidWarning, stacklevel=2)
+    if not idn.converged:
+        _warnings.warn("not converged: " + idn.verdict, ScoleidWarning, stacklevel=2)
+    return idn
 
 
 def crosscheck_modes(scenario, count=10, segments=0, elements=0, levels=3):
-    """The Simbody chain's modes against the FE model's (scole-crosscheck modes), as a dict."""
+    """The Simbody chain's modes against the FE model's (``scole-crosscheck modes``).
+
+    Args:
+        scenario: a built-in name, a path, YAML text or a dict.
+        count (int): modes compared.  segments, elements (int): 0 = the scenario's.
+        levels (int): refinement levels of the extrapolation.
+    Returns:
+        dict: the report, as ``scole-crosscheck modes`` writes it.
+    """
     text, source = _scenario(scenario)
-    return json.loads(_core.crosscheck_modes(text, source, count, segments, elements, levels))
+    return _json.loads(_core.crosscheck_modes(text, source, _integer("count", count), _integer("segments", segments),
+                                              _integer("elements", elements), _integer("levels", levels)))
 
 
 def crosscheck_trajectories(scenario, truth_dir, segments=0, levels=3, elements=0):
-    """The chain's and the FE model's sensor records side by side (scole-crosscheck trajectories):
-    the report as a dict, with "t", "chain" and "fe" (samples x sensors, finest level) as arrays."""
+    """The chain's and the FE model's sensor records side by side (``scole-crosscheck trajectories``).
+
+    Args:
+        scenario: a built-in name, a path, YAML text or a dict.
+        truth_dir (str | os.PathLike): where the truths of the chain levels are (made when missing).
+        segments, elements (int): 0 = the scenario's.  levels (int): chain refinement levels.
+    Returns:
+        dict: the report, with "t", "chain" and "fe" (samples x sensors, finest level) as arrays.
+    """
     text, source = _scenario(scenario)
-    report, t, chain, fe = _core.crosscheck_trajectories(text, source, segments, levels, elements, os.fspath(truth_dir))
-    out = json.loads(report)
+    report, t, chain, fe = _core.crosscheck_trajectories(text, source, _integer("segments", segments),
+                                                         _integer("levels", levels), _integer("elements", elements),
+                                                         _os.fspath(truth_dir))
+    out = _json.loads(report)
     out.update({"t": t, "chain": chain, "fe": fe})
     return out
+

@@ -87,6 +87,9 @@ public:
   // io::InputError for another extension or a .mat the build cannot write.
   void export_model(const std::string& path) const;
 
+  // fit.csv's table: per sensor <name>_measured, <name>_predicted, <name>_residual at the times.
+  io::DataTable fit_table() const { return identify::fit_table(problem_->data, identify::predicted_outputs(*problem_, result_)); }
+
   std::string FullReport() const { return result_.FullReport(); }
   nlohmann::json to_json() const { return result_.to_json(*problem_); }
   // identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's staging

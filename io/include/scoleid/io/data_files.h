@@ -51,6 +51,12 @@ DataTable read_csv(const std::string& path, const CsvOptions& options = {});
 // The same on text already in memory / a stream; `path` names it in messages.
 DataTable read_csv_text(const std::string& text, const std::string& path, const CsvOptions& options = {});
 DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options = {});
+// A table held as columns in memory (a program's arrays, a DataFrame), read as read_csv reads a
+// file with that header: the time column chosen by options (the first when none is named), each
+// column's unit from its name's bracketed suffix, the time converted into seconds, then
+// check_table. `source` names it in messages.
+DataTable table_from_columns(const std::vector<std::string>& header, const std::vector<std::vector<double>>& columns,
+                             const std::string& source, const CsvOptions& options = {});
 // What every record must satisfy however it arrives (a file, a program's memory, Python): at
 // least 2 and at most limits::kMaxSamples samples, times strictly increasing, one value per time
 // in every column, names non-empty, unique and not the time column's, every value finite and of

@@ -31,6 +31,9 @@ void install_interrupt_handlers();
 int interrupt_signal();
 // Throws Interrupted if a signal has been received.
 void check_interrupt();
+// Records a signal as if it had been received: the run under way ends at its next check (a
+// caller's callback that must stop the run it is called from).
+void request_interrupt(int signal);
 // Forgets a received signal (a test that raised one; a caller that has dealt with it).
 void clear_interrupt();
 

@@ -159,6 +159,9 @@ FitTest test_fit(const Problem& problem, Objective& objective, const VectorXd& q
 // The fit table: per sensor <name>_measured, <name>_predicted (Y, samples × sensors) and
 // <name>_residual (predicted − measured) at the sample times.
 io::DataTable fit_table(const Measurements& data, const MatrixXd& Y);
+// The model's outputs at a run's estimate (the fit test's, else one forward solve): fit.csv's
+// predicted columns.
+MatrixXd predicted_outputs(Problem& problem, const RunResult& r);
 
 // Writes identify.json, fit.csv, fit.gp and (with gnuplot) fit.png into the run directory's
 // staging area; the caller commits them as one unit (io/run_directory.h).
