@@ -1,4 +1,5 @@
 #include "scoleid/io/data_source.h"
+#include "scoleid/io/time_grid.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/lvm.h"
 
@@ -230,9 +231,15 @@ DataFileInfo describe_table(const DataTable& tab, const std::string& format) {
   DataFileInfo info{tab.source, format, {}, {}};
   const double n = static_cast<double>(tab.t.size());
   const double mean_step = (tab.t.back() - tab.t.front()) / (n - 1.0);
-  bool even = true;
-  for (std::size_t k = 1; k < tab.t.size(); ++k)
-    even = even && std::abs(tab.t[k] - tab.t[k - 1] - mean_step) <= 1e-6 * mean_step;
+  // Evenly sampled when the times lie on a uniform grid within their written precision.
+  const TimeGrid grid = uniform_grid(tab.t);
+  const bool even = grid.uniform;
+  if (grid.uniform && grid.precision != "full")
+    info.notes.push_back("times written to " + grid.precision + ": a uniform clock of " + format_value(1.0 / grid.step) +
+                         " Hz (largest rounding " + format_value(grid.max_shift) + " s)");
+  else if (!grid.uniform)
+    info.notes.push_back("times not uniform: sample " + std::to_string(grid.worst + 1) + " at " + format_value(tab.t[grid.worst]) +
+                         " s lies " + format_value(grid.max_shift / grid.step) + " mean steps off the uniform grid");
   for (std::size_t j = 0; j < tab.names.size(); ++j) {
     Channel c;
     c.name = tab.names[j];

@@ -196,11 +196,38 @@ private:
     for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
   }
+  // Levenshtein distance of two keys (short strings), for "did you mean".
+  static std::size_t distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diag = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    return row[b.size()];
+  }
+  // An unknown key is refused with the fields known here (those this map's parser asked for) and
+  // the nearest of them when it is within two edits.
   void check_unknown() const {
     if (!node_ || !node_.IsMap()) return;
     for (const auto& kv : node_) {
       const std::string key = kv.first.as<std::string>();
-      if (!seen_.count(key)) fail_field(source_, field(key), "is not a known field", "'" + key + "'");
+      if (seen_.count(key)) continue;
+      std::string known, nearest;
+      std::size_t best = 3;
+      for (const auto& k : seen_) {
+        known += (known.empty() ? "" : ", ") + k;
+        const std::size_t d = distance(lower(key), lower(k));
+        if (d < best) best = d, nearest = k;
+      }
+      fail_field(source_, field(key),
+                 "is not a known field (" + (nearest.empty() ? std::string() : "did you mean '" + nearest + "'? ") + "known here: " + known + ")",
+                 "'" + key + "'");
     }
   }
 
@@ -916,6 +943,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
       Reader d(r.child("data"), source, "data");
       sc.data.time_column = d.str("time_column", "");
       sc.data.time_unit = d.str("time_unit", "");
+      sc.data.sample_rate = d.positive("sample_rate", 0.0);
       if (!sc.data.time_unit.empty())
         if (const auto why = units::problem_with(sc.data.time_unit, units::Quantity::Time))
           fail_field(source, "data.time_unit", "must be a unit of time (" + *why + ")", "'" + sc.data.time_unit + "'");
@@ -1035,8 +1063,10 @@ nlohmann::json to_json(const Scenario& s) {
   j["source"] = s.source;
   j["structure"] = to_string(s.structure);
   if (s.units != units::System::None) j["units"] = units::system_name(s.units);
-  if (!s.data.time_column.empty() || !s.data.time_unit.empty())
+  if (!s.data.time_column.empty() || !s.data.time_unit.empty() || s.data.sample_rate > 0) {
     j["data"] = {{"time_column", s.data.time_column}, {"time_unit", s.data.time_unit}};
+    if (s.data.sample_rate > 0) j["data"]["sample_rate"] = s.data.sample_rate;
+  }
   auto beam = [](const BeamSpec& b) {
     json j{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},
                 {"rho_A", b.rho_A}, {"EI", b.EI}, {"zeta", b.zeta}, {"c_kv", b.c_kv},

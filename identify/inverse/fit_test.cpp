@@ -50,6 +50,8 @@ FitTest fit_test(const FitTestInputs& in) {
       }
       s.noise_estimated = true;
     }
+    const std::string origin = static_cast<std::size_t>(k) < in.noise_origin.size() ? in.noise_origin[static_cast<std::size_t>(k)] : "";
+    s.noise_origin = s.noise_estimated ? "estimated" : origin == "pre-trigger" ? "from the pre-trigger" : "stated";
     s.noise = std::sqrt(var);
     s.systematic = std::sqrt(std::max(0.0, ms_r - var));
     s.discretisation = disc ? std::sqrt(in.discretisation.col(k).squaredNorm() / static_cast<double>(N)) : std::nan("");
@@ -105,7 +107,7 @@ FitTest fit_test(const FitTestInputs& in) {
                     "allow; worst sensor %s: %.3g %% of its RMS signal against %.3g %% (noise %.3g %%%s, discretisation %s)",
                     f.ratio, 100.0 * in.model_error, worst->name.c_str(), 100.0 * worst->systematic / worst->rms_signal,
                     100.0 * worst->allowed / worst->rms_signal, 100.0 * worst->noise / worst->rms_signal,
-                    worst->noise_estimated ? " estimated" : " stated", dbuf);
+                    (" " + worst->noise_origin).c_str(), dbuf);
     f.message = buf;
   }
   return f;

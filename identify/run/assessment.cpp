@@ -1,5 +1,6 @@
 #include "scoleid/identify/run/assessment.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -272,8 +273,11 @@ std::vector<io::SensorSpec> sensors_with_noise(const Problem& p) {
 
 std::string noise_origin(const Problem& p, const std::string& fisher_source) {
   if (fisher_source != "scenario") return fisher_source;
+  std::vector<std::string> origins;  // the distinct origins, in sensor order
+  for (const auto& o : p.noise_origin)
+    if (std::find(origins.begin(), origins.end(), o) == origins.end()) origins.push_back(o);
   std::string origin;
-  for (const auto& o : p.noise_origin) origin = origin.empty() || origin == o ? o : "scenario and truth.json";
+  for (const auto& o : origins) origin += (origin.empty() ? "" : " and ") + o;
   return origin;
 }
 

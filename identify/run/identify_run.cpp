@@ -31,6 +31,7 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const Matr
   in.data = p.data.z;
   in.names = p.data.names;
   in.noise_std = p.noise_std;
+  in.noise_origin = p.noise_origin;
   in.model_error = model_error(p);
   in.independent_fraction = p.band_gain;
   if (!q.allFinite()) {

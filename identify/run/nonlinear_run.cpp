@@ -29,6 +29,7 @@ FitTest nonlinear_fit(const Problem& p, NonlinearObjective& obj, const VectorXd&
   in.data = p.data.z;
   in.names = p.data.names;
   in.noise_std = p.noise_std;
+  in.noise_origin = p.noise_origin;
   in.model_error = model_error(p);
   predicted = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));
   obj.set_horizon(obj.data_end());

@@ -530,9 +530,39 @@ void check_lone_spike(const std::vector<double>& v, const io::DataTable& tab, in
                    "): a spike, a corrupted cell or a unit slip that a least-squares fit would chase; correct or remove it");
 }
 
-// The table column of a sensor or input: its `column`, else its name (-1 when absent).
-int column_of(const io::DataTable& tab, const std::string& name, const std::string& column) {
-  return tab.find(column.empty() ? name : column);
+// A header without its unit suffix ("acc [m/s^2]" → "acc"); the header itself when it states none.
+std::string name_without_unit(const std::string& header) {
+  if (io::units::bracketed_unit(header).empty()) return header;
+  const auto e = header.find_last_not_of(" \t");
+  const auto open = header.rfind(header[e] == ']' ? '[' : '(', e);
+  const auto end = header.find_last_not_of(" \t", open == 0 ? std::string::npos : open - 1);
+  return open == 0 || end == std::string::npos ? std::string() : header.substr(0, end + 1);
+}
+
+// The table column of a sensor or input: its `column` (exactly), else its name — a column of that
+// name, or the one column that is that name with a unit ("acc [m/s^2]" for a sensor acc: labs write
+// units into headers); -1 when absent. Two columns that are the name with units are refused.
+int column_of(const io::DataTable& tab, const std::string& name, const std::string& column, const std::string& csv,
+              const std::string& field) {
+  if (!column.empty()) return tab.find(column);
+  if (const int exact = tab.find(name); exact >= 0) return exact;
+  int found = -1;
+  for (std::size_t c = 0; c < tab.names.size(); ++c) {
+    if (name_without_unit(tab.names[c]) != name) continue;
+    if (found >= 0)
+      throw InputError("data file '" + csv + "': columns '" + io::one_line(tab.names[static_cast<std::size_t>(found)]) + "' and '" +
+                       io::one_line(tab.names[c]) + "' are both '" + name + "' with a unit; name one in " + field + ".column");
+    found = static_cast<int>(c);
+  }
+  return found;
+}
+
+// The table's columns, for a message (the first 12).
+std::string columns_listed(const io::DataTable& tab) {
+  std::string s;
+  for (std::size_t c = 0; c < tab.names.size() && c < 12; ++c) s += (c ? ", '" : "'") + io::one_line(tab.names[c]) + "'";
+  if (tab.names.size() > 12) s += ", ... (" + std::to_string(tab.names.size()) + " in all)";
+  return s;
 }
 
 // The values of column `col` in the unit of a sensor or input of kind `kind` and unit `unit`
@@ -689,11 +719,11 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
   for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
     const auto& s = sc.sensors[j];
     const std::string field = "sensors[" + std::to_string(j) + "]";
-    const int col = column_of(tab, s.name, s.column);
+    const int col = column_of(tab, s.name, s.column, csv, field);
     if (col < 0)
       throw InputError("data file '" + csv + "': no column " +
                        (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
-                       " (" + field + " of " + sc.source + ")");
+                       " (" + field + " of " + sc.source + "); its columns: " + columns_listed(tab));
     const auto v = column_values(p, tab, col, field, s.name, io::to_string(s.kind), s.unit, s.column_unit, s.conditioning);
     check_lone_spike(v, tab, col, field, s.name);
     for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
@@ -703,12 +733,13 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
   }
   for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
     const auto& in = sc.inputs[i];
-    const int col = column_of(tab, in.name, in.column);
     const std::string field = "inputs[" + std::to_string(i) + "]";
+    const int col = column_of(tab, in.name, in.column, csv, field);
     if ((in.signal_from == io::SignalFrom::Data || !in.column.empty()) && col < 0)
       throw InputError("data file '" + csv + "': no column " +
                        (in.column.empty() ? "for input '" + in.name + "'" : "'" + io::one_line(in.column) + "' (" + field + ".column)") +
-                       " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + ")");
+                       " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + "); its columns: " +
+                       columns_listed(tab));
     if (in.signal_from != io::SignalFrom::Scenario && col >= 0) {
       input_from_column(p, i, tab, col);
       used[static_cast<std::size_t>(col)] = true;
@@ -790,10 +821,15 @@ void apply_band(Problem& p) {
   const auto& t = p.data.t;
   const std::string& src = p.scenario.source;
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  for (std::size_t i = 1; i < t.size(); ++i)
-    if (std::abs((t[i] - t[i - 1]) - dt) > 1e-6 * dt)
-      fail_field(src, "identification.band", "needs uniformly sampled data (the interval at t = " + io::format_value(t[i]) + " is " +
-                 io::format_value(t[i] - t[i - 1]) + " s against the mean " + io::format_value(dt) + " s)", io::format_value(band[1]));
+  if (const io::TimeGrid g = io::uniform_grid(t); !g.uniform) {  // (a coarsely written clock is on its grid by now)
+    char buf[320];
+    std::snprintf(buf, sizeof buf, "sample %zu at t = %.9g s lies %.3g steps off the uniform grid of %.9g s, more than their writing (%s) explains",
+                  g.worst + 1, t[g.worst], g.max_shift / g.step, g.step, g.precision.c_str());
+    fail_field(src, "identification.band",
+               "needs uniformly sampled data, and the times of '" + p.data_source + "' are not: " + buf +
+                   " (a dropped sample, a second segment?); when the DAQ's clock was uniform, state data.sample_rate",
+               io::format_value(band[0]) + " .. " + io::format_value(band[1]) + " Hz");
+  }
   if (!(band[1] < 0.5 / dt))
     fail_field(src, "identification.band[1]", "must lie below the data's Nyquist frequency " + io::format_value(0.5 / dt) + " Hz",
                io::format_value(band[1]));
@@ -876,12 +912,86 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
                                                                              : SolverOptions::Integrator::Esdirk;
 }
 
+// The record's times on their grid (io/time_grid.h): a stated data.sample_rate's (the times within
+// half a step of it), else the uniform grid they round to when their jitter is their written
+// precision's. Times already uniform to their arithmetic, or not uniform at all, stay as they are.
+void regularise_time(const io::Scenario& sc, io::DataTable& tab, const std::string& source, ColumnUse& use) {
+  if (sc.data.sample_rate > 0) {
+    std::string why;
+    const auto g = io::stated_grid(tab.t, sc.data.sample_rate, &why);
+    if (!g)
+      fail_field(sc.source, "data.sample_rate", "disagrees with the time column '" + tab.time_name + "' of data file '" + source + "': " + why,
+                 io::format_value(sc.data.sample_rate));
+    use.time = *g;
+    use.time_regularised = true;
+    tab.t = g->times(tab.t.size());
+    return;
+  }
+  use.time = io::uniform_grid(tab.t);
+  if (use.time.uniform && use.time.precision != "full") {
+    use.time_regularised = true;
+    tab.t = use.time.times(tab.t.size());
+  }
+}
+
+// Noise levels a lab does not state, from the record's quiet start (docs/data.md §2). A record
+// starts at rest; until the first input acts — the earliest sample at which an input (its column or
+// the scenario's signal) exceeds a twentieth of its peak — a sensor reads its noise (and an offset).
+// With at least kQuiet samples before that, less a margin of kMargin samples (a DAQ filter's
+// pre-ringing), a sensor without a stated level gets
+//     σ̂² = min( variance about the mean ,  mean square first difference / 2 ),
+// both σ² for white noise; the second is the smaller for a slow drift or a ringing start, so a
+// start that is not quiet can only lower σ̂ (a stricter fit test), never raise it. A quiet start
+// that reads exactly zero (a clean simulation) says nothing of the noise and is not used.
+void noise_from_quiet_start(Problem& p) {
+  constexpr int kQuiet = 50, kMargin = 4;
+  const auto& t = p.data.t;
+  const std::size_t n = t.size();
+  if (n < static_cast<std::size_t>(kQuiet + kMargin) || p.signals.empty()) return;
+  std::size_t trigger = n;
+  for (const auto& sig : p.signals) {
+    double peak = 0.0;
+    for (std::size_t i = 0; i < n; ++i) peak = std::max(peak, std::abs(sig(t[i])));
+    if (!(peak > 0)) continue;
+    for (std::size_t i = 0; i < n && i < trigger; ++i)
+      if (std::abs(sig(t[i])) > 0.05 * peak) {
+        trigger = i;
+        break;
+      }
+  }
+  if (trigger >= n || trigger < static_cast<std::size_t>(kQuiet + kMargin)) return;
+  const std::size_t quiet = trigger - kMargin;
+  bool used = false;
+  for (std::size_t j = 0; j < p.noise_std.size(); ++j) {
+    if (p.noise_std[j] > 0) continue;
+    const auto col = p.data.z.col(static_cast<Eigen::Index>(j));
+    double mean = 0.0;
+    for (std::size_t i = 0; i < quiet; ++i) mean += col[static_cast<Eigen::Index>(i)] / static_cast<double>(quiet);
+    double var = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i < quiet; ++i) var += std::pow(col[static_cast<Eigen::Index>(i)] - mean, 2) / static_cast<double>(quiet - 1);
+    for (std::size_t i = 1; i < quiet; ++i)
+      diff += std::pow(col[static_cast<Eigen::Index>(i)] - col[static_cast<Eigen::Index>(i - 1)], 2) / (2.0 * static_cast<double>(quiet - 1));
+    const double sd = std::sqrt(std::min(var, diff));
+    if (!(sd > 0) || !std::isfinite(sd)) continue;
+    p.noise_std[j] = sd;
+    p.noise_origin[j] = "pre-trigger";
+    used = true;
+  }
+  if (used) {
+    p.columns.trigger_time = t[trigger];
+    p.columns.quiet_samples = static_cast<int>(quiet);
+  }
+}
+
 // The problem from measured data: the table's columns, the metadata beside it.
-std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTable& tab, const std::string& source,
+std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTable& table, const std::string& source,
                                     const io::TruthMeta* meta, const std::string& meta_source) {
+  io::DataTable tab = table;
+  regularise_time(p->scenario, tab, source, p->columns);
   std::map<std::string, double> meta_truth;
   if (meta) meta_truth = apply_truth_meta(*p, tab, source, *meta, meta_source);
   measurements_from_table(*p, tab, source);
+  noise_from_quiet_start(*p);
   if (!meta_truth.empty()) {
     io::Scenario truth_sc = p->scenario;
     io::set_structure_parameters(truth_sc, meta_truth);

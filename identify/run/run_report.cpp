@@ -73,7 +73,7 @@ json fit_test_json(const FitTest& fit) {
   json sens = json::array();
   for (const auto& sf : fit.sensors)
     sens.push_back({{"name", sf.name}, {"rms_signal", sf.rms_signal}, {"rms_residual", sf.rms_residual},
-                    {"noise", sf.noise}, {"noise_estimated", sf.noise_estimated}, {"systematic", sf.systematic},
+                    {"noise", sf.noise}, {"noise_estimated", sf.noise_estimated}, {"noise_origin", sf.noise_origin}, {"systematic", sf.systematic},
                     {"discretisation", finite_or_null(sf.discretisation)},
                     {"allowed", sf.allowed}, {"explained", sf.explained}});
   return {{"explains_data", fit.explains_data},
@@ -202,7 +202,16 @@ json data_columns_json(const ColumnUse& c) {
           {"input_interpolation", interpolation},
           {"inputs_from_scenario", c.inputs_from_scenario},
           {"unused", c.unused},
-          {"stepped_inputs", stepped}};
+          {"stepped_inputs", stepped},
+          {"time",
+           {{"uniform", c.time.uniform},
+            {"step", c.time.uniform ? json(c.time.step) : json(nullptr)},
+            {"sample_rate_hz", c.time.uniform ? json(1.0 / c.time.step) : json(nullptr)},
+            {"written_precision", c.time.precision},
+            {"largest_shift_to_grid", c.time.max_shift},
+            {"placed_on_grid", c.time_regularised}}},
+          {"quiet_start",
+           c.quiet_samples > 0 ? json{{"trigger_time", c.trigger_time}, {"samples", c.quiet_samples}} : json(nullptr)}};
 }
 
 json counts_json(const RunResult& r, json& out) {

@@ -121,3 +121,68 @@ TEST(Band, MeaninglessBandsAreRefusedWithTheirField) {
   quiet.replace(quiet.find(", noise_std: 0.05"), 17, "");
   refuse(quiet, "noise_std");
 }
+
+// A DAQ's time column written to 6 significant digits ("0.00146484" for 0.00146484375) is its
+// uniform clock: the band accepts it and the times are placed back on the grid. A dropped sample
+// is not rounding: refused, naming the sample and data.sample_rate. A stated rate fixes the grid.
+TEST(Band, ATimeColumnWrittenCoarselyIsItsClockAndAGapIsNamed) {
+  const std::string yaml = strip("[5, 300]");
+  auto sc = scoleid::io::parse_scenario(yaml, "band.yaml");
+  sc.simulation.sample_interval = 1.0 / 2048.0;
+  sc.simulation.duration = 614.0 / 2048.0;  // a whole number of samples: the synthetic record is on its clock
+  const auto synthetic = make_problem(sc, std::nullopt);
+  const auto& d = synthetic->data;
+  scoleid::io::DataTable tab;
+  tab.source = "daq.csv";
+  tab.names = {"hammer", "acc1", "w_tip"};
+  tab.columns.assign(3, {});
+  for (std::size_t i = 0; i < d.t.size(); ++i) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", d.t[i]);
+    tab.t.push_back(std::strtod(buf, nullptr));
+    tab.columns[0].push_back(synthetic->signals[0](d.t[i]));
+    for (int k = 0; k < 2; ++k) tab.columns[static_cast<std::size_t>(k + 1)].push_back(d.z(static_cast<Eigen::Index>(i), k));
+  }
+  double jitter = 0.0;
+  for (std::size_t i = 1; i < tab.t.size(); ++i) jitter = std::max(jitter, std::abs(tab.t[i] - tab.t[i - 1] - 1.0 / 2048.0) * 2048.0);
+  std::printf("  written to 6 digits: intervals vary by %.2e of a step\n", jitter);
+  ASSERT_GT(jitter, 1e-6);  // what the band refused before
+  const auto p = make_problem(sc, tab, "daq.csv", nullptr, "");
+  EXPECT_TRUE(p->columns.time_regularised);
+  EXPECT_EQ(p->columns.time.precision, "6 significant digits");
+  // The grid is fitted to the rounded times: far closer to the clock than the times as written.
+  EXPECT_NEAR(p->columns.time.step * 2048.0, 1.0, 1e-7);
+  double written_error = 0.0, grid_error = 0.0;
+  for (std::size_t i = 0; i < p->data.t.size(); ++i) {
+    written_error = std::max(written_error, std::abs(tab.t[i] - d.t[i]));
+    grid_error = std::max(grid_error, std::abs(p->data.t[i] - d.t[i]));
+  }
+  std::printf("  largest time error: as written %.3g s, on the fitted grid %.3g s\n", written_error, grid_error);
+  EXPECT_LT(grid_error, written_error / 50);
+  // A dropped sample.
+  auto gap = tab;
+  const std::size_t drop = gap.t.size() / 3;
+  gap.t.erase(gap.t.begin() + static_cast<std::ptrdiff_t>(drop));
+  for (auto& c : gap.columns) c.erase(c.begin() + static_cast<std::ptrdiff_t>(drop));
+  try {
+    make_problem(sc, gap, "daq.csv", nullptr, "");
+    ADD_FAILURE() << "a record with a dropped sample was accepted by the band";
+  } catch (const scoleid::io::InputError& e) {
+    const std::string m = e.what();
+    std::printf("  %s\n", m.c_str());
+    EXPECT_NE(m.find("identification.band needs uniformly sampled data, and the times of 'daq.csv' are not"), std::string::npos) << m;
+    EXPECT_NE(m.find("state data.sample_rate"), std::string::npos) << m;
+  }
+  // A stated rate: the right one places the times on its grid; another is refused.
+  sc.data.sample_rate = 2048.0;
+  const auto stated = make_problem(sc, tab, "daq.csv", nullptr, "");
+  for (std::size_t i = 0; i < stated->data.t.size(); ++i) ASSERT_NEAR(stated->data.t[i], d.t[i], 1e-12) << i;
+  sc.data.sample_rate = 2000.0;
+  try {
+    make_problem(sc, tab, "daq.csv", nullptr, "");
+    ADD_FAILURE() << "a sample rate the times contradict was accepted";
+  } catch (const scoleid::io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("data.sample_rate"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("steps off the uniform grid"), std::string::npos) << e.what();
+  }
+}

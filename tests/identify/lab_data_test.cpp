@@ -244,3 +244,80 @@ TEST(LabData, TheSameRecordAsAUniversalFileIdentifiesTheSame) {
     EXPECT_EQ(std::string(e.what()), "UFF file '" + p + "': record 1 (dataset 58 at line 2, 'Acc1 @0.30m [g]'): function type 12 (Spectrum) is not a time response; only time responses (type 1) are data to identify from");
   }
 }
+
+// A DAQ header writes each channel's unit beside its name: "acc1 [g]" is the sensor acc1's column
+// without any `column:` in the scenario, and the record identifies as with the columns named.
+TEST(LabData, ChannelsNamedWithTheirUnitsAreTheSensorsOfThatName) {
+  const io::Scenario sc = io::parse_scenario(kStrip, "strip.yaml");
+  const Record r = tap_record(sc);
+  const fs::path d = scratch("units-in-names");
+  std::string csv = daq_csv(r);
+  const std::string named = write(d / "named.csv", csv.replace(csv.find(kHeader), std::string(kHeader).size(),
+                                                                   "Time [s],hammer [N],acc1 [g],acc2 [g]"));
+  const std::string original = write(d / "daq.csv", daq_csv(r));
+  const Identification a = identify_parameters(sc, DataSource::file(original), {});
+  const Identification b = identify_parameters(without_columns(sc), DataSource::file(named), {});
+  EXPECT_EQ(a.estimate(), b.estimate());
+  // Two columns that are both the name with a unit: refused, naming both.
+  std::string twice = daq_csv(r);
+  twice.replace(twice.find(kHeader), std::string(kHeader).size(), "Time [s],hammer [N],acc1 [g],acc1 [m/s^2]");
+  try {
+    prepare(without_columns(sc), DataSource::file(write(d / "twice.csv", twice)));
+    ADD_FAILURE() << "two candidate columns accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("columns 'acc1 [g]' and 'acc1 [m/s^2]' are both 'acc1' with a unit"), std::string::npos) << e.what();
+  }
+}
+
+// A record that starts at rest holds each channel's noise: without a stated noise_std, the
+// sensors get it from the samples before the hammer (within the √(2/N) scatter of N samples), the
+// origin says so; a stated level is kept; a clean simulation's zeros give none; a start that
+// already rings gives no more than the noise (the first-difference bound).
+TEST(LabData, NoiseLevelsComeFromTheQuietStartWhenNotStated) {
+  io::Scenario sc = io::parse_scenario(kStrip, "strip.yaml");
+  sc.inputs[0].signal = io::parse_scenario(std::string(kStrip).replace(std::string(kStrip).find("t0: 0.002"), 9, "t0: 0.1"),
+                                           "strip.yaml").inputs[0].signal;
+  const double sigma = 0.02;
+  const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 2.5e-5, true);
+  auto table = [&](const identify::Measurements& meas, double ring) {
+    io::DataTable tab;
+    tab.source = "quiet.csv";
+    tab.t = meas.t;
+    tab.names = {"hammer", "acc1", "acc2"};
+    tab.columns.assign(3, {});
+    for (std::size_t k = 0; k < meas.t.size(); ++k) {
+      tab.columns[0].push_back(sc.inputs[0].signal(meas.t[k]));
+      tab.columns[1].push_back(meas.z(static_cast<Eigen::Index>(k), 0) + ring * std::sin(2 * M_PI * 20 * meas.t[k]));
+      tab.columns[2].push_back(meas.z(static_cast<Eigen::Index>(k), 1));
+    }
+    return tab;
+  };
+  io::Scenario unstated = without_columns(sc);
+  for (auto& s : unstated.sensors) s.noise_std = 0.0;
+  auto p = prepare(unstated, DataSource::in_memory(table(m, 0.0), "quiet.csv"));
+  const int quiet = p->columns.quiet_samples;
+  std::printf("  trigger at %.4f s, %d quiet samples; noise %.4g and %.4g (true %.3g, scatter %.2g)\n", p->columns.trigger_time, quiet,
+              p->noise_std[0], p->noise_std[1], sigma, std::sqrt(2.0 / quiet));
+  EXPECT_GT(quiet, 180);
+  EXPECT_NEAR(p->columns.trigger_time, 0.1, 0.002);
+  for (std::size_t j = 0; j < 2; ++j) {
+    EXPECT_NEAR(p->noise_std[j] / sigma, 1.0, 3.0 * std::sqrt(2.0 / quiet)) << j;
+    EXPECT_EQ(p->noise_origin[j], "pre-trigger");
+  }
+  // A stated level is used as stated; the other sensor's comes from the quiet start.
+  io::Scenario one = unstated;
+  one.sensors[1].noise_std = 0.05;
+  p = prepare(one, DataSource::in_memory(table(m, 0.0), "quiet.csv"));
+  EXPECT_EQ(p->noise_std[1], 0.05);
+  EXPECT_EQ(p->noise_origin[1], "scenario");
+  EXPECT_EQ(p->noise_origin[0], "pre-trigger");
+  // A clean record: zeros before the hammer say nothing of the noise.
+  const identify::Measurements clean = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 2.5e-5, false);
+  p = prepare(unstated, DataSource::in_memory(table(clean, 0.0), "quiet.csv"));
+  EXPECT_EQ(p->noise_std[0], 0.0);
+  EXPECT_EQ(p->columns.quiet_samples, 0);
+  // A start that already rings (20 Hz, ten times the noise): the level is not inflated by it.
+  p = prepare(unstated, DataSource::in_memory(table(m, 10 * sigma), "quiet.csv"));
+  std::printf("  ringing start: acc1 noise %.4g (its quiet samples' RMS about %.3g)\n", p->noise_std[0], 10 * sigma / std::sqrt(2.0));
+  EXPECT_LT(p->noise_std[0], 1.3 * sigma);
+}

@@ -103,7 +103,9 @@ TEST(Scenario, NanAndTextAreRejected) {
 }
 
 TEST(Scenario, UnknownFieldIsRejected) {
-  EXPECT_EQ(error_of("beam: {lenght: 3}"), "scenario 'x.yaml': beam.lenght is not a known field, got 'lenght'");
+  EXPECT_EQ(error_of("beam: {lenght: 3}"),
+            "scenario 'x.yaml': beam.lenght is not a known field (did you mean 'length'? known here: EI, attachments, c_kv, left, "
+            "length, rho_A, right, supports, tip_inertia, tip_mass, zeta), got 'lenght'");
 }
 
 TEST(Scenario, SensorOutsideBeamIsRejected) {

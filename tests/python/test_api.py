@@ -69,11 +69,10 @@ def test_time_in_the_index_in_a_ms_column_in_a_csv_and_through_the_cli_identify_
         assert seconds.estimates[k] == pytest.approx(v, rel=1e-6)
     rows = pd.DataFrame({"t": rec["t"], "P": rec["P"], "w_mid": rec["w_mid"]})
     assert scoleid.identify("paper-beam-1", data=rows).estimates == seconds.estimates
-    # Units of other columns are applied as a CSV header's: the deflection in mm.
+    # Units of other columns are applied as a CSV header's: the deflection in mm; the sensor w_mid
+    # reads the column 'w_mid [mm]' (a name with its unit), as from a file.
     mm = pd.DataFrame({"P": rec["P"], "w_mid [mm]": rec["w_mid"] * 1e3}, index=pd.Index(rec["t"], name="t"))
-    sc = scoleid.builtin_scenario("paper-beam-1").replace("name: w_mid,", "name: w_mid, column: 'w_mid [mm]',")
-    assert "w_mid [mm]" in sc
-    for k, v in scoleid.identify(sc, data=mm).estimates.items():
+    for k, v in scoleid.identify("paper-beam-1", data=mm).estimates.items():
         assert seconds.estimates[k] == pytest.approx(v, rel=1e-9)
 
 

@@ -17,7 +17,7 @@
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
 //   units:     SI | slug-ft-s (optional: the unit system; sensor and input units must agree)
 //   inputs/sensors may name their data column and its unit: column, column_unit
-//   data:      { time_column, time_unit }  (how a measured data file is read)
+//   data:      { time_column, time_unit, sample_rate }  (how a measured data file is read)
 //   simulation:{ duration, sample_interval, seed }
 //   identification: { parameterization, estimate, initial, elements, data_elements, method, ...,
 //                      uncertain: {field path: tolerance | alternative switch setting} }
@@ -307,6 +307,8 @@ struct IdentificationSpec {
 struct DataSpec {
   std::string time_column;
   std::string time_unit;
+  // The DAQ's sample rate [Hz] (0 = not stated): the times become t0 + k/rate (io/time_grid.h).
+  double sample_rate = 0.0;
 };
 
 struct TruthModelSpec {

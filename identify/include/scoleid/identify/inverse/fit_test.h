@@ -52,6 +52,9 @@ struct FitTestInputs {
   Eigen::MatrixXd discretisation;  // samples × sensors, refined − identifier outputs at q̂; empty = not estimated
   double model_error = 0.0;        // m, relative to each sensor's RMS signal
   std::vector<std::string> names;  // sensor names, for the message
+  // Where each stated level came from ("scenario", "truth.json", "pre-trigger"), for the message;
+  // empty or "" = "stated".
+  std::vector<std::string> noise_origin;
   // The share of the samples that are independent (1 for white noise; g = Σh² for data filtered to
   // a band, inverse/band_filter.h): the noise's χ² band is drawn for that many values.
   double independent_fraction = 1.0;
@@ -62,6 +65,7 @@ struct SensorFit {
   double rms_signal = 0, rms_residual = 0;
   double noise = 0;            // σ_k used
   bool noise_estimated = false;
+  std::string noise_origin;    // "estimated" (from the residual), or where the level was stated
   double systematic = 0;       // s_k (RMS, >= 0)
   double discretisation = 0;   // d_k (RMS), NaN when not estimated
   double allowed = 0;          // a_k (RMS)

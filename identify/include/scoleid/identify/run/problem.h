@@ -19,6 +19,7 @@
 #include "scoleid/identify/inverse/objective.h"
 #include "scoleid/identify/time/esdirk_stepper.h"
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/time_grid.h"
 #include "scoleid/io/scenario.h"
 
 namespace scoleid::identify {
@@ -81,6 +82,15 @@ struct ColumnUse {
     bool cubic = false;  // read cubically all the same (interpolation: cubic): it overshoots at each jump
   };
   std::vector<SteppedInput> stepped_inputs;
+  // The record's time (io/time_grid.h): the uniform grid it lies on (if it does) and whether the
+  // times were replaced by it — a stated data.sample_rate, or a uniform clock written coarsely
+  // (the column's jitter within its own rounding).
+  io::TimeGrid time;
+  bool time_regularised = false;
+  // The record's quiet start (noise_from_quiet_start in problem.cpp): the samples before the first
+  // input acts, from which sensors without a stated noise level get one. 0 samples: none used.
+  double trigger_time = 0.0;
+  int quiet_samples = 0;
 };
 
 struct Problem {
@@ -92,7 +102,7 @@ struct Problem {
   std::string data_source;                    // "synthetic (N elements)" or the CSV path
   std::map<std::string, double> true_values;  // by parameter name, where known
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
-  std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "" (unknown)
+  std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "pre-trigger" | "" (unknown)
   // Column units truth.json states (by column name), for columns whose file states none.
   std::map<std::string, std::string> meta_units;
   ColumnUse columns;                          // with a data file
