@@ -3,8 +3,10 @@
 The extension scoleid._core is the library's CMake target scoleid_python. It is built in
 SCOLEID_BUILD_DIR when that is set (an existing build directory is reused as it is), else in
 build/ (the Makefile's build directory: configured here, Release, when it has not been), for the
-interpreter running this build. Its file is then placed beside scoleid/__init__.py, its stub and
-py.typed, and setuptools makes the wheel. The version is CMakeLists.txt's project version.
+interpreter running this build. With SCOLEID_NO_BUILD=1 the extension already built there is
+taken as it is (CMake is not run: a test of the packaging beside a build in use). Its file is then
+placed beside scoleid/__init__.py, its stub and py.typed, and setuptools makes the wheel. The
+version is CMakeLists.txt's project version.
 """
 import glob
 import os
@@ -33,11 +35,12 @@ class CMakeBuild(build_ext):
 
     def build_extension(self, ext):
         build_dir = os.path.abspath(os.environ.get("SCOLEID_BUILD_DIR") or os.path.join(ROOT, "build"))
-        if not os.path.exists(os.path.join(build_dir, "CMakeCache.txt")):
-            subprocess.check_call(["cmake", "-S", ROOT, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release",
-                                   "-DPYTHON_EXECUTABLE=" + sys.executable])
-        jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
-        subprocess.check_call(["cmake", "--build", build_dir, "--target", "scoleid_python", "-j", jobs])
+        if os.environ.get("SCOLEID_NO_BUILD") != "1":
+            if not os.path.exists(os.path.join(build_dir, "CMakeCache.txt")):
+                subprocess.check_call(["cmake", "-S", ROOT, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release",
+                                       "-DPYTHON_EXECUTABLE=" + sys.executable])
+            jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
+            subprocess.check_call(["cmake", "--build", build_dir, "--target", "scoleid_python", "-j", jobs])
         suffix = sysconfig.get_config_var("EXT_SUFFIX")
         built = os.path.join(build_dir, "python", "scoleid", "_core" + suffix)
         if not os.path.exists(built):

@@ -139,6 +139,17 @@ void print_problem(const identify::Problem& problem, bool from_file) {
                        : "");
   }
   for (const auto& st : c.stepped_inputs) {
+    if (st.windowed)
+      std::fprintf(stderr,
+                   "scole-identify: input '%s': force window %g .. %g s (an impact; the column is zero outside it, where it "
+                   "read only its noise; conditioning: {window: none} keeps it)\n",
+                   st.name.c_str(), st.window_from, st.window_to);
+    if (st.hits.size() > 1) {
+      std::string hits;
+      for (const auto& [at, rel] : st.hits) hits += (hits.empty() ? "" : ", ") + io::format_value(at) + " s (" + io::format_value(std::round(100 * rel)) + " %)";
+      std::fprintf(stderr, "scole-identify: warning: input '%s': a double hit: %zu hits at %s; the model is driven by all of them\n",
+                   st.name.c_str(), st.hits.size(), hits.c_str());
+    }
     if (st.cubic) {
       std::fprintf(stderr,
                    "scole-identify: warning: input '%s' from the data jumps by %g within one sample (to t = %g) and is read "

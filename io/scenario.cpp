@@ -571,7 +571,7 @@ void check_location(const Scenario& sc, const std::string& field, Site at, doubl
 // A sensor's or input's unit and its column's must be units of its quantity, and the unit the
 // scenario's unit system gives it (no label may disagree with the numbers).
 // conditioning: {offset: none | mean | {mean_before: T} | value, scale, sign, detrend} (scenario.h).
-Conditioning parse_conditioning(Reader& parent, const std::string& source) {
+Conditioning parse_conditioning(Reader& parent, const std::string& source, bool input) {
   Conditioning c;
   if (!parent.has("conditioning")) return c;
   const YAML::Node n = parent.child("conditioning");
@@ -596,6 +596,21 @@ Conditioning parse_conditioning(Reader& parent, const std::string& source) {
   c.sign = r.num("sign", 1.0);
   if (c.sign != 1.0 && c.sign != -1.0) fail_field(source, r.field("sign"), "must be 1 or -1", format_value(c.sign));
   c.detrend = r.boolean("detrend", false);
+  if (input && r.has("window")) {
+    const YAML::Node w = r.child("window");
+    if (w.IsScalar() && (w.Scalar() == "auto" || w.Scalar() == "none")) {
+      c.window = w.Scalar() == "auto" ? Conditioning::Window::Auto : Conditioning::Window::None;
+    } else if (w.IsSequence() && w.size() == 2) {
+      c.window = Conditioning::Window::Span;
+      c.window_from = r.as_number(w[0], r.field("window[0]"));
+      c.window_to = r.as_number(w[1], r.field("window[1]"));
+      if (!(c.window_to > c.window_from))
+        fail_field(source, r.field("window"), "must be [from, to] with to > from (seconds)",
+                   "[" + format_value(c.window_from) + ", " + format_value(c.window_to) + "]");
+    } else {
+      fail_field(source, r.field("window"), "must be auto, none or [from, to] (seconds)", Reader::kind(w));
+    }
+  }
   return c;
 }
 
@@ -607,6 +622,8 @@ nlohmann::json conditioning_json(const Conditioning& c) {
   if (c.scale != 1.0) j["scale"] = c.scale;
   if (c.sign != 1.0) j["sign"] = c.sign;
   if (c.detrend) j["detrend"] = true;
+  if (c.window == Conditioning::Window::None) j["window"] = "none";
+  if (c.window == Conditioning::Window::Span) j["window"] = {c.window_from, c.window_to};
   return j;
 }
 
@@ -650,7 +667,7 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     in.column = r.str("column", "");
     in.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(in.kind), in.unit, in.column_unit);
-    in.conditioning = parse_conditioning(r, sc.source);
+    in.conditioning = parse_conditioning(r, sc.source, true);
     sc.inputs.push_back(std::move(in));
   }
 }
@@ -712,7 +729,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     s.column = r.str("column", "");
     s.column_unit = r.str("column_unit", "");
     check_units(sc, r, to_string(s.kind), s.unit, s.column_unit);
-    s.conditioning = parse_conditioning(r, sc.source);
+    s.conditioning = parse_conditioning(r, sc.source, false);
     parse_sensor_fields(sc, r, s);
     // The identifier models an ideal sensor plus noise: a bias or drift here would be data it
     // cannot explain, so they belong to the truth's side of a mismatch study only.

@@ -78,8 +78,9 @@ TimeGrid uniform_grid(const std::vector<double>& t) {
   long double ss = 0;
   for (std::size_t k = 0; k < n; ++k) ss += std::pow(static_cast<long double>(t[k]) - (a + b * static_cast<long double>(k)), 2);
   const double s2 = n > 2 ? static_cast<double>(ss / static_cast<long double>(n - 2)) : 0.0;
-  g.uniform = true;
-  for (std::size_t k = 0; k < n; ++k) {
+  // Rounding that moves a sample by a quarter of a step or more leaves no clock to recognise.
+  g.uniform = g.max_shift < 0.25 * g.step;
+  for (std::size_t k = 0; k < n && g.uniform; ++k) {
     const double dk = static_cast<double>(k) - static_cast<double>(kbar);
     const double se = std::sqrt(s2 * (1.0 / static_cast<double>(n) + dk * dk / static_cast<double>(skk)));
     const double x = std::abs(t[k]);

@@ -572,7 +572,7 @@ std::string columns_listed(const io::DataTable& tab) {
 // less its least-squares line with detrend; what was removed is recorded in `src`.
 void condition(std::vector<double>& v, const std::vector<double>& t, const io::Conditioning& c, const std::string& where,
                const std::string& field, ColumnUse::Source& src) {
-  if (!c.stated()) return;
+  if (!c.transforms()) return;
   double offset = 0.0;
   switch (c.offset) {
     case io::Conditioning::Offset::None: break;
@@ -664,12 +664,70 @@ bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable&
 
 // An input driven by its column, read between samples as inputs[i].interpolation says (auto:
 // cubic unless the column jumps, then piecewise linear), with its largest jump within one sample.
-void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col) {
+// An input column's force window (io::Conditioning::Window; docs/data.md §2). A force transducer
+// reads noise before and after a hit, and a model driven by it answers that noise (at an
+// accelerometer, whose response to force has a direct term, as much as to the hit). Auto, on an
+// impact (add_stepped_input: a pulse over at most kImpactSamples samples): the hits are the runs
+// of samples above a fifth of the peak, separated by at least two samples under a twentieth; the
+// window runs from the first sample above a twentieth of the peak to the last, widened on each side
+// by that span (at least 2 samples); outside it the column is zero. A column whose level outside
+// the pulse is not small (RMS over a twentieth of the peak: an offset not removed, a shaker's
+// continuous force) is left as it is. Span keeps [from, to] s. What was done is recorded in `st`.
+void force_window(const io::InputSpec& in, const std::string& field, const io::DataTable& tab, std::vector<double>& f,
+                  ColumnUse::SteppedInput* st, const std::string& csv) {
+  const auto& c = in.conditioning;
+  const auto& t = tab.t;
+  if (c.window == io::Conditioning::Window::Span) {
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < f.size(); ++k)
+      if (t[k] < c.window_from || t[k] > c.window_to) f[k] = 0.0;
+      else ++kept;
+    if (kept == 0)
+      throw InputError("data file '" + csv + "': " + field + ".conditioning.window [" + io::format_value(c.window_from) + ", " +
+                       io::format_value(c.window_to) + "] s holds no sample of the record (" + io::format_value(t.front()) + " .. " +
+                       io::format_value(t.back()) + " s)");
+    return;
+  }
+  if (c.window != io::Conditioning::Window::Auto || !st || st->pulse_samples == 0) return;
+  double peak = 0.0;
+  for (double x : f) peak = std::max(peak, std::abs(x));
+  if (!(peak > 0)) return;
+  std::size_t a = f.size(), b = 0;
+  for (std::size_t k = 0; k < f.size(); ++k)
+    if (std::abs(f[k]) > 0.05 * peak) a = std::min(a, k), b = k;
+  const std::size_t width = std::max<std::size_t>(2, b - a + 1);
+  const std::size_t from = a > width ? a - width : 0, to = std::min(f.size() - 1, b + width);
+  double outside = 0.0;
+  std::size_t n_out = 0;
+  for (std::size_t k = 0; k < f.size(); ++k)
+    if (k < from || k > to) outside += f[k] * f[k], ++n_out;
+  if (n_out == 0 || std::sqrt(outside / static_cast<double>(n_out)) > 0.05 * peak) return;
+  // The hits: runs above a fifth of the peak, apart by at least two samples under a twentieth.
+  std::size_t quiet = 2;
+  for (std::size_t k = a; k <= b; ++k) {
+    const double x = std::abs(f[k]);
+    if (x > 0.2 * peak) {
+      if (quiet >= 2) st->hits.push_back({t[k], x / peak});
+      else if (x / peak > st->hits.back().second) st->hits.back() = {t[k], x / peak};
+      quiet = 0;
+    } else if (x < 0.05 * peak) {
+      ++quiet;
+    }
+  }
+  for (std::size_t k = 0; k < f.size(); ++k)
+    if (k < from || k > to) f[k] = 0.0;
+  st->window_from = t[from];
+  st->window_to = t[to];
+  st->windowed = true;
+}
+
+void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col, const std::string& csv) {
   const auto& in = p.scenario.inputs[i];
-  const auto f = column_values(p, tab, col, "inputs[" + std::to_string(i) + "]", in.name, io::to_string(in.kind), in.unit, in.column_unit,
-                               in.conditioning);
+  const std::string field = "inputs[" + std::to_string(i) + "]";
+  auto f = column_values(p, tab, col, field, in.name, io::to_string(in.kind), in.unit, in.column_unit, in.conditioning);
   p.columns.inputs_from_data.push_back(in.name);
   const bool stepped = add_stepped_input(p, in, tab, f);
+  force_window(in, field, tab, f, stepped ? &p.columns.stepped_inputs.back() : nullptr, csv);
   const bool cubic = in.interpolation == io::Interpolation::Cubic || (in.interpolation == io::Interpolation::Auto && !stepped);
   p.signals[i] = cubic ? io::Signal::cubic_table(tab.t, f) : io::Signal::table(tab.t, f);
   if (stepped) p.columns.stepped_inputs.back().cubic = cubic;
@@ -741,7 +799,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
                        " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + "); its columns: " +
                        columns_listed(tab));
     if (in.signal_from != io::SignalFrom::Scenario && col >= 0) {
-      input_from_column(p, i, tab, col);
+      input_from_column(p, i, tab, col, csv);
       used[static_cast<std::size_t>(col)] = true;
     } else {
       if (in.signal.terms().empty())

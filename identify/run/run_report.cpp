@@ -181,10 +181,16 @@ json modes_json(const RunResult& r) {
 
 json data_columns_json(const ColumnUse& c) {
   json stepped = json::array();
-  for (const auto& st : c.stepped_inputs)
+  for (const auto& st : c.stepped_inputs) {
     stepped.push_back({{"name", st.name}, {"largest_jump", st.jump}, {"at", st.at}, {"switch_shift_up_to", 0.5 * st.sample},
                        {"scenario_gives_signal", st.scenario_signal}, {"pulse_samples", st.pulse_samples},
                        {"interpolation", st.cubic ? "cubic" : "linear"}});
+    if (st.windowed) {
+      json hits = json::array();
+      for (const auto& [at, rel] : st.hits) hits.push_back({{"at", at}, {"relative_peak", rel}});
+      stepped.back()["force_window"] = {{"from", st.window_from}, {"to", st.window_to}, {"hits", hits}};
+    }
+  }
   json interpolation = json::array();
   for (const auto k : c.input_interpolation) interpolation.push_back(io::to_string(k));
   json sources = json::array();

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "scoleid/identify.h"
@@ -320,4 +321,62 @@ TEST(LabData, NoiseLevelsComeFromTheQuietStartWhenNotStated) {
   p = prepare(unstated, DataSource::in_memory(table(m, 10 * sigma), "quiet.csv"));
   std::printf("  ringing start: acc1 noise %.4g (its quiet samples' RMS about %.3g)\n", p->noise_std[0], 10 * sigma / std::sqrt(2.0));
   EXPECT_LT(p->noise_std[0], 1.3 * sigma);
+}
+
+// A hammer's force channel reads its converter's noise before and after the hit. Taken as force,
+// that noise drives the model at every sample (an accelerometer answers force directly); the
+// default force window zeroes the column outside the hit, recorded with the hits it found. A
+// second hit is named. `window: none` keeps the column as it is.
+TEST(LabData, AnImpactForceIsWindowedByDefaultAndADoubleHitIsNamed) {
+  io::Scenario sc = io::parse_scenario(std::string(kStrip).replace(std::string(kStrip).find("t0: 0.002"), 9, "t0: 0.05"), "strip.yaml");
+  sc = without_columns(sc);
+  const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 2.5e-5, true);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.05);  // N: the force channel's converter noise
+  io::DataTable tab;
+  tab.source = "hammer.csv";
+  tab.t = m.t;
+  tab.names = {"hammer", "acc1", "acc2"};
+  tab.columns.assign(3, {});
+  for (std::size_t k = 0; k < m.t.size(); ++k) {
+    tab.columns[0].push_back(sc.inputs[0].signal(m.t[k]) + noise(rng));
+    for (int j = 0; j < 2; ++j) tab.columns[static_cast<std::size_t>(j + 1)].push_back(m.z(static_cast<Eigen::Index>(k), j));
+  }
+  const Identification windowed = identify_parameters(sc, DataSource::in_memory(tab, "hammer.csv"), {});
+  io::Scenario raw_sc = sc;
+  raw_sc.inputs[0].conditioning.window = io::Conditioning::Window::None;
+  const Identification raw = identify_parameters(raw_sc, DataSource::in_memory(tab, "hammer.csv"), {});
+  const auto& st = windowed.problem().columns.stepped_inputs.at(0);
+  ASSERT_TRUE(st.windowed);
+  EXPECT_FALSE(raw.problem().columns.stepped_inputs.at(0).windowed);
+  EXPECT_LE(st.window_from, 0.05);
+  EXPECT_GE(st.window_to, 0.052);
+  EXPECT_LT(st.window_to - st.window_from, 0.01);
+  ASSERT_EQ(st.hits.size(), 1u);
+  // The model's response before the window: nothing with it; the noise's answer without.
+  auto before_window_rms = [&](const Identification& id) {
+    const io::DataTable fit = id.fit_table();
+    double s = 0.0;
+    int n = 0;
+    for (std::size_t k = 0; k < fit.t.size() && fit.t[k] < st.window_from - 0.001; ++k, ++n) s += std::pow(fit.columns[4][k], 2);  // acc2_predicted
+    return std::sqrt(s / n);
+  };
+  const double w_rms = before_window_rms(windowed), r_rms = before_window_rms(raw);
+  std::printf("  tip acceleration predicted before the window (%.4g s): %.3g m/s^2 windowed, %.3g raw\n", st.window_from, w_rms, r_rms);
+  std::printf("  windowed: EI %.5g rho_A %.5g (%s); raw: EI %.5g rho_A %.5g (%s)\n", windowed.estimate()[0], windowed.estimate()[1],
+              windowed.converged() ? "converged" : "not converged", raw.estimate()[0], raw.estimate()[1],
+              raw.converged() ? "converged" : "not converged");
+  EXPECT_EQ(w_rms, 0.0);
+  EXPECT_GT(r_rms, 1e-4);
+  EXPECT_TRUE(windowed.converged()) << windowed.verdict();
+  EXPECT_NEAR(windowed.estimate()[0] / 30.0, 1.0, 0.01);
+  EXPECT_NEAR(windowed.estimate()[1] / 0.4, 1.0, 0.01);
+  // A double hit: a second tap of 40 % three milliseconds on.
+  io::DataTable twice = tab;
+  for (std::size_t k = 0; k < twice.t.size(); ++k) twice.columns[0][k] += 0.4 * sc.inputs[0].signal(twice.t[k] - 0.003);
+  const auto p = prepare(sc, DataSource::in_memory(twice, "hammer.csv"));
+  const auto& st2 = p->columns.stepped_inputs.at(0);
+  ASSERT_EQ(st2.hits.size(), 2u);
+  EXPECT_NEAR(st2.hits[1].first - st2.hits[0].first, 0.003, 0.0006);
+  EXPECT_NEAR(st2.hits[1].second, 0.4, 0.05);
 }

@@ -228,7 +228,8 @@ TEST(TruthOverrides, SensorEntryErrorsNameTheField) {
         "scenario 'x.yaml': truth.overrides.sensors[0].location applies to beam and mast sensors only (sensor "
         "'yaw_tip' is at reflector), got 100"},
        {"      - {name: roll_tip, noise_std: 1}\n",
-        "scenario 'x.yaml': truth.overrides.sensors[0].noise_std is not a known field, got 'noise_std'"},
+        "scenario 'x.yaml': truth.overrides.sensors[0].noise_std is not a known field (known here: bias, direction, drift, "
+        "location, name), got 'noise_std'"},
        {"      {name: roll_tip}\n", "scenario 'x.yaml': truth.overrides.sensors must be a list, got map"}});
   // The main section refuses them: the identifier models an ideal sensor plus noise.
   EXPECT_EQ(error_of("name: b\nsensors:\n  - {name: w, location: 5, bias: 0.001}\n"),

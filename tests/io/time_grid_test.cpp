@@ -68,6 +68,8 @@ TEST(TimeGrid, AUniformClockIsFoundWithinItsWrittenPrecisionAndAGapIsNot) {
     jittered[k] = std::strtod(buf, nullptr);
   }
   EXPECT_FALSE(uniform_grid(jittered).uniform);
+  // A typo (1e20 for 0.03): one significant digit "explains" it, but no clock is left to recognise.
+  EXPECT_FALSE(uniform_grid({0.0, 0.01, 0.02, 1e20}).uniform);
 }
 
 TEST(TimeGrid, AStatedRateFixesTheGridOrIsRefused) {

@@ -3,8 +3,9 @@
 Run by ctest (test Python.Install, label python) as
     python3 install_check.py SOURCE_DIR BUILD_DIR INSTALL_PREFIX INSTALL_DIR VERSION
 1. A venv made with --system-site-packages (numpy from Debian), then
-   pip install --no-build-isolation --no-deps --no-index SOURCE_DIR, the extension taken from
-   BUILD_DIR (SCOLEID_BUILD_DIR): `import scoleid` from elsewhere gives VERSION from the venv.
+   pip install --no-build-isolation --no-deps --no-index SOURCE_DIR, the extension taken as built
+   in BUILD_DIR (SCOLEID_BUILD_DIR, SCOLEID_NO_BUILD): `import scoleid` from elsewhere gives
+   VERSION from the venv.
 2. cmake --install BUILD_DIR --component python into a scratch prefix: the package's files land
    under INSTALL_DIR there and import; and INSTALL_PREFIX/INSTALL_DIR, where the real install goes,
    is on the system interpreter's own sys.path (no PYTHONPATH needed).
@@ -29,7 +30,9 @@ def main():
         venv = os.path.join(tmp, "venv")
         run([sys.executable, "-m", "venv", "--system-site-packages", venv])
         py = os.path.join(venv, "bin", "python")
-        env = dict(os.environ, SCOLEID_BUILD_DIR=build, PIP_NO_CACHE_DIR="1", PIP_DISABLE_PIP_VERSION_CHECK="1")
+        # The extension as ctest's build made it (SCOLEID_NO_BUILD: no CMake run beside the tests).
+        env = dict(os.environ, SCOLEID_BUILD_DIR=build, SCOLEID_NO_BUILD="1", PIP_NO_CACHE_DIR="1",
+                   PIP_DISABLE_PIP_VERSION_CHECK="1")
         env.pop("PYTHONPATH", None)
         run([py, "-m", "pip", "install", "--no-build-isolation", "--no-deps", "--no-index", source], env=env)
         out = run([py, "-c", "import scoleid; print(scoleid.__version__); print(scoleid.__file__); "

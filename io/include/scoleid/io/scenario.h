@@ -172,7 +172,15 @@ struct Conditioning {
   double scale = 1.0;
   double sign = 1.0;
   bool detrend = false;
-  bool stated() const { return offset != Offset::None || scale != 1.0 || sign != 1.0 || detrend; }
+  // An input's force window (docs/data.md §2): Auto keeps an impact's column around its hits and
+  // zeroes it elsewhere (the channel's noise before and after a hit is no force); None leaves the
+  // column as it is; Span keeps [window_from, window_to] s. Sensors have none.
+  enum class Window { Auto, None, Span };
+  Window window = Window::Auto;
+  double window_from = 0.0, window_to = 0.0;
+  // The values change: an offset, a factor or a trend.
+  bool transforms() const { return offset != Offset::None || scale != 1.0 || sign != 1.0 || detrend; }
+  bool stated() const { return transforms() || window != Window::Auto; }
 };
 
 // A point input, a force or a moment. At "actuatorK" (K = 1, 2) it is the proof mass's commanded

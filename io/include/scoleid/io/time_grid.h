@@ -8,7 +8,8 @@
 //   - the grid by least squares over k (t0, step);
 //   - uniform when every sample lies within its own rounding (half a unit of its last written
 //     digit, by either reading, 5 % more) of the grid, plus three of the fitted grid's standard
-//     errors there and 1e-9 of a step; else the sample farthest from
+//     errors there and 1e-9 of a step, and none a quarter of a step or more off it (writing that
+//     coarse leaves no clock to recognise); else the sample farthest from
 //     the grid, in steps, names the culprit (a dropped sample, a second segment, another rate).
 // A stated sample rate (data.sample_rate) fixes the step: the times must lie within half a step of
 // t0 + k/rate, and are replaced by the grid.

@@ -80,6 +80,12 @@ struct ColumnUse {
     // `pulse_samples` samples hold more than a tenth of its peak. 0 for a step.
     int pulse_samples = 0;
     bool cubic = false;  // read cubically all the same (interpolation: cubic): it overshoots at each jump
+    // An impact's force window (conditioning.window auto; problem.cpp force_window): the column is
+    // zero outside [window_from, window_to]; the hits found in it (time of each one's peak, and its
+    // peak relative to the largest): two or more are a double hit.
+    bool windowed = false;
+    double window_from = 0, window_to = 0;
+    std::vector<std::pair<double, double>> hits;
   };
   std::vector<SteppedInput> stepped_inputs;
   // The record's time (io/time_grid.h): the uniform grid it lies on (if it does) and whether the
