@@ -159,6 +159,18 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
   }
   T_ = data_.t.back();
   const double t0 = data_.t.front();
+  response_start_ = t0;
+  {
+    std::size_t onset = data_.t.size();
+    for (const auto& sig : inputs_) {
+      double peak = 0.0;
+      for (double t : data_.t) peak = std::max(peak, std::abs(sig(t)));
+      if (!(peak > 0)) continue;
+      for (std::size_t i = 0; i < data_.t.size() && i < onset; ++i)
+        if (std::abs(sig(data_.t[i])) > 0.05 * peak) onset = i;
+    }
+    if (onset < data_.t.size() && data_.t[onset] - t0 > 0.05 * (data_.t.back() - t0)) response_start_ = data_.t[onset];
+  }
   const int ns = data_.sensors();
   noise_share();
   if (!options_.weights.empty()) {

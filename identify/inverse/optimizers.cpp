@@ -123,7 +123,7 @@ struct Run {
   // Horizon continuation: the longest T >= t0 + continuation_min_fraction·(t_end − t0) up to
   // which the misfit profile stays within the bound, never shorter than `current`.
   double horizon_from(const Misfit::MisfitProfile& p, double current) const {
-    const double t0 = obj.data_start(), t_end = obj.data_end();
+    const double t0 = obj.response_start(), t_end = obj.data_end();
     const double t_min = t0 + opt.continuation_min_fraction * (t_end - t0);
     double T = t_min;
     for (std::size_t i = 0; i < p.t.size(); ++i) {
@@ -202,7 +202,7 @@ public:
 
 void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   Misfit& obj = r.obj;
-  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const double t0 = obj.response_start(), t_end = obj.data_end();  // horizons measured from t0
   const bool continuation = r.opt.continuation;
   auto full = [&]() { return obj.horizon() >= t_end; };
   auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
@@ -507,7 +507,7 @@ VectorXd lbfgs_direction(const VectorXd& x, const VectorXd& gx, std::deque<std::
 
 void lbfgs(Run& r, VectorXd x, bool steepest) {
   Misfit& obj = r.obj;
-  const double t0 = obj.data_start(), t_end = obj.data_end();
+  const double t0 = obj.response_start(), t_end = obj.data_end();  // horizons measured from t0
   // Horizon continuation as for Gauss–Newton (header, Run::horizon_from), from the misfit profile
   // of one extra state solve per accepted step while the horizon is short of the record.
   // The paper's update with fixed weights is reproduced as it is: on the whole record.

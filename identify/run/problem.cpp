@@ -667,12 +667,15 @@ bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable&
 // An input column's force window (io::Conditioning::Window; docs/data.md §2). A force transducer
 // reads noise before and after a hit, and a model driven by it answers that noise (at an
 // accelerometer, whose response to force has a direct term, as much as to the hit). Auto, on an
-// impact (add_stepped_input: a pulse over at most kImpactSamples samples): the hits are the runs
-// of samples above a fifth of the peak, separated by at least two samples under a twentieth; the
-// window runs from the first sample above a twentieth of the peak to the last, widened on each side
-// by that span (at least 2 samples); outside it the column is zero. A column whose level outside
-// the pulse is not small (RMS over a twentieth of the peak: an offset not removed, a shaker's
-// continuous force) is left as it is. Span keeps [from, to] s. What was done is recorded in `st`.
+// impact (add_stepped_input: a pulse over at most kImpactSamples samples): the channel's noise σ_f
+// is read where it holds no force — at least 20 samples before the pulse, else the record's last
+// quarter when that lies after it; the window runs from before the pulse's first sample above a
+// twentieth of its peak, back to where the column falls to 4σ_f, to the start of the first run of
+// 20 samples under 4σ_f after its last (a DAQ filter's ringing is force the accelerometers felt, and
+// stays in); outside it the column is zero. A clean column (σ_f = 0) is thus left as it is, and so
+// is one whose level outside the window is not small (RMS over a twentieth of the peak: an offset
+// not removed, a continuous force). The hits are the runs above a fifth of the peak, apart by at
+// least two samples under a twentieth. Span keeps [from, to] s. What was done is recorded in `st`.
 void force_window(const io::InputSpec& in, const std::string& field, const io::DataTable& tab, std::vector<double>& f,
                   ColumnUse::SteppedInput* st, const std::string& csv) {
   const auto& c = in.conditioning;
@@ -689,17 +692,40 @@ void force_window(const io::InputSpec& in, const std::string& field, const io::D
     return;
   }
   if (c.window != io::Conditioning::Window::Auto || !st || st->pulse_samples == 0) return;
+  const std::size_t n = f.size();
   double peak = 0.0;
   for (double x : f) peak = std::max(peak, std::abs(x));
   if (!(peak > 0)) return;
-  std::size_t a = f.size(), b = 0;
-  for (std::size_t k = 0; k < f.size(); ++k)
+  std::size_t a = n, b = 0;
+  for (std::size_t k = 0; k < n; ++k)
     if (std::abs(f[k]) > 0.05 * peak) a = std::min(a, k), b = k;
-  const std::size_t width = std::max<std::size_t>(2, b - a + 1);
-  const std::size_t from = a > width ? a - width : 0, to = std::min(f.size() - 1, b + width);
+  // The channel's noise where it holds no force.
+  constexpr std::size_t kNoiseSamples = 20, kQuietRun = 20;
+  auto rms = [&](std::size_t from, std::size_t to) {  // about the mean, samples [from, to)
+    double m = 0.0, s = 0.0;
+    for (std::size_t k = from; k < to; ++k) m += f[k] / static_cast<double>(to - from);
+    for (std::size_t k = from; k < to; ++k) s += (f[k] - m) * (f[k] - m) / static_cast<double>(to - from);
+    return std::sqrt(s);
+  };
+  double sigma = -1.0;
+  if (a >= kNoiseSamples + 4) sigma = rms(0, a - 4);
+  else if (3 * n / 4 > b + kQuietRun) sigma = rms(3 * n / 4, n);
+  if (!(sigma >= 0.0)) return;
+  const double level = 4.0 * sigma;
+  std::size_t from = a;
+  while (from > 0 && std::abs(f[from - 1]) > level) --from;
+  from = from >= 2 ? from - 2 : 0;
+  std::size_t to = n - 1, run = 0;
+  for (std::size_t k = b + 1; k < n; ++k) {
+    run = std::abs(f[k]) <= level ? run + 1 : 0;
+    if (run == kQuietRun) {
+      to = k - kQuietRun + 1;
+      break;
+    }
+  }
   double outside = 0.0;
   std::size_t n_out = 0;
-  for (std::size_t k = 0; k < f.size(); ++k)
+  for (std::size_t k = 0; k < n; ++k)
     if (k < from || k > to) outside += f[k] * f[k], ++n_out;
   if (n_out == 0 || std::sqrt(outside / static_cast<double>(n_out)) > 0.05 * peak) return;
   // The hits: runs above a fifth of the peak, apart by at least two samples under a twentieth.
@@ -714,7 +740,7 @@ void force_window(const io::InputSpec& in, const std::string& field, const io::D
       ++quiet;
     }
   }
-  for (std::size_t k = 0; k < f.size(); ++k)
+  for (std::size_t k = 0; k < n; ++k)
     if (k < from || k > to) f[k] = 0.0;
   st->window_from = t[from];
   st->window_to = t[to];

@@ -29,6 +29,9 @@ public:
   virtual int size() const = 0;
   virtual double horizon() const = 0;
   virtual double data_start() const = 0;
+  // Where horizons are measured from (optimizers.h, horizon continuation): the data's start, or
+  // for a record with a quiet start, where the inputs begin to act (Objective).
+  virtual double response_start() const { return data_start(); }
   virtual double data_end() const = 0;
   virtual void set_horizon(double T) = 0;
   // Whether the data form a time record the horizon cuts (false for modal data).

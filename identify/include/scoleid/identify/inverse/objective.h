@@ -124,6 +124,10 @@ public:
   int size() const override { return params_.size(); }
   double horizon() const override { return T_; }
   double data_start() const override { return data_.t.front(); }
+  // The first sample at which an input exceeds a twentieth of its peak, when the record's quiet
+  // start before it is more than 5 % of the record (a lab's pre-trigger: horizons from the record's
+  // start would spend their first length on the model's rest); else data_start().
+  double response_start() const override { return response_start_; }
   double data_end() const override { return data_.t.back(); }
   // Restricts the cost to [t0, T] (clamped to the data span, at least two samples); T = data_end()
   // restores the whole span.
@@ -319,6 +323,7 @@ private:
   NoiseShare noise_;
   void noise_share();  // noise_ from options_.noise_std and the sample times
   double T_ = 0.0;  // horizon: end of the cost integral
+  double response_start_ = 0.0;
   ObjectiveCounters counters_;
   // The last whole-record Gauss–Newton evaluation's output sensitivities and its q (empty q: none).
   struct KeptSensitivities {

@@ -29,7 +29,8 @@
 // record, and over many cycles the cost is no longer well described by its Gauss–Newton model
 // (its valleys repeat at every cycle slipped). The misfit of the data on [t0, T] against the model
 // therefore bounds the phase error accumulated up to T. The optimiser fits the data on a horizon
-// [t0, T] with T the longest time up to which the relative mean-square misfit per sensor
+// [t0, T] (t0 the misfit's response_start: after a quiet start, where the inputs begin to act)
+// with T the longest time up to which the relative mean-square misfit per sensor
 // (objective.h, MisfitProfile) stays below `continuation_misfit` (but at least
 // `continuation_min_fraction` of the record), and after every accepted step lengthens T the same
 // way from the state solve it has just done (the misfit profile comes with it). When the fit on a
