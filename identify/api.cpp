@@ -166,7 +166,7 @@ std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const D
   io::validate_scenario(scenario);
   if (data.table) {
     io::check_table(*data.table);  // a table built in memory passes the checks a file's does
-    return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.name + " (metadata)");
+    return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.meta_name.empty() ? data.name + " (metadata)" : data.meta_name);
   }
   return identify::make_problem(scenario, data.csv);
 }

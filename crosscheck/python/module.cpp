@@ -16,6 +16,8 @@
 #include <chrono>
 #include <memory>
 #include <csignal>
+#include <pthread.h>
+#include <stdexcept>
 #include <mutex>
 #include <cstring>
 #include <optional>
@@ -40,11 +42,31 @@ namespace {
 
 // For the duration of one call: the GIL released, then one library call at a time (the signal
 // handlers and the interrupt flag are the process's), the library's SIGINT/SIGTERM recorder in
-// place of Python's handlers (restored after).
-std::mutex& call_mutex() {
-  static std::mutex m;
-  return m;
+// place of Python's handlers (restored after). A call from within a call (a progress callback
+// calling the library) is refused at once: it would wait for itself. A process forked while
+// another thread is inside a call gets a fresh lock (the child has no such thread).
+std::mutex* g_call_mutex = new std::mutex;
+thread_local bool t_in_call = false;
+
+std::mutex& call_mutex() { return *g_call_mutex; }
+
+void reset_after_fork() {
+  g_call_mutex = new std::mutex;  // the parent's may be held by a thread the child does not have (leaked: it cannot be destroyed)
+  t_in_call = false;
 }
+
+// Marks the calling thread as inside a library call; refuses a second one on the same thread.
+class ReentryGuard {
+public:
+  ReentryGuard() {
+    if (t_in_call)
+      throw std::runtime_error("scoleid: a library call cannot be made from within another (e.g. from a progress callback)");
+    t_in_call = true;
+  }
+  ~ReentryGuard() { t_in_call = false; }
+  ReentryGuard(const ReentryGuard&) = delete;
+  ReentryGuard& operator=(const ReentryGuard&) = delete;
+};
 
 class LibraryCall {
 public:
@@ -62,6 +84,7 @@ public:
   LibraryCall& operator=(const LibraryCall&) = delete;
 
 private:
+  ReentryGuard reentry_;                                    // first: a nested call is refused before it waits
   struct sigaction old_int_ {}, old_term_ {};
   py::gil_scoped_release release_;                          // constructed before the lock, released after it
   std::lock_guard<std::mutex> one_at_a_time_{call_mutex()};
@@ -123,6 +146,7 @@ struct IdentifyArgs {
   std::string time_column;               // the time column's name ("" = as a CSV's: see table_of)
   std::string source = "data";           // the table's name in messages
   std::string meta_json;                 // truth.json text for an in-memory table ("" = none)
+  std::string meta_source = "data (truth metadata)";  // where that came from, for messages
   std::optional<std::string> method;
   std::optional<int> max_iterations;
   bool compute_std = true, verbose = false;
@@ -185,8 +209,8 @@ py::tuple identify_call(const std::string& yaml_text, const std::string& source,
   if (!a.data_file.empty()) data = DataSource::file(a.data_file);
   if (a.header) {
     std::optional<io::TruthMeta> meta;
-    if (!a.meta_json.empty()) meta = io::truth_meta_from_json(nlohmann::json::parse(a.meta_json), a.source + " (truth metadata)");
-    data = DataSource::in_memory(table_of(sc, *a.header, *a.values, a.time_column, a.source), a.source, meta);
+    if (!a.meta_json.empty()) meta = io::truth_meta_from_json(nlohmann::json::parse(a.meta_json), a.meta_source);
+    data = DataSource::in_memory(table_of(sc, *a.header, *a.values, a.time_column, a.source), a.source, meta, a.meta_source);
   }
   std::optional<Identification> id;
   PythonProgress progress(a.progress);
@@ -283,6 +307,7 @@ PYBIND11_MODULE(_core, m) {
     }
   });
   m.attr("__version__") = SCOLEID_VERSION;
+  pthread_atfork(nullptr, nullptr, &reset_after_fork);
   m.def("builtin_scenarios", &io::builtin_scenario_names);
   m.def("builtin_scenario_description", &io::builtin_scenario_description);
   m.def("builtin_scenario", &io::builtin_scenario_text);
@@ -297,6 +322,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("source", &IdentifyArgs::source)
       .def_readwrite("progress", &IdentifyArgs::progress)
       .def_readwrite("meta_json", &IdentifyArgs::meta_json)
+      .def_readwrite("meta_source", &IdentifyArgs::meta_source)
       .def_readwrite("method", &IdentifyArgs::method)
       .def_readwrite("max_iterations", &IdentifyArgs::max_iterations)
       .def_readwrite("compute_std", &IdentifyArgs::compute_std)

@@ -219,3 +219,58 @@ def test_the_example_passes_mypy_strict_and_runs(tmp_path):
     r = subprocess.run([sys.executable, example], capture_output=True, text=True)
     print(r.stdout)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_a_call_from_a_progress_callback_is_refused_not_a_deadlock():
+    code = ("import scoleid\n"
+            "try:\n"
+            "    scoleid.identify('paper-beam-1', progress=lambda line: scoleid.truth('paper-beam-1'))\n"
+            "except RuntimeError as e:\n"
+            "    print('RuntimeError:', e)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "RuntimeError: scoleid: a library call cannot be made from within another" in r.stdout, r.stdout + r.stderr
+
+
+def test_a_process_forked_while_a_thread_is_in_a_call_starts_free():
+    code = ("import os, threading, time, scoleid\n"
+            "th = threading.Thread(target=lambda: scoleid.identify('paper-scole-2'))\n"
+            "th.start(); time.sleep(0.3)\n"
+            "pid = os.fork()\n"
+            "if pid == 0:\n"
+            "    idn = scoleid.identify('paper-beam-1')\n"
+            "    os._exit(0 if idn.converged else 3)\n"
+            "_, status = os.waitpid(pid, 0)\n"
+            "th.join()\n"
+            "print('child', os.waitstatus_to_exitcode(status))\n")
+    r = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True, timeout=120)
+    assert "child 0" in r.stdout, r.stdout + r.stderr
+
+
+def test_row_numbers_are_not_time_and_unused_text_columns_are_left_out(beam_record):
+    rec = beam_record
+    plain = scoleid.identify("paper-beam-1", data=rec)
+    df = pd.DataFrame({"t": rec["t"], "P": rec["P"], "w_mid": rec["w_mid"]}).rename_axis("sample")
+    df["label"] = ["tap"] * len(df)  # a text column no sensor reads
+    assert scoleid.identify("paper-beam-1", data=df).estimates == plain.estimates
+    df["w_mid"] = df["w_mid"].astype(str).where(df.index > 3, "x")  # a text column a sensor reads: refused
+    with pytest.raises(scoleid.InputError, match="column 'w_mid' is not numeric"):
+        scoleid.identify("paper-beam-1", data=df)
+
+
+def test_results_handed_out_are_copies_and_truth_metadata_is_named_when_stale(beam_record):
+    idn = scoleid.identify("paper-beam-1")
+    a0 = idn.state_space().A[0, 0]
+    ss = idn.state_space()
+    ss.A[0, 0] = 12345.0
+    mm = idn.modal_model()
+    mm["omega"][0] = -1.0
+    idn.iterations[0]["cost"] = -1.0
+    assert idn.state_space().A[0, 0] == a0
+    assert idn.modal_model()["omega"][0] > 0 and idn.iterations[0]["cost"] > 0
+    df = beam_record.to_dataframe().rename(columns={"w_mid": "w_mid [mm]"})
+    df["w_mid [mm]"] *= 1e3
+    with pytest.raises(scoleid.InputError, match=r"data.attrs\['meta'\].*does not describe column 'w_mid \[mm\]'"):
+        scoleid.identify("paper-beam-1", data=df)
+    del df.attrs["meta"]
+    for k, v in scoleid.identify("paper-beam-1", data=df).estimates.items():
+        assert v == pytest.approx(scoleid.identify("paper-beam-1", data=beam_record).estimates[k], rel=1e-9)

@@ -13,10 +13,11 @@ the YAML's structure (numpy scalars and arrays are taken as the numbers they hol
 
 Data. ``None`` (the scenario synthesises its own), a file (CSV, Universal File, LabVIEW LVM: read as
 ``scole-identify --data`` reads it), a dict of equal-length arrays, or a pandas DataFrame. The time
-of a table is, in this order: the column or array given as ``time=``; a DataFrame's index when it is
-named or holds floats or time spans (an unnamed integer index is row numbers, not time); the
-scenario's ``data.time_column``; a column named ``t``; the first column. Column names are read as a
-CSV header is: a bracketed suffix states the unit (``"Time [ms]"``, ``"acc_tip [g]"``,
+of a table is, in this order: the column or array given as ``time=``; a DataFrame's index when it
+holds floats, time spans or dates, or integers under a time's name (``t``, ``time``, a bracketed
+unit such as ``t [ms]``; an integer index under another name, ``sample``, counts rows); the
+scenario's ``data.time_column``; a column named ``t``; the first column. A text column that no
+sensor or input reads is left out. Column names are read as a CSV header is: a bracketed suffix states the unit (``"Time [ms]"``, ``"acc_tip [g]"``,
 ``"hammer [lbf]"``) and is converted exactly as the CSV reader converts it; a time-span
 (``Timedelta``) time is taken in seconds. A record's truth.json (true values, noise levels) travels
 as ``TruthRecord.meta`` or a DataFrame's ``attrs["meta"]``.
@@ -33,7 +34,8 @@ message; an argument of the wrong type raises ``TypeError``; Ctrl-C ends a solve
 
 Threads. One library call runs at a time in a process: calls from several threads wait for one
 another (the solver's signal handling belongs to the process). The GIL is released while a call
-runs. For runs in parallel use processes (``concurrent.futures.ProcessPoolExecutor``, joblib).
+runs. For runs in parallel use processes (``concurrent.futures.ProcessPoolExecutor``, joblib; a
+process forked while another thread is inside a call starts with the library free).
 """
 import json as _json
 import logging as _logging
@@ -151,6 +153,7 @@ class TruthRecord(dict):
     true parameters, each column's unit, kind and noise level)."""
 
     def __init__(self, columns, meta):
+        """columns: {"t": times, name: values}; meta: the truth.json dict."""
         super().__init__(columns)
         self.meta = meta
 
@@ -240,17 +243,43 @@ def _time_column(name, values):
     return (_UNIT.sub("", name).rstrip() or "t") + " [s]", seconds
 
 
+_TIME_NAME = _re.compile(r"^\s*(t|time|zeit|temps)\b", _re.IGNORECASE)
+
+
 def _index_is_time(index):
-    """A DataFrame's index is its time when named, or when it holds floats or time spans."""
-    return index.name is not None or index.dtype.kind in "fmM"
+    """A DataFrame's index is its time when it holds floats, time spans or dates, or when it holds
+    integers under a time's name ("t", "time", a bracketed unit such as "t [ms]"). An integer index
+    under any other name ("sample", "row") counts rows, not time."""
+    if index.dtype.kind in "fmM":
+        return True
+    name = index.name
+    return (index.dtype.kind in "iu" and isinstance(name, str)
+            and (_TIME_NAME.match(name) is not None or _UNIT.search(name) is not None))
 
 
-def _table(data, time):
-    """(header, values[samples x columns], time column, source, meta_json) of a dict or DataFrame."""
-    columns, time_name, source = {}, "", "data"
+def _is_text(values):
+    """A column of words (strings, categories of strings), not numbers."""
+    kind = _dtype_kind(values)
+    if kind in ("U", "S"):
+        return True
+    if kind == "O" or str(getattr(values, "dtype", "")) in ("string", "category"):
+        try:
+            _np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            return True
+    return False
+
+
+def _table(data, time, wanted=None):
+    """(header, values[samples x columns], time column, source, meta_json, meta_source) of a dict or
+    DataFrame. A text column that no sensor or input reads (`wanted`: their names and columns) is
+    left out, as a file's unused columns are."""
+    columns, time_name, source, meta_source = {}, "", "data", "data (truth metadata)"
     if hasattr(data, "columns") and hasattr(data, "index") and hasattr(data, "to_numpy"):  # a pandas DataFrame
         source = "data (DataFrame)"
         meta = getattr(data, "attrs", {}).get("meta")
+        meta_source = ("data.attrs['meta'] (the truth.json the DataFrame carries: delete it, "
+                       "del df.attrs['meta'], when its columns were renamed or dropped)")
         names = [str(c) for c in data.columns]
         if len(set(names)) != len(names):
             raise InputError("data: the DataFrame's column names repeat")
@@ -259,13 +288,17 @@ def _table(data, time):
         columns = {str(c): data[c] for c in data.columns}
         if time is None and _index_is_time(data.index):
             name = "t" if data.index.name is None else str(data.index.name)
-            if name in columns:
-                raise InputError("data: the index '%s' and a column share a name; which is the time?" % name)
+            if name in columns or "t" in columns:
+                raise InputError("data: the DataFrame has a time index%s and a column '%s'; which is the time? "
+                                 "(pass time='%s', or reset the index)"
+                                 % ("" if data.index.name is None else " '%s'" % name, name if name in columns else "t",
+                                    name if name in columns else "t"))
             time_name, values = _time_column(name, data.index)
             columns = {time_name: values, **columns}
     elif isinstance(data, dict):
         source = "data (dict)"
         meta = data.meta if isinstance(data, TruthRecord) else None
+        meta_source = "TruthRecord.meta (the record's truth.json)"
         if not data:
             raise InputError("data: the dict has no columns")
         columns = {str(k): v for k, v in data.items()}
@@ -278,11 +311,19 @@ def _table(data, time):
             if time not in columns:
                 raise InputError("data: time='%s' is not a column (%s)" % (time, ", ".join(list(columns)[:12])))
             time_name, values = _time_column(time, columns.pop(time))
-        else:  # the sample times themselves
-            time_name, values = _time_column(getattr(time, "name", None) or "t", time)
+        elif _np.ndim(time) == 1 and not isinstance(time, (bytes, dict)):  # the sample times themselves
+            time_name, values = _time_column(str(getattr(time, "name", None) or "t"), time)
             if time_name in columns:
-                raise InputError("data: time= is named '%s', as a column is" % time_name)
+                raise InputError("data: time= gives the times, and the table has a column '%s' already: "
+                                 "pass time='%s', or leave that column out" % (time_name, time_name))
+        else:
+            raise TypeError("time= names the time column (a str) or gives the sample times (a 1-D array), got %s"
+                            % type(time).__name__)
         columns = {time_name: values, **columns}
+    if wanted is not None:
+        for name in [n for n in columns if n != time_name and _is_text(columns[n])]:
+            if name not in wanted and _UNIT.sub("", name).rstrip() not in wanted:
+                del columns[name]
     header = list(columns)
     n = None
     values = None
@@ -296,7 +337,7 @@ def _table(data, time):
             n = len(v)
             values = _np.empty((n, len(header)))
         values[:, j] = v
-    return header, values, time_name, source, _json.dumps(meta) if meta is not None else ""
+    return header, values, time_name, source, _json.dumps(meta) if meta is not None else "", meta_source
 
 
 class StateSpace:
@@ -306,6 +347,7 @@ class StateSpace:
     ``scipy.signal.StateSpace`` (whose rows and columns follow ``inputs`` and ``outputs``)."""
 
     def __init__(self, A, B, C, D, inputs, outputs, input_units=(), output_units=()):
+        """A, B, C, D: the matrices (numpy); inputs, outputs: their names; input_units, output_units: their units."""
         self.A, self.B, self.C, self.D = A, B, C, D
         self.inputs, self.outputs = list(inputs), list(outputs)
         self.input_units, self.output_units = list(input_units), list(output_units)
@@ -332,6 +374,7 @@ class Identification:
     """
 
     def __init__(self, core, library_seconds=float("nan")):
+        """Made by identify(); core is the library's result, library_seconds the call's duration."""
         self._core = core
         self._json_text = core.to_json()
         self._dict = _json.loads(self._json_text)
@@ -355,6 +398,18 @@ class Identification:
         self._cache = state["cache"]
         self._plain = state["plain"]
         self.library_seconds = state["library_seconds"]
+
+    def __copy__(self):
+        other = Identification.__new__(Identification)
+        other.__dict__.update(self.__dict__)
+        return other
+
+    def __deepcopy__(self, memo):
+        import copy
+        other = Identification.__new__(Identification)
+        for k, v in self.__dict__.items():
+            other.__dict__[k] = v if k == "_core" else copy.deepcopy(v, memo)  # the solver's state is immutable: shared
+        return other
 
     def _need_core(self, what):
         if self._core is None:
@@ -409,8 +464,8 @@ class Identification:
 
     @property
     def physical(self):
-        """The structure's physical values at the estimate (EI, rho_A, zeta, ...), as a dict."""
-        return dict(self._dict["physical_estimate"])
+        """The structure's physical values at the estimate (EI, rho_A, zeta, ...), as a dict (a copy)."""
+        return _json.loads(_json.dumps(self._dict["physical_estimate"]))
 
     @property
     def std(self):
@@ -487,8 +542,8 @@ class Identification:
 
     @property
     def iterations(self):
-        """The iteration history, as identify.json's "iterations" (list of dict)."""
-        return list(self._dict.get("iterations", []))
+        """The iteration history, as identify.json's "iterations" (list of dict; a copy)."""
+        return _json.loads(_json.dumps(self._dict.get("iterations", [])))
 
     # ----- the fit
     @property
@@ -501,7 +556,8 @@ class Identification:
 
     # ----- outputs
     def to_json(self, indent=None):
-        """identify.json as JSON text (``indent`` as ``json.dumps``'s; None: as the library writes it)."""
+        """identify.json's content as JSON text: compact (``indent=None``), or indented as ``json.dumps``
+        indents (the file ``write()`` makes holds the same content)."""
         return self._json_text if indent is None else _json.dumps(self._dict, indent=indent)
 
     def to_dict(self):
@@ -520,19 +576,21 @@ class Identification:
         """
         c = self._model_arrays()
         ss, model = c["state_space"], _json.loads(c["model_json"])["state_space"]
-        return StateSpace(ss["A"], ss["B"], ss["C"], ss["D"], ss["inputs"], ss["outputs"],
-                          model.get("input_units", ()), model.get("output_units", ()))
+        return StateSpace(_np.array(ss["A"]), _np.array(ss["B"]), _np.array(ss["C"]), _np.array(ss["D"]), ss["inputs"],
+                          ss["outputs"], model.get("input_units", ()), model.get("output_units", ()))
 
     def modal_model(self):
         """The identified model's modes, all of them (rigid-body modes too), ascending.
 
         Returns:
             dict: ``omega`` [rad/s], ``zeta`` (NaN for a rigid-body mode), ``rigid`` (bool array: a mode
-            whose frequency is under 1e-6 of the highest, i.e. a free structure's rigid motion, at ω ~ 0),
+            whose frequency is under 1e-6 of the highest, at ω ~ 0: a free structure's rigid motions —
+            six for a free body such as SCOLE, plus one per proof-mass actuator on its slider, and
+            each one's rotation where the model has it),
             ``output_shapes`` (outputs x modes: a sensor's reading per unit modal coordinate),
             ``input_shapes`` (inputs x modes), ``inputs``, ``outputs``.
         """
-        m = dict(self._model_arrays()["modal_model"])
+        m = {k: (_np.array(v) if isinstance(v, _np.ndarray) else list(v)) for k, v in self._model_arrays()["modal_model"].items()}
         m["rigid"] = ~_np.isfinite(_np.asarray(m["zeta"], dtype=float))
         return m
 
@@ -597,13 +655,14 @@ def identify(scenario, data=None, *, time=None, method=None, max_iterations=None
             arrays; a DataFrame. See the module's help for how the time and the units are found.
         time (None | str | array): the time column's name, or the sample times themselves (seconds, or
             time spans); None: the DataFrame's index when it is time, else as a CSV file's.
-        method (None | str): the optimiser, one of "gauss-newton", "lbfgs", ... (scole-identify --help);
-            None: the scenario's identification.method.
+        method (None | str): the optimiser: "auto", "gauss-newton", "gauss-newton-krylov", "lbfgs" or
+            "steepest-descent" (scole-identify --help); None: the scenario's identification.method.
         max_iterations (None | int): None: the scenario's identification.max_iterations.
         compute_std (bool): identifiability, standard deviations and uncertainty intervals.
         verbose (bool): print the progress (iteration table, restarts, fit test) on sys.stdout.
         progress (None | callable): called with each progress line (str) as the run goes; an exception it
-            raises ends the run and is raised in its place.
+            raises ends the run and is raised in its place. It may not call the library itself
+            (RuntimeError).
     Returns:
         Identification: the estimates and the verdict. ``converged`` is True only when earned; a run that
         is not converged, or whose parameters the data do not determine, also emits a ScoleidWarning.
@@ -622,11 +681,17 @@ def identify(scenario, data=None, *, time=None, method=None, max_iterations=None
             raise TypeError("time= applies to a table; a file's time column is the scenario's data.time_column")
         args.data_file = _os.fspath(data)
     else:
-        args.header, args.values, args.time_column, args.source, args.meta_json = _table(data, time)
+        spec = _json.loads(_core.scenario_json(text, source))
+        wanted = {x.get(k) for x in spec.get("sensors", []) + spec.get("inputs", []) for k in ("name", "column")} - {None}
+        args.header, args.values, args.time_column, args.source, args.meta_json, args.meta_source = _table(data, time, wanted)
     if method is not None and not isinstance(method, str):
         raise TypeError("method must be a str, got %s" % type(method).__name__)
     args.method = method
-    args.max_iterations = None if max_iterations is None else _integer("max_iterations", max_iterations)
+    if max_iterations is not None:
+        max_iterations = _integer("max_iterations", max_iterations)
+        if not 0 <= max_iterations <= 2**31 - 1:
+            raise InputError("identify: max_iterations must be between 0 and 2147483647, got %d" % max_iterations)
+    args.max_iterations = max_iterations
     args.compute_std = _flag("compute_std", compute_std)
     _flag("verbose", verbose)
     sink = _progress_sink(progress, verbose)

@@ -33,18 +33,20 @@ namespace scoleid {
 
 // Where the measurements come from: a data file (header t,<columns>; sensors and inputs matched by
 // name; a truth.json beside it gives noise levels and true values), a table in memory (the same
-// columns; `name` stands for the file in messages; optional truth metadata), or neither — then the
-// scenario synthesises them on a finer mesh (run/problem.h).
+// columns; `name` stands for the file in messages; optional truth metadata, named `meta_name` in
+// messages — "<name> (metadata)" when empty), or neither — then the scenario synthesises them on a
+// finer mesh (run/problem.h).
 struct DataSource {
   std::optional<std::string> csv;
   std::optional<io::DataTable> table;
   std::string name;
   std::optional<io::TruthMeta> meta;
+  std::string meta_name;
   static DataSource synthetic() { return {}; }
-  static DataSource file(std::string path) { return {std::move(path), std::nullopt, "", std::nullopt}; }
+  static DataSource file(std::string path) { return {std::move(path), std::nullopt, "", std::nullopt, ""}; }
   static DataSource in_memory(io::DataTable t, std::string name = "data table",
-                              std::optional<io::TruthMeta> meta = std::nullopt) {
-    return {std::nullopt, std::move(t), std::move(name), std::move(meta)};
+                              std::optional<io::TruthMeta> meta = std::nullopt, std::string meta_name = "") {
+    return {std::nullopt, std::move(t), std::move(name), std::move(meta), std::move(meta_name)};
   }
 };
 
