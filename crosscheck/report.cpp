@@ -49,7 +49,7 @@ void check_modes(const nlohmann::json& m, const std::string& file) {
     s.array(mode, "fe_hz", w, 0, "numbers", is_number_or_null);
     for (const char* key : {"chain_extrapolated_hz", "analytic_hz", "extrapolated_vs_fe", "chain_rate", "fe_rate", "mac"})
       s.number(mode, key, w);
-  });
+  }, true);
 }
 
 void check_trajectories(const nlohmann::json& t, const std::string& file) {
@@ -63,7 +63,7 @@ void check_trajectories(const nlohmann::json& t, const std::string& file) {
     s.text(sensor, "kind", w);
     s.array(sensor, "relative_rms", w, levels, "numbers", is_number_or_null);
     s.number(sensor, "rate", w);
-  });
+  }, true);
 }
 
 void check_identify(const nlohmann::json& id, const std::string& file) {
@@ -84,7 +84,7 @@ void check_identify(const nlohmann::json& id, const std::string& file) {
     if (p.contains("half_width")) s.array(p, "half_width", w, levels, "numbers", is_number_or_null);
     if (p.contains("half_width") || p.contains("covered_by_interval"))
       s.array(p, "covered_by_interval", w, levels, "true or false", is_flag);
-  });
+  }, true);
 }
 
 // The verbs' files, each with its shape check, in the order they are read.

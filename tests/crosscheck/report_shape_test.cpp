@@ -93,6 +93,16 @@ TEST(ReportShape, EmptiedOrMissingFieldsAreRefusedWithFileAndField) {
   i = identify();
   i["segments"] = json::array({10, -20});
   expect_refused(modes(), trajectories(), i, "identify.json", "segments[1]");
+  // Lists emptied: a summary over nothing would read "within 0 % of the truth".
+  i = identify();
+  i["parameters"] = json::array();
+  expect_refused(modes(), trajectories(), i, "identify.json", "parameters");
+  m = modes();
+  m["modes"] = json::array();
+  expect_refused(m, trajectories(), identify(), "modes.json", "modes");
+  t = trajectories();
+  t["sensors"] = json::array();
+  expect_refused(modes(), t, identify(), "trajectories.json", "sensors");
 }
 
 TEST(ReportShape, SuiteResultsAreCheckedBeforeTheSummary) {

@@ -62,10 +62,12 @@ public:
       if (!v[i].is_object()) fail(where + key + "[" + std::to_string(i) + "]", "an object", &v[i]);
     return v;
   }
-  // `check(entry, prefix)` for each object of the array `key`, the prefix naming it ("key[i].").
+  // `check(entry, prefix)` for each object of the array `key`, the prefix naming it ("key[i].");
+  // with `nonempty`, an empty array is refused (a summary over nothing would read as perfect).
   template <class Check>
-  void each(const nlohmann::json& obj, const std::string& key, const std::string& where, Check check) const {
+  void each(const nlohmann::json& obj, const std::string& key, const std::string& where, Check check, bool nonempty = false) const {
     const auto& v = objects(obj, key, where);
+    if (nonempty && v.empty()) fail(where + key, "a non-empty array of objects", &v);
     for (std::size_t i = 0; i < v.size(); ++i) check(v[i], where + key + "[" + std::to_string(i) + "].");
   }
 
