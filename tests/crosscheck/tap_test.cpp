@@ -12,7 +12,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
+#include <vector>
+
+#include <unistd.h>
 
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/identify.h"
@@ -95,5 +101,60 @@ TEST(TapTest, FromHandbookAndFarStartsTheStripsParametersAndModesAreFound) {
       EXPECT_LE(std::abs(m.damping_ratio - c.chain_zeta), m.damping_half_width) << "mode " << k + 1;
       EXPECT_LT(std::abs(m.frequency_hz / c.chain_hz.front() - 1.0), 0.01) << "mode " << k + 1;
     }
+  }
+}
+
+// The record as a DAQ writes it, and a scenario with only the lab's facts: the time column in ms
+// to 6 significant digits, accelerations in g under headers that carry their units ("acc1 [g]"),
+// 0.05 s of pre-trigger, no noise_std anywhere (no truth.json beside the file), the band stated.
+// The defaults do the rest: the sensors find their columns by name, the units are converted, the
+// noise levels come from the pre-trigger, the force is windowed, the horizons start at the hit.
+// Converged, EI and ρA within 1 %, ζ within 10 %, every interval covering the truth.
+TEST(TapTest, ADaqFileWithOnlyTheLabsFactsIsIdentified) {
+  const std::string truth_yaml = R"(name: daq-strip
+structure: beam
+beam: {length: 0.6, left: clamped, right: free, rho_A: 0.4, EI: 30, zeta: 0.01}
+inputs:
+  - {name: hammer, at: beam, kind: force, location: 0.55, unit: N, signal: {type: haversine, amplitude: 5, t0: 0.05, width: 0.002}}
+sensors:
+  - {name: acc1, at: beam, kind: acceleration, location: 0.3, unit: m/s^2, noise_std: 0.05}
+  - {name: acc3, at: beam, kind: acceleration, location: 0.6, unit: m/s^2, noise_std: 0.05}
+simulation: {duration: 1.0, sample_interval: 0.0005, seed: 3}
+identification: {estimate: [EI, rho_A, zeta], initial: {EI: 27, rho_A: 0.44, zeta: 0.02}, elements: 16, band: [5, 300]}
+truth: {segments: 80, anti_alias_hz: 800}
+)";
+  const Truth truth = simulate_truth(io::parse_scenario(truth_yaml, "truth.yaml"));
+  std::string lab_yaml = truth_yaml;
+  for (std::size_t at; (at = lab_yaml.find(", noise_std: 0.05")) != std::string::npos;) lab_yaml.erase(at, 17);
+  const io::Scenario lab = io::parse_scenario(lab_yaml, "lab.yaml");
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("scoleid-daq-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string csv = (dir / "daq.csv").string();
+  {
+    std::ofstream f(csv);
+    f << "Time [ms],hammer [N],acc1 [g],acc3 [g]\n";
+    const auto& tab = truth.table;
+    char buf[128];
+    for (std::size_t k = 0; k < tab.t.size(); ++k) {
+      std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g\n", tab.t[k] * 1e3, tab.columns[tab.find("hammer")][k],
+                    tab.columns[tab.find("acc1")][k] / 9.80665, tab.columns[tab.find("acc3")][k] / 9.80665);
+      f << buf;
+    }
+  }
+  const Identification id = identify_parameters(lab, DataSource::file(csv), {});
+  std::filesystem::remove_all(dir);
+  std::printf("%s", id.FullReport().c_str());
+  const auto& p = id.problem();
+  EXPECT_EQ(p.noise_origin, (std::vector<std::string>{"pre-trigger", "pre-trigger"}));
+  EXPECT_GE(p.columns.quiet_samples, 50);
+  ASSERT_TRUE(id.converged()) << id.verdict();
+  const auto& r = id.result();
+  const std::map<std::string, double> true_values{{"EI", 30.0}, {"rho_A", 0.4}, {"zeta", 0.01}};
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    const double truth_value = true_values.at(r.names[i]);
+    EXPECT_LT(std::abs(r.estimate[e] / truth_value - 1.0), r.names[i] == "zeta" ? 0.10 : 0.01) << r.names[i];
+    ASSERT_TRUE(r.ident.identifiable[i]) << r.names[i];
+    EXPECT_LE(std::abs(r.estimate[e] - truth_value), r.interval.half_width[e]) << r.names[i];
   }
 }
