@@ -1,5 +1,6 @@
 #include "scoleid/identify/run/fit_plot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -56,19 +57,54 @@ std::string fit_plot_script(const std::vector<std::string>& sensors, const std::
   return gp;
 }
 
+SpectrumView spectrum_view(const std::vector<double>& f, const Eigen::MatrixXd& measured, const Eigen::MatrixXd& predicted,
+                           const std::vector<double>& band) {
+  SpectrumView v;
+  v.band = band;
+  const double lo = band.size() == 2 ? 0.5 * band[0] : 0.0, hi = band.size() == 2 ? 2.0 * band[1] : INFINITY;
+  for (Eigen::Index k = 0; k < measured.cols(); ++k) {
+    double top = 0.0, floor = INFINITY;
+    for (std::size_t b = 0; b < f.size(); ++b) {
+      if (f[b] < lo || f[b] > hi) continue;
+      const auto i = static_cast<Eigen::Index>(b);
+      const double m = measured(i, k), p = predicted.rows() > i ? predicted(i, k) : 0.0;
+      if (std::isfinite(m)) top = std::max(top, m);
+      if (std::isfinite(p)) top = std::max(top, p);
+      if (std::isfinite(m) && m > 0) floor = std::min(floor, m);
+    }
+    if (!(top > 0) || !std::isfinite(floor)) {
+      v.psd_range.emplace_back(0.0, 0.0);
+      continue;
+    }
+    v.psd_range.emplace_back(std::max(floor, 1e-9 * top) / 3.0, 10.0 * top);
+  }
+  return v;
+}
+
 std::string spectrum_plot_script(const std::vector<std::string>& sensors, const std::vector<std::string>& units,
-                                 const std::vector<double>& modes_hz, const std::string& title, const std::string& csv,
-                                 const std::string& png) {
+                                 const std::vector<double>& modes_hz, const std::string& title, const SpectrumView& view,
+                                 const std::string& csv, const std::string& png) {
   const std::size_t ns = sensors.size();
   std::string gp = "set terminal pngcairo size 1000," + std::to_string(300 * ns + 40) + " noenhanced\nset output " +
                    gnuplot_quote(png) + "\nset datafile separator ','\nset multiplot layout " + std::to_string(ns) + ",1" +
                    (title.empty() ? std::string() : " title " + gnuplot_quote(title)) +
-                   "\nset grid\nset key top right\nset logscale xy\nset xlabel 'frequency [Hz]'\n";
+                   "\nset grid\nset key top right\nset logscale xy\nset format y '%g'\nset xlabel 'frequency [Hz]'\n";
   for (double f : modes_hz)
     if (std::isfinite(f) && f > 0) gp += "set arrow from " + io::format_value(f) + ", graph 0 to " + io::format_value(f) + ", graph 1 nohead front lc rgb 'red' dt 2\n";
+  if (view.band.size() == 2 && view.band[0] > 0 && view.band[1] > view.band[0]) {
+    gp += "set xrange [" + io::format_value(0.5 * view.band[0]) + ":" + io::format_value(2.0 * view.band[1]) + "]\n";
+    for (double f : view.band)
+      gp += "set arrow from " + io::format_value(f) + ", graph 0 to " + io::format_value(f) + ", graph 1 nohead front lc rgb 'blue' lw 2\n";
+  }
   for (std::size_t k = 0; k < ns; ++k) {
+    if (k < view.psd_range.size() && view.psd_range[k].second > view.psd_range[k].first && view.psd_range[k].first > 0)
+      gp += "set yrange [" + io::format_value(view.psd_range[k].first) + ":" + io::format_value(view.psd_range[k].second) + "]\n";
+    else
+      gp += "set autoscale y\n";
     const std::string unit = k < units.size() && !units[k].empty() ? " [(" + units[k] + ")^2/Hz]" : "";
-    gp += "set title " + gnuplot_quote(sensors[k] + " (the model's natural frequencies dashed)") + "\nset ylabel " +
+    gp += "set title " + gnuplot_quote(sensors[k] + " (the model's natural frequencies dashed" +
+                                       (view.band.size() == 2 ? std::string(", the fitted band's edges solid)") : std::string(")"))) +
+          "\nset ylabel " +
           gnuplot_quote("PSD" + unit) + "\n";
     gp += "plot " + gnuplot_quote(csv) + " every ::1 using 1:" + std::to_string(2 + 2 * k) +
           " with lines lw 2 title 'measured', '' every ::1 using 1:" + std::to_string(3 + 2 * k) + " with lines dt 2 lw 2 title 'predicted'\n";

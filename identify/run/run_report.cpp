@@ -484,7 +484,8 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
     io::write_csv(dir.path("spectrum.csv"), spec);
     std::vector<double> modes_hz;
     for (const auto& m : r.modes) modes_hz.push_back(m.frequency_hz);
-    io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title));
+    io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title,
+                                                                        spectrum_view(sm.f, sm.psd, sp.psd, p.scenario.identification.band)));
     scripts.push_back("spectrum.gp");
   }
   // fit.png (from a raw float64 copy of fit.csv: the same numbers, no text to parse) and

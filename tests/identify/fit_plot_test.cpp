@@ -55,7 +55,8 @@ TEST(FitPlot, HostileNamesAreDrawnNotExecuted) {
       spec << "\n";
     }
     spec.close();
-    std::ofstream(dir / "spectrum.gp") << spectrum_plot_script(names, notes.units, {2.0, 7.5}, notes.title);
+    std::ofstream(dir / "spectrum.gp") << spectrum_plot_script(names, notes.units, {2.0, 7.5}, notes.title,
+                                                                 SpectrumView{{{1e-3, 1.0}, {1e-3, 1.0}, {0.0, 0.0}}, {1.0, 10.0}});
   }
   EXPECT_EQ(render_gnuplot(dir.string(), "fit.gp"), RenderStatus::Rendered);
   EXPECT_TRUE(fs::exists(dir / "fit.png") && fs::file_size(dir / "fit.png") > 1000) << "plot not drawn";
@@ -111,4 +112,31 @@ TEST(FitPlot, TheBinaryCopyDrawsTheSamePictureAsTheCsv) {
   EXPECT_GT(a.size(), 1000u);
   EXPECT_TRUE(a == b) << "the binary copy draws a different picture";
   fs::remove_all(dir);
+}
+
+// The spectrum's view: within the band (half its lower edge to twice its upper), each sensor from a
+// third of its measured floor — at most nine decades under its peak — to ten times the peak.
+TEST(FitPlot, TheSpectrumIsShownWithinTheBandAndAboveTheNoiseFloor) {
+  std::vector<double> f;
+  Eigen::MatrixXd m(200, 2), p(200, 2);
+  for (int b = 0; b < 200; ++b) {
+    f.push_back(1.0 + b);
+    m(b, 0) = 1.0 / (1.0 + std::pow((f.back() - 50.0) / 2.0, 2)) + 1e-4;  // a resonance over a noise floor
+    m(b, 1) = std::pow(10.0, -25.0 * b / 199.0);                          // a filtered record: 25 decades
+    p(b, 0) = m(b, 0);
+    p(b, 1) = 2.0 * m(b, 1);
+  }
+  const SpectrumView v = spectrum_view(f, m, p, {20.0, 60.0});
+  ASSERT_EQ(v.psd_range.size(), 2u);
+  double floor = INFINITY;  // the measured floor within 10..120 Hz
+  for (int b = 0; b < 200; ++b)
+    if (f[static_cast<std::size_t>(b)] >= 10.0 && f[static_cast<std::size_t>(b)] <= 120.0) floor = std::min(floor, m(b, 0));
+  EXPECT_NEAR(v.psd_range[0].first, floor / 3.0, 1e-15);
+  EXPECT_NEAR(v.psd_range[0].second, 10.0 * (1.0 + 1e-4), 1e-9);
+  const double top = 2.0 * std::pow(10.0, -25.0 * 9 / 199.0);  // the predicted peak at f = 10 Hz
+  EXPECT_NEAR(v.psd_range[1].second / (10.0 * top), 1.0, 1e-12);
+  EXPECT_NEAR(v.psd_range[1].first / (1e-9 * top / 3.0), 1.0, 1e-12);  // nine decades, not the stop band's floor
+  const std::string gp = spectrum_plot_script({"a", "b"}, {"m", "m"}, {50.0}, "t", v);
+  EXPECT_NE(gp.find("set xrange [10:120]"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("set yrange ["), std::string::npos) << gp;
 }

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "scoleid/io/data_files.h"
 
 namespace scoleid::identify {
@@ -41,11 +43,25 @@ std::string fit_plot_script(const std::vector<std::string>& sensors, const std::
 // draw the same picture.
 void write_plot_binary(const std::string& path, const io::DataTable& tab);
 
+// What spectrum.gp shows: per sensor its PSD range (empty: gnuplot's own), and the fitted band
+// (empty: the whole spectrum; else the x axis from half its lower edge to twice its upper one,
+// the edges drawn).
+struct SpectrumView {
+  std::vector<std::pair<double, double>> psd_range;
+  std::vector<double> band;
+};
+// The view of measured and predicted PSDs (bins × sensors at f): within the band's view, each
+// sensor's axis from a third of the measured spectrum's lowest value (its noise floor), but at
+// most nine decades under, to ten times the highest of either — not the 25 decades of a filtered
+// record's stop band.
+SpectrumView spectrum_view(const std::vector<double>& f, const Eigen::MatrixXd& measured, const Eigen::MatrixXd& predicted,
+                           const std::vector<double>& band);
+
 // spectrum.gp: reads `csv` (frequency in Hz, then measured and predicted power spectral density per
 // sensor) and draws both on logarithmic axes, one panel per sensor, with the identified model's
-// natural frequencies as vertical lines.
+// natural frequencies as vertical lines, within `view`.
 std::string spectrum_plot_script(const std::vector<std::string>& sensors, const std::vector<std::string>& units,
-                                 const std::vector<double>& modes_hz, const std::string& title,
+                                 const std::vector<double>& modes_hz, const std::string& title, const SpectrumView& view = {},
                                  const std::string& csv = "spectrum.csv", const std::string& png = "spectrum.png");
 
 enum class RenderStatus { Rendered, NoGnuplot, Failed };
