@@ -4,13 +4,16 @@
 //   scole-data convert FILE --out OUT.csv   the time responses as the product's CSV (t in s, then
 //                                           the channels in file order, values in the file's units)
 //                                           and OUT.json beside it describing each column
+//   scole-data convert FILE --out OUT.lvm   the same record as a LabVIEW Measurement file (lvm.h)
+//   scole-data convert FILE --out OUT.tdms  the same record as an NI TDMS file (tdms.h)
 // FILE is a Universal File (58/58b, 151, 164, 15, 2411, 55), a LabVIEW Measurement file (.lvm, one
-// segment) or a CSV (DAQ dialects: comment lines, any time-column name, quoted headers, ';' with
-// decimal commas, units in brackets).
+// segment), an NI TDMS file (.tdms, binary) or a CSV (DAQ dialects: comment lines, any time-column
+// name, quoted headers, ';' with decimal commas, units in brackets).
 // Exit codes: 0 success, 2 bad usage or bad input (one line naming the file, record or line, field
 // and value; nothing written), 130/143 interrupted.
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -22,7 +25,9 @@
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/lvm.h"
 #include "scoleid/io/output_paths.h"
+#include "scoleid/io/tdms.h"
 #include "scoleid/io/validation.h"
 
 namespace {
@@ -58,8 +63,36 @@ void print_info(const io::DataFileInfo& info) {
   for (const auto& n : info.notes) std::printf("  %s\n", n.c_str());
 }
 
-// OUT.csv and OUT.json (written to temporary files and renamed: both or neither).
+// The format OUT's extension asks for (any case): "lvm", "tdms", "uff" (.uff, .unv: no writer), else
+// "csv" (.csv, or any other name, as before).
+std::string out_format(const std::string& out) {
+  std::string ext = std::filesystem::path(out).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".lvm") return "lvm";
+  if (ext == ".tdms") return "tdms";
+  if (ext == ".uff" || ext == ".unv") return "uff";
+  return "csv";
+}
+
+// OUT.lvm or OUT.tdms: the record in that format, nothing beside it (the file holds the units).
+void convert_to(const std::string& format, const std::string& file, const std::string& out, const io::CsvOptions& options,
+                bool quiet) {
+  io::check_output_file("--out", out, {file});
+  const io::DataTable tab = io::read_data(file, options);
+  if (format == "lvm") io::write_lvm(tab, out);
+  else io::write_tdms(tab, out);
+  if (!quiet)
+    std::fprintf(stderr, "scole-data: %zu channel%s x %zu samples -> %s\n", tab.names.size(), tab.names.size() == 1 ? "" : "s",
+                 tab.t.size(), out.c_str());
+}
+
+// OUT.csv and OUT.json (written to temporary files and renamed: both or neither); OUT.lvm or
+// OUT.tdms alone.
 void convert(const std::string& file, const std::string& out, const io::CsvOptions& options, bool quiet) {
+  const std::string format = out_format(out);
+  if (format == "uff")
+    throw io::InputError("command line: --out '" + out + "': no Universal File writer; write .csv, .lvm or .tdms");
+  if (format != "csv") return convert_to(format, file, out, options, quiet);
   // Neither output may be the input, a directory, or in a directory that cannot be written.
   {
     std::filesystem::path m(out);
@@ -117,16 +150,23 @@ int main(int argc, char** argv) {
       "scole-data: measured data as labs export it. Reads Universal Files (UFF/UNV datasets 58 and 58b time\n"
       "histories and functions, 151 header, 164 units, 15/2411 nodes, 55 mode shapes) and DAQ CSV exports\n"
       "(comment lines, any time-column name, quoted headers, ';' with decimal commas, units in brackets), and\n"
-      "LabVIEW Measurement files (.lvm text: X_Columns No/One/Multi, Tab or Comma, decimal point or comma)."};
+      "LabVIEW Measurement files (.lvm text: X_Columns No/One/Multi, Tab or Comma, decimal point or comma), and\n"
+      "NI TDMS files (.tdms binary: integer and float channels, contiguous or interleaved, either byte order,\n"
+      "linear NI_Scaling, time from wf_increment or a Time channel; DAQmx raw data refused). `convert` writes the\n"
+      "record as the product's CSV, an LVM or a TDMS file, by the output's extension, every time and value exact."};
   app.require_subcommand(1);
   std::string file, out, time_column, time_unit;
   bool as_json = false, quiet = false;
   auto* info = app.add_subcommand("info", "list the file's channels (name, unit, quantity, samples, start, step, node)");
-  info->add_option("file", file, "data file (UFF, LabVIEW LVM or CSV)")->required();
+  info->add_option("file", file, "data file (UFF, LabVIEW LVM, TDMS or CSV)")->required();
   info->add_flag("--json", as_json, "print the listing as JSON");
-  auto* conv = app.add_subcommand("convert", "write the time responses as the product's CSV and a JSON of its columns");
-  conv->add_option("file", file, "data file (UFF, LabVIEW LVM or CSV)")->required();
-  conv->add_option("-o,--out", out, "output CSV; OUT.json is written beside it")->required();
+  auto* conv = app.add_subcommand("convert", "write the time responses as the product's CSV (and a JSON of its columns), "
+                                             "a LabVIEW LVM or an NI TDMS file, by OUT's extension");
+  conv->add_option("file", file, "data file (UFF, LabVIEW LVM, TDMS or CSV)")->required();
+  conv->add_option("-o,--out", out,
+                   "output: OUT.csv (OUT.json is written beside it), OUT.lvm (LabVIEW Measurement, tab-separated, X_Columns "
+                   "One) or OUT.tdms (one group 'record', float64 channels); every time and value reads back exactly")
+      ->required();
   conv->add_flag("-q,--quiet", quiet, "no summary on stderr");
   for (auto* sub : {info, conv}) {
     sub->add_option("--time-column", time_column, "CSV: the time column's header (default: the first column)");

@@ -2,6 +2,7 @@
 #include "scoleid/io/time_grid.h"
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/lvm.h"
+#include "scoleid/io/tdms.h"
 
 #include <cmath>
 #include <filesystem>
@@ -257,15 +258,22 @@ DataFileInfo describe_table(const DataTable& tab, const std::string& format) {
 
 bool is_lvm_file(const std::string& path) { return looks_like_lvm(file_head(path, 64)); }
 
+namespace {
+// Whether the file at `path` is a TDMS file (by its first 4 bytes, the lead-in tag "TDSm").
+bool is_tdms_file(const std::string& path) { return looks_like_tdms(file_head(path, 4)); }
+}  // namespace
+
 DataTable read_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return uff_table(uff::read_file(path));
   if (is_lvm_file(path)) return read_lvm(path);
+  if (is_tdms_file(path)) return read_tdms(path);
   return read_csv_data(path, options);
 }
 
 DataFileInfo describe_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return describe_uff(path);
   if (is_lvm_file(path)) return describe_lvm(path);
+  if (is_tdms_file(path)) return describe_tdms(path);
   return describe_csv(path, options);
 }
 

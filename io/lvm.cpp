@@ -1,11 +1,14 @@
 #include "scoleid/io/lvm.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/input_file.h"
@@ -36,6 +39,23 @@ std::vector<std::string> split(const std::string& line, char sep) {
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r"), e = s.find_last_not_of(" \t\r");
   return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+// The data rows' fields as views into the row (no copy per cell: a record has millions of them).
+std::string_view trim_view(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r"), e = s.find_last_not_of(" \t\r");
+  return b == std::string_view::npos ? std::string_view() : s.substr(b, e - b + 1);
+}
+
+void split_view(std::string_view line, char sep, std::vector<std::string_view>& f) {
+  f.clear();
+  std::size_t b = 0;
+  for (;;) {
+    const std::size_t e = line.find(sep, b);
+    f.push_back(line.substr(b, e == std::string_view::npos ? std::string_view::npos : e - b));
+    if (e == std::string_view::npos) break;
+    b = e + 1;
+  }
 }
 
 // Text in Windows-1252 (LabVIEW's code page) as UTF-8; UTF-8 text as it is.
@@ -86,6 +106,14 @@ bool number(const Lvm& f, std::string cell, double& v) {
   cell = trim(cell);
   if (f.decimal == ',') std::replace(cell.begin(), cell.end(), ',', '.');
   return parse_number(cell, v);
+}
+
+// The same on a trimmed cell of a data row.
+bool number_view(const Lvm& f, std::string_view cell, double& v) {
+  if (f.decimal != ',' || cell.find(',') == std::string_view::npos) return parse_number(cell, v);
+  std::string c(cell);
+  std::replace(c.begin(), c.end(), ',', '.');
+  return parse_number(c, v);
 }
 
 // The per-channel value of a segment tag, or "".
@@ -198,9 +226,10 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
   // The data rows, to a blank row or the end.
   std::vector<std::vector<double>> y(f.channels), x(f.x_columns == "Multi" ? f.channels : 1);
   std::vector<std::size_t> count(f.channels, 0);
+  std::vector<std::string_view> fl;
   while (pending || next(line)) {
     pending = false;
-    if (trim(line).empty() || line.find_first_not_of(f.sep) == std::string::npos) {
+    if (trim_view(line).empty() || line.find_first_not_of(f.sep) == std::string::npos) {
       // A blank row ends the segment: anything after it is a further segment.
       while (next(line))
         if (!trim(line).empty() && line.find_first_not_of(f.sep) != std::string::npos)
@@ -208,31 +237,33 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
                           "Multi_Headings No)");
       break;
     }
-    const auto fl = split(line, f.sep);
-    const std::string first = trim(fl[0]);
+    split_view(line, f.sep, fl);
+    const std::string_view first = trim_view(fl[0]);
     if (first == kMagic || first == "Channels" || first == kEnd || first == "X_Value" || first == "***Start_Special***")
       fail(f, lineno, "a second segment begins here; this reader takes files of one segment (one write, or Multi_Headings No)");
     if (y[0].size() >= static_cast<std::size_t>(limits::kMaxSamples))
       fail(f, lineno, "more than " + format_value(limits::kMaxSamples) + " samples (the limit of one record)");
     for (int i = 0; i < f.channels; ++i) {
       const std::size_t c = value_column(f, i);
-      const std::string cell = c < fl.size() ? trim(fl[c]) : std::string();
+      const std::string_view cell = c < fl.size() ? trim_view(fl[c]) : std::string_view();
       if (cell.empty()) {
         y[i].push_back(std::nan(""));  // no sample: allowed only where every row of the channel is empty
         continue;
       }
       double v = 0;
-      if (!number(f, cell, v)) fail(f, lineno, "column " + std::to_string(c + 1) + " ('" + shorten(f.names[i]) + "'): not a number, got '" + shorten(cell) + "'");
-      if (!std::isfinite(v)) fail(f, lineno, "column " + std::to_string(c + 1) + " ('" + shorten(f.names[i]) + "'): must be finite, got " + cell);
+      if (!number_view(f, cell, v))
+        fail(f, lineno, "column " + std::to_string(c + 1) + " ('" + shorten(f.names[i]) + "'): not a number, got '" + shorten(std::string(cell)) + "'");
+      if (!std::isfinite(v)) fail(f, lineno, "column " + std::to_string(c + 1) + " ('" + shorten(f.names[i]) + "'): must be finite, got " + std::string(cell));
       y[i].push_back(v);
       ++count[i];
     }
     for (std::size_t k = 0; k < x.size(); ++k) {
       if (f.x_columns == "No") break;
       const std::size_t c = f.x_columns == "Multi" ? 2 * k : 0;
-      const std::string cell = c < fl.size() ? trim(fl[c]) : std::string();
+      const std::string_view cell = c < fl.size() ? trim_view(fl[c]) : std::string_view();
       double v = std::nan("");
-      if (!cell.empty() && !number(f, cell, v)) fail(f, lineno, "column " + std::to_string(c + 1) + " (X_Value): not a number, got '" + shorten(cell) + "'");
+      if (!cell.empty() && !number_view(f, cell, v))
+        fail(f, lineno, "column " + std::to_string(c + 1) + " (X_Value): not a number, got '" + shorten(std::string(cell)) + "'");
       x[k].push_back(v);
     }
   }
@@ -279,9 +310,9 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
             throw InputError(one_line("LVM file '" + path + "': channel '" + f.names[i] + "' is sampled at other times than '" +
                                       f.names[first] + "' (row " + std::to_string(k + 1) + "): one record shares one time grid"));
       }
-    tab.t = t;
+    tab.t = std::move(x[f.x_columns == "Multi" ? static_cast<std::size_t>(first) : 0]);  // (t is no longer used)
     if (have_dx && n > 1) {
-      const double step = (t.back() - t.front()) / static_cast<double>(n - 1);
+      const double step = (tab.t.back() - tab.t.front()) / static_cast<double>(n - 1);
       if (std::abs(step - dx) > 1e-6 * dx)
         f.notes.push_back("Delta_X " + format_value(dx) + " s disagrees with the X_Value column's mean step " + format_value(step) +
                           " s (a decimated file keeps the original Delta_X); the X_Value column is used");
@@ -312,6 +343,94 @@ DataTable read_lvm_text(const std::string& text, const std::string& source) {
 bool looks_like_lvm(const std::string& head) { return head.rfind(kMagic, 0) == 0; }
 
 DataTable read_lvm(const std::string& path) { return parse(path).table; }
+
+namespace {
+
+// A number as LabVIEW's "%.17g" writes it: 17 significant digits, which read back to the same
+// double (std::to_chars: no locale, so the decimal mark is always '.').
+void put_number(std::string& out, double v) {
+  char buf[40];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 17);
+  out.append(buf, r.ptr);
+}
+
+// Whether a name or unit reads back as written: no separator, line break or other control
+// character, no blanks at either end (the reader trims cells), UTF-8.
+std::string cell_problem(const std::string& s) {
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7F) return "holds a tab, line break or other control character";
+  if (!s.empty() && (s.front() == ' ' || s.back() == ' ')) return "begins or ends with a blank";
+  if (first_invalid_utf8(s) != std::string::npos) return "is not UTF-8 text";
+  return "";
+}
+
+}  // namespace
+
+void write_lvm(const DataTable& tab, const std::string& path) {
+  const std::string where = "LVM file '" + path + "'";
+  try {
+    check_table(tab);
+  } catch (const InputError& e) {
+    throw InputError(one_line(where + ": cannot be written: " + e.what()));
+  }
+  auto refuse = [&](const std::string& what) { throw InputError(one_line(where + ": cannot be written: " + what)); };
+  for (std::size_t j = 0; j < tab.names.size(); ++j) {
+    const std::string& n = tab.names[j];
+    if (const std::string p = cell_problem(n); !p.empty()) refuse("column name '" + shorten(n) + "' " + p);
+    if (n == "X_Value") refuse("a column named 'X_Value' (the name of the file's time column)");
+    if (const std::string p = cell_problem(tab.unit(static_cast<int>(j))); !p.empty())
+      refuse("the unit '" + shorten(tab.unit(static_cast<int>(j))) + "' of column '" + shorten(n) + "' " + p);
+  }
+  const std::size_t channels = tab.names.size(), n = tab.t.size();
+  // The write's date and time, as LabVIEW stamps a file (local time).
+  char date[32] = "", clock[32] = "";
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  if (localtime_r(&now, &tm)) {
+    std::strftime(date, sizeof date, "%Y/%m/%d", &tm);
+    std::strftime(clock, sizeof clock, "%H:%M:%S", &tm);
+  }
+  std::string out;
+  out.reserve(1024 + n * (channels + 1) * 25);
+  out += std::string(kMagic) + "\t\n";
+  out += "Writer_Version\t2\nReader_Version\t2\nSeparator\tTab\nDecimal_Separator\t.\nMulti_Headings\tNo\n"
+         "X_Columns\tOne\nTime_Pref\tRelative\n";
+  out += std::string("Date\t") + date + "\nTime\t" + clock + "\n";
+  out += std::string(kEnd) + "\t\n\t\n";
+  // The segment header: one value per channel, in the channel's own column.
+  auto row = [&](const char* tag, auto value) {
+    out += tag;
+    for (std::size_t j = 0; j < channels; ++j) {
+      out += '\t';
+      value(j);
+    }
+    out += "\t\n";
+  };
+  out += "Channels\t" + std::to_string(channels) + "\t\n";
+  row("Samples", [&](std::size_t) { out += std::to_string(n); });
+  row("Date", [&](std::size_t) { out += date; });
+  row("Time", [&](std::size_t) { out += clock; });
+  row("Y_Unit_Label", [&](std::size_t j) { out += tab.unit(static_cast<int>(j)); });
+  row("X_Dimension", [&](std::size_t) { out += "Time"; });
+  // X0 and Delta_X: the first time and the mean step (the X_Value column holds every time).
+  const double step = (tab.t.back() - tab.t.front()) / static_cast<double>(n - 1);
+  row("X0", [&](std::size_t) { put_number(out, tab.t.front()); });
+  row("Delta_X", [&](std::size_t) { put_number(out, step); });
+  out += std::string(kEnd) + "\t\n";
+  out += "X_Value";
+  for (const auto& name : tab.names) out += '\t' + name;
+  out += "\tComment\n";
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k % 4096 == 0) check_interrupt();
+    put_number(out, tab.t[k]);
+    for (const auto& c : tab.columns) {
+      out += '\t';
+      put_number(out, c[k]);
+    }
+    out += '\n';
+  }
+  write_text_atomic(path, out);
+}
 
 DataFileInfo describe_lvm(const std::string& path) {
   const Lvm f = parse(path);

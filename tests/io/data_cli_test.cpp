@@ -5,7 +5,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -180,4 +182,81 @@ TEST(DataCli, ConvertNeverOverwritesItsInputNorWritesOntoADirectory) {
   EXPECT_EQ(j.code, 2);
   EXPECT_NE(j.err.find("names the column description"), std::string::npos) << j.err;
   EXPECT_FALSE(fs::exists(dir / "x.json"));
+}
+
+namespace {
+
+std::vector<std::uint64_t> bit_patterns(const std::vector<double>& v) {
+  std::vector<std::uint64_t> b(v.size());
+  std::memcpy(b.data(), v.data(), v.size() * sizeof(double));
+  return b;
+}
+
+void expect_same_record(const DataTable& got, const DataTable& want, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(bit_patterns(got.t), bit_patterns(want.t));
+  EXPECT_EQ(got.names, want.names);
+  EXPECT_EQ(got.units, want.units);
+  ASSERT_EQ(got.columns.size(), want.columns.size());
+  for (std::size_t j = 0; j < want.columns.size(); ++j) EXPECT_EQ(bit_patterns(got.columns[j]), bit_patterns(want.columns[j])) << j;
+}
+
+}  // namespace
+
+// convert writes by the output's extension: .lvm and .tdms hold the record themselves (no JSON
+// beside them), and every time, name, unit and value reads back bit for bit, through either and
+// back to CSV.
+TEST(DataCli, ConvertWritesLvmAndTdmsByTheOutputsExtension) {
+  const fs::path dir = scratch();
+  for (const bool uniform : {true, false}) {
+    DataTable raw;
+    raw.source = "raw.csv";
+    for (int k = 0; k < 30; ++k) {
+      raw.t.push_back(uniform ? k / 2048.0 : k / 3.0 + 1e-9 * (k % 4));
+    }
+    raw.names = {"acc [g]", "F [N]"};
+    raw.columns.resize(2);
+    for (int k = 0; k < 30; ++k) {
+      raw.columns[0].push_back(k % 3 == 0 ? -0.0 : 1.0 / (k + 2.0));
+      raw.columns[1].push_back(k % 2 ? 123456789.123456789 * k : 1e-300 * (k + 1));
+    }
+    write_csv((dir / "raw.csv").string(), raw);
+    const DataTable want = read_data((dir / "raw.csv").string());
+    ASSERT_EQ(want.units, (std::vector<std::string>{"g", "N"}));
+    for (const std::string out : {"out.lvm", "out.tdms", "OUT.TDMS"}) {
+      const Result r = run({"convert", "raw.csv", "-o", out}, dir);
+      ASSERT_EQ(r.code, 0) << r.err;
+      EXPECT_NE(r.err.find("2 channels x 30 samples -> " + out), std::string::npos) << r.err;
+      expect_same_record(read_data((dir / out).string()), want, out);
+    }
+    EXPECT_FALSE(fs::exists(dir / "out.json"));
+    EXPECT_EQ(slurp(dir / "out.lvm").rfind("LabVIEW Measurement", 0), 0u);
+    EXPECT_EQ(slurp(dir / "out.tdms").rfind("TDSm", 0), 0u);
+    // LVM to TDMS, TDMS to LVM and to CSV (with its JSON): the same record every time.
+    ASSERT_EQ(run({"convert", "out.lvm", "-o", "lvm.tdms", "-q"}, dir).code, 0);
+    ASSERT_EQ(run({"convert", "out.tdms", "-o", "tdms.lvm", "-q"}, dir).code, 0);
+    ASSERT_EQ(run({"convert", "out.tdms", "-o", "tdms.csv", "-q"}, dir).code, 0);
+    expect_same_record(read_data((dir / "lvm.tdms").string()), want, "lvm.tdms");
+    expect_same_record(read_data((dir / "tdms.lvm").string()), want, "tdms.lvm");
+    expect_same_record(read_data((dir / "tdms.csv").string()), want, "tdms.csv");
+  }
+}
+
+// An output in a format without a writer, or over the input, exits 2 with one line; nothing written.
+TEST(DataCli, ConvertRefusesAUniversalFileOutputAndItsOwnInput) {
+  const fs::path dir = scratch();
+  scoleid::test::write_file(dir / "data.csv", "t,a\n0,1\n0.5,2\n");
+  for (const std::string out : {"x.uff", "x.unv"}) {
+    const Result r = run({"convert", "data.csv", "-o", out}, dir);
+    EXPECT_EQ(r.code, 2) << out;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("no Universal File writer"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / out));
+  }
+  ASSERT_EQ(run({"convert", "data.csv", "-o", "d.lvm", "-q"}, dir).code, 0);
+  const std::string lvm = slurp(dir / "d.lvm");
+  const Result r = run({"convert", "./d.lvm", "-o", "d.lvm"}, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("is an input of this run"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir / "d.lvm"), lvm);
 }

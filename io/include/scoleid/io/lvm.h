@@ -34,4 +34,16 @@ DataTable read_lvm(const std::string& path);
 DataTable read_lvm_text(const std::string& text, const std::string& source);
 DataFileInfo describe_lvm(const std::string& path);
 
+// The table as LabVIEW's "Write To Measurement File" writes one segment: file header (Writer and
+// Reader_Version 2, Separator Tab, Decimal_Separator '.', Multi_Headings No, X_Columns One,
+// Time_Pref Relative, the write's Date and Time), segment header (Channels; per channel Samples,
+// Date, Time, Y_Unit_Label = the column's unit, X_Dimension Time, X0 = the first time, Delta_X =
+// the mean step), the row X_Value, names, Comment, then one row per sample: the time in seconds
+// and each value, 17 significant digits, so read_lvm gives back every time and value bit for bit.
+// Written to a temporary file and renamed into place. InputError naming the path for a table that
+// fails check_table or that the format cannot hold: a name or unit with a tab, line break or other
+// control character, with a blank at either end (cells are read trimmed), or not UTF-8, and a
+// column named X_Value.
+void write_lvm(const DataTable& tab, const std::string& path);
+
 }  // namespace scoleid::io
