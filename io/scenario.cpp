@@ -1,5 +1,6 @@
 #include "scoleid/io/scenario.h"
 #include "scoleid/io/scenario_fields.h"
+#include "scoleid/io/scenario_schema.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -41,6 +42,21 @@ const char* to_string(EndCondition e) {
 
 namespace {
 
+// The live ScenarioFieldRecorder's set on this thread (scenario_schema.h), or none.
+thread_local std::set<std::string>* recorded_fields = nullptr;
+
+// Notes a field's path in the recorder's set, list indices written `[]`.
+void note_field(const std::string& path) {
+  std::string p;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    p += path[i];
+    std::size_t j = i + 1;
+    while (path[i] == '[' && j < path.size() && path[j] >= '0' && path[j] <= '9') ++j;
+    if (j > i + 1 && j < path.size() && path[j] == ']') i = j - 1;
+  }
+  recorded_fields->insert(p);
+}
+
 // Reads typed fields from a YAML map, naming `source` and the dotted field path on any error,
 // and rejects keys the schema does not know (a typo must not silently fall back to a default).
 class Reader {
@@ -58,6 +74,7 @@ public:
 
   bool has(const std::string& key) {
     seen_.insert(key);
+    if (recorded_fields) note_field(field(key));
     return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
   }
   // The field holds exactly this text (a keyword such as "auto" where a number may stand).
@@ -66,6 +83,7 @@ public:
   }
   YAML::Node child(const std::string& key) {
     seen_.insert(key);
+    if (recorded_fields) note_field(field(key));
     return node_ && node_.IsMap() ? node_[key] : YAML::Node();
   }
   std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
@@ -772,10 +790,13 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     fail_field(source, "identification.step_tolerance",
                "must be below 1 (a relative parameter change: at 1 or more any first step passes it)", format_value(id.step_tolerance));
   id.continuation_misfit = r.nonneg("continuation_misfit", id.continuation_misfit);
-  id.band = r.numbers("band", {});
+  if (r.is_scalar("band", "auto") || r.is_scalar("band", "none"))
+    id.band_mode = r.str("band", "auto") == "none" ? IdentificationSpec::BandMode::None : IdentificationSpec::BandMode::Auto;
+  else
+    id.band = r.numbers("band", {});
   if (!id.band.empty()) {
     if (id.band.size() != 2)
-      fail_field(source, "identification.band", "must be [f_lo, f_hi] in Hz (two numbers)", std::to_string(id.band.size()) + " numbers");
+      fail_field(source, "identification.band", "must be [f_lo, f_hi] in Hz (two numbers), auto or none", std::to_string(id.band.size()) + " numbers");
     if (!(std::isfinite(id.band[0]) && id.band[0] >= 0.0))
       fail_field(source, "identification.band[0]", "must be a frequency >= 0 Hz (0: low-pass only)", format_value(id.band[0]));
     if (!(std::isfinite(id.band[1]) && id.band[1] > id.band[0]))
@@ -903,6 +924,8 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
 
 }  // namespace
 
+ScenarioFieldRecorder::ScenarioFieldRecorder() : outer_(recorded_fields) { recorded_fields = &fields_; }
+ScenarioFieldRecorder::~ScenarioFieldRecorder() { recorded_fields = outer_; }
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source) {
   check_utf8(yaml_text, source);
@@ -960,7 +983,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
       Reader d(r.child("data"), source, "data");
       sc.data.time_column = d.str("time_column", "");
       sc.data.time_unit = d.str("time_unit", "");
-      sc.data.sample_rate = d.positive("sample_rate", 0.0);
+      if (d.has("sample_rate")) sc.data.sample_rate = d.positive("sample_rate", 0.0);  // (absent: not stated)
       if (!sc.data.time_unit.empty())
         if (const auto why = units::problem_with(sc.data.time_unit, units::Quantity::Time))
           fail_field(source, "data.time_unit", "must be a unit of time (" + *why + ")", "'" + sc.data.time_unit + "'");
@@ -1176,7 +1199,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"method", to_string(id.method)}, {"max_iterations", id.max_iterations},
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
-                         {"band", id.band.empty() ? json(nullptr) : json(id.band)},
+                         {"band", !id.band.empty() ? json(id.band) : json(id.band_mode == IdentificationSpec::BandMode::None ? "none" : "auto")},
                          {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
                          {"time_step", id.time_step}, {"step_rule", to_string(id.step_rule)}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},

@@ -496,3 +496,20 @@ TEST(Scenario, ConditioningParsesChecksAndRoundTrips) {
   EXPECT_NE(error_of(head + "{offset: {median: 1}}" + tail).find("inputs[0].conditioning.offset as a map must be {mean_before: T}"),
             std::string::npos);
 }
+
+// A data section that states only the time column leaves the sample rate unstated (0), and a
+// stated rate must be positive.
+TEST(Scenario, DataSectionWithoutSampleRateLeavesItUnstated) {
+  const std::string base = "name: s\nstructure: beam\nbeam: {length: 1, EI: 1, rho_A: 1}\n"
+                           "sensors: [{name: a, at: beam, kind: displacement, location: 1}]\n";
+  const Scenario sc = parse_scenario(base + "data: {time_column: \"Time [ms]\"}\n", "s.yaml");
+  EXPECT_EQ(sc.data.time_column, "Time [ms]");
+  EXPECT_EQ(sc.data.sample_rate, 0.0);
+  EXPECT_EQ(parse_scenario(base + "data: {sample_rate: 2048}\n", "s.yaml").data.sample_rate, 2048.0);
+  try {
+    parse_scenario(base + "data: {sample_rate: -1}\n", "s.yaml");
+    FAIL() << "a negative rate was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("data.sample_rate"), std::string::npos) << e.what();
+  }
+}

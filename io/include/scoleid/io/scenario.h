@@ -1,4 +1,5 @@
 #pragma once
+// Every field for users, by its path, with its unit, default and range: docs/scenario.md.
 // The scenario: one YAML document that both the Simbody truth (model/) and the finite-element
 // identifier (identify/) read. Each struct maps one-to-one onto a YAML section; every field has
 // its default written here, and parse errors name the source, the field path and the value.
@@ -278,6 +279,11 @@ struct IdentificationSpec {
   // record): inputs and outputs pass the same causal Butterworth band-pass
   // (identify/include/scoleid/identify/inverse/band_filter.h); f_lo = 0: low-pass only.
   std::vector<double> band;
+  // `band: auto` (the default, with no band stated): a measured record's band is chosen from its
+  // spectral peaks and its sampling (docs/data.md §2.4); a synthetic record is fitted whole.
+  // `band: none`: the whole record. A stated band always wins.
+  enum class BandMode { Auto, None };
+  BandMode band_mode = BandMode::Auto;
   std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (step_rule)
   // The automatic step's rule (docs/theory.md §5.2): "parameters" resolves flexible modes up to
