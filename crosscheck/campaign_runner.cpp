@@ -141,6 +141,7 @@ json execute_case(const Campaign& c, const CampaignStore& store, std::size_t k, 
     // The truth is noise-free: the identifier is told the noise it is given, no other.
     io::Scenario sc = c.points[kc.point].scenario;
     for (auto& s : sc.sensors) s.noise_std = 0.0;
+    sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // (the noise added below comes after any band)
     auto p = identify::make_problem(sc, csv);
     if (sweep_threads > 0) p->objective_options.sweep_threads = sweep_threads;
     if (kc.seed >= 0) add_noise(*p, c.noise_relative, case_noise_seed(c, kc));

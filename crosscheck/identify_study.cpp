@@ -70,7 +70,9 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
   st.truths = same ? reuse : run_truth_levels(scenario, st.segments, truth_root, !opt.with_noise, opt.progress);
   for (std::size_t l = 0; l < st.truths.size(); ++l) {
     if (opt.progress) std::fprintf(stderr, "scole-crosscheck: identifying from the %d-segment truth\n", st.segments[l]);
-    std::shared_ptr<identify::Problem> p = identify::make_problem(scenario, st.truths[l].csv);
+    io::Scenario sc = scenario;
+    sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // each level fitted whole, as the FE run below
+    std::shared_ptr<identify::Problem> p = identify::make_problem(sc, st.truths[l].csv);
     identify::RunResult res;
     st.runs.push_back(run_one(p, st.segments[l], res));
     if (l == 0)

@@ -256,6 +256,7 @@ json suite_case(const SuiteFile& f, std::size_t k, const std::string& out, const
   // The truth is noise-free: the identifier is told no noise level it does not have.
   io::Scenario id_sc = sc;
   for (auto& s : id_sc.sensors) s.noise_std = 0.0;
+  id_sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // (the noise added below comes after any band)
   auto p = identify::make_problem(id_sc, truths.front().csv);
   json row = identify_row(std::move(p));
   row["label"] = c.label;

@@ -78,6 +78,7 @@ AtTruth at_truth(const io::Scenario& scenario, const std::string& csv, int eleme
   // the others from the structure, not from the identifier's starting guesses.
   sc.identification.initial.clear();
   for (auto& in : sc.inputs) in.signal_from = io::SignalFrom::Scenario;
+  sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // trajectories compared whole
   a.p = identify::make_problem(sc, csv);
   const auto& names = a.p->params->names();
   a.q.resize(static_cast<Eigen::Index>(names.size()));

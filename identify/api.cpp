@@ -54,7 +54,8 @@ std::string Identification::verdict() const {
 }
 
 std::vector<std::string> Identification::warnings() const {
-  std::vector<std::string> w;
+  std::vector<std::string> w = problem_->warnings;  // what the record says of its channels
+  w.insert(w.end(), result_.start_check.warnings.begin(), result_.start_check.warnings.end());
   const auto& id = result_.ident.identifiable;
   if (!id.empty() && std::none_of(id.begin(), id.end(), [](bool b) { return b; }))
     w.push_back("none of the " + std::to_string(id.size()) +

@@ -172,6 +172,9 @@ void print_problem(const identify::Problem& problem, bool from_file) {
                  st.name.c_str(), st.jump, st.at, 0.5 * st.sample,
                  st.scenario_signal ? "; the scenario gives its signal: signal_from: scenario drives the model with it" : "");
   }
+  for (const auto& w : problem.warnings) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
+  if (!problem.band_note.empty())
+    std::fprintf(stderr, "scole-identify: band %s (identification.band: [f_lo, f_hi] states one, none fits the whole record)\n", problem.band_note.c_str());
 }
 
 // --export-model FILE: a .json or .mat file, no input of the run and outside --out, in a

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <sstream>
 
@@ -9,6 +10,22 @@ namespace scoleid::io {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+double cubic_table_gain_error(double x) {
+  std::complex<double> g = 0.0;
+  constexpr int n = 512;  // midpoint rule in μ on a smooth integrand
+  for (int k = 0; k < n; ++k) {
+    const double mu = (k + 0.5) / n;
+    const double L[4] = {-mu * (mu - 1) * (mu - 2) / 6, (mu + 1) * (mu - 1) * (mu - 2) / 2, -(mu + 1) * mu * (mu - 2) / 2,
+                         (mu + 1) * mu * (mu - 1) / 6};
+    for (int j = -1; j <= 2; ++j) g += L[j + 1] * std::exp(std::complex<double>(0.0, 2.0 * kPi * x * (j - mu)));
+  }
+  return std::abs(g / static_cast<double>(n) - 1.0);
+}
+
+namespace {
 
 // The 4-point Lagrange cubic through the samples around t (the stencil shifted inside the range at
 // the ends; linear below four samples), constant beyond the ends.

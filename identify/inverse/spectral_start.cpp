@@ -28,9 +28,16 @@ VectorXd log_frequencies(const StructuralModel& model, const Parameterization& p
   return Eigen::Map<VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
 }
 
-}  // namespace
+// The sensors' Hann-windowed periodograms, each normalised by its total power, summed; zero-padded
+// twice over. `first` is the lowest bin with four cycles in the record, clear of the window's
+// main lobe about zero.
+struct SummedSpectrum {
+  std::vector<double> power;
+  double df = 0.0;
+  std::size_t first = 0;
+};
 
-std::optional<double> dominant_frequency(const std::vector<double>& t, const MatrixXd& values) {
+std::optional<SummedSpectrum> summed_spectrum(const std::vector<double>& t, const MatrixXd& values) {
   const std::size_t N = std::min<std::size_t>(t.size(), kMaxSamples);
   if (N < 16 || values.rows() < static_cast<Eigen::Index>(N)) return std::nullopt;
   const double dt = (t[N - 1] - t[0]) / static_cast<double>(N - 1);
@@ -38,7 +45,9 @@ std::optional<double> dominant_frequency(const std::vector<double>& t, const Mat
   std::size_t nfft = 1;
   while (nfft < 2 * N) nfft <<= 1;  // zero-padded twice over: the peak between bins
   Eigen::FFT<double> fft;
-  std::vector<double> power(nfft / 2 + 1, 0.0), x(nfft);
+  SummedSpectrum s;
+  s.power.assign(nfft / 2 + 1, 0.0);
+  std::vector<double> x(nfft);
   std::vector<std::complex<double>> X;
   for (Eigen::Index k = 0; k < values.cols(); ++k) {
     double mean = 0.0;
@@ -50,22 +59,94 @@ std::optional<double> dominant_frequency(const std::vector<double>& t, const Mat
     }
     fft.fwd(X, x);
     double total = 0.0;
-    for (std::size_t b = 1; b < power.size(); ++b) total += std::norm(X[b]);
+    for (std::size_t b = 1; b < s.power.size(); ++b) total += std::norm(X[b]);
     if (!(total > 0) || !std::isfinite(total)) continue;
-    for (std::size_t b = 1; b < power.size(); ++b) power[b] += std::norm(X[b]) / total;
+    for (std::size_t b = 1; b < s.power.size(); ++b) s.power[b] += std::norm(X[b]) / total;
   }
-  const double df = 1.0 / (static_cast<double>(nfft) * dt), T = dt * static_cast<double>(N - 1);
-  // At least four cycles in the record, and clear of the window's main lobe about zero.
-  const auto first = static_cast<std::size_t>(std::ceil(4.0 / T / df));
-  std::size_t best = 0;
-  for (std::size_t b = std::max<std::size_t>(first, 2); b + 1 < power.size(); ++b)
-    if (power[b] > power[b - 1] && power[b] >= power[b + 1] && (best == 0 || power[b] > power[best])) best = b;
-  if (best == 0 || !(power[best] > 0)) return std::nullopt;
-  // The parabola through the peak's three log-power bins.
-  const double a = std::log(power[best - 1]), b = std::log(power[best]), c = std::log(power[best + 1]);
-  const double denom = a - 2.0 * b + c;
+  s.df = 1.0 / (static_cast<double>(nfft) * dt);
+  const double T = dt * static_cast<double>(N - 1);
+  s.first = std::max<std::size_t>(static_cast<std::size_t>(std::ceil(4.0 / T / s.df)), 2);
+  return s;
+}
+
+// The peak at bin b refined by the parabola through its three log-power bins.
+double refined(const SummedSpectrum& s, std::size_t b) {
+  const double a = std::log(s.power[b - 1]), c0 = std::log(s.power[b]), c = std::log(s.power[b + 1]);
+  const double denom = a - 2.0 * c0 + c;
   const double shift = denom < 0 ? 0.5 * (a - c) / denom : 0.0;
-  return (static_cast<double>(best) + std::clamp(shift, -0.5, 0.5)) * df;
+  return (static_cast<double>(b) + std::clamp(shift, -0.5, 0.5)) * s.df;
+}
+
+}  // namespace
+
+std::optional<double> dominant_frequency(const std::vector<double>& t, const MatrixXd& values) {
+  const auto s = summed_spectrum(t, values);
+  if (!s) return std::nullopt;
+  const auto& power = s->power;
+  std::size_t best = 0;
+  for (std::size_t b = s->first; b + 1 < power.size(); ++b)
+    if (power[b] > power[b - 1] && power[b] >= power[b + 1] && (best == 0 || power[b] > power[best])) best = b;
+  if (best == 0 || !(power[best] > 0) || !(power[best - 1] > 0) || !(power[best + 1] > 0)) return std::nullopt;
+  return refined(*s, best);
+}
+
+std::vector<SpectralPeak> spectral_peaks(const std::vector<double>& t, const MatrixXd& values, std::size_t max_peaks) {
+  std::vector<SpectralPeak> out;
+  const auto s = summed_spectrum(t, values);
+  if (!s) return out;
+  const auto& power = s->power;
+  const std::size_t n = power.size();
+  std::vector<SpectralPeak> all;
+  for (std::size_t b = s->first; b + 1 < n; ++b) {
+    if (!(power[b] > power[b - 1] && power[b] >= power[b + 1] && power[b - 1] > 0 && power[b + 1] > 0)) continue;
+    // the largest within ±3 % of its frequency (at least ±2 bins): not a ripple on a peak's skirt
+    const auto w = std::max<std::size_t>(2, static_cast<std::size_t>(0.03 * static_cast<double>(b)));
+    bool largest = true;
+    for (std::size_t i = b > w ? b - w : 0; i <= std::min(n - 1, b + w) && largest; ++i)
+      if (i != b && power[i] > power[b]) largest = false;
+    if (largest) all.push_back({refined(*s, b), power[b]});
+  }
+  if (all.empty()) return out;
+  std::sort(all.begin(), all.end(), [](const SpectralPeak& a, const SpectralPeak& b) { return a.power > b.power; });
+  for (const auto& pk : all)
+    if (pk.power >= 1e-3 * all.front().power && out.size() < max_peaks) out.push_back(pk);
+  return out;
+}
+
+std::optional<PeakMatch> match_peaks(const std::vector<SpectralPeak>& data, const std::vector<SpectralPeak>& model) {
+  constexpr double kTol = 0.05, kMaxShift = 10.0;
+  std::optional<PeakMatch> best;
+  double best_score = 0.0;
+  for (const auto& dj : data)
+    for (const auto& mi : model) {
+      const double r = dj.f / mi.f;
+      if (!(r >= 1.0 / kMaxShift && r <= kMaxShift)) continue;
+      double score = 0.0, sum_w = 0.0, sum_wlog = 0.0, strongest = 0.0;
+      PeakMatch m;
+      for (const auto& mk : model) {
+        const SpectralPeak* near = nullptr;
+        for (const auto& dl : data)
+          if (!near || std::abs(std::log(r * mk.f / dl.f)) < std::abs(std::log(r * mk.f / near->f))) near = &dl;
+        if (!near || !(std::abs(std::log(r * mk.f / near->f)) < kTol)) continue;
+        const double w = std::sqrt(mk.power * near->power);
+        score += w;
+        sum_w += w;
+        sum_wlog += w * std::log(near->f / mk.f);
+        ++m.pairs;
+        if (w > strongest) strongest = w, m.data_hz = near->f, m.model_hz = mk.f;
+      }
+      // the shift that lines up the most peaks; between as many, the stronger; between equals, the smaller
+      const bool more = best && m.pairs > best->pairs, as_many = best && m.pairs == best->pairs;
+      const bool better = !best || more ||
+                          (as_many && (score > best_score * (1 + 1e-9) ||
+                                       (score >= best_score * (1 - 1e-9) && std::abs(std::log(r)) < std::abs(std::log(best->ratio)))));
+      if (m.pairs > 0 && better) {
+        m.ratio = std::exp(sum_wlog / sum_w);
+        best = m;
+        best_score = score;
+      }
+    }
+  return best;
 }
 
 Spectrum power_spectrum(const std::vector<double>& t, const MatrixXd& values) {
@@ -99,15 +180,21 @@ Spectrum power_spectrum(const std::vector<double>& t, const MatrixXd& values) {
 SpectralStart spectral_start(const StructuralModel& model, const Parameterization& params, const VectorXd& q0,
                              const Measurements& data, const MatrixXd& predicted) {
   SpectralStart out;
-  const auto fd = dominant_frequency(data.t, data.z);
-  const auto fm = dominant_frequency(data.t, predicted);
-  if (!fd || !fm) {
-    out.note = !fd ? "the record has no spectral peak of four cycles or more" : "the model's response at the start has no spectral peak";
+  const auto pd = spectral_peaks(data.t, data.z), pm = spectral_peaks(data.t, predicted);
+  if (pd.empty() || pm.empty()) {
+    out.note = pd.empty() ? "the record has no spectral peak of four cycles or more" : "the model's response at the start has no spectral peak";
     return out;
   }
-  out.data_hz = *fd;
-  out.model_hz = *fm;
-  const double log_r = std::log(*fd / *fm);
+  const auto match = match_peaks(pd, pm);
+  if (!match) {
+    out.note = "no shift within a factor 10 lines the model's peaks up with the record's";
+    return out;
+  }
+  out.data_hz = match->data_hz;
+  out.model_hz = match->model_hz;
+  out.ratio = match->ratio;
+  out.pairs = match->pairs;
+  const double log_r = std::log(match->ratio);
   const VectorXd f0 = log_frequencies(model, params, q0, 3);
   const Eigen::Index n = f0.size(), P = q0.size();
   if (n == 0 || P == 0) {

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "scoleid/identify/inverse/spectral_start.h"
+#include "scoleid/identify/run/start_check.h"
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
@@ -373,13 +374,60 @@ OptimizerSummary explained_by_level(const Runner& run, const VectorXd& q, int bl
   return s;
 }
 
-// The first attempt: plain or from the ladder, with the prior's given or discrepancy weight.
-void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, bool from_ladder) {
+// The spectral start (spectral_start.h) from q0; q empty when there is none or it is q0 within 1 %.
+SpectralStart spectral_start_of(AttemptsContext& c, const VectorXd& q0) {
+  const Problem& p = c.problem;
+  SpectralStart ss;
+  try {
+    c.objective.set_horizon(c.objective.data_end());
+    ss = spectral_start(p.model(), *p.params, q0, p.data, c.objective.predict(q0));
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    ss.q.resize(0);
+    ss.note = e.what();
+  }
+  if (ss.q.size() == q0.size() && std::abs(std::log(ss.ratio)) < 0.01) {
+    ss.q.resize(0);
+    ss.note = "the model's peak is within 1 % of the record's";
+  }
+  return ss;
+}
+
+std::string spectral_label(const AttemptsContext& c, const SpectralStart& ss) {
+  return "spectral start (x" + io::format_value(ss.ratio) + ", " + std::to_string(ss.pairs) + (ss.pairs == 1 ? " peak" : " peaks") +
+         " lined up; " + io::format_value(ss.model_hz) + " Hz -> " + io::format_value(ss.data_hz) + " Hz), " + io::to_string(c.options.method);
+}
+
+// The first attempt: plain or from the ladder, with the prior's given or discrepancy weight. On a
+// measured record without sections the plain attempt starts from the spectral start when it moves
+// the frequencies by more than 1 % (docs/theory.md §7.6): a lab's handbook start is seldom within
+// the few per cent of frequency a lightly damped record forgives, and a fit started out of phase
+// spends its first steps raising the damping to shrink a response it cannot line up. Returns
+// whether it did.
+bool first_attempt(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, bool from_ladder) {
   AttemptsContext& c = run.c;
   VectorXd start = r.initial;
   std::string label = std::string("plain ") + io::to_string(c.options.method);
   int iterations = 0;
   std::vector<RunResult::Attempt::Level> levels;
+  bool spectral = false;
+  if (c.problem.measured && families.empty() && !from_ladder) {
+    const SpectralStart ss = spectral_start_of(c, r.initial);
+    if (ss.q.size() == r.initial.size()) {
+      start = ss.q;
+      label = spectral_label(c, ss);
+      spectral = true;
+      if (c.verbose)
+        io::progress("spectral start: the model's peaks at the start x%.4g line %d of the record's up (%.6g Hz -> %.6g Hz)\n", ss.ratio,
+                     ss.pairs, ss.model_hz, ss.data_hz);
+    }
+  }
+  if (c.problem.measured && c.problem.scenario.identification.model == io::Model::Linear) {
+    r.start_check = check_start(c.problem, c.objective, start);
+    if (c.verbose)
+      for (const auto& w : r.start_check.warnings) io::progress("warning: %s\n", w.c_str());
+  }
   if (from_ladder) {
     if (c.verbose) io::progress("%zu sections: coarse to fine from the start\n", longest(families));
     // With a prior the attempt goes on from an explained level on the full parameterization.
@@ -413,6 +461,7 @@ void first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   const bool explained = r.summary.termination == OptimizerSummary::Termination::DataExplained;  // cost taken
   r.fit = c.fit_at(r.summary.q, explained ? A::Nothing : families.empty() && r.summary.converged() ? A::CostAndRefits : A::Cost);
   r.attempts.push_back(attempt_record(c, label, r.summary, r.fit, iterations + r.summary.iterations_done, std::move(levels)));
+  return spectral;
 }
 
 // The estimate with every sectional family smoothed once by the kernel (¼, ½, ¼) along its sections
@@ -429,26 +478,6 @@ VectorXd smoothed(const VectorXd& q, const std::vector<std::vector<int>>& famili
     }
   }
   return out;
-}
-
-// The spectral start (spectral_start.h) from q0; q empty when there is none or it is q0 within 1 %.
-SpectralStart spectral_start_of(AttemptsContext& c, const VectorXd& q0) {
-  const Problem& p = c.problem;
-  SpectralStart ss;
-  try {
-    c.objective.set_horizon(c.objective.data_end());
-    ss = spectral_start(p.model(), *p.params, q0, p.data, c.objective.predict(q0));
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception& e) {
-    ss.q.resize(0);
-    ss.note = e.what();
-  }
-  if (ss.q.size() == q0.size() && std::abs(std::log(ss.data_hz / ss.model_hz)) < 0.01) {
-    ss.q.resize(0);
-    ss.note = "the model's peak is within 1 % of the record's";
-  }
-  return ss;
 }
 
 // One restart: from the starting point ("coarse-to-fine", "plain", "cautious-continuation") or from
@@ -482,11 +511,10 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     s = run.minimize_from(lad.q, c.options);
   } else if (how == "spectral") {
     const SpectralStart& ss = spectral;
-    label = "spectral start (" + io::format_value(ss.model_hz) + " Hz -> " + io::format_value(ss.data_hz) + " Hz), " +
-            io::to_string(c.options.method);
+    label = spectral_label(c, ss);
     if (c.verbose)
-      io::progress("spectral start: the record's peak at %.6g Hz, the model's at %.6g Hz from the starting point\n", ss.data_hz,
-                  ss.model_hz);
+      io::progress("spectral start: the model's peaks at the start x%.4g line %d of the record's up (%.6g Hz -> %.6g Hz)\n", ss.ratio,
+                   ss.pairs, ss.model_hz, ss.data_hz);
     run.header();
     s = run.minimize_from(ss.q, c.options);
   } else {
@@ -515,7 +543,7 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   const Runner run{c, Table(*p.params, p.params->names().size() <= 3 && p.params->paper_form())};
   const auto families = section_families(r.names);
   const bool from_ladder = ladder_first(p.scenario.identification, longest(families), p.scenario.source);
-  first_attempt(run, r, families, from_ladder);
+  const bool spectral_first = first_attempt(run, r, families, from_ladder);
   // The restarts, each tried when its condition holds, up to identification.restarts of them:
   //  - the other start of a sectional family (coarse to fine after a plain run, the plain run after
   //    the ladder: a coarse level can land in a basin the full profile does not leave — beam-ei8
@@ -543,7 +571,8 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   // the assessment flags the parameters they disagree on (assessment.cpp, the other-minimum test).
   std::vector<std::string> strategies;
   if (!families.empty()) strategies.insert(strategies.end(), {from_ladder ? "plain" : "coarse-to-fine", "smoothed"});
-  strategies.insert(strategies.end(), {"spectral", "cautious-continuation"});
+  // (after a spectral first attempt, the plain one from the stated start takes the spectral's place)
+  strategies.insert(strategies.end(), {spectral_first ? "plain" : "spectral", "cautious-continuation"});
   int done = 0;
   SpectralStart spectral;
   auto failed = [&r]() { return !(r.summary.converged() && r.fit.explains_data); };
@@ -558,7 +587,7 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
       if (failed()) spectral = spectral_start_of(c, r.initial);
       wanted = failed() && spectral.q.size() == r.initial.size();
     }
-    else if (how == "cautious-continuation") wanted = failed();
+    else if (how == "cautious-continuation" || (how == "plain" && spectral_first)) wanted = failed();
     else
       wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
     if (!wanted) continue;

@@ -228,6 +228,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
       bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
           std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",
           r.scenario);
+    sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // (a joint run takes no band; above)
     ep->runs.push_back(make_problem(sc, r.data));
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
   }

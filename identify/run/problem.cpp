@@ -12,6 +12,7 @@
 
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/inverse/band_filter.h"
+#include "scoleid/identify/inverse/spectral_start.h"
 #include "scoleid/identify/fe/scole_model.h"
 #include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/io/error.h"
@@ -939,6 +940,121 @@ void apply_band(Problem& p) {
   for (double& sd : p.noise_std) sd *= std::sqrt(p.band_gain);
 }
 
+// identification.band: auto on a measured record (docs/data.md §2.4). The band's top stays where
+// the model can follow what it is given: an input read from a data column reaches the model,
+// once band-filtered, through the 4-point Lagrange cubic through its samples (io::Signal's
+// cubic-table), whose gain at x = f·Δt is G(x) (io::cubic_table_gain_error):
+// |G − 1| is 0.25 % at x = 0.104, 1 % at 0.146, 5.4 % at 0.23. Peaks are kept where that error is
+// at most half the declared model error a (1 % unless stated), and the top edge stays where it is
+// at most a; without such an input both limits are 0.45/Δt, under the Nyquist frequency. Below
+// the limit the record's spectral peaks (spectral_start.h, at least 10⁻³ of the strongest) are
+// kept; the top edge lies midway (in log frequency) between the highest peak kept and the next one
+// above, if any, and at least 10 % above the peak kept (else that peak is dropped, a skirt that
+// cuts a mode being worse than one without it); the bottom edge at half the lowest peak (an
+// offset, a drift and a transducer's low-frequency noise stay out). No band when no peak lies below
+// the limit, a sensor has no noise level, the times are not uniform, or a data input steps within
+// a sample (not an impact) or at the record's first sample: the run says which.
+// The x = f·Δt below which io::cubic_table_gain_error stays within `error` (it grows monotonically up to 0.45).
+double lagrange_limit(double error) {
+  double lo = 0.0, hi = 0.45;
+  if (io::cubic_table_gain_error(hi) <= error) return hi;
+  for (int it = 0; it < 60; ++it) (io::cubic_table_gain_error(0.5 * (lo + hi)) > error ? hi : lo) = 0.5 * (lo + hi);
+  return lo;
+}
+
+void choose_band(Problem& p) {
+  auto& id = p.scenario.identification;
+  if (!p.measured || !id.band.empty() || id.band_mode != io::IdentificationSpec::BandMode::Auto || id.model != io::Model::Linear) return;
+  const auto& t = p.data.t;
+  auto hz = [](double f) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", f);
+    return std::string(b);
+  };
+  auto none = [&](const std::string& why) { p.band_note = "auto: the whole record (" + why + ")"; };
+  if (t.size() < 64) return none("fewer than 64 samples");
+  for (std::size_t k = 0; k < p.noise_std.size(); ++k)
+    if (!(p.noise_std[k] > 0)) return none("sensor '" + p.scenario.sensors[k].name + "' has no noise level; a band needs every sensor's");
+  if (!io::uniform_grid(t).uniform) return none("the times are not uniform");
+  // A data input that steps within a sample (not an impact): the band's filter would turn its
+  // jump into a band-limited edge the cubic reading rings on, where the linear reading keeps it
+  // within its sample.
+  for (const auto& st : p.columns.stepped_inputs)
+    if (st.pulse_samples == 0) return none("input '" + st.name + "' steps within a sample");
+  // (the same for an input that is not at rest at the record's first sample: it jumps there from
+  // the rest the model starts at)
+  for (std::size_t i = 0; i < p.scenario.inputs.size() && i < p.signals.size(); ++i) {
+    const auto& from_data = p.columns.inputs_from_data;
+    if (std::find(from_data.begin(), from_data.end(), p.scenario.inputs[i].name) == from_data.end()) continue;
+    double peak = 0.0;
+    for (double ti : t) peak = std::max(peak, std::abs(p.signals[i](ti)));
+    if (std::abs(p.signals[i](t.front())) > 0.05 * peak)
+      return none("input '" + p.scenario.inputs[i].name + "' is not at rest at the record's first sample: it steps there from the model's rest");
+  }
+  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  const double allowance = id.model_error > 0 ? id.model_error : 0.01;
+  const bool data_input = !p.columns.inputs_from_data.empty();
+  const double f_peaks = (data_input ? lagrange_limit(0.5 * allowance) : 0.45) / dt;
+  const double f_limit = (data_input ? lagrange_limit(allowance) : 0.45) / dt;
+  std::vector<SpectralPeak> peaks = spectral_peaks(t, p.data.z, 12);
+  std::sort(peaks.begin(), peaks.end(), [](const SpectralPeak& a, const SpectralPeak& b) { return a.f < b.f; });
+  std::vector<double> kept;
+  double above = 0.0;
+  for (const auto& pk : peaks) {
+    if (pk.f < f_peaks) kept.push_back(pk.f);
+    else if (above == 0.0) above = pk.f;
+  }
+  double f_hi = 0.0;
+  while (!kept.empty()) {
+    f_hi = above > 0 ? std::min(f_limit, std::sqrt(kept.back() * above)) : f_limit;
+    if (f_hi >= 1.1 * kept.back()) break;
+    above = kept.back();
+    kept.pop_back();
+  }
+  const std::string limit = !data_input ? hz(f_limit) + " Hz (0.45 of the sample rate)"
+                                        : hz(f_limit) + " Hz, peaks below " + hz(f_peaks) +
+                                              " Hz (where the data input's cubic between samples departs from it by the model error " +
+                                              hz(100 * allowance) + " %, and half that)";
+  if (kept.empty()) return none("no spectral peak below " + hz(f_peaks) + " Hz");
+  id.band = {0.5 * kept.front(), f_hi};
+  std::string list;
+  for (double f : kept) list += (list.empty() ? "" : ", ") + hz(f);
+  p.band_note = "auto: [" + hz(id.band[0]) + ", " + hz(id.band[1]) + "] Hz around the record's peaks at " +
+                list + " Hz" + (above > 0 ? "; the next, " + hz(above) + " Hz, left out" : std::string()) +
+                "; the top at most " + limit;
+}
+
+// An input read from the data that oscillates (20 or more crossings of its mean) about a level
+// that is not zero (95 % of its samples on that level's side of zero) carries a static offset the
+// model would take as a force — a shaker's load cell reads a force that reverses; a step or a slew
+// crosses its mean a few times and is left alone (docs/data.md §2.5): a warning naming it and the
+// conditioning that removes it. Read before the band, whose high-pass would hide it.
+void input_offsets(Problem& p) {
+  const auto& t = p.data.t;
+  if (!p.measured || t.size() < 4) return;
+  const auto& from_data = p.columns.inputs_from_data;
+  for (std::size_t i = 0; i < p.scenario.inputs.size() && i < p.signals.size(); ++i) {
+    const auto& in = p.scenario.inputs[i];
+    if (std::find(from_data.begin(), from_data.end(), in.name) == from_data.end()) continue;
+    std::vector<double> x(t.size());
+    double mean = 0.0, ms = 0.0;
+    for (std::size_t k = 0; k < t.size(); ++k) mean += (x[k] = p.signals[i](t[k])) / static_cast<double>(t.size());
+    for (double v : x) ms += (v - mean) * (v - mean) / static_cast<double>(t.size());
+    std::size_t crossings = 0, same_side = 0;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      if (k > 0 && (x[k] - mean) * (x[k - 1] - mean) < 0) ++crossings;
+      if (x[k] * mean > 0) ++same_side;
+    }
+    if (crossings < 20 || !(static_cast<double>(same_side) >= 0.95 * static_cast<double>(x.size())) || !(ms > 0)) continue;
+    char b[160];
+    std::snprintf(b, sizeof b, "input '%s' has a mean of %.3g %s (%.3g times its RMS about the mean)", in.name.c_str(), mean, in.unit.c_str(),
+                  std::abs(mean) / std::sqrt(ms));
+    p.warnings.push_back(std::string(b) +
+                         ": a transducer's static offset, which the model takes as force? conditioning: {offset: mean} (or "
+                         "{offset: {mean_before: T}}) on it removes it");
+  }
+}
+
 // The solver's options, once the data are in: a record in which no sensor moves is refused (every
 // parameter fits it the same until the model moves, and then only worse).
 void finish_problem(Problem& p, const IdentifierStep& step, const std::string* csv) {
@@ -985,6 +1101,8 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
                  "as much signal, from which no parameter can be determined",
                  io::format_value(p.noise_std.front()));
   }
+  input_offsets(p);
+  choose_band(p);
   apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
   p.objective_options.solver.step = step.step;
@@ -1070,6 +1188,7 @@ void noise_from_quiet_start(Problem& p) {
 // The problem from measured data: the table's columns, the metadata beside it.
 std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTable& table, const std::string& source,
                                     const io::TruthMeta* meta, const std::string& meta_source) {
+  p->measured = true;
   io::DataTable tab = table;
   regularise_time(p->scenario, tab, source, p->columns);
   std::map<std::string, double> meta_truth;

@@ -325,12 +325,23 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"identifiability", identifiability_json(*this)},
            {"modes", modes_json(*this)},
            {"band", p.scenario.identification.band.empty()
-                        ? json(nullptr)
+                        ? (p.band_note.empty() ? json(nullptr) : json{{"chosen", "auto"}, {"note", p.band_note}})
                         : json{{"f_lo_hz", p.scenario.identification.band[0]},
                                {"f_hi_hz", p.scenario.identification.band[1]},
-                               {"noise_gain", p.band_gain}}}};
+                               {"noise_gain", p.band_gain},
+                               {"chosen", p.band_note.empty() ? "stated" : "auto"},
+                               {"note", p.band_note.empty() ? "the scenario's identification.band" : p.band_note}}}};
   counts_json(*this, out);
   if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0) out["data_columns"] = data_columns_json(p.columns);
+  if (!start_check.sensors.empty()) {
+    json sensors = json::array();
+    for (const auto& s : start_check.sensors)
+      sensors.push_back({{"name", s.name},
+                         {"correlation", std::isfinite(s.correlation) ? json(s.correlation) : json(nullptr)},
+                         {"scale", std::isfinite(s.scale) ? json(s.scale) : json(nullptr)}});
+    out["start_check"] = {{"from", start_check.from}, {"to", start_check.to}, {"sensors", sensors}, {"warnings", start_check.warnings}};
+  }
+  if (!p.warnings.empty()) out["data_warnings"] = p.warnings;
   return out;
 }
 

@@ -295,6 +295,7 @@ TEST(LabData, NoiseLevelsComeFromTheQuietStartWhenNotStated) {
   };
   io::Scenario unstated = without_columns(sc);
   for (auto& s : unstated.sensors) s.noise_std = 0.0;
+  unstated.identification.band_mode = io::IdentificationSpec::BandMode::None;  // the levels as read, not as a band filters them
   auto p = prepare(unstated, DataSource::in_memory(table(m, 0.0), "quiet.csv"));
   const int quiet = p->columns.quiet_samples;
   std::printf("  trigger at %.4f s, %d quiet samples; noise %.4g and %.4g (true %.3g, scatter %.2g)\n", p->columns.trigger_time, quiet,

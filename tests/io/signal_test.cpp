@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 
 using scoleid::io::Signal;
 using scoleid::io::SignalTerm;
+using scoleid::io::cubic_table_gain_error;
 
 namespace {
 // A signal of one term: `type` and `amplitude`, its other fields as `set` leaves them.
@@ -67,4 +69,31 @@ TEST(Signal, HaversineIntegratesToHalfAmplitudeTimesWidth) {
   const int n = 100000;
   for (int i = 0; i < n; ++i) integral += s((i + 0.5) * 0.5 / n) * 0.5 / n;
   EXPECT_NEAR(integral, 0.5 * 4.0 * 0.5, 1e-9);
+}
+
+// A cubic-table's gain at x = f·Δt against the table itself: sample cos and sin of x cycles per
+// sample, read each table densely between samples, project on the same exponential. The gain is
+// that of G(x) (signal.h), within the projection's quadrature error.
+TEST(Signal, CubicTableGainErrorIsTheTablesOwn) {
+  for (double x : {0.05, 0.104, 0.146, 0.23, 0.3}) {
+    const int n = 400;
+    std::vector<double> t(n), c(n), s(n);
+    for (int k = 0; k < n; ++k) {
+      t[static_cast<std::size_t>(k)] = k;
+      c[static_cast<std::size_t>(k)] = std::cos(2 * M_PI * x * k);
+      s[static_cast<std::size_t>(k)] = std::sin(2 * M_PI * x * k);
+    }
+    const Signal fc = Signal::cubic_table(t, c), fs = Signal::cubic_table(t, s);
+    std::complex<double> g = 0.0;
+    const int m = 64, from = 10, to = 390;  // away from the ends, where the stencil shifts
+    for (int k = from * m; k < to * m; ++k) {
+      const double tt = (k + 0.5) / m;
+      g += std::complex<double>(fc(tt), fs(tt)) * std::exp(std::complex<double>(0.0, -2 * M_PI * x * tt));
+    }
+    g /= static_cast<double>((to - from) * m);
+    std::printf("  x = %.3f: table %.6f, G(x) %.6f\n", x, std::abs(g - 1.0), cubic_table_gain_error(x));
+    EXPECT_NEAR(std::abs(g - 1.0), cubic_table_gain_error(x), 2e-4) << x;
+  }
+  EXPECT_NEAR(cubic_table_gain_error(0.146), 0.01, 3e-4);  // the values the band's top is read from
+  EXPECT_NEAR(cubic_table_gain_error(0.23), 0.054, 1e-3);
 }

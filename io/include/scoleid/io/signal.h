@@ -21,6 +21,13 @@
 
 namespace scoleid::io {
 
+// A cubic-table's fidelity to what it was sampled from: a complex exponential of x = f·Δt cycles
+// per sample, read through the table, holds the component G(x) e^{i2πxt/Δt} with
+//   G(x) = ∫₀¹ Σ_{j=-1..2} L_j(μ) e^{i2πx(j−μ)} dμ,
+// L_j the Lagrange basis through the nodes −1, 0, 1, 2 (the table's reading between samples 0 and 1
+// at μ). Returns |G(x) − 1|: 0.25 % at x = 0.104, 1 % at 0.146, 5.4 % at 0.23 (real; G has no phase).
+double cubic_table_gain_error(double x);
+
 struct SignalTerm {
   enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table, CubicTable };
   Type type = Type::Step;

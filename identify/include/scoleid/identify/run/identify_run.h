@@ -31,6 +31,7 @@
 #include "scoleid/identify/inverse/modal_uncertainty.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
+#include "scoleid/identify/run/start_check.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/run_directory.h"
 
@@ -83,6 +84,9 @@ struct RunResult {
   };
   std::vector<Attempt> attempts;  // the first is the plain run, or the coarse-to-fine ladder's
   int chosen_attempt = 0;
+  // A measured record's sensors against the model at the first attempt's start (start_check.h):
+  // empty sensors when not checked.
+  StartCheck start_check;
   // The smoothness prior (identification.smoothness): its weight, and with the discrepancy
   // principle the weights tried, whether one met it, and the noise's expected misfit.
   double smoothness_weight = 0.0;

@@ -106,6 +106,9 @@ struct Problem {
   std::vector<io::Signal> signals;
   Measurements data;
   std::string data_source;                    // "synthetic (N elements)" or the CSV path
+  // The data are a measured record (a file or a table), not synthesised from the scenario: the lab
+  // defaults apply (quiet-start noise, force window, automatic band, spectral first start).
+  bool measured = false;
   std::map<std::string, double> true_values;  // by parameter name, where known
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "pre-trigger" | "" (unknown)
@@ -117,6 +120,12 @@ struct Problem {
   // the noise_std above are then the filtered data's, σ √g, and about g of the samples are
   // independent.
   double band_gain = 1.0;
+  // How the band came about with identification.band: auto ("" when stated or not asked for):
+  // the band chosen and why, or why the whole record is fitted.
+  std::string band_note;
+  // What the record says of its own channels before any fit (an input's static offset;
+  // docs/data.md §2.5), one line each naming the channel.
+  std::vector<std::string> warnings;
   const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };

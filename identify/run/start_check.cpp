@@ -1,0 +1,88 @@
+#include "scoleid/identify/run/start_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "scoleid/identify/inverse/spectral_start.h"
+
+namespace scoleid::identify {
+
+namespace {
+
+std::string num(double v, const char* fmt = "%.3g") {
+  char b[48];
+  std::snprintf(b, sizeof b, fmt, v);
+  return b;
+}
+
+}  // namespace
+
+StartCheck check_start(const Problem& p, Objective& obj, const VectorXd& q) {
+  StartCheck out;
+  const auto& t = p.data.t;
+  const auto& z = p.data.z;
+  if (t.size() < 4 || z.cols() == 0) return out;
+  obj.set_horizon(obj.data_end());
+  const MatrixXd y = obj.predict(q);
+  // The window: ten cycles of the record's lowest peak from where the inputs begin to act.
+  out.from = obj.response_start();
+  out.to = t.back();
+  auto peaks = spectral_peaks(t, z);
+  if (!peaks.empty()) {
+    double f_low = peaks.front().f;
+    for (const auto& pk : peaks) f_low = std::min(f_low, pk.f);
+    out.to = std::min(t.back(), out.from + 10.0 / f_low);
+  }
+  const auto first = static_cast<Eigen::Index>(std::lower_bound(t.begin(), t.end(), out.from) - t.begin());
+  const auto last = static_cast<Eigen::Index>(std::upper_bound(t.begin(), t.end(), out.to) - t.begin());
+  const Eigen::Index n = last - first;
+  if (n < 4) return out;
+  int inverted = 0, scaled = 0, assessed = 0;
+  double a_lo = INFINITY, a_hi = 0.0;
+  for (Eigen::Index k = 0; k < z.cols(); ++k) {
+    StartCheck::Sensor s;
+    s.name = p.scenario.sensors[static_cast<std::size_t>(k)].name;
+    const auto ym = y.col(k).segment(first, n), zm = z.col(k).segment(first, n);
+    const double yy = ym.squaredNorm(), zz = zm.squaredNorm(), yz = ym.dot(zm);
+    s.correlation = yy > 0 && zz > 0 ? yz / std::sqrt(yy * zz) : NAN;
+    s.scale = yy > 0 ? yz / yy : NAN;
+    out.sensors.push_back(s);
+    if (!std::isfinite(s.correlation)) continue;
+    ++assessed;
+    if (s.correlation < -0.5) ++inverted;
+    if (std::abs(s.correlation) >= 0.5) {
+      const double a = std::abs(s.scale);
+      a_lo = std::min(a_lo, a);
+      a_hi = std::max(a_hi, a);
+      if (a > 3.0 || a < 1.0 / 3.0) ++scaled;
+    }
+  }
+  // The one input read from the data, if there is exactly one: where every sensor agrees, it is the suspect.
+  const std::string input = p.columns.inputs_from_data.size() == 1 ? p.columns.inputs_from_data.front() : std::string();
+  const std::string span = "over " + num(out.from, "%.4g") + " .. " + num(out.to, "%.4g") + " s at the start";
+  const std::string window = " (" + span + ")";
+  if (assessed > 1 && inverted == assessed && !input.empty()) {
+    out.warnings.push_back("every sensor reads the model's response inverted" + window + ": input '" + input +
+                           "' is likely of the other sign (a load cell mounted or wired the other way round); "
+                           "conditioning: {sign: -1} on it states that");
+  } else {
+    for (const auto& s : out.sensors)
+      if (std::isfinite(s.correlation) && s.correlation < -0.5)
+        out.warnings.push_back("sensor '" + s.name + "' reads the model's response inverted (correlation " + num(s.correlation, "%.2f") + " " +
+                               span + "): mounted or wired the other way round? conditioning: {sign: -1} on it states that");
+  }
+  if (assessed > 1 && scaled == assessed && !input.empty() && a_hi <= 2.0 * a_lo) {
+    out.warnings.push_back("every sensor reads about " + num(std::sqrt(a_lo * a_hi)) + " times the model's response" + window +
+                           ": input '" + input + "' is likely in another unit or calibration (state its column's unit, or "
+                           "conditioning: {scale: ...} on it)");
+  } else {
+    for (const auto& s : out.sensors)
+      if (std::isfinite(s.correlation) && std::abs(s.correlation) >= 0.5 && (std::abs(s.scale) > 3.0 || std::abs(s.scale) < 1.0 / 3.0))
+        out.warnings.push_back("sensor '" + s.name + "' reads " + num(std::abs(s.scale)) + " times the model's response" + window +
+                               ": another unit or calibration than stated? (its column's unit, or conditioning: {scale: ...})");
+  }
+  return out;
+}
+
+}  // namespace scoleid::identify
