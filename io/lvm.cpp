@@ -58,28 +58,6 @@ void split_view(std::string_view line, char sep, std::vector<std::string_view>& 
   }
 }
 
-// Text in Windows-1252 (LabVIEW's code page) as UTF-8; UTF-8 text as it is.
-std::string to_utf8(const std::string& s) {
-  if (first_invalid_utf8(s) == std::string::npos) return s;
-  static const char16_t k80[32] = {0x20AC, 0xFFFD, 0x201A, 0x0192, 0x201E, 0x2026, 0x2020, 0x2021, 0x02C6, 0x2030, 0x0160,
-                                   0x2039, 0x0152, 0xFFFD, 0x017D, 0xFFFD, 0xFFFD, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022,
-                                   0x2013, 0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0xFFFD, 0x017E, 0x0178};
-  std::string out;
-  for (unsigned char c : s) {
-    const unsigned cp = c < 0x80 ? c : c < 0xA0 ? static_cast<unsigned>(k80[c - 0x80]) : c;
-    if (cp < 0x80) {
-      out += static_cast<char>(cp);
-    } else if (cp < 0x800) {
-      out += static_cast<char>(0xC0 | (cp >> 6));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    } else {
-      out += static_cast<char>(0xE0 | (cp >> 12));
-      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    }
-  }
-  return out;
-}
 
 struct Lvm {
   std::string path;
@@ -212,7 +190,7 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
       const auto fl = split(line, f.sep);
       for (int i = 0; i < f.channels; ++i) {
         const std::size_t c = value_column(f, i);
-        f.names.push_back(c < fl.size() ? to_utf8(trim(fl[c])) : std::string());
+        f.names.push_back(c < fl.size() ? windows1252_to_utf8(trim(fl[c])) : std::string());
       }
     } else {
       pending = true;
@@ -286,7 +264,7 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
                                 " rows: the channels of one record share one time grid"));
     if (first < 0) first = i;
     tab.names.push_back(f.names[i]);
-    tab.units.push_back(to_utf8(seg_value(f, "Y_Unit_Label", i)));
+    tab.units.push_back(windows1252_to_utf8(seg_value(f, "Y_Unit_Label", i)));
     tab.columns.push_back(std::move(y[i]));
   }
   if (first < 0) fail(f, lineno, "no channel holds samples");

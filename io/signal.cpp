@@ -13,6 +13,20 @@ constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace
 
+double cubic_table_error(double x) {
+  double e2 = 0.0;
+  constexpr int n = 512;
+  for (int k = 0; k < n; ++k) {
+    const double mu = (k + 0.5) / n;
+    const double L[4] = {-mu * (mu - 1) * (mu - 2) / 6, (mu + 1) * (mu - 1) * (mu - 2) / 2, -(mu + 1) * mu * (mu - 2) / 2,
+                         (mu + 1) * mu * (mu - 1) / 6};
+    std::complex<double> r = 0.0;
+    for (int j = -1; j <= 2; ++j) r += L[j + 1] * std::exp(std::complex<double>(0.0, 2.0 * kPi * x * (j - mu)));
+    e2 += std::norm(r - 1.0) / n;
+  }
+  return std::sqrt(e2);
+}
+
 double cubic_table_gain_error(double x) {
   std::complex<double> g = 0.0;
   constexpr int n = 512;  // midpoint rule in μ on a smooth integrand

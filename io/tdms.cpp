@@ -259,28 +259,6 @@ private:
   int fd_ = -1;
 };
 
-// Text in UTF-8 as it is; other text read as Windows-1252 (LabVIEW's code page on Windows).
-std::string to_utf8(const std::string& s) {
-  if (first_invalid_utf8(s) == std::string::npos) return s;
-  static const char16_t k80[32] = {0x20AC, 0xFFFD, 0x201A, 0x0192, 0x201E, 0x2026, 0x2020, 0x2021, 0x02C6, 0x2030, 0x0160,
-                                   0x2039, 0x0152, 0xFFFD, 0x017D, 0xFFFD, 0xFFFD, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022,
-                                   0x2013, 0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0xFFFD, 0x017E, 0x0178};
-  std::string out;
-  for (unsigned char c : s) {
-    const unsigned cp = c < 0x80 ? c : c < 0xA0 ? static_cast<unsigned>(k80[c - 0x80]) : c;
-    if (cp < 0x80) {
-      out += static_cast<char>(cp);
-    } else if (cp < 0x800) {
-      out += static_cast<char>(0xC0 | (cp >> 6));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    } else {
-      out += static_cast<char>(0xE0 | (cp >> 12));
-      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    }
-  }
-  return out;
-}
 
 struct Property {
   std::uint32_t type = 0;
@@ -417,7 +395,7 @@ Property read_property(Cursor& c, const Object& o, const std::string& name) {
   const bool big = c.swap != kHostBig;
   const std::size_t size = value_size(p.type);
   if (p.type == kString) {
-    p.text = to_utf8(c.text("a property's value"));
+    p.text = windows1252_to_utf8(c.text("a property's value"));
   } else if (p.type == kTimeStamp) {
     p.stamp = true;
     p.time = load_stamp(c.take(16, "a property's value"), big);
@@ -454,8 +432,8 @@ void read_metadata(Tdms& f, Cursor& c, std::vector<Entry>& list, bool new_list) 
       Object o;
       o.path = path;
       o.level = static_cast<int>(names.size());
-      if (o.level >= 1) o.group = to_utf8(names[0]);
-      if (o.level == 2) o.channel = to_utf8(names[1]);
+      if (o.level >= 1) o.group = windows1252_to_utf8(names[0]);
+      if (o.level == 2) o.channel = windows1252_to_utf8(names[1]);
       f.objects.push_back(std::move(o));
       found = f.by_path.emplace(path, f.objects.size() - 1).first;
     }
@@ -505,7 +483,7 @@ void read_metadata(Tdms& f, Cursor& c, std::vector<Entry>& list, bool new_list) 
     }
     const std::uint32_t np = c.u32("a property count");
     for (std::uint32_t k = 0; k < np; ++k) {
-      const std::string name = to_utf8(c.text("a property's name"));
+      const std::string name = windows1252_to_utf8(c.text("a property's name"));
       Property p = read_property(c, f.objects[id], name);
       f.objects[id].properties[name] = std::move(p);
     }

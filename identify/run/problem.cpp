@@ -73,6 +73,7 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
       if (x > 1e-6 * wmax && x <= d.nyquist) below.push_back(x);
     d.modes_below_nyquist = static_cast<int>(below.size());
     if (below.empty()) return d;
+    d.omega_first = below.front();
     d.mode = std::min(d.modes_below_nyquist, params.size() + 2);
     d.omega = below[static_cast<std::size_t>(d.mode - 1)];
   }
@@ -943,22 +944,27 @@ void apply_band(Problem& p) {
 // identification.band: auto on a measured record (docs/data.md §2.4). The band's top stays where
 // the model can follow what it is given: an input read from a data column reaches the model,
 // once band-filtered, through the 4-point Lagrange cubic through its samples (io::Signal's
-// cubic-table), whose gain at x = f·Δt is G(x) (io::cubic_table_gain_error):
-// |G − 1| is 0.25 % at x = 0.104, 1 % at 0.146, 5.4 % at 0.23. Peaks are kept where that error is
-// at most half the declared model error a (1 % unless stated), and the top edge stays where it is
-// at most a; without such an input both limits are 0.45/Δt, under the Nyquist frequency. Below
-// the limit the record's spectral peaks (spectral_start.h, at least 10⁻³ of the strongest) are
-// kept; the top edge lies midway (in log frequency) between the highest peak kept and the next one
-// above, if any, and at least 10 % above the peak kept (else that peak is dropped, a skirt that
-// cuts a mode being worse than one without it); the bottom edge at half the lowest peak (an
-// offset, a drift and a transducer's low-frequency noise stay out). No band when no peak lies below
-// the limit, a sensor has no noise level, the times are not uniform, or a data input steps within
-// a sample (not an impact) or at the record's first sample: the run says which.
-// The x = f·Δt below which io::cubic_table_gain_error stays within `error` (it grows monotonically up to 0.45).
+// cubic-table), whose reading of a sinusoid of x = f·Δt cycles per sample is wrong by E(x)
+// (io::cubic_table_error, relative RMS: its gain's share and the images at multiples of the
+// sample rate ± f, which the model's high modes answer and its sampled outputs fold back onto f):
+// 0.25 % at x = 0.0996, 0.5 % at 0.119, 6.2 % at 0.23. A 2 kHz steel-strip record fitted with its
+// fourth mode at x = 0.117 gave EI and ρA 1.5 % low; sampled at 4 kHz (x = 0.058), 0.15 %. Peaks
+// are kept where E is at most a quarter of the declared model error a (1 % unless stated), and the
+// top edge stays where it is at most half; without such an input both limits are 0.45/Δt, under
+// the Nyquist frequency. Below the limit the record's spectral peaks (spectral_start.h, at least
+// 10⁻³ of the strongest) are kept; the top edge lies midway (in log frequency) between the
+// highest peak kept and the next one above, if any, and at least 10 % above the peak kept (else
+// that peak is dropped, a skirt that cuts a mode being worse than one without it); the bottom
+// edge at half the lowest peak or half the model's first mode at the start, whichever is lower
+// (an offset, a drift and a transducer's low-frequency noise stay out; a record too short to show
+// its first mode as a peak still holds it). No band when no peak lies below the limit, a sensor has no noise level, the times are not
+// uniform, or a data input steps within a sample (not an impact) or at the record's first sample:
+// the run says which.
+// The x = f·Δt below which io::cubic_table_error stays within `error` (it grows monotonically up to 0.45).
 double lagrange_limit(double error) {
   double lo = 0.0, hi = 0.45;
-  if (io::cubic_table_gain_error(hi) <= error) return hi;
-  for (int it = 0; it < 60; ++it) (io::cubic_table_gain_error(0.5 * (lo + hi)) > error ? hi : lo) = 0.5 * (lo + hi);
+  if (io::cubic_table_error(hi) <= error) return hi;
+  for (int it = 0; it < 60; ++it) (io::cubic_table_error(0.5 * (lo + hi)) > error ? hi : lo) = 0.5 * (lo + hi);
   return lo;
 }
 
@@ -994,8 +1000,8 @@ void choose_band(Problem& p) {
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   const double allowance = id.model_error > 0 ? id.model_error : 0.01;
   const bool data_input = !p.columns.inputs_from_data.empty();
-  const double f_peaks = (data_input ? lagrange_limit(0.5 * allowance) : 0.45) / dt;
-  const double f_limit = (data_input ? lagrange_limit(allowance) : 0.45) / dt;
+  const double f_peaks = (data_input ? lagrange_limit(0.25 * allowance) : 0.45) / dt;
+  const double f_limit = (data_input ? lagrange_limit(0.5 * allowance) : 0.45) / dt;
   std::vector<SpectralPeak> peaks = spectral_peaks(t, p.data.z, 12);
   std::sort(peaks.begin(), peaks.end(), [](const SpectralPeak& a, const SpectralPeak& b) { return a.f < b.f; });
   std::vector<double> kept;
@@ -1013,10 +1019,13 @@ void choose_band(Problem& p) {
   }
   const std::string limit = !data_input ? hz(f_limit) + " Hz (0.45 of the sample rate)"
                                         : hz(f_limit) + " Hz, peaks below " + hz(f_peaks) +
-                                              " Hz (where the data input's cubic between samples departs from it by the model error " +
-                                              hz(100 * allowance) + " %, and half that)";
+                                              " Hz (where the data input's cubic reading between samples is wrong by half the model error, " +
+                                              hz(50 * allowance) + " %, and by a quarter)";
   if (kept.empty()) return none("no spectral peak below " + hz(f_peaks) + " Hz");
-  id.band = {0.5 * kept.front(), f_hi};
+  // (the bottom edge also under half the model's first mode at the start: a record too short to
+  // show that mode as a peak still holds it)
+  const double f_first = p.content.omega_first / (2.0 * M_PI);
+  id.band = {f_first > 0 ? 0.5 * std::min(kept.front(), f_first) : 0.5 * kept.front(), f_hi};
   std::string list;
   for (double f : kept) list += (list.empty() ? "" : ", ") + hz(f);
   p.band_note = "auto: [" + hz(id.band[0]) + ", " + hz(id.band[1]) + "] Hz around the record's peaks at " +

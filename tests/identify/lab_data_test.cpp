@@ -136,7 +136,12 @@ io::Scenario without_columns(io::Scenario sc) {
 }  // namespace
 
 TEST(LabData, DaqCsvInGIdentifiesAsTheHandConvertedFileDigitForDigit) {
-  const io::Scenario sc = io::parse_scenario(kStrip, "tap-strip.yaml");
+  io::Scenario sc = io::parse_scenario(kStrip, "tap-strip.yaml");
+  // The whole record (as before the band was chosen by default): this hammer is sampled without an
+  // anti-alias filter, 4 samples across its pulse, and in the automatic band [6, 141] Hz its
+  // reading's error leaves a residual 1.01 times the fit test's allowance (EI +0.09 %), where the
+  // whole record passes (EI -1.4 %, within its interval).
+  sc.identification.band_mode = io::IdentificationSpec::BandMode::None;
   const fs::path dir = scratch("daq");
   const std::string daq = write(dir / "tap.csv", daq_csv(tap_record(sc)));
   const std::string si = (dir / "tap-si.csv").string();

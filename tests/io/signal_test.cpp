@@ -8,6 +8,7 @@
 using scoleid::io::Signal;
 using scoleid::io::SignalTerm;
 using scoleid::io::cubic_table_gain_error;
+using scoleid::io::cubic_table_error;
 
 namespace {
 // A signal of one term: `type` and `amplitude`, its other fields as `set` leaves them.
@@ -71,10 +72,10 @@ TEST(Signal, HaversineIntegratesToHalfAmplitudeTimesWidth) {
   EXPECT_NEAR(integral, 0.5 * 4.0 * 0.5, 1e-9);
 }
 
-// A cubic-table's gain at x = f·Δt against the table itself: sample cos and sin of x cycles per
-// sample, read each table densely between samples, project on the same exponential. The gain is
-// that of G(x) (signal.h), within the projection's quadrature error.
-TEST(Signal, CubicTableGainErrorIsTheTablesOwn) {
+// A cubic-table's gain and error at x = f·Δt against the table itself: sample cos and sin of x
+// cycles per sample, read each table densely between samples, project on the same exponential
+// (the gain, G(x)) and take the reading's RMS difference from it (the error, E(x); signal.h).
+TEST(Signal, CubicTableErrorsAreTheTablesOwn) {
   for (double x : {0.05, 0.104, 0.146, 0.23, 0.3}) {
     const int n = 400;
     std::vector<double> t(n), c(n), s(n);
@@ -91,9 +92,20 @@ TEST(Signal, CubicTableGainErrorIsTheTablesOwn) {
       g += std::complex<double>(fc(tt), fs(tt)) * std::exp(std::complex<double>(0.0, -2 * M_PI * x * tt));
     }
     g /= static_cast<double>((to - from) * m);
-    std::printf("  x = %.3f: table %.6f, G(x) %.6f\n", x, std::abs(g - 1.0), cubic_table_gain_error(x));
+    // the whole error: relative RMS of the reading against the exponential itself
+    double e2 = 0.0;
+    for (int k = from * m; k < to * m; ++k) {
+      const double tt = (k + 0.5) / m;
+      e2 += std::norm(std::complex<double>(fc(tt), fs(tt)) - std::exp(std::complex<double>(0.0, 2 * M_PI * x * tt)));
+    }
+    const double e = std::sqrt(e2 / static_cast<double>((to - from) * m));
+    std::printf("  x = %.3f: table gain %.6f, G(x) %.6f; table error %.6f, E(x) %.6f\n", x, std::abs(g - 1.0),
+                cubic_table_gain_error(x), e, cubic_table_error(x));
     EXPECT_NEAR(std::abs(g - 1.0), cubic_table_gain_error(x), 2e-4) << x;
+    EXPECT_NEAR(e, cubic_table_error(x), 2e-4 + 1e-3 * e) << x;
   }
-  EXPECT_NEAR(cubic_table_gain_error(0.146), 0.01, 3e-4);  // the values the band's top is read from
+  // the values the automatic band's limits are read from (docs/data.md §2.4)
+  EXPECT_NEAR(cubic_table_error(0.0996), 0.0025, 2e-5);
+  EXPECT_NEAR(cubic_table_error(0.119), 0.005, 5e-5);
   EXPECT_NEAR(cubic_table_gain_error(0.23), 0.054, 1e-3);
 }

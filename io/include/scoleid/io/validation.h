@@ -19,6 +19,9 @@ void check_name(const std::string& source, const std::string& field, const std::
 std::size_t first_invalid_utf8(const std::string& text);
 // InputError "<what>: byte N (line L) is not valid UTF-8" unless the text is well-formed.
 void check_utf8(const std::string& text, const std::string& what);
+// Text in UTF-8 as it is; other text read as Windows-1252 (LabVIEW's code page on Windows:
+// LVM and TDMS names and units) into UTF-8.
+std::string windows1252_to_utf8(const std::string& text);
 
 // A number read from a scenario: finite, and 0 or of magnitude in
 // [limits::kMinMagnitude, limits::kMaxMagnitude].

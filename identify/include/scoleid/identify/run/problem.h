@@ -43,6 +43,7 @@ struct DataContent {
   int mode = 0;                 // K (0: no flexible mode below Nyquist)
   int content_mode = 0;         // K_data (reported)
   double omega = 0.0;           // ω_K [rad/s]
+  double omega_first = 0.0;     // the lowest flexible mode at the start [rad/s] (0: none below Nyquist)
   double nyquist = 0.0;         // π / sample interval
   int modes_below_nyquist = 0;  // flexible modes below it
 };
