@@ -6,6 +6,8 @@
 //                                           and OUT.json beside it describing each column
 //   scole-data convert FILE --out OUT.lvm   the same record as a LabVIEW Measurement file (lvm.h)
 //   scole-data convert FILE --out OUT.tdms  the same record as an NI TDMS file (tdms.h)
+//   scole-data convert FILE --out OUT.uff   the same record as a Universal File, a binary 58 per
+//                                           channel (uff.h; .unv too)
 // FILE is a Universal File (58/58b, 151, 164, 15, 2411, 55), a LabVIEW Measurement file (.lvm, one
 // segment), an NI TDMS file (.tdms, binary) or a CSV (DAQ dialects: comment lines, any time-column
 // name, quoted headers, ';' with decimal commas, units in brackets).
@@ -24,6 +26,7 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/uff.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/lvm.h"
 #include "scoleid/io/output_paths.h"
@@ -63,7 +66,7 @@ void print_info(const io::DataFileInfo& info) {
   for (const auto& n : info.notes) std::printf("  %s\n", n.c_str());
 }
 
-// The format OUT's extension asks for (any case): "lvm", "tdms", "uff" (.uff, .unv: no writer), else
+// The format OUT's extension asks for (any case): "lvm", "tdms", "uff" (.uff, .unv), else
 // "csv" (.csv, or any other name, as before).
 std::string out_format(const std::string& out) {
   std::string ext = std::filesystem::path(out).extension().string();
@@ -74,24 +77,23 @@ std::string out_format(const std::string& out) {
   return "csv";
 }
 
-// OUT.lvm or OUT.tdms: the record in that format, nothing beside it (the file holds the units).
+// OUT.lvm, OUT.tdms or OUT.uff: the record in that format, nothing beside it (the file holds the units).
 void convert_to(const std::string& format, const std::string& file, const std::string& out, const io::CsvOptions& options,
                 bool quiet) {
   io::check_output_file("--out", out, {file});
   const io::DataTable tab = io::read_data(file, options);
   if (format == "lvm") io::write_lvm(tab, out);
+  else if (format == "uff") io::uff::write_file(tab, out);
   else io::write_tdms(tab, out);
   if (!quiet)
     std::fprintf(stderr, "scole-data: %zu channel%s x %zu samples -> %s\n", tab.names.size(), tab.names.size() == 1 ? "" : "s",
                  tab.t.size(), out.c_str());
 }
 
-// OUT.csv and OUT.json (written to temporary files and renamed: both or neither); OUT.lvm or
-// OUT.tdms alone.
+// OUT.csv and OUT.json (written to temporary files and renamed: both or neither); OUT.lvm,
+// OUT.tdms or OUT.uff alone.
 void convert(const std::string& file, const std::string& out, const io::CsvOptions& options, bool quiet) {
   const std::string format = out_format(out);
-  if (format == "uff")
-    throw io::InputError("command line: --out '" + out + "': no Universal File writer; write .csv, .lvm or .tdms");
   if (format != "csv") return convert_to(format, file, out, options, quiet);
   // Neither output may be the input, a directory, or in a directory that cannot be written.
   {
@@ -161,11 +163,12 @@ int main(int argc, char** argv) {
   info->add_option("file", file, "data file (UFF, LabVIEW LVM, TDMS or CSV)")->required();
   info->add_flag("--json", as_json, "print the listing as JSON");
   auto* conv = app.add_subcommand("convert", "write the time responses as the product's CSV (and a JSON of its columns), "
-                                             "a LabVIEW LVM or an NI TDMS file, by OUT's extension");
+                                             "a LabVIEW LVM, an NI TDMS or a Universal File, by OUT's extension");
   conv->add_option("file", file, "data file (UFF, LabVIEW LVM, TDMS or CSV)")->required();
   conv->add_option("-o,--out", out,
                    "output: OUT.csv (OUT.json is written beside it), OUT.lvm (LabVIEW Measurement, tab-separated, X_Columns "
-                   "One) or OUT.tdms (one group 'record', float64 channels); every time and value reads back exactly")
+                   "One), OUT.tdms (one group 'record', float64 channels) or OUT.uff / OUT.unv (a binary dataset 58 per "
+                   "channel, doubles); every time and value reads back exactly")
       ->required();
   conv->add_flag("-q,--quiet", quiet, "no summary on stderr");
   for (auto* sub : {info, conv}) {

@@ -183,6 +183,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     r.predicted = r.fit.predicted;
   if (ro.compute_std) assess_estimate(p, obj, c.options, r, early.estimate.size() != 0 ? &early : nullptr);
   estimate_modes(p, r);
+  if (r.predicted.size() != 0) r.residual_bands = residual_bands(p.data.t, p.data.z, r.predicted, r.modes, r.fit.explains_data);
   r.counters = obj.counters();
   r.counters.Accumulate(c.extra);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

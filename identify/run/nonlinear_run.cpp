@@ -193,6 +193,7 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
   r.estimate = r.summary.q;
   if (ro.compute_std && r.estimate.allFinite() && r.predicted.allFinite()) run.assess(oo);
   estimate_modes(p, r);  // the small-amplitude modes about the undeformed state
+  if (r.predicted.size() != 0) r.residual_bands = residual_bands(p.data.t, p.data.z, r.predicted, r.modes, r.fit.explains_data);
   r.counters = run.obj.counters();
   r.integrator_step = fo.max_step;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1061,6 +1061,7 @@ void input_offsets(Problem& p) {
     p.warnings.push_back(std::string(b) +
                          ": a transducer's static offset, which the model takes as force? conditioning: {offset: mean} (or "
                          "{offset: {mean_before: T}}) on it removes it");
+    p.static_offsets.emplace_back(i, mean);
   }
 }
 

@@ -342,6 +342,16 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     out["start_check"] = {{"from", start_check.from}, {"to", start_check.to}, {"sensors", sensors}, {"warnings", start_check.warnings}};
   }
   if (!p.warnings.empty()) out["data_warnings"] = p.warnings;
+  if (!residual_bands.bands.empty() || !residual_bands.note.empty()) {
+    json bands = json::array();
+    for (const auto& b : residual_bands.bands) {
+      json rms = json::object();
+      for (std::size_t j = 0; j < b.rms.size() && j < p.data.names.size(); ++j) rms[p.data.names[j]] = b.rms[j];
+      bands.push_back({{"from_hz", b.from_hz}, {"to_hz", b.to_hz}, {"holds", b.holds}, {"mode", b.mode}, {"share", b.share}, {"rms", rms}});
+    }
+    out["residual_bands"] = {{"bands", bands}, {"at_modes", residual_bands.at_modes}, {"summary", residual_bands.summary},
+                             {"note", residual_bands.note}};
+  }
   return out;
 }
 
@@ -374,6 +384,7 @@ std::string RunResult::FullReport() const {
   }
   s += correlation_table(*this);
   s += modes_table(modes);
+  if (!residual_bands.summary.empty()) s += "\n" + residual_bands.summary + "\n";
   std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
                 summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
                 wall_seconds);

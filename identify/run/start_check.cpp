@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "scoleid/identify/inverse/spectral_start.h"
 
@@ -23,10 +24,29 @@ StartCheck check_start(const Problem& p, Objective& obj, const VectorXd& q) {
   const auto& t = p.data.t;
   const auto& z = p.data.z;
   if (t.size() < 4 || z.cols() == 0) return out;
+  // An input read with a static offset (problem.cpp input_offsets) drives the model with a constant
+  // force from the first sample, whose ringing no record shows: the model is run without it (the
+  // column less its mean; the model is linear), so the signs and scales are still judged.
+  std::unique_ptr<Objective> unoffset;
+  std::string set_aside;
+  if (!p.static_offsets.empty()) {
+    std::vector<io::Signal> signals = p.signals;
+    for (const auto& [i, mean] : p.static_offsets) {
+      auto terms = signals[i].terms();
+      for (auto& term : terms)
+        if (term.type == io::SignalTerm::Type::Table || term.type == io::SignalTerm::Type::CubicTable)
+          for (double& v : term.values) v -= mean;
+      signals[i] = io::Signal(std::move(terms));
+      set_aside += std::string(set_aside.empty() ? "" : ", ") + "'" + p.scenario.inputs[i].name + "'";
+    }
+    unoffset = std::make_unique<Objective>(p.model(), *p.params, std::move(signals), p.data, p.objective_options);
+  }
+  Objective& model = unoffset ? *unoffset : obj;
   obj.set_horizon(obj.data_end());
-  const MatrixXd y = obj.predict(q);
+  model.set_horizon(model.data_end());
+  const MatrixXd y = model.predict(q);
   // The window: ten cycles of the record's lowest peak from where the inputs begin to act.
-  out.from = obj.response_start();
+  out.from = model.response_start();
   out.to = t.back();
   auto peaks = spectral_peaks(t, z);
   if (!peaks.empty()) {
@@ -60,7 +80,8 @@ StartCheck check_start(const Problem& p, Objective& obj, const VectorXd& q) {
   }
   // The one input read from the data, if there is exactly one: where every sensor agrees, it is the suspect.
   const std::string input = p.columns.inputs_from_data.size() == 1 ? p.columns.inputs_from_data.front() : std::string();
-  const std::string span = "over " + num(out.from, "%.4g") + " .. " + num(out.to, "%.4g") + " s at the start";
+  const std::string span = "over " + num(out.from, "%.4g") + " .. " + num(out.to, "%.4g") + " s at the start" +
+                           (set_aside.empty() ? "" : ", the static offset of input " + set_aside + " set aside");
   const std::string window = " (" + span + ")";
   if (assessed > 1 && inverted == assessed && !input.empty()) {
     out.warnings.push_back("every sensor reads the model's response inverted" + window + ": input '" + input +

@@ -233,9 +233,11 @@ truth: {segments: 80, anti_alias_hz: 800}
     for (const auto& x : w) std::printf("warning: %s\n", x.c_str());
     return std::any_of(w.begin(), w.end(), [&](const std::string& x) { return x.find(a) != std::string::npos && x.find(b) != std::string::npos; });
   };
-  // The raw record: the offset named, with the input (a force of -23 N from t = 0 rings the model
-  // as no record did, so the start says nothing of the sign until the offset is gone).
+  // The raw record: the offset named, with the input, and its sign judged with the offset set
+  // aside (a force of -23 N from t = 0 would ring the model as no record did).
   EXPECT_TRUE(said(raw, "input 'shaker' has a mean of -23", "offset")) << "no offset warning";
+  EXPECT_TRUE(said(raw, "inverted", "input 'shaker'")) << "no polarity warning with the offset present";
+  EXPECT_TRUE(said(raw, "inverted", "static offset of input 'shaker' set aside")) << "the offset's setting aside unsaid";
   // The offset stated: the sign named, with the input.
   EXPECT_TRUE(said(offset_stated, "inverted", "input 'shaker'")) << "no polarity warning";
   EXPECT_FALSE(said(offset_stated, "has a mean", "shaker"));

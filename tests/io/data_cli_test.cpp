@@ -203,10 +203,10 @@ void expect_same_record(const DataTable& got, const DataTable& want, const std::
 
 }  // namespace
 
-// convert writes by the output's extension: .lvm and .tdms hold the record themselves (no JSON
-// beside them), and every time, name, unit and value reads back bit for bit, through either and
-// back to CSV.
-TEST(DataCli, ConvertWritesLvmAndTdmsByTheOutputsExtension) {
+// convert writes by the output's extension: .lvm, .tdms and .uff hold the record themselves (no
+// JSON beside them), and every time, name, unit and value reads back bit for bit, through any of
+// them and back to CSV.
+TEST(DataCli, ConvertWritesLvmTdmsAndUffByTheOutputsExtension) {
   const fs::path dir = scratch();
   for (const bool uniform : {true, false}) {
     DataTable raw;
@@ -223,7 +223,7 @@ TEST(DataCli, ConvertWritesLvmAndTdmsByTheOutputsExtension) {
     write_csv((dir / "raw.csv").string(), raw);
     const DataTable want = read_data((dir / "raw.csv").string());
     ASSERT_EQ(want.units, (std::vector<std::string>{"g", "N"}));
-    for (const std::string out : {"out.lvm", "out.tdms", "OUT.TDMS"}) {
+    for (const std::string out : {"out.lvm", "out.tdms", "OUT.TDMS", "out.uff", "out.unv"}) {
       const Result r = run({"convert", "raw.csv", "-o", out}, dir);
       ASSERT_EQ(r.code, 0) << r.err;
       EXPECT_NE(r.err.find("2 channels x 30 samples -> " + out), std::string::npos) << r.err;
@@ -232,26 +232,46 @@ TEST(DataCli, ConvertWritesLvmAndTdmsByTheOutputsExtension) {
     EXPECT_FALSE(fs::exists(dir / "out.json"));
     EXPECT_EQ(slurp(dir / "out.lvm").rfind("LabVIEW Measurement", 0), 0u);
     EXPECT_EQ(slurp(dir / "out.tdms").rfind("TDSm", 0), 0u);
+    EXPECT_EQ(slurp(dir / "out.uff").rfind("    -1\n   151\n", 0), 0u);
+    // A uniform clock is written as an even abscissa, any other as times beside the values.
+    const uff::File u = uff::read_file((dir / "out.uff").string());
+    ASSERT_EQ(u.functions.size(), 2u);
+    EXPECT_EQ(u.functions[0].even, uniform);
+    EXPECT_EQ(u.functions[0].function_type, 1);
+    EXPECT_EQ(u.functions[0].ordinate.spec_type, 12);  // g: an acceleration
+    EXPECT_EQ(u.functions[1].ordinate.spec_type, 13);  // N: a force
     // LVM to TDMS, TDMS to LVM and to CSV (with its JSON): the same record every time.
     ASSERT_EQ(run({"convert", "out.lvm", "-o", "lvm.tdms", "-q"}, dir).code, 0);
     ASSERT_EQ(run({"convert", "out.tdms", "-o", "tdms.lvm", "-q"}, dir).code, 0);
     ASSERT_EQ(run({"convert", "out.tdms", "-o", "tdms.csv", "-q"}, dir).code, 0);
+    ASSERT_EQ(run({"convert", "out.uff", "-o", "uff.tdms", "-q"}, dir).code, 0);
+    ASSERT_EQ(run({"convert", "out.lvm", "-o", "lvm.uff", "-q"}, dir).code, 0);
+    expect_same_record(read_data((dir / "uff.tdms").string()), want, "uff.tdms");
+    expect_same_record(read_data((dir / "lvm.uff").string()), want, "lvm.uff");
     expect_same_record(read_data((dir / "lvm.tdms").string()), want, "lvm.tdms");
     expect_same_record(read_data((dir / "tdms.lvm").string()), want, "tdms.lvm");
     expect_same_record(read_data((dir / "tdms.csv").string()), want, "tdms.csv");
   }
 }
 
-// An output in a format without a writer, or over the input, exits 2 with one line; nothing written.
-TEST(DataCli, ConvertRefusesAUniversalFileOutputAndItsOwnInput) {
+// A record the output's format cannot hold, or an output over the input, exits 2 with one line
+// naming it; nothing written.
+TEST(DataCli, ConvertRefusesWhatTheFormatCannotHoldAndItsOwnInput) {
   const fs::path dir = scratch();
   scoleid::test::write_file(dir / "data.csv", "t,a\n0,1\n0.5,2\n");
-  for (const std::string out : {"x.uff", "x.unv"}) {
-    const Result r = run({"convert", "data.csv", "-o", out}, dir);
-    EXPECT_EQ(r.code, 2) << out;
+  const std::string long_name(81, 'x');
+  scoleid::test::write_file(dir / "long.csv", "t," + long_name + ",b [" + std::string(21, 'm') + "]\n0,1,2\n0.5,2,3\n");
+  scoleid::test::write_file(dir / "units.csv", "t,a,b [" + std::string(21, 'm') + "]\n0,1,2\n0.5,2,3\n");
+  scoleid::test::write_file(dir / "hash.csv", "t,a#2,b\n0,1,2\n0.5,2,3\n");
+  const std::pair<const char*, const char*> cases[] = {
+      {"long.csv", "does not fit ID line 1"}, {"units.csv", "does not fit the axis units label"}, {"hash.csv", "ends in '#<number>'"}};
+  for (const auto& [in, why] : cases) {
+    const Result r = run({"convert", in, "-o", "x.uff"}, dir);
+    EXPECT_EQ(r.code, 2) << in;
     EXPECT_EQ(lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find("no Universal File writer"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(dir / out));
+    EXPECT_NE(r.err.find("UFF file 'x.uff': cannot be written"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.uff"));
   }
   ASSERT_EQ(run({"convert", "data.csv", "-o", "d.lvm", "-q"}, dir).code, 0);
   const std::string lvm = slurp(dir / "d.lvm");

@@ -23,9 +23,9 @@ for bench in steel:lvm aluminium:tdms; do
   # (exit 1: not converged, outputs written and marked; check.py reads the verdict)
   "$build/identify/scole-identify" -s "$here/$name.yaml" --data "$out/$name.$ext" -o "$out/$name" || [ $? -eq 1 ]
 done
-# The steel record as the other formats a lab may hand over (bit-identical numbers): the same
+# The steel record as the other formats a lab may hand over (TDMS, CSV, UFF) (bit-identical numbers): the same
 # estimates from each.
-for ext in tdms csv; do
+for ext in tdms csv uff; do
   rm -rf "$out/steel-as-$ext" "$out/steel-as.$ext" "$out/steel-as.$ext.json"
   "$build/io/scole-data" convert -q "$out/steel.lvm" -o "$out/steel-as.$ext"
   "$build/identify/scole-identify" -q -s "$here/steel.yaml" --data "$out/steel-as.$ext" -o "$out/steel-as-$ext"

@@ -74,6 +74,10 @@
 #include <string>
 #include <vector>
 
+namespace scoleid::io {
+struct DataTable;  // data_files.h
+}  // namespace scoleid::io
+
 namespace scoleid::io::uff {
 
 // One dataset 58 or 58b.
@@ -188,6 +192,21 @@ File parse(const std::string& bytes, const std::string& source);
 // True when the text starts (after an optional UTF-8 byte-order mark and blank lines) with a
 // "-1" delimiter line. `first_bytes` may be any prefix of a file.
 bool looks_like_uff(const std::string& first_bytes);
+
+// Writes a record (a table of time responses on one time grid) as a Universal File: a header
+// (dataset 151), then per column one dataset 58b — function type 1 (time response), response node
+// = the column's 1-based index, scalar; ID line 1 the column's name; ordinate real double
+// (type 4), little-endian IEEE 754; abscissa time in s (specific type 17); ordinate units label
+// the column's unit, its specific data type from the unit's quantity (12 acceleration,
+// 11 velocity, 8 displacement, 13 force, 3 strain, else 0). The abscissa is even (minimum and
+// increment in the 13-character header fields) when x_k = minimum + k·increment read back from
+// those fields gives every time exactly, else uneven with each time interleaved before its value
+// in double precision. read_file gives back every name, unit, time and value bit for bit.
+// Written to a temporary file and renamed into place. InputError naming the path for a table that
+// fails check_table or that the format cannot hold: a name that is not printable UTF-8 of 1..80
+// bytes without a blank at either end (ID line 1), or is NONE, or ends in '#<number>' (the
+// reader's mark of a repeated name); a unit over 20 bytes (the axis units label).
+void write_file(const DataTable& tab, const std::string& path);
 
 // "General", "Time Response", "Frequency Response Function", ... ("Unknown" outside 0..27).
 std::string function_type_name(int type);

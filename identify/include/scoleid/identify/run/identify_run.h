@@ -31,6 +31,7 @@
 #include "scoleid/identify/inverse/modal_uncertainty.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/run/problem.h"
+#include "scoleid/identify/run/residual_bands.h"
 #include "scoleid/identify/run/start_check.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/run_directory.h"
@@ -87,6 +88,9 @@ struct RunResult {
   // A measured record's sensors against the model at the first attempt's start (start_check.h):
   // empty sensors when not checked.
   StartCheck start_check;
+  // Where the residual at the estimate sits in frequency, by the identified modes (residual_bands.h);
+  // empty bands when the run kept no outputs at the estimate.
+  ResidualBands residual_bands;
   // The smoothness prior (identification.smoothness): its weight, and with the discrepancy
   // principle the weights tried, whether one met it, and the noise's expected misfit.
   double smoothness_weight = 0.0;

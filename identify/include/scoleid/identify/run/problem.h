@@ -127,6 +127,9 @@ struct Problem {
   // What the record says of its own channels before any fit (an input's static offset;
   // docs/data.md §2.5), one line each naming the channel.
   std::vector<std::string> warnings;
+  // Inputs driven by their column that read with a static offset (the warning above): the input's
+  // index and the column's mean, which the start check sets aside before it judges signs and scales.
+  std::vector<std::pair<std::size_t, double>> static_offsets;
   const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };

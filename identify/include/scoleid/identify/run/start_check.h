@@ -13,6 +13,8 @@
 // is read from the data). |ρ| >= 0.5 and a outside [1/3, 3]: a size the handbook start cannot
 // explain (a unit, a calibration; every sensor alike points at the input). Each finding is a
 // warning that names the channel and the conditioning that states the fix; none refuses the run.
+// An input read with a static offset (Problem::static_offsets) is set aside first: the model runs
+// on the column less its mean, so a load cell's offset and its sign are both named in one run.
 #include <string>
 #include <vector>
 
