@@ -19,6 +19,7 @@
 #include "scoleid/identify/run/problem.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/run_directory.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/validation.h"
 
@@ -35,6 +36,8 @@ const std::vector<std::string>& campaign_report_files() {
 
 CampaignStore::CampaignStore(const Campaign& c, std::string out, bool exclusive) : c_(c), out_(std::move(out)) {
   std::error_code ec;
+  // Not inside another run's output (its commit would take this campaign's files with it).
+  io::check_not_inside_running(out_, "campaign output directory");
   // Only a campaign's own files may be there: nothing of the user's is ever replaced.
   if (fs::exists(out_, ec)) {
     if (!fs::is_directory(out_, ec)) throw io::InputError("campaign output directory '" + out_ + "': exists and is not a directory");
@@ -62,6 +65,9 @@ CampaignStore::CampaignStore(const Campaign& c, std::string out, bool exclusive)
       throw io::InputError("campaign output directory '" + out_ + "': another campaign run is using it");
     }
   }
+  // This process works for the campaign: its truths inside out_ are not refused for out_'s lock
+  // (the coordinator's, held here, or the coordinator's that an MPI worker's store runs beside).
+  io::register_campaign_directory(out_);
 }
 
 CampaignStore::~CampaignStore() {

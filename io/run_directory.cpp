@@ -22,7 +22,34 @@ namespace {
 bool is_lock_name(const std::string& n) { return n.size() > 6 && n[0] == '.' && n.compare(n.size() - 5, 5, ".lock") == 0; }
 // The lock of directory d: d's parent/.NAME.lock.
 fs::path lock_of(const fs::path& d) { return d.parent_path() / ("." + d.filename().string() + ".lock"); }
+// The campaign directories this process works for (register_campaign_directory).
+std::vector<fs::path>& own_campaigns() {
+  static std::vector<fs::path> dirs;
+  return dirs;
+}
+fs::path normal_absolute(const fs::path& p) {
+  std::error_code ec;
+  fs::path a = fs::absolute(p, ec).lexically_normal();
+  if (!a.has_filename() && a.has_parent_path()) a = a.parent_path();
+  return a;
+}
 }  // namespace
+
+void register_campaign_directory(const std::string& dir) { own_campaigns().push_back(normal_absolute(dir)); }
+
+void check_not_inside_running(const std::string& target, const std::string& what) {
+  const fs::path t = normal_absolute(target);
+  for (fs::path d = t.parent_path(); d.has_relative_path() && d.has_filename(); d = d.parent_path()) {
+    const fs::path l = lock_of(d);
+    if (RunDirectory::lock_held(l))
+      throw InputError(what + " '" + target + "': lies inside '" + d.string() + "', which another run (" + RunDirectory::lock_holder(l) +
+                       ") is writing; wait for it to finish or choose another directory");
+    const auto& own = own_campaigns();
+    if (std::find(own.begin(), own.end(), d) == own.end() && RunDirectory::lock_held(d / ".lock"))
+      throw InputError(what + " '" + target + "': lies inside '" + d.string() +
+                       "', which a campaign run is writing; wait for it to finish or choose another directory");
+  }
+}
 
 RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> owned, const std::string& program)
     : program_(program), owned_(std::move(owned)) {
@@ -157,12 +184,14 @@ void RunDirectory::lock(const fs::path& t) {
   const std::string who = program_ + " (pid " + std::to_string(::getpid()) + ")\n";
   if (::ftruncate(lock_fd_, 0) == 0 && ::write(lock_fd_, who.data(), who.size()) < 0) {
   }
-  // Nor inside a directory another run is writing (its commit would replace this run's outputs).
-  for (fs::path d = t.parent_path(); d.has_relative_path() && d.has_filename(); d = d.parent_path()) {
-    const fs::path l = lock_of(d);
-    if (lock_held(l))
-      throw InputError("output directory '" + target_ + "': lies inside '" + d.string() + "', which another run (" +
-                       lock_holder(l) + ") is writing; wait for it to finish or choose another directory");
+  // Nor inside a directory another run is writing (its commit would replace this run's outputs),
+  // nor inside a campaign's that this process does not work for. Refused, the lock is let go (the
+  // constructor throws: no destructor runs, and a long-lived caller, Python, would keep it).
+  try {
+    check_not_inside_running(target_, "output directory");
+  } catch (...) {
+    release_lock();
+    throw;
   }
 }
 

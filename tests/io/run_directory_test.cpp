@@ -4,6 +4,8 @@
 #include "scoleid/io/run_directory.h"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -267,4 +269,49 @@ TEST_F(RunDirectoryTest, AnUnwritableTargetIsRefusedNotReplaced) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no setuid, 4: another message, 6: accepted";
   EXPECT_TRUE(fs::is_directory(parent / "out"));
+}
+
+// A campaign holds its lock inside its directory (DIR/.lock, crosscheck/campaign_runner.cpp): a run
+// into DIR/x from another process is refused while it is held, and accepted once the process says
+// it works for that campaign (its truths, its MPI workers) or once the lock is gone.
+TEST_F(RunDirectoryTest, ARunInsideARunningCampaignIsRefusedUnlessThisProcessWorksForIt) {
+  const fs::path cam = root_ / "cam";
+  fs::create_directories(cam / "truths");
+  const int fd = ::open((cam / ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  for (const fs::path target : {cam / "x", cam / "truths" / "p1"}) {
+    try {
+      RunDirectory d(target.string(), {"a.txt"}, "test");
+      ADD_FAILURE() << "a run into " << target << " inside a running campaign was accepted";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("lies inside '" + cam.string() + "', which a campaign run is writing"), std::string::npos) << msg;
+    }
+    EXPECT_FALSE(fs::exists(target));
+    // Refused, it holds no lock of its own.
+    EXPECT_FALSE(fs::exists(target.parent_path() / ("." + target.filename().string() + ".lock")));
+  }
+  // The shared check says the same for any other writer (a campaign inside a campaign).
+  EXPECT_THROW(check_not_inside_running((cam / "inner").string(), "campaign output directory"), InputError);
+  // The lock released: accepted.
+  ::close(fd);
+  {
+    RunDirectory d((cam / "x").string(), {"a.txt"}, "test");
+    write_text_atomic(d.path("a.txt"), "1");
+    d.commit();
+  }
+  EXPECT_EQ(slurp(cam / "x" / "a.txt"), "1");
+  // Held again, by the campaign this process works for: its own runs inside are accepted.
+  const int fd2 = ::open((cam / ".lock").c_str(), O_RDWR | O_CLOEXEC);
+  ASSERT_GE(fd2, 0);
+  ASSERT_EQ(::flock(fd2, LOCK_EX | LOCK_NB), 0);
+  register_campaign_directory(cam.string());
+  {
+    RunDirectory d((cam / "truths" / "p1").string(), {"a.txt"}, "test");
+    write_text_atomic(d.path("a.txt"), "2");
+    d.commit();
+  }
+  EXPECT_EQ(slurp(cam / "truths" / "p1" / "a.txt"), "2");
+  ::close(fd2);
 }

@@ -11,7 +11,10 @@
 // One run at a time per directory, and none inside another's: the run holds PARENT/.NAME.lock
 // (flock; the file holds the program and pid, and is removed at the end) from the constructor to
 // the destructor, and a run whose target lies inside a directory whose lock is held, or a
-// directory holding a held lock, is refused up front (InputError naming the other run).
+// directory holding a held lock, is refused up front (InputError naming the other run). A
+// campaign (scole-crosscheck campaign) holds its lock inside its directory, DIR/.lock; a run inside
+// DIR is refused too while that lock is held, unless this process works for that campaign
+// (register_campaign_directory: the campaign's own truths, its MPI workers).
 //
 // The target may be new, empty, or hold an earlier run of the same program (only files from
 // `owned`; an owned name may be a file or a directory). Anything else in it is refused up front, so no user file is ever replaced. The
@@ -21,6 +24,13 @@
 #include <vector>
 
 namespace scoleid::io {
+
+// Throws InputError ("<what> '<target>': lies inside '<dir>', which another run ... is writing")
+// when `target` lies inside a directory a RunDirectory or a campaign of another process holds.
+void check_not_inside_running(const std::string& target, const std::string& what);
+// This process works for the campaign writing `dir` (its lock DIR/.lock is its own): runs inside
+// it are not refused by the check above.
+void register_campaign_directory(const std::string& dir);
 
 class RunDirectory {
 public:
@@ -44,13 +54,16 @@ public:
   void commit();
   bool committed() const { return committed_; }
 
+  // Whether another open file description holds a flock on `lock`, and what its file says of the
+  // holder ("another program" when nothing).
+  static bool lock_held(const std::filesystem::path& lock);
+  static std::string lock_holder(const std::filesystem::path& lock);
+
 private:
   void lock(const std::filesystem::path& target);
   void release_lock();
   // The target's contents and the staging directory (the constructor's work after the lock).
   void check_target(const std::filesystem::path& target, const std::string& given, const std::string& program);
-  static bool lock_held(const std::filesystem::path& lock);
-  static std::string lock_holder(const std::filesystem::path& lock);
 
   std::string target_, staging_, program_, lock_path_;
   int lock_fd_ = -1;
