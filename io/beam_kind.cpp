@@ -12,6 +12,10 @@ ParameterInfo point_element_info(const std::string& group, const PointElement& e
   if (field == "k_w") return {point_element_parameter(group, e, "k_w"), "translational spring to ground of " + where, "force/length"};
   if (field == "k_theta") return {point_element_parameter(group, e, "k_theta"), "rotational spring to ground of " + where, "force·length/rad"};
   if (field == "c_w") return {point_element_parameter(group, e, "c_w"), "translational dashpot to ground of " + where, "force·time/length"};
+  if (field == "lumped_mass") return {point_element_parameter(group, e, "lumped_mass"), "lumped mass (its own degree of freedom) of " + where, "mass"};
+  if (field == "lumped_k") return {point_element_parameter(group, e, "lumped_k"), "spring joining the lumped mass to the beam at " + where, "force/length"};
+  if (field == "lumped_c") return {point_element_parameter(group, e, "lumped_c"), "dashpot joining the lumped mass to the beam at " + where, "force·time/length"};
+  if (field == "lumped_k_ground") return {point_element_parameter(group, e, "lumped_k_ground"), "spring from the lumped mass of " + where + " to ground", "force/length"};
   return {point_element_parameter(group, e, "c_theta"), "rotational dashpot to ground of " + where, "force·length·time/rad"};
 }
 
@@ -28,8 +32,8 @@ std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
       const EndCondition end = e.name == "left" ? b.left : b.right;
       for (const auto& [key, member] : point_element_fields()) {
         const std::string k = key;
-        const bool on_w = k == "mass" || k == "k_w" || k == "c_w";
-        if (group == &b.supports && (k == "mass" || k == "inertia" || end == EndCondition::Clamped ||
+        const bool on_w = displacement_field(k);
+        if (group == &b.supports && (attachment_only_field(k) || end == EndCondition::Clamped ||
                                      (on_w && end == EndCondition::Pinned)))
           continue;
         v.emplace_back(prefix + e.name + "." + key, &(e.*member));

@@ -23,8 +23,24 @@
 namespace scoleid::io {
 
 std::vector<std::pair<const char*, double PointElement::*>> point_element_fields() {
-  return {{"mass", &PointElement::mass}, {"inertia", &PointElement::inertia}, {"k_w", &PointElement::k_w},
-          {"k_theta", &PointElement::k_theta}, {"c_w", &PointElement::c_w}, {"c_theta", &PointElement::c_theta}};
+  return {{"mass", &PointElement::mass},
+          {"inertia", &PointElement::inertia},
+          {"k_w", &PointElement::k_w},
+          {"k_theta", &PointElement::k_theta},
+          {"c_w", &PointElement::c_w},
+          {"c_theta", &PointElement::c_theta},
+          {"lumped_mass", &PointElement::lumped_mass},
+          {"lumped_k", &PointElement::lumped_k},
+          {"lumped_c", &PointElement::lumped_c},
+          {"lumped_k_ground", &PointElement::lumped_k_ground}};
+}
+
+bool attachment_only_field(const std::string& key) {
+  return key == "mass" || key == "inertia" || key.rfind("lumped_", 0) == 0;
+}
+
+bool displacement_field(const std::string& key) {
+  return key == "mass" || key == "k_w" || key == "c_w" || key.rfind("lumped_", 0) == 0;
 }
 
 std::string point_element_parameter(const std::string& group, const PointElement& e, const char* field) {
@@ -392,8 +408,7 @@ void check_offset(const std::string& source, const std::string& field, double v,
 // A point element's quantities from its map (the fields present; the others keep e's values).
 void parse_point_element_fields(Reader& r, PointElement& e, bool with_mass) {
   for (const auto& [key, member] : point_element_fields()) {
-    const bool mass_like = std::string(key) == "mass" || std::string(key) == "inertia";
-    if (mass_like && !with_mass) continue;
+    if (attachment_only_field(key) && !with_mass) continue;
     e.*member = r.nonneg(key, e.*member);
   }
 }
@@ -415,7 +430,7 @@ void parse_supports(const YAML::Node& n, const std::string& source, const std::s
   }
 }
 
-// attachments: [{name, location, mass, inertia, k_w, k_theta, c_w, c_theta}]. In
+// attachments: [{name, location, mass, inertia, k_w, k_theta, c_w, c_theta, lumped_*}]. In
 // truth.overrides, each entry names an attachment of the scenario and replaces the fields it gives.
 void parse_attachments(const YAML::Node& n, const std::string& source, const std::string& path, BeamSpec& b, bool base) {
   if (!n.IsSequence()) fail_field(source, path, "must be a list", Reader::kind(n));
@@ -455,14 +470,26 @@ void check_point_elements(const std::string& source, const std::string& path, Be
       fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(L) + "]", format_value(e.location));
     bool holds = false;
     for (const auto& [key, member] : point_element_fields()) holds = holds || e.*member > 0.0;
-    if (!holds) fail_field(source, f, "holds nothing: give one of mass, inertia, k_w, k_theta, c_w, c_theta > 0", "all 0");
+    if (!holds)
+      fail_field(source, f, "holds nothing: give one of mass, inertia, k_w, k_theta, c_w, c_theta, lumped_mass with lumped_k > 0",
+                 "all 0");
+    // A lumped attachment is a mass on a spring: without the mass its springs are one spring in
+    // series (k_w), without the spring the mass is not attached.
+    if (e.has_lumped()) {
+      if (!(e.lumped_mass > 0.0))
+        fail_field(source, f + ".lumped_mass", "must be > 0 with lumped_k, lumped_c or lumped_k_ground (springs in series without a mass are k_w)",
+                   format_value(e.lumped_mass));
+      if (!(e.lumped_k > 0.0))
+        fail_field(source, f + ".lumped_k", "must be > 0 with a lumped_mass (the spring that joins it to the beam)", format_value(e.lumped_k));
+    }
     check_attached_mass(source, f + ".mass", e.mass, m, true);
     check_attached_inertia(source, f + ".inertia", e.inertia, m, L);
     if (const EndCondition* ec = end_at(e.location)) {
       const std::string end = e.location == 0.0 ? "left" : "right";
       // What acts on a held degree of freedom would be a parameter no data can see.
-      for (const char* key : {"mass", "k_w", "c_w"}) {
-        const double v = e.*(key == std::string("mass") ? &PointElement::mass : key == std::string("k_w") ? &PointElement::k_w : &PointElement::c_w);
+      for (const auto& [key, member] : point_element_fields()) {
+        if (!displacement_field(key)) continue;
+        const double v = e.*member;
         if (*ec != EndCondition::Free && v > 0.0)
           fail_field(source, f + "." + key,
                      "acts on the " + end + " end's displacement, which the " + to_string(*ec) +
@@ -1114,7 +1141,7 @@ nlohmann::json to_json(const Scenario& s) {
     auto fields = [](const PointElement& e, bool with_mass) {
       json f = json::object();
       for (const auto& [key, member] : point_element_fields())
-        if (with_mass || (std::string(key) != "mass" && std::string(key) != "inertia")) f[key] = e.*member;
+        if (with_mass || !attachment_only_field(key)) f[key] = e.*member;
       return f;
     };
     if (!b.supports.empty()) {

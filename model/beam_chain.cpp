@@ -163,6 +163,20 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     anchors.push_back({tip_body && e.location == length_ ? tip_body_ : segment_bodies_[static_cast<std::size_t>(i)], e.k_theta,
                        e.c_theta});
   for (std::size_t k = 0; k < points.size(); ++k) points[k].body = segment_bodies_[static_cast<std::size_t>(point_bar[k])];
+  // A lumped attachment: its mass a particle on a Slider from ground along y at the station (rest
+  // at y = 0), its spring-dashpot to the bar's station a PointSpring between the two, its spring to
+  // ground the slider's own spring (docs/theory.md §2.5).
+  for (const auto& e : elements) {
+    if (!(e.lumped_mass > 0.0)) continue;
+    double x = 0.0;
+    const int i = bar_of(e.location, x);
+    const MobilizedBody::Slider mass(matter_.updGround(), Transform(Rotation(Pi / 2, ZAxis), Vec3(e.location, 0, 0)),
+                                     Body::Rigid(MassProperties(e.lumped_mass, Vec3(0), Inertia(0))), Transform());
+    PointSpring coupling{segment_bodies_[static_cast<std::size_t>(i)], Vec3(x, 0, 0), e.lumped_k, e.lumped_c};
+    coupling.other = mass.getMobilizedBodyIndex();
+    points.push_back(coupling);
+    if (e.lumped_k_ground > 0.0) joints.push_back({mass.getMobilizedBodyIndex(), 0, e.lumped_k_ground, 0.0});
+  }
   if (beam.right != io::EndCondition::Free) {
     Constraint::PointInPlane(matter_.updGround(), UnitVec3(0, 1, 0), 0.0, parent, Vec3(h, 0, 0));
     if (beam.right == io::EndCondition::Clamped) {

@@ -52,8 +52,14 @@ void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces
   }
   for (const auto& p : points_) {
     const MobilizedBody& b = matter_.getMobilizedBody(p.body);
-    const Real y = b.findStationLocationInGround(state, p.station)[1];
-    const Real v = b.findStationVelocityInGround(state, p.station)[1];
+    Real y = b.findStationLocationInGround(state, p.station)[1];
+    Real v = b.findStationVelocityInGround(state, p.station)[1];
+    if (p.other.isValid()) {
+      const MobilizedBody& o = matter_.getMobilizedBody(p.other);
+      y -= o.findStationLocationInGround(state, p.other_station)[1];
+      v -= o.findStationVelocityInGround(state, p.other_station)[1];
+      o.applyForceToBodyPoint(state, p.other_station, Vec3(0, p.k * y + p.c * v, 0), body_forces);
+    }
     b.applyForceToBodyPoint(state, p.station, Vec3(0, -p.k * y - p.c * v, 0), body_forces);
   }
 }
@@ -69,7 +75,8 @@ Real JointForces::calcPotentialEnergy(const State& state) const {
     e += 0.5 * a.k * theta * theta;
   }
   for (const auto& p : points_) {
-    const Real y = matter_.getMobilizedBody(p.body).findStationLocationInGround(state, p.station)[1];
+    Real y = matter_.getMobilizedBody(p.body).findStationLocationInGround(state, p.station)[1];
+    if (p.other.isValid()) y -= matter_.getMobilizedBody(p.other).findStationLocationInGround(state, p.other_station)[1];
     e += 0.5 * p.k * y * y;
   }
   return e;

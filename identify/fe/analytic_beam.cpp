@@ -93,9 +93,19 @@ double end_determinant(const io::BeamSpec& b, const std::vector<io::PointElement
     n1 = std::sqrt(n1);
     for (auto& r : z) r[1] /= n1;
   };
+  // A lumped attachment adds its dynamic stiffness at the station, k_l (k_g − m_l ω²)/(k_l + k_g −
+  // m_l ω²); the determinant is multiplied by each denominator so that its poles (the lumped mass
+  // alone on its springs, the beam held) are no sign changes and its zeros stay the modes.
+  double poles = 1.0;
   auto jump = [&](const io::PointElement& e) {
+    double lumped = 0.0;
+    if (e.lumped_mass > 0.0) {
+      const double d = e.lumped_k + e.lumped_k_ground - e.lumped_mass * w * w;
+      poles *= d;
+      lumped = e.lumped_k * (e.lumped_k_ground - e.lumped_mass * w * w) / d;
+    }
     for (int c = 0; c < 2; ++c) {
-      z[3][c] += (e.mass * w * w - e.k_w) / (EI * beta * beta * beta) * z[0][c];
+      z[3][c] += (e.mass * w * w - e.k_w - lumped) / (EI * beta * beta * beta) * z[0][c];
       z[2][c] -= (e.inertia * w * w - e.k_theta) / (EI * beta) * z[1][c];
     }
   };
@@ -126,7 +136,7 @@ double end_determinant(const io::BeamSpec& b, const std::vector<io::PointElement
   const int* r = end_rows[b.right == EndCondition::Pinned ? 0 : b.right == EndCondition::Clamped ? 1 : 2];
   const auto& a = z[static_cast<std::size_t>(r[0])];
   const auto& c = z[static_cast<std::size_t>(r[1])];
-  return a[0] * c[1] - a[1] * c[0];
+  return (a[0] * c[1] - a[1] * c[0]) * poles;
 }
 
 }  // namespace

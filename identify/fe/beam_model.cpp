@@ -1,6 +1,7 @@
 #include "scoleid/identify/fe/beam_model.h"
 
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "scoleid/identify/fe/hermite_beam.h"
@@ -134,6 +135,12 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     if (!fixed[static_cast<std::size_t>(i)]) fe.full_to_reduced[static_cast<std::size_t>(i)] = n++;
   if (n == 0) fail_field(source, "beam", "leaves no free degree of freedom", std::to_string(elements) + " elements");
 
+  // A lumped attachment's mass has a degree of freedom of its own, after the beam's (docs/theory.md
+  // §2.5): its displacement along w.
+  std::map<std::string, int> lumped_dof;
+  for (const auto& e : beam.attachments)
+    if (e.lumped_mass > 0.0) lumped_dof[e.name] = n + static_cast<int>(lumped_dof.size());
+  n += static_cast<int>(lumped_dof.size());
   StructuralModel& m = fe.model;
   m.ndof = n;
   m.ncoef = 2 + 2 * sections;
@@ -151,7 +158,7 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
           m.coefficient_names.push_back(fe.points.back().name);
         }
   m.ncoef += static_cast<int>(fe.points.size());
-  m.dof_group.resize(static_cast<std::size_t>(n));
+  m.dof_group.assign(static_cast<std::size_t>(n), 0);  // a lumped mass's DOF is a displacement
   for (int i = 0; i < nfull; ++i) {
     const int r = fe.full_to_reduced[static_cast<std::size_t>(i)];
     if (r >= 0) m.dof_group[static_cast<std::size_t>(r)] = i % 2;  // 0: w, 1: θ
@@ -217,22 +224,31 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   }
   // A point element at s: m N Nᵀ and J N′N′ᵀ in M, k_w N Nᵀ and k_θ N′N′ᵀ in K, c_w N Nᵀ and
   // c_θ N′N′ᵀ in D, N (N′) the displacement (slope) row at s (docs/theory.md §2.5). Each row lies
-  // on one element's DOFs, so the operators keep the mesh's pattern.
+  // on one element's DOFs, so the operators keep the mesh's pattern. A lumped attachment with DOF
+  // a (unit row e_a): m_l e_a e_aᵀ in M, k_l (N − e_a)(N − e_a)ᵀ in K and c_l the same in D, the
+  // ground spring k_g e_a e_aᵀ in K (its row joins the banded solver's border).
   for (std::size_t k = 0; k < fe.points.size(); ++k) {
     const auto& p = fe.points[k];
+    const std::string element = p.name.substr(p.name.find('.') + 1, p.name.rfind('.') - p.name.find('.') - 1);
     if (!(p.location >= 0.0 && p.location <= beam.length))  // a station moved by identification.uncertain
       fail_field(source, "beam." + p.name.substr(0, p.name.rfind('.')) + ".location",
                  "must lie on the beam [0, " + format_value(beam.length) + "]", format_value(p.location));
     const bool slope = p.field == "inertia" || p.field == "k_theta" || p.field == "c_theta";
-    const Eigen::RowVectorXd row = slope ? fe.rotation_row(p.location) : fe.displacement_row(p.location);
+    const bool lumped = p.field.rfind("lumped_", 0) == 0;
+    Eigen::RowVectorXd row = slope ? fe.rotation_row(p.location) : fe.displacement_row(p.location);
+    if (lumped) {
+      Eigen::RowVectorXd unit = Eigen::RowVectorXd::Zero(n);
+      unit[lumped_dof.at(element)] = 1.0;
+      row = p.field == "lumped_k" || p.field == "lumped_c" ? Eigen::RowVectorXd(row - unit) : unit;
+    }
     std::vector<Trip> t;
     for (int a = 0; a < n; ++a)
       if (row[a] != 0.0)
         for (int b = 0; b < n; ++b)
           if (row[b] != 0.0) t.emplace_back(a, b, row[a] * row[b]);
     OperatorTerm term{to_sparse(t), fe.coef_point(static_cast<int>(k))};
-    if (p.field == "mass" || p.field == "inertia") m.mass.push_back(std::move(term));
-    else if (p.field == "k_w" || p.field == "k_theta") m.stiffness.push_back(std::move(term));
+    if (p.field == "mass" || p.field == "inertia" || p.field == "lumped_mass") m.mass.push_back(std::move(term));
+    else if (p.field == "k_w" || p.field == "k_theta" || p.field == "lumped_k" || p.field == "lumped_k_ground") m.stiffness.push_back(std::move(term));
     else m.damping.push_back(std::move(term));
   }
 

@@ -47,6 +47,13 @@ TEST(Gradient, SupportsAndAttachments) {
   Case e = make_case(yaml, false);
   test_support::expect_second_order(test_support::taylor_remainders(*e.obj, e.p->params->initial(), 13), 1, 5);
 }
+// A lumped attachment (its own degree of freedom, docs/theory.md §2.5): its mass and springs.
+TEST(Gradient, LumpedAttachment) {
+  const std::string yaml = scoleid::test::test_scenario("gradient_test/grad-lumped");
+  check_kind(yaml);
+  Case e = make_case(yaml, false);
+  test_support::expect_second_order(test_support::taylor_remainders(*e.obj, e.p->params->initial(), 13), 1, 5);
+}
 TEST(Gradient, PhysicalParameters) { check_kind(kPhysical); }
 TEST(Gradient, SectionalStiffnessMassAndDamping) { check_kind(kSections); }
 

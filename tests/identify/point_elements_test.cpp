@@ -257,3 +257,105 @@ TEST(PointElements, TruthOverridesReplaceFieldsByName) {
     EXPECT_NE(std::string(e.what()).find("truth.overrides.beam.attachments[0].name"), std::string::npos) << e.what();
   }
 }
+
+// A lumped attachment (a mass on a spring, its own degree of freedom): the exact roots against
+// their two limits — a coupling spring far stiffer than the beam makes the mass ride on w(s) (an
+// attached mass, the ground spring a k_w there); a coupling far softer leaves the bare beam's
+// modes and adds the mass's own, ω² = (k_l + k_g)/m_l.
+TEST(PointElements, ALumpedAttachmentMeetsItsStiffAndSoftLimits) {
+  io::BeamSpec b;
+  b.length = 2.0;
+  b.EI = {500.0};
+  b.rho_A = 3.0;
+  b.left = io::EndCondition::Clamped;
+  b.right = io::EndCondition::Free;
+  const double L = b.length, EI = b.EI[0];
+  io::PointElement lumped{"shaker", 1.3};
+  lumped.lumped_mass = 0.8;
+  lumped.lumped_k_ground = 40.0;
+  lumped.lumped_k = 1e10 * EI / (L * L * L);
+  io::PointElement rigid{"shaker", 1.3};
+  rigid.mass = 0.8;
+  rigid.k_w = 40.0;
+  io::BeamSpec s = b, r = b;
+  s.attachments = {lumped};
+  r.attachments = {rigid};
+  const auto ws = an::point_element_omegas(s, 4), wr = an::point_element_omegas(r, 4);
+  for (int k = 0; k < 4; ++k) EXPECT_LT(rel(ws[static_cast<std::size_t>(k)], wr[static_cast<std::size_t>(k)]), 1e-8) << "stiff, mode " << k + 1;
+  // Soft: k_l + k_g = 0.8 · 30² puts the mass's own mode at 30 rad/s, between the bare beam's first
+  // two (about 10.2 and 64 rad/s); k_l = 1e-6 of it barely couples.
+  s.attachments[0].lumped_k_ground = 0.8 * 900.0 * (1 - 1e-6);
+  s.attachments[0].lumped_k = 0.8 * 900.0 * 1e-6;
+  const auto soft = an::point_element_omegas(s, 4), bare = an::point_element_omegas(b, 3);
+  EXPECT_LT(rel(soft[0], bare[0]), 1e-6);
+  EXPECT_LT(rel(soft[1], 30.0), 1e-6);
+  EXPECT_LT(rel(soft[2], bare[1]), 1e-6);
+  EXPECT_LT(rel(soft[3], bare[2]), 1e-6);
+}
+
+// The FE model with a lumped attachment (its DOF after the beam's) against the exact roots: upper
+// bounds, within 5e-6 at 40 elements, fourth order in the modes the beam's field carries.
+TEST(PointElements, ALumpedAttachmentConvergesAtFourthOrder) {
+  std::string y = kBench;
+  const std::string at = "    - {name: spring, location: 0.3, k_w: 40, c_w: 0.05}\n";
+  y.replace(y.find(at), at.size(),
+            at + "    - {name: shaker, location: 0.35, lumped_mass: 0.02, lumped_k: 2000, lumped_c: 0.1, lumped_k_ground: 50}\n");
+  const io::Scenario sc = io::parse_scenario(y, "bench");
+  const auto exact = an::point_element_omegas(sc.beam, 5);
+  ASSERT_EQ(exact.size(), 5u);
+  std::printf("  exact [Hz]");
+  for (double w : exact) std::printf(" %.6f", w / (2 * M_PI));
+  std::printf("\n");
+  std::vector<std::vector<double>> err;
+  for (int ne : {5, 10, 20, 40}) {
+    const auto st = identify::make_structure(sc, ne);
+    EXPECT_EQ(st->model().ndof, 2 * ne + 1 + 1) << "the pinned root leaves 2 ne + 1 beam DOFs, and the lumped mass one";
+    const auto w = fe_omegas(sc, ne);
+    err.emplace_back();
+    std::printf("  %3d", ne);
+    for (int k = 0; k < 5; ++k) {
+      err.back().push_back(w[static_cast<std::size_t>(k)] / exact[static_cast<std::size_t>(k)] - 1.0);
+      std::printf(" %12.3e", err.back().back());
+    }
+    std::printf("\n");
+  }
+  for (int k = 0; k < 5; ++k) {
+    SCOPED_TRACE("mode " + std::to_string(k + 1));
+    for (const auto& e : err) EXPECT_GT(e[static_cast<std::size_t>(k)], -5e-9);
+    EXPECT_LT(std::abs(err.back()[static_cast<std::size_t>(k)]), 5e-6);
+    if (err[1][static_cast<std::size_t>(k)] > 1e-6) EXPECT_NEAR(std::log2(err[1][static_cast<std::size_t>(k)] / err[2][static_cast<std::size_t>(k)]), 4.0, 0.3);
+  }
+  // Its four quantities are named, estimable parameters.
+  const auto values = io::structure_parameters(sc);
+  EXPECT_EQ(values.at("attachments.shaker.lumped_mass"), 0.02);
+  EXPECT_EQ(values.at("attachments.shaker.lumped_k"), 2000.0);
+  EXPECT_EQ(values.at("attachments.shaker.lumped_c"), 0.1);
+  EXPECT_EQ(values.at("attachments.shaker.lumped_k_ground"), 50.0);
+}
+
+// A lumped attachment needs its mass and its spring, and a displacement to ride on.
+TEST(PointElements, ALumpedAttachmentIsRefusedWithoutItsMassOrSpringOrOnAHeldEnd) {
+  auto refused = [](const std::string& attachment, const std::string& field, const std::string& why) {
+    const std::string y = "beam: {length: 1, left: pinned, right: free, rho_A: 1, EI: 10, attachments: [" + attachment + "]}\n";
+    try {
+      io::parse_scenario(y, "s.yaml");
+      ADD_FAILURE() << "accepted: " << attachment;
+    } catch (const io::InputError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("s.yaml"), std::string::npos) << m;
+      EXPECT_NE(m.find(field), std::string::npos) << m;
+      EXPECT_NE(m.find(why), std::string::npos) << m;
+    }
+  };
+  refused("{name: a, location: 0.5, lumped_k: 10}", "beam.attachments[0].lumped_mass", "must be > 0");
+  refused("{name: a, location: 0.5, lumped_mass: 0.1, lumped_k_ground: 10}", "beam.attachments[0].lumped_k", "must be > 0");
+  refused("{name: a, location: 0, lumped_mass: 0.1, lumped_k: 10}", "beam.attachments[0].lumped_mass", "pinned");
+  refused("{name: a, location: 0.5, lumped_mass: -1, lumped_k: 10}", "beam.attachments[0].lumped_mass", ">= 0");
+  // A support has no lumped attachment (an attachment at the end has).
+  try {
+    io::parse_scenario("beam: {length: 1, left: pinned, right: free, rho_A: 1, EI: 10, supports: {left: {lumped_k: 5}}}\n", "s.yaml");
+    ADD_FAILURE() << "a support's lumped_k accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("beam.supports.left.lumped_k"), std::string::npos) << e.what();
+  }
+}

@@ -12,7 +12,8 @@
 //   structure: beam | scole
 //   beam:      { length, left, right, rho_A, EI: x | [x1..xN], zeta, c_kv, tip_mass, tip_inertia,
 //                supports: { left|right: { k_w, k_theta, c_w, c_theta } },
-//                attachments: [ { name, location, mass, inertia, k_w, k_theta, c_w, c_theta } ] }
+//                attachments: [ { name, location, mass, inertia, k_w, k_theta, c_w, c_theta,
+//                                 lumped_mass, lumped_k, lumped_c, lumped_k_ground } ] }
 //   scole:     see ScoleSpec
 //   inputs:    [ { name, at, kind, location, direction, unit, signal } ]
 //   sensors:   [ { name, at, kind, location, direction, unit, noise_std } ]
@@ -59,15 +60,25 @@ const char* to_string(EndCondition e);
 // inertia J riding on the member's displacement w(s) and slope w_s(s), and springs and dashpots
 // from that point to ground, k_w, c_w on w(s) and k_theta, c_theta on w_s(s). Every quantity is a
 // named, estimable parameter when it is > 0 (point_element_quantities).
+// An attachment may also carry a lumped attachment: a mass lumped_mass with a degree of freedom of
+// its own, along w, joined to w(s) by a spring lumped_k with a dashpot lumped_c in parallel and to
+// ground by a spring lumped_k_ground (a shaker's armature on its stinger and flexures, a tuned
+// absorber); lumped_mass and lumped_k both > 0 when any of the four is.
 struct PointElement {
   std::string name;
   double location = 0.0;
   double mass = 0.0, inertia = 0.0;
   double k_w = 0.0, k_theta = 0.0, c_w = 0.0, c_theta = 0.0;
+  double lumped_mass = 0.0, lumped_k = 0.0, lumped_c = 0.0, lumped_k_ground = 0.0;
+  bool has_lumped() const { return lumped_mass > 0.0 || lumped_k > 0.0 || lumped_c > 0.0 || lumped_k_ground > 0.0; }
 };
-// The quantities of a point element by field name (mass, inertia, k_w, k_theta, c_w, c_theta), in
-// that order.
+// The quantities of a point element by field name (mass, inertia, k_w, k_theta, c_w, c_theta,
+// lumped_mass, lumped_k, lumped_c, lumped_k_ground), in that order.
 std::vector<std::pair<const char*, double PointElement::*>> point_element_fields();
+// Fields only an attachment has, not a support: mass, inertia and the lumped attachment's.
+bool attachment_only_field(const std::string& key);
+// Fields that act on the displacement w(s) (the others on the slope w_s(s)).
+bool displacement_field(const std::string& key);
 // The parameter name of a point element's quantity: "supports.left.k_theta",
 // "attachments.clamp.mass" (`group` is "supports" or "attachments").
 std::string point_element_parameter(const std::string& group, const PointElement& e, const char* field);

@@ -5,7 +5,7 @@
 // Gimbal mobilizers): generalized force f = -k q - c u, potential energy 1/2 k q^2. Mobility
 // forces are internal: they act equally and oppositely on the two bodies of the joint, so they
 // conserve the system's linear and angular momentum. A PointSpring ties a body's station to
-// ground along y. An AnchorSpring ties a planar body's
+// ground along y, or to another body's station (a lumped attachment's mass on its spring). An AnchorSpring ties a planar body's
 // absolute rotation about ground z to zero (a clamped end that is not the chain's root):
 // torque -k theta - c omega_z on the body. A RelativeDamper damps a body's angular velocity
 // relative to a reference body, per axis of the reference frame: torque -R_GR diag(c) R_GR^T
@@ -28,12 +28,16 @@ struct AnchorSpring {
 
 // A translational spring-dashpot from a body's station to ground along ground y (a planar
 // structure's grounded spring at a point, docs/theory.md §2.5): force (0, -k y - c v_y, 0) at the
-// station, y and v_y its ground position and velocity along y; potential energy 1/2 k y^2.
+// station, y and v_y its ground position and velocity along y; potential energy 1/2 k y^2. With
+// `other` valid, y and v_y are taken relative to the other body's station (ground y of the one
+// less the other's), and the opposite force acts there: a spring-dashpot between two bodies along y.
 struct PointSpring {
   SimTK::MobilizedBodyIndex body;
   SimTK::Vec3 station{0.0};  // in the body's frame
   double k = 0.0;
   double c = 0.0;
+  SimTK::MobilizedBodyIndex other;  // invalid: ground
+  SimTK::Vec3 other_station{0.0};
 };
 
 struct RelativeDamper {

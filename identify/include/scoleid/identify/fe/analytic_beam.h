@@ -36,7 +36,9 @@ double omega(double betaL, double L, double EI, double rhoA);
 // carried along each stretch between stations by the transfer matrix of the uniform beam at ω
 // (Krylov–Duncan functions of β x, β⁴ = ρA ω²/EI), with the jumps a point element makes at its
 // station (docs/theory.md §2.5):
-//   [EI w_sss] = (m ω² − k_w) w(s_p),   [EI w_ss] = −(J ω² − k_θ) w_s(s_p),
+//   [EI w_sss] = (m ω² − k_w − K_l(ω)) w(s_p),   [EI w_ss] = −(J ω² − k_θ) w_s(s_p),
+// K_l(ω) = k_l (k_g − m_l ω²)/(k_l + k_g − m_l ω²) the dynamic stiffness of a lumped attachment
+// (the determinant multiplied by its denominator, which only removes its poles),
 // the left end's two free unknowns carried to the right end, whose two conditions vanish at a
 // natural frequency. Carried in the scaled field (w, w_s/β, w_ss/β², w_sss/β³) in steps of β x <= 1,
 // the two columns orthonormalised after each step (the determinant keeps its sign; unscaled, its
