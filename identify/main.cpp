@@ -287,7 +287,8 @@ int main(int argc, char** argv) {
     run_dir.commit();
     if (staged_model) staged_model->commit();
     std::printf("\n%s", id.FullReport().c_str());
-    std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with gnuplot)\n", out.c_str());
+    std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp%s (and fit.png, spectrum.png%s with gnuplot)\n", out.c_str(),
+                id.result().start_check.frf.empty() ? "" : ", start_frf.csv, start_frf.gp", id.result().start_check.frf.empty() ? "" : ", start_frf.png");
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
     if (!id.converged())
       std::fprintf(stderr, "scole-identify: %s; outputs written with \"converged\": false\n", id.verdict().c_str());

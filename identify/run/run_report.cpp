@@ -8,6 +8,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/error.h"
 #include "scoleid/io/run_directory.h"
 
 namespace scoleid::identify {
@@ -340,6 +341,18 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                          {"correlation", std::isfinite(s.correlation) ? json(s.correlation) : json(nullptr)},
                          {"scale", std::isfinite(s.scale) ? json(s.scale) : json(nullptr)}});
     out["start_check"] = {{"from", start_check.from}, {"to", start_check.to}, {"sensors", sensors}, {"warnings", start_check.warnings}};
+    json frf = json::array();
+    auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    for (const auto& r : start_check.frf) {
+      json lines = json::array();
+      for (const auto& l : r.lines)
+        lines.push_back({{"hz", l.hz}, {"measured", number(l.measured)}, {"model", number(l.model)}, {"ratio", number(l.ratio)},
+                         {"phase_deg", number(l.phase_deg)}});
+      frf.push_back({{"input", r.input}, {"sensor", r.sensor}, {"median_ratio", number(r.median_ratio)},
+                     {"median_abs_phase_deg", number(r.median_phase_deg)}, {"lines", lines}});
+    }
+    out["start_check"]["frf"] = frf;
+    if (!start_check.frf_note.empty()) out["start_check"]["frf_note"] = start_check.frf_note;
   }
   if (!p.warnings.empty()) out["data_warnings"] = p.warnings;
   if (!residual_bands.bands.empty() || !residual_bands.note.empty()) {
@@ -510,12 +523,53 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
                                                                         spectrum_view(sm.f, sm.psd, sp.psd, p.scenario.identification.band)));
     scripts.push_back("spectrum.gp");
   }
+  // start_frf.csv / start_frf.gp / start_frf.png: the record's and the model's frequency responses
+  // at the start, per sensor (start_check.h).
+  if (!r.start_check.frf.empty()) {
+    const auto& first = r.start_check.frf.front();
+    io::DataTable frf;
+    frf.t = first.f;
+    frf.time_name = "frequency_hz";
+    std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * r.start_check.frf.size() + 40) +
+                     " noenhanced\nset output 'start_frf.png'\nset datafile separator ','\nset multiplot layout " +
+                     std::to_string(r.start_check.frf.size()) + ",2 title " +
+                     gnuplot_quote(p.scenario.name + ": the record against the model at the start (H1 = response / input '" + first.input + "')") +
+                     "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\n" +
+                     (first.f.size() > 1 ? "set xrange [" + io::format_value(first.f.front()) + ":" + io::format_value(first.f.back()) + "]\n"
+                                         : std::string());
+    int col = 2;
+    for (const auto& pair : r.start_check.frf) {
+      if (pair.f.size() != frf.t.size()) continue;
+      std::vector<double> mm, pm, mp, pp;
+      for (std::size_t b = 0; b < pair.f.size(); ++b) {
+        mm.push_back(std::abs(pair.measured[b]));
+        pm.push_back(std::abs(pair.model[b]));
+        mp.push_back(std::arg(pair.measured[b]) * 180.0 / M_PI);
+        pp.push_back(std::arg(pair.model[b]) * 180.0 / M_PI);
+      }
+      const std::string& n = pair.sensor;
+      frf.names.insert(frf.names.end(), {n + "_measured_magnitude", n + "_model_magnitude", n + "_measured_phase_deg", n + "_model_phase_deg"});
+      frf.columns.insert(frf.columns.end(), {mm, pm, mp, pp});
+      const std::string c = std::to_string(col);
+      gp += "set logscale y\nset format y '%g'\nset yrange [*:*]\nset title " + gnuplot_quote(n + ": magnitude") +
+            "\nplot 'start_frf.csv' every ::1 using 1:" + c + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
+            std::to_string(col + 1) + " with lines dt 2 lw 2 title 'model at the start'\n";
+      gp += "unset logscale y\nset yrange [-180:180]\nset ytics 90\nset title " + gnuplot_quote(n + ": phase [deg]") +
+            "\nplot 'start_frf.csv' every ::1 using 1:" + std::to_string(col + 2) + " with points pt 7 ps 0.3 title 'measured', '' every ::1 using 1:" +
+            std::to_string(col + 3) + " with points pt 6 ps 0.3 title 'model at the start'\nset ytics autofreq\n";
+      col += 4;
+    }
+    gp += "unset multiplot\n";
+    io::write_csv(dir.path("start_frf.csv"), frf);
+    io::write_text_atomic(dir.path("start_frf.gp"), gp);
+    scripts.push_back("start_frf.gp");
+  }
   // fit.png (from a raw float64 copy of fit.csv: the same numbers, no text to parse) and
   // spectrum.png rendered side by side.
   const std::vector<RenderStatus> rendered =
       render_fit_plots(dir.staging(), {FitPlot{&tab, p.data.names, cost, "fit.png", notes}}, scripts);
   for (std::size_t i = 0; i < rendered.size(); ++i)
-    render(i == 0 ? "fit.png" : "spectrum.png", rendered[i]);
+    render(i == 0 ? "fit.png" : scripts[i - 1] == "spectrum.gp" ? "spectrum.png" : "start_frf.png", rendered[i]);
   io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
 }
 

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <memory>
 
+#include <unsupported/Eigen/FFT>
+
 #include "scoleid/identify/inverse/spectral_start.h"
 
 namespace scoleid::identify {
@@ -15,6 +17,90 @@ std::string num(double v, const char* fmt = "%.3g") {
   char b[48];
   std::snprintf(b, sizeof b, fmt, v);
   return b;
+}
+
+// H1 of each sensor against the one data input (StartFrf), at the record's peaks `peaks`.
+void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPeak>& peaks, StartCheck& out) {
+  const auto& t = p.data.t;
+  const auto& z = p.data.z;
+  if (p.columns.inputs_from_data.size() != 1) {
+    out.frf_note = p.columns.inputs_from_data.empty() ? "no input is read from the data"
+                                                      : "several inputs are read from the data (a single-input estimate would be biased)";
+    return;
+  }
+  const std::string input = p.columns.inputs_from_data.front();
+  std::size_t i = 0;
+  while (i < p.scenario.inputs.size() && p.scenario.inputs[i].name != input) ++i;
+  if (i >= p.signals.size()) return;
+  const std::size_t N = t.size();
+  const double dt = (t.back() - t.front()) / static_cast<double>(N - 1);
+  for (std::size_t k = 1; k < N; ++k)
+    if (!(std::abs(t[k] - t[k - 1] - dt) <= 1e-6 * dt)) {
+      out.frf_note = "the record is not uniformly sampled";
+      return;
+    }
+  Eigen::FFT<double> fft;
+  std::vector<double> x(N);
+  std::vector<std::complex<double>> F, Z, Y;
+  for (std::size_t k = 0; k < N; ++k) x[k] = p.signals[i](t[k]);
+  fft.fwd(F, x);
+  const double T = static_cast<double>(N) * dt;
+  const auto& band = p.scenario.identification.band;
+  double fmax = 0.0;
+  for (std::size_t b = 1; b <= N / 2; ++b) fmax = std::max(fmax, std::abs(F[b]));
+  std::vector<std::size_t> bins;
+  for (std::size_t b = 1; b <= N / 2; ++b) {
+    const double f = static_cast<double>(b) / T;
+    if (band.size() == 2 && (f < band[0] || f > band[1])) continue;
+    if (std::abs(F[b]) >= 1e-3 * fmax && fmax > 0) bins.push_back(b);
+  }
+  if (bins.empty()) {
+    out.frf_note = "input '" + input + "' carries nothing in the band";
+    return;
+  }
+  for (Eigen::Index j = 0; j < z.cols(); ++j) {
+    StartFrf r;
+    r.input = input;
+    r.sensor = p.scenario.sensors[static_cast<std::size_t>(j)].name;
+    for (std::size_t k = 0; k < N; ++k) x[k] = z(static_cast<Eigen::Index>(k), j);
+    fft.fwd(Z, x);
+    for (std::size_t k = 0; k < N; ++k) x[k] = y(static_cast<Eigen::Index>(k), j);
+    fft.fwd(Y, x);
+    for (std::size_t b : bins) {
+      r.f.push_back(static_cast<double>(b) / T);
+      r.measured.push_back(Z[b] / F[b]);
+      r.model.push_back(Y[b] / F[b]);
+    }
+    for (const auto& pk : peaks) {
+      const auto at = std::lower_bound(r.f.begin(), r.f.end(), pk.f);
+      if (at == r.f.end() || (at == r.f.begin() && *at > pk.f * 1.001)) continue;
+      std::size_t b = static_cast<std::size_t>(at - r.f.begin());
+      if (b > 0 && std::abs(r.f[b - 1] - pk.f) < std::abs(r.f[b] - pk.f)) --b;
+      if (std::abs(r.f[b] - pk.f) > 1.5 / T) continue;  // the peak's bin is not among those the input carries
+      StartFrf::Line l;
+      l.hz = r.f[b];
+      l.measured = std::abs(r.measured[b]);
+      l.model = std::abs(r.model[b]);
+      l.ratio = l.model > 0 ? l.measured / l.model : NAN;
+      l.phase_deg = l.model > 0 && l.measured > 0 ? std::arg(r.measured[b] / r.model[b]) * 180.0 / M_PI : NAN;
+      r.lines.push_back(l);
+    }
+    std::sort(r.lines.begin(), r.lines.end(), [](const auto& a, const auto& b) { return a.hz < b.hz; });
+    std::vector<double> ratios, phases;
+    for (std::size_t b = 0; b < r.f.size(); ++b)
+      if (std::abs(r.model[b]) > 0 && std::abs(r.measured[b]) > 0) {
+        ratios.push_back(std::abs(r.measured[b]) / std::abs(r.model[b]));
+        phases.push_back(std::abs(std::arg(r.measured[b] / r.model[b])) * 180.0 / M_PI);
+      }
+    auto median = [](std::vector<double> v) {
+      if (v.empty()) return std::nan("");
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      return v[v.size() / 2];
+    };
+    r.median_ratio = median(ratios);
+    r.median_phase_deg = median(phases);
+    out.frf.push_back(std::move(r));
+  }
 }
 
 }  // namespace
@@ -54,6 +140,7 @@ StartCheck check_start(const Problem& p, Objective& obj, const VectorXd& q) {
     for (const auto& pk : peaks) f_low = std::min(f_low, pk.f);
     out.to = std::min(t.back(), out.from + 10.0 / f_low);
   }
+  start_frf(p, y, peaks, out);
   const auto first = static_cast<Eigen::Index>(std::lower_bound(t.begin(), t.end(), out.from) - t.begin());
   const auto last = static_cast<Eigen::Index>(std::upper_bound(t.begin(), t.end(), out.to) - t.begin());
   const Eigen::Index n = last - first;

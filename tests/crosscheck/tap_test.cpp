@@ -241,6 +241,22 @@ truth: {segments: 80, anti_alias_hz: 800}
   // The offset stated: the sign named, with the input.
   EXPECT_TRUE(said(offset_stated, "inverted", "input 'shaker'")) << "no polarity warning";
   EXPECT_FALSE(said(offset_stated, "has a mean", "shaker"));
+  // The same in frequency (start_check.frf): the raw record's responses half a turn from the
+  // model's across the band, the conditioned record's in phase, each at about the model's scale.
+  for (const Identification* id : {&raw, &conditioned}) {
+    const auto& frf = id->result().start_check.frf;
+    ASSERT_EQ(frf.size(), 2u) << id->result().start_check.frf_note;
+    for (const auto& pair : frf) {
+      std::printf("frf %s/%s: median ratio %.3g, median |phase| %.1f deg, %zu peaks\n", pair.input.c_str(), pair.sensor.c_str(),
+                  pair.median_ratio, pair.median_phase_deg, pair.lines.size());
+      EXPECT_EQ(pair.input, "shaker");
+      EXPECT_FALSE(pair.lines.empty());
+      if (id == &raw) EXPECT_GT(pair.median_phase_deg, 135.0) << pair.sensor;
+      else EXPECT_LT(pair.median_phase_deg, 45.0) << pair.sensor;
+      EXPECT_GT(pair.median_ratio, 1.0 / 3.0) << pair.sensor;
+      EXPECT_LT(pair.median_ratio, 3.0) << pair.sensor;
+    }
+  }
   // The clean and the conditioned record: no such warning, the same estimates, within 1 % of the truth.
   for (const Identification* id : {&clean, &conditioned}) {
     for (const auto& x : id->warnings()) EXPECT_EQ(x.find("shaker"), std::string::npos) << x;

@@ -610,7 +610,8 @@ class Identification:
 
     def write(self, directory):
         """identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp (and fit.png, spectrum.png with
-        gnuplot) into ``directory``, as ``scole-identify --out`` writes them (all or none).
+        gnuplot; on a measured record with one input from the data also start_frf.csv, start_frf.gp,
+        start_frf.png) into ``directory``, as ``scole-identify --out`` writes them (all or none).
 
         Raises:
             InputError: the directory holds an input of the run, or another run is writing into it.

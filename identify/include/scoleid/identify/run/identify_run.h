@@ -175,6 +175,8 @@ MatrixXd predicted_outputs(Problem& problem, const RunResult& r);
 // staging area; the caller commits them as one unit (io/run_directory.h).
 void write_outputs(io::RunDirectory& dir, Problem& problem, const RunResult& r);
 // The file names write_outputs produces (what a RunDirectory for them may replace).
-inline std::vector<std::string> output_files() { return {"identify.json", "fit.csv", "fit.gp", "fit.png", "spectrum.csv", "spectrum.gp", "spectrum.png"}; }
+inline std::vector<std::string> output_files() {
+  return {"identify.json", "fit.csv", "fit.gp", "fit.png", "spectrum.csv", "spectrum.gp", "spectrum.png", "start_frf.csv", "start_frf.gp", "start_frf.png"};
+}
 
 }  // namespace scoleid::identify

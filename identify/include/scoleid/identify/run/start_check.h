@@ -15,6 +15,7 @@
 // warning that names the channel and the conditioning that states the fix; none refuses the run.
 // An input read with a static offset (Problem::static_offsets) is set aside first: the model runs
 // on the column less its mean, so a load cell's offset and its sign are both named in one run.
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -23,12 +24,36 @@
 
 namespace scoleid::identify {
 
+// The same start seen in frequency, per pair of the one input read from the data and a sensor:
+// the record's and the model's frequency responses H1 = Z(f)/F(f) over the whole record (the
+// discrete Fourier transforms of the sensor's record, of the model's output at the start and of the
+// input's samples; no window: the transients of a tap or a chirp lie inside the record), at the
+// bins where the input carries at least 10⁻³ of its largest amplitude, up to Nyquist or within the
+// fitted band. At each of the record's spectral peaks: the two magnitudes, their ratio and the
+// phase of the record's relative to the model's (deg, in (−180, 180]; near ±180 is a sign, a ratio
+// far from 1 a scale or unit). run_report.cpp writes the curves as start_frf.csv / start_frf.png.
+struct StartFrf {
+  std::string input, sensor;
+  std::vector<double> f;                          // Hz
+  std::vector<std::complex<double>> measured, model;
+  struct Line {
+    double hz = 0.0, measured = 0.0, model = 0.0, ratio = 0.0, phase_deg = 0.0;
+  };
+  std::vector<Line> lines;
+  // Over every bin: the median of |H_record|/|H_model| and of |phase(H_record/H_model)| (deg), a
+  // scale and a sign less sensitive than a peak's, whose height also holds the start's damping
+  // (a peak's height goes as 1/ζ).
+  double median_ratio = 0.0, median_phase_deg = 0.0;
+};
+
 struct StartCheck {
   struct Sensor {
     std::string name;
     double correlation = 0.0, scale = 0.0;  // NaN where the model's or the record's window is zero
   };
   std::vector<Sensor> sensors;
+  std::vector<StartFrf> frf;   // one per sensor, for a record with one input from the data
+  std::string frf_note;        // why there is none ("" when there is)
   double from = 0.0, to = 0.0;        // the window [s]
   std::vector<std::string> warnings;  // one line each, naming the channel
 };
