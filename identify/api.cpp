@@ -180,6 +180,7 @@ Identification identify_parameters(std::shared_ptr<identify::Problem> problem, c
   ro.max_iterations = options.max_iterations;
   ro.compute_std = options.compute_std;
   ro.verbose = options.verbose;
+  ro.keep_interrupted = options.keep_interrupted;
   identify::RunResult r = identify::run_identification(*problem, ro);
   return Identification(std::move(problem), std::move(r));
 }

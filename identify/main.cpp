@@ -3,8 +3,13 @@
 #include <algorithm>
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <csignal>
 #include <cstdio>
+#include <mutex>
+#include <thread>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -23,6 +28,34 @@ using namespace scoleid;
 using Eigen::VectorXd;
 
 namespace {
+
+// --max-wall-time: after `seconds` (0: never) the run is asked to stop as at a signal, SIGALRM
+// standing for the limit (io::request_interrupt; the run keeps its last iterate, RunOptions).
+class WallClock {
+public:
+  explicit WallClock(double seconds) {
+    if (seconds > 0)
+      thread_ = std::thread([this, seconds] {
+        std::unique_lock<std::mutex> lock(m_);
+        if (!cv_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) io::request_interrupt(SIGALRM);
+      });
+  }
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  ~WallClock() { stop(); }
+
+private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
 
 // scole-identify --experiments FILE: the joint identification (identify/run/experiments.h).
 int run_experiments_command(const std::string& file, std::string out, std::optional<io::Method> method, int threads,
@@ -203,9 +236,11 @@ int main(int argc, char** argv) {
       "(measured, predicted, residual per sensor), and prints the iteration table.\n\n"
       "Exit codes: 0 converged; 1 the run failed, did not converge, or stopped at a point that does not explain\n"
       "the data (the fit test: residual beyond noise, discretisation and identification.model_error; its outputs\n"
-      "are written, marked \"converged\": false); 2 bad usage or bad input (nothing written); 130/143 interrupted by\n"
-      "SIGINT/SIGTERM (nothing written). The outputs of a run appear together or not at all: they are\n"
-      "written beside --out and moved into place as one directory at the end.\n\n"
+      "are written, marked \"converged\": false; also a run stopped at --max-wall-time); 2 bad usage or bad input\n"
+      "(nothing written); 130/143 interrupted by SIGINT/SIGTERM: during the optimiser or the assessment the last\n"
+      "iterate reached is written, marked \"interrupted\" and not converged, before the first iterate nothing. The\n"
+      "outputs of a run appear together or not at all: they are written beside --out and moved into place as one\n"
+      "directory at the end.\n\n"
       "With --experiments FILE, several runs (each its own scenario: inputs, sensors, data) and/or measured\n"
       "modes (frequencies, damping ratios, shapes; CSV) are fitted with one parameter vector, the runs solved\n"
       "concurrently (README \"Several experiments and modal data\"). Writes identify.json (joint estimate, joint\n"
@@ -230,6 +265,11 @@ int main(int argc, char** argv) {
                "skip the Fisher-information standard deviations and with them the identifiability flags "
                "(identify.json then says \"identifiable\": null, not assessed)");
   app.add_flag("-q,--quiet", quiet, "do not print the iteration table");
+  double max_wall_time = 0.0;
+  app.add_option("--max-wall-time", max_wall_time,
+                 "stop after SECONDS of wall time, keeping the last iterate reached as a complete run marked \"interrupted\" "
+                 "(exit 1; nothing written if there is no iterate yet)")
+      ->check(CLI::Range(1e-3, 1e9));
   auto* export_opt = app.add_option("--export-model", export_model,
                  "write the identified linear model to FILE.json or FILE.mat (MATLAB): state space A, B, C, D over the scenario's inputs and "
                  "sensors, and the modal model (frequencies, damping ratios, shapes at sensors and inputs)");
@@ -245,6 +285,7 @@ int main(int argc, char** argv) {
   ex_opt->excludes(export_opt);
   if (const auto code = io::parse_command_line(app, argc, argv, "scole-identify")) return *code;
   io::install_interrupt_handlers();
+  WallClock wall_clock(max_wall_time);
   return io::guarded_main("scole-identify", [&] {
     // A path option given empty is a typo, not a request for the default.
     for (const char* name : {"--data", "--out", "--experiments", "--scenario", "--print-scenario", "--export-model"})
@@ -259,6 +300,7 @@ int main(int argc, char** argv) {
     options.method = method_given;
     options.compute_std = !no_std;
     options.verbose = !quiet;
+    options.keep_interrupted = true;  // a run stopped by a signal or the wall-time limit keeps its last iterate
     if (max_iterations >= 0) {
       options.max_iterations = max_iterations;
       sc.identification.max_iterations = max_iterations;
@@ -282,14 +324,22 @@ int main(int argc, char** argv) {
                      std::to_string(w.size()) + " values");
     print_problem(*problem, !data.empty());
     const Identification id = identify_parameters(problem, options);
+    const int interrupted = id.result().interrupted_by;
+    wall_clock.stop();
+    if (!interrupted && io::interrupt_signal() == SIGALRM) io::clear_interrupt();  // the limit came as the run ended
     id.write(run_dir);
-    if (staged_model) id.export_model(staged_model->path());
+    if (staged_model && !interrupted) id.export_model(staged_model->path());  // an interrupted run is no model to export
     run_dir.commit();
-    if (staged_model) staged_model->commit();
+    if (staged_model && !interrupted) staged_model->commit();
     std::printf("\n%s", id.FullReport().c_str());
     std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp%s (and fit.png, spectrum.png%s with gnuplot)\n", out.c_str(),
                 id.result().start_check.frf.empty() ? "" : ", start_frf.csv, start_frf.gp", id.result().start_check.frf.empty() ? "" : ", start_frf.png");
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
+    if (interrupted) {
+      std::fprintf(stderr, "scole-identify: %s; outputs written, marked \"interrupted\" and \"converged\": false%s\n",
+                   id.result().interrupted_note.c_str(), staged_model ? " (no model exported)" : "");
+      return interrupted == SIGALRM ? 1 : 128 + interrupted;
+    }
     if (!id.converged())
       std::fprintf(stderr, "scole-identify: %s; outputs written with \"converged\": false\n", id.verdict().c_str());
     return id.exit_code();

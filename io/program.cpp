@@ -1,5 +1,6 @@
 #include "scoleid/io/program.h"
 
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -18,6 +19,10 @@ int guarded_main(const char* program, const std::function<int()>& run) {
     return 2;
   } catch (const Interrupted& e) {
     // A fresh line: a progress line may be open on stderr.
+    if (e.signal() == SIGALRM) {  // scole-identify's --max-wall-time, before there was an iterate to keep
+      std::fprintf(stderr, "\n%s: stopped at the wall-time limit (--max-wall-time) before the first iterate; no output written\n", program);
+      return 1;
+    }
     std::fprintf(stderr, "\n%s: %s\n", program, e.what());
     return e.exit_code();
   } catch (const std::exception& e) {

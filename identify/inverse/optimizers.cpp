@@ -39,8 +39,8 @@ const char* to_string(OptimizerSummary::Termination t) {
     case T::CostStalled: return "cost_stalled";
     case T::MaxIterations: return "max_iterations";
     case T::LineSearchFailed: return "line_search_failed";
-    case T::DataExplained:
-      return "data_explained";
+    case T::DataExplained: return "data_explained";
+    case T::Interrupted: return "interrupted";
   }
   return "?";
 }

@@ -109,6 +109,8 @@ struct Runner {
   }
   OptimizerSummary minimize_from(const VectorXd& start, const OptimizerOptions& o) const {
     return minimize(c.objective, start, o, [this](const IterationRecord& rec) {
+      if (rec.k == 0) c.iterates.clear();
+      c.iterates.push_back(rec);
       io::check_interrupt();
       if (c.verbose) table.row(rec);
     });

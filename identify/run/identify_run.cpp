@@ -2,6 +2,8 @@
 // attempts (run/attempts.h), assessment (run/assessment.h); the outputs: run/run_report.cpp.
 #include "scoleid/identify/run/identify_run.h"
 
+#include <csignal>
+#include <cstdio>
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -151,6 +153,39 @@ std::vector<std::vector<int>> smoothness_chains(const Problem& p, const std::vec
 }
 }  // namespace
 
+namespace {
+// An interrupted run's result (RunOptions::keep_interrupted): the chosen estimate when the attempts
+// had ended (the assessment was under way), else the last iterate accepted; not assessed, no fit
+// test (so not converged), the signal recorded and cleared so that the outputs can be made.
+void keep_interrupted(const Problem& p, const AttemptsContext& c, RunResult& r, bool attempts_done, int signal) {
+  io::clear_interrupt();
+  const char* what = signal == SIGALRM ? "the wall-time limit" : signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a signal";
+  char note[256];
+  if (attempts_done) {
+    std::snprintf(note, sizeof note, "%s during the assessment: the estimate is the optimiser's (%s), not assessed", what,
+                  to_string(r.summary.termination));
+  } else {
+    const IterationRecord& last = c.iterates.back();
+    r.summary.iterations = c.iterates;
+    r.summary.q = last.q;
+    r.summary.cost = last.cost;
+    r.summary.iterations_done = last.k;
+    std::snprintf(note, sizeof note, "%s at iteration %d: the last iterate reached (its cost over %.6g of %.6g s of record), not converged",
+                  what, last.k, last.horizon - p.data.t.front(), p.data.t.back() - p.data.t.front());
+  }
+  r.summary.termination = OptimizerSummary::Termination::Interrupted;
+  r.summary.message = note;
+  r.estimate = r.summary.q;
+  r.fit = FitTest{};
+  r.fit.message = std::string("not tested: ") + note;
+  r.ident = Identifiability{};
+  r.interval = UncertaintyInterval{};
+  r.predicted.resize(0, 0);
+  r.interrupted_by = signal;
+  r.interrupted_note = note;
+}
+}  // namespace
+
 RunResult run_identification(Problem& p, const RunOptions& ro) {
   if (p.scenario.identification.model == io::Model::Nonlinear) return run_nonlinear_identification(p, ro);
   const auto t0 = std::chrono::steady_clock::now();
@@ -176,12 +211,20 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
         early = {};  // made again, if needed, in the assessment
       }
     };
-  run_attempts(c, r);
-  r.estimate = r.summary.q;
-  // The fit test's outputs at the estimate (the chosen attempt's), kept for the assessment and fit.csv.
-  if (r.fit.predicted.rows() == p.data.z.rows() && r.fit.predicted.cols() == p.data.z.cols() && r.fit.predicted.allFinite())
-    r.predicted = r.fit.predicted;
-  if (ro.compute_std) assess_estimate(p, obj, c.options, r, early.estimate.size() != 0 ? &early : nullptr);
+  bool attempts_done = false;
+  try {
+    run_attempts(c, r);
+    attempts_done = true;
+    r.estimate = r.summary.q;
+    // The fit test's outputs at the estimate (the chosen attempt's), kept for the assessment and fit.csv.
+    if (r.fit.predicted.rows() == p.data.z.rows() && r.fit.predicted.cols() == p.data.z.cols() && r.fit.predicted.allFinite())
+      r.predicted = r.fit.predicted;
+    if (ro.compute_std) assess_estimate(p, obj, c.options, r, early.estimate.size() != 0 ? &early : nullptr);
+  } catch (const io::Interrupted& e) {
+    if (!ro.keep_interrupted || (!attempts_done && c.iterates.empty())) throw;
+    keep_interrupted(p, c, r, attempts_done, e.signal());
+    r.summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   estimate_modes(p, r);
   if (r.predicted.size() != 0) r.residual_bands = residual_bands(p.data.t, p.data.z, r.predicted, r.modes, r.fit.explains_data);
   r.counters = obj.counters();

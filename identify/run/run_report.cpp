@@ -1,6 +1,7 @@
 // identify.json, fit.csv / fit.gp / fit.png and the printed summary of one identification run
 // (identify_run.h; the file format: docs/theory.md §10).
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <tuple>
 
@@ -355,6 +356,9 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     if (!start_check.frf_note.empty()) out["start_check"]["frf_note"] = start_check.frf_note;
   }
   if (!p.warnings.empty()) out["data_warnings"] = p.warnings;
+  if (interrupted_by != 0)
+    out["interrupted"] = {{"signal", interrupted_by == SIGALRM ? "wall-time limit" : interrupted_by == SIGINT ? "SIGINT" : interrupted_by == SIGTERM ? "SIGTERM" : std::to_string(interrupted_by)},
+                          {"note", interrupted_note}};
   if (!residual_bands.bands.empty() || !residual_bands.note.empty()) {
     json bands = json::array();
     for (const auto& b : residual_bands.bands) {

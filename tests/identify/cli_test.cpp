@@ -684,20 +684,76 @@ TEST(ScoleIdentifyHardening, EarlierRunIsReplacedWholeOrKept) {
   expect_only(dir.path(), {"good.yaml", "bad.csv", "out", "stderr.txt"});
 }
 
-TEST(ScoleIdentifyHardening, SigtermAndSigintLeaveNothingHalfWritten) {
+// What an interrupted run leaves (RunOptions::keep_interrupted): before the first iterate nothing;
+// once the optimiser has an iterate, a complete run — every output, the last iterate as the
+// estimate, "termination": "interrupted", "converged": false, the signal named — and never half a
+// run. Either way within a second of the signal, exit 128 + signal.
+void expect_interrupted_run(const fs::path& dir, const fs::path& out, const std::string& signal, bool written) {
+  if (!written) {
+    EXPECT_FALSE(fs::exists(out)) << "outputs of a run interrupted before its first iterate";
+    expect_only(dir, {"stderr.txt"});
+    return;
+  }
+  for (const char* f : {"identify.json", "fit.csv", "fit.gp", "spectrum.csv", "spectrum.gp"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto j = read_json_file(out / "identify.json");
+  EXPECT_EQ(j.value("termination", ""), "interrupted");
+  EXPECT_EQ(j.value("converged", true), false);
+  ASSERT_TRUE(j.contains("interrupted")) << j.dump().substr(0, 400);
+  EXPECT_EQ(j["interrupted"].value("signal", ""), signal);
+  EXPECT_EQ(j["interrupted"].value("note", "").rfind(signal + " at iteration ", 0), 0u) << j["interrupted"].dump();
+  int finite = 0;
+  for (const auto& p : j["parameters"]) finite += p["estimate"].is_number() && std::isfinite(p["estimate"].get<double>());
+  EXPECT_EQ(finite, static_cast<int>(j["parameters"].size()));
+  expect_only(dir, {"out", "stderr.txt"});
+}
+
+TEST(ScoleIdentifyHardening, SigtermAndSigintKeepTheLastIterateAsACompleteRunOrLeaveNothing) {
   for (const int sig : {SIGTERM, SIGINT}) {
+    // beam-ei8 takes about 6 s: at 0.3 s it is still synthesising its data (no iterate), at 2.5 s
+    // it is iterating (the first iterate comes at about 1 s on an idle machine).
+    for (const double delay : {0.3, 2.5}) {
+      TempDir dir;
+      const fs::path out = dir / "out";
+      double after = 0.0;
+      const int code = run_and_signal({"--scenario", "beam-ei8", "--out", out.string(), "-q"}, dir, delay, sig, &after);
+      std::printf("  signal %d at %.2f s: exit %d, %.2f s after it, outputs %s\n", sig, delay, code, after,
+                  fs::exists(out) ? "written" : "none");
+      EXPECT_EQ(code, 128 + sig);
+      EXPECT_LT(after, 1.0);
+      if (delay < 0.5) EXPECT_FALSE(fs::exists(out));
+      expect_interrupted_run(dir.path(), out, sig == SIGTERM ? "SIGTERM" : "SIGINT", fs::exists(out));
+    }
+  }
+}
+
+// --max-wall-time: the same as a signal, exit 1 (a limit the user set, not an interruption), the
+// limit named; and a limit reached before the first iterate writes nothing, exit 1.
+TEST(ScoleIdentifyHardening, TheWallTimeLimitKeepsTheLastIterateOrSaysThereWasNone) {
+  for (const std::string limit : {"0.05", "2.5"}) {
     TempDir dir;
     const fs::path out = dir / "out";
-    // beam-ei8 takes several seconds; the signal lands mid-run, and is honoured within the
-    // linear solve under way.
-    double after = 0.0;
-    const int code = run_and_signal({"--scenario", "beam-ei8", "--out", out.string(), "-q"}, dir, 1.0, sig, &after);
-    std::printf("  signal %d: exit %d, %.2f s after it\n", sig, code, after);
-    EXPECT_EQ(code, 128 + sig);
-    EXPECT_LT(after, 1.0);
-    EXPECT_FALSE(fs::exists(out)) << "outputs of an interrupted run";
-    expect_only(dir.path(), {});
+    const auto t0 = std::chrono::steady_clock::now();
+    const Result r = run({"--scenario", "beam-ei8", "--out", out.string(), "-q", "--max-wall-time", limit}, dir);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("  --max-wall-time %s: exit %d after %.2f s, outputs %s\n", limit.c_str(), r.code, wall, fs::exists(out) ? "written" : "none");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_LT(wall, std::stod(limit) + 1.5);
+    if (!fs::exists(out)) {
+      EXPECT_NE(r.err.find("stopped at the wall-time limit (--max-wall-time) before the first iterate; no output written"), std::string::npos) << r.err;
+      if (limit == "0.05") continue;
+    }
+    ASSERT_TRUE(fs::exists(out)) << r.err;
+    EXPECT_NE(r.err.find("the wall-time limit at iteration "), std::string::npos) << r.err;
+    const auto j = read_json_file(out / "identify.json");
+    EXPECT_EQ(j.value("termination", ""), "interrupted");
+    EXPECT_EQ(j.value("converged", true), false);
+    EXPECT_EQ(j["interrupted"].value("signal", ""), "wall-time limit");
   }
+  // A run that ends before its limit is the run it always was.
+  TempDir dir;
+  const Result r = run({"--scenario", "paper-beam-1", "--out", (dir / "out").string(), "-q", "--max-wall-time", "600"}, dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(read_json_file(dir / "out" / "identify.json").contains("interrupted"));
 }
 
 TEST(ScoleIdentifyHardening, ASignalEndsANonlinearRunWithinItsSolveNotAfterIt) {

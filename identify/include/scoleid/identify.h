@@ -55,6 +55,10 @@ struct IdentifyOptions {
   std::optional<int> max_iterations;  // unset: the scenario's identification.max_iterations
   bool compute_std = true;            // identifiability, std and the uncertainty interval
   bool verbose = false;               // the iteration table on stdout as the run goes
+  // A signal during the optimiser or the assessment returns the last iterate reached, marked
+  // interrupted and not converged (result().interrupted_by), instead of throwing io::Interrupted;
+  // scole-identify's choice, so that a run stopped by a scheduler keeps its progress.
+  bool keep_interrupted = false;
   bool IsValid(std::string* why) const;
 };
 

@@ -3,7 +3,9 @@
 // truth's sample loop, the optimiser's iterations, a plotting child being waited for) call
 // check_interrupt(), which throws Interrupted. The program's main catches it, its RunDirectory
 // (run_directory.h) discards the staged outputs, and it exits 128 + signal (130 for SIGINT,
-// 143 for SIGTERM): nothing half-written, nothing from the interrupted run left behind.
+// 143 for SIGTERM): nothing half-written, nothing from the interrupted run left behind. (One
+// exception, a whole run: scole-identify keeps the last iterate of an identification interrupted
+// while it iterates, identify/run/identify_run.h RunOptions::keep_interrupted.)
 #include <chrono>
 #include <future>
 #include <memory>

@@ -121,7 +121,10 @@ struct OptimizerSummary {
     CostStalled,
     MaxIterations,
     LineSearchFailed,
-    DataExplained
+    DataExplained,
+    // Not an optimiser's stop: a signal or the wall-time limit ended the run, and the run layer kept
+    // the last iterate reached (run/identify_run.h, RunOptions::keep_interrupted).
+    Interrupted
   };
   Termination termination = Termination::MaxIterations;
   std::string message;

@@ -8,6 +8,7 @@
 // explaining it, else the lowest cost over the whole record; better_attempt) is the result.
 #include <cmath>
 #include <functional>
+#include <optional>
 
 #include "scoleid/identify/run/identify_run.h"
 
@@ -19,6 +20,9 @@ struct AttemptsContext {
   OptimizerOptions options;  // the run's; the discrepancy principle leaves its chosen weight here
   bool verbose = true;
   ObjectiveCounters extra{};  // solves of the coarse-to-fine levels' own objectives
+  // The iterates the current attempt's optimiser accepted so far (in the run's parameters; the
+  // coarse-to-fine levels' tied ones are not kept): an interrupted run keeps the last.
+  std::vector<IterationRecord> iterates;
 
   // The fit test at q (test_fit, identify_run.h), the last one kept: the run asks again at an
   // estimate it has just tested (a ladder level that ends the attempt, the discrepancy path's

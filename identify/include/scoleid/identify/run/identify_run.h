@@ -44,6 +44,13 @@ struct RunOptions {
   bool compute_std = true;     // identifiability and the uncertainty interval
   bool verbose = true;         // print the iteration table on stdout as it goes
   std::optional<int> max_iterations;
+  // A signal (or the wall-time limit's SIGALRM, io::request_interrupt) during the optimiser or the
+  // assessment ends the run with the last iterate reached as its result instead of throwing
+  // io::Interrupted: termination "interrupted", not converged, not assessed, interrupted_by set,
+  // the interrupt cleared (the caller writes the outputs and exits 128 + signal, or 1 at the
+  // wall-time limit). A signal before the first iterate still throws, and so does any signal in a
+  // nonlinear-model run (identification.model: nonlinear).
+  bool keep_interrupted = false;
 };
 
 struct RunResult {
@@ -126,6 +133,10 @@ struct RunResult {
   double wall_seconds = 0;
   double identifiability_seconds = 0;
   MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
+  // The signal that ended the run (RunOptions::keep_interrupted; SIGALRM: the wall-time limit), 0
+  // when it ran to its end; and where it stood then.
+  int interrupted_by = 0;
+  std::string interrupted_note;
   double integrator_step = 0.0;  // the nonlinear model's largest step (identify.json integrator.step)
   nlohmann::json to_json(const Problem& p) const;
   // The summary table scole-identify prints: per parameter initial, estimate, truth, relative
