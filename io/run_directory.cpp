@@ -38,7 +38,12 @@ fs::path normal_absolute(const fs::path& p) {
 void register_campaign_directory(const std::string& dir) { own_campaigns().push_back(normal_absolute(dir)); }
 
 void check_not_inside_running(const std::string& target, const std::string& what) {
-  const fs::path t = normal_absolute(target);
+  // The path as spelled and as resolved (a symbolic link to a directory inside a campaign's).
+  std::vector<fs::path> paths{normal_absolute(target)};
+  std::error_code ec;
+  const fs::path resolved = fs::weakly_canonical(paths.front(), ec);
+  if (!ec && resolved != paths.front()) paths.push_back(resolved);
+  for (const fs::path& t : paths)
   for (fs::path d = t.parent_path(); d.has_relative_path() && d.has_filename(); d = d.parent_path()) {
     const fs::path l = lock_of(d);
     if (RunDirectory::lock_held(l))
@@ -67,6 +72,8 @@ RunDirectory::RunDirectory(const std::string& target, std::vector<std::string> o
     throw InputError("output directory '" + target + "': is a symbolic link" +
                      (fs::exists(t, ec) ? std::string() : std::string(" to nothing")) +
                      "; give the directory itself");
+  // Refused before anything is made: a run inside another's directory creates no directory there.
+  check_not_inside_running(target_, "output directory");
   fs::create_directories(parent, ec);
   if (ec || !fs::is_directory(parent))
     throw InputError("output directory '" + target + "': its parent cannot be created (" +

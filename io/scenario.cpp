@@ -483,6 +483,21 @@ void check_point_elements(const std::string& source, const std::string& path, Be
         fail_field(source, f + ".lumped_k", "must be > 0 with a lumped_mass (the spring that joins it to the beam)", format_value(e.lumped_k));
     }
     check_attached_mass(source, f + ".mass", e.mass, m, true);
+    check_attached_mass(source, f + ".lumped_mass", e.lumped_mass, m, true);
+    // A lumped mass whose own frequency lies four decades above the beam's scale √(EI/(ρA L⁴))
+    // rides rigidly on w(s) (an attached mass), and a mode that far above the others is one no
+    // time step of the truth or the identifier can follow.
+    if (e.lumped_mass > 0.0) {
+      double ei = 0.0;
+      for (double v : b.EI) ei = std::max(ei, v);
+      const double scale = std::sqrt(ei / (b.rho_A * L * L * L * L)), own = std::sqrt((e.lumped_k + e.lumped_k_ground) / e.lumped_mass);
+      if (!(own <= 1e4 * scale))
+        fail_field(source, f + ".lumped_k",
+                   "with lumped_k_ground and lumped_mass gives the lumped mass a frequency of " + format_value(own) +
+                       " rad/s, over 1e4 times the beam's sqrt(EI/(rho_A L^4)) = " + format_value(scale) +
+                       ": it rides rigidly on the beam; give it as `mass`",
+                   format_value(e.lumped_k));
+    }
     check_attached_inertia(source, f + ".inertia", e.inertia, m, L);
     if (const EndCondition* ec = end_at(e.location)) {
       const std::string end = e.location == 0.0 ? "left" : "right";

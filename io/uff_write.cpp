@@ -1,3 +1,4 @@
+#include <cctype>
 #include <cmath>
 #include <cstdarg>
 #include <cstdint>
@@ -93,14 +94,20 @@ void write_file(const DataTable& tab, const std::string& path) {
     return first_invalid_utf8(s) == std::string::npos;
   };
   auto unpadded = [](const std::string& s) { return s.empty() || (s.front() != ' ' && s.back() != ' '); };
+  // The reader takes NONE in any case for "no name" / "no unit".
+  auto none = [](const std::string& s) {
+    std::string u = s;
+    for (char& c : u) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return u == "NONE";
+  };
   for (std::size_t j = 0; j < tab.names.size(); ++j) {
     const std::string& name = tab.names[j];
     const std::string unit = tab.unit(static_cast<int>(j));
-    if (!printable(name) || name.size() > 80 || !unpadded(name) || name.empty() || name == "NONE")
-      refuse("column name '" + shorten(name) + "' does not fit ID line 1 (printable UTF-8 of at most 80 bytes, no blank at either end, not NONE)");
-    if (!printable(unit) || unit.size() > 20 || !unpadded(unit) || unit == "NONE")
+    if (!printable(name) || name.size() > 80 || !unpadded(name) || name.empty() || none(name))
+      refuse("column name '" + shorten(name) + "' does not fit ID line 1 (printable UTF-8 of at most 80 bytes, no blank at either end, not NONE in any case)");
+    if (!printable(unit) || unit.size() > 20 || !unpadded(unit) || none(unit))
       refuse("the unit '" + shorten(unit) + "' of column '" + shorten(name) +
-             "' does not fit the axis units label (printable UTF-8 of at most 20 bytes, no blank at either end, not NONE)");
+             "' does not fit the axis units label (printable UTF-8 of at most 20 bytes, no blank at either end, not NONE in any case)");
     // channel_names makes a repeated name unique with '#k': a name of that form could collide.
     if (name.find('#') != std::string::npos) {
       const auto p = name.rfind('#');

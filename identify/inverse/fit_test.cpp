@@ -75,8 +75,16 @@ FitTest fit_test(const FitTestInputs& in) {
   }
   A += 3.0 * std::sqrt(band_var);
   A_strict += 3.0 * std::sqrt(band_var);
-  f.explains_data = finite && S <= A;
-  f.within_noise_and_discretisation = finite && S <= A_strict;
+  // A discretisation estimate over a tenth of a sensor's signal says the model at this point is not
+  // resolved by its own mesh and step (a start or an estimate far stiffer than the step was chosen
+  // for): an allowance of twice that would pass any fit, so the fit is not tested — not explained.
+  const SensorFit* unresolved = nullptr;
+  for (const auto& s : f.sensors)
+    if (disc && s.rms_signal > 0 && s.discretisation > kUnresolvedDiscretisation * s.rms_signal &&
+        (!unresolved || s.discretisation / s.rms_signal > unresolved->discretisation / unresolved->rms_signal))
+      unresolved = &s;
+  f.explains_data = finite && !unresolved && S <= A;
+  f.within_noise_and_discretisation = finite && !unresolved && S <= A_strict;
   f.ratio = A > 0 ? std::sqrt(S / A) : (S > 0 ? INFINITY : 0.0);
   // The least model error with which the sum passes: S <= A_strict + moving·m².
   f.model_error_needed = S <= A_strict ? 0.0 : moving > 0 ? std::sqrt((S - A_strict) / moving) : INFINITY;
@@ -85,6 +93,13 @@ FitTest fit_test(const FitTestInputs& in) {
     f.message = "fewer than 3 samples: the fit cannot be tested";
   } else if (!finite) {
     f.message = "the model's outputs at the estimate are not finite";
+  } else if (unresolved) {
+    std::snprintf(buf, sizeof buf,
+                  "the model's own discretisation error at this point is %.3g %% of sensor %s's RMS signal (over %.0f %%): its mesh "
+                  "and step do not resolve it, and no fit can be tested against such an allowance (start nearer, or refine "
+                  "identification.elements or identification.time_step)",
+                  100.0 * unresolved->discretisation / unresolved->rms_signal, unresolved->name.c_str(), 100.0 * kUnresolvedDiscretisation);
+    f.message = buf;
   } else {
     // The sensor furthest beyond its own allowance, to say where the misfit is.
     const SensorFit* worst = nullptr;

@@ -42,7 +42,18 @@ void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPe
   Eigen::FFT<double> fft;
   std::vector<double> x(N);
   std::vector<std::complex<double>> F, Z, Y;
-  for (std::size_t k = 0; k < N; ++k) x[k] = p.signals[i](t[k]);
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t k = 0; k < N; ++k) {
+    x[k] = p.signals[i](t[k]);
+    lo = std::min(lo, x[k]);
+    hi = std::max(hi, x[k]);
+  }
+  // A constant input (to its rounding) carries nothing at any frequency but zero: its bins are
+  // rounding, and a ratio to them is none.
+  if (!(hi - lo > 1e-9 * std::max(std::abs(lo), std::abs(hi)))) {
+    out.frf_note = "input '" + input + "' is constant: it carries nothing in the band";
+    return;
+  }
   fft.fwd(F, x);
   const double T = static_cast<double>(N) * dt;
   const auto& band = p.scenario.identification.band;
@@ -86,9 +97,11 @@ void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPe
       r.lines.push_back(l);
     }
     std::sort(r.lines.begin(), r.lines.end(), [](const auto& a, const auto& b) { return a.hz < b.hz; });
+    // The medians over the bins where the input carries at least a tenth of its largest amplitude
+    // (below that, a chirp's or a tap's leakage: the ratio of two small numbers).
     std::vector<double> ratios, phases;
     for (std::size_t b = 0; b < r.f.size(); ++b)
-      if (std::abs(r.model[b]) > 0 && std::abs(r.measured[b]) > 0) {
+      if (std::abs(F[bins[b]]) >= 0.1 * fmax && std::abs(r.model[b]) > 0 && std::abs(r.measured[b]) > 0) {
         ratios.push_back(std::abs(r.measured[b]) / std::abs(r.model[b]));
         phases.push_back(std::abs(std::arg(r.measured[b] / r.model[b])) * 180.0 / M_PI);
       }

@@ -351,6 +351,9 @@ TEST(PointElements, ALumpedAttachmentIsRefusedWithoutItsMassOrSpringOrOnAHeldEnd
   refused("{name: a, location: 0.5, lumped_mass: 0.1, lumped_k_ground: 10}", "beam.attachments[0].lumped_k", "must be > 0");
   refused("{name: a, location: 0, lumped_mass: 0.1, lumped_k: 10}", "beam.attachments[0].lumped_mass", "pinned");
   refused("{name: a, location: 0.5, lumped_mass: -1, lumped_k: 10}", "beam.attachments[0].lumped_mass", ">= 0");
+  refused("{name: a, location: 0.5, lumped_mass: 1e-24, lumped_k: 10}", "beam.attachments[0].lumped_mass", "1e-12 and 1e12");
+  // Its own frequency four decades above the beam's scale (here √10 rad/s): a rigid mass, and a mode no step follows.
+  refused("{name: a, location: 0.5, lumped_mass: 1e-6, lumped_k: 1e9}", "beam.attachments[0].lumped_k", "rides rigidly");
   // A support has no lumped attachment (an attachment at the end has).
   try {
     io::parse_scenario("beam: {length: 1, left: pinned, right: free, rho_A: 1, EI: 10, supports: {left: {lumped_k: 5}}}\n", "s.yaml");

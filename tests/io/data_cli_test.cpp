@@ -263,8 +263,11 @@ TEST(DataCli, ConvertRefusesWhatTheFormatCannotHoldAndItsOwnInput) {
   scoleid::test::write_file(dir / "long.csv", "t," + long_name + ",b [" + std::string(21, 'm') + "]\n0,1,2\n0.5,2,3\n");
   scoleid::test::write_file(dir / "units.csv", "t,a,b [" + std::string(21, 'm') + "]\n0,1,2\n0.5,2,3\n");
   scoleid::test::write_file(dir / "hash.csv", "t,a#2,b\n0,1,2\n0.5,2,3\n");
+  scoleid::test::write_file(dir / "none.csv", "t,none,b\n0,1,2\n0.5,2,3\n");
+  scoleid::test::write_file(dir / "none_unit.csv", "t,a [None],b\n0,1,2\n0.5,2,3\n");
   const std::pair<const char*, const char*> cases[] = {
-      {"long.csv", "does not fit ID line 1"}, {"units.csv", "does not fit the axis units label"}, {"hash.csv", "ends in '#<number>'"}};
+      {"long.csv", "does not fit ID line 1"}, {"units.csv", "does not fit the axis units label"}, {"hash.csv", "ends in '#<number>'"},
+      {"none.csv", "does not fit ID line 1"}, {"none_unit.csv", "does not fit the axis units label"}};
   for (const auto& [in, why] : cases) {
     const Result r = run({"convert", in, "-o", "x.uff"}, dir);
     EXPECT_EQ(r.code, 2) << in;

@@ -280,7 +280,8 @@ TEST_F(RunDirectoryTest, ARunInsideARunningCampaignIsRefusedUnlessThisProcessWor
   const int fd = ::open((cam / ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
-  for (const fs::path target : {cam / "x", cam / "truths" / "p1"}) {
+  fs::create_directory_symlink(cam / "truths", root_ / "link");
+  for (const fs::path target : {cam / "x", cam / "truths" / "p1", cam / "a" / "b" / "c", root_ / "link" / "evil"}) {
     try {
       RunDirectory d(target.string(), {"a.txt"}, "test");
       ADD_FAILURE() << "a run into " << target << " inside a running campaign was accepted";
@@ -289,6 +290,7 @@ TEST_F(RunDirectoryTest, ARunInsideARunningCampaignIsRefusedUnlessThisProcessWor
       EXPECT_NE(msg.find("lies inside '" + cam.string() + "', which a campaign run is writing"), std::string::npos) << msg;
     }
     EXPECT_FALSE(fs::exists(target));
+    EXPECT_FALSE(fs::exists(cam / "a")) << "a refused run made directories inside the campaign's";
     // Refused, it holds no lock of its own.
     EXPECT_FALSE(fs::exists(target.parent_path() / ("." + target.filename().string() + ".lock")));
   }

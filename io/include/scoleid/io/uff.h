@@ -204,7 +204,7 @@ bool looks_like_uff(const std::string& first_bytes);
 // in double precision. read_file gives back every name, unit, time and value bit for bit.
 // Written to a temporary file and renamed into place. InputError naming the path for a table that
 // fails check_table or that the format cannot hold: a name that is not printable UTF-8 of 1..80
-// bytes without a blank at either end (ID line 1), or is NONE, or ends in '#<number>' (the
+// bytes without a blank at either end (ID line 1), or is NONE in any case, or ends in '#<number>' (the
 // reader's mark of a repeated name); a unit over 20 bytes (the axis units label).
 void write_file(const DataTable& tab, const std::string& path);
 

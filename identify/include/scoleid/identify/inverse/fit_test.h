@@ -92,6 +92,10 @@ struct FitTest {
   Eigen::MatrixXd predicted;
 };
 
+// A sensor whose discretisation estimate d_k exceeds this share of its RMS signal makes the fit
+// untestable (explains_data false, the message says why): the model is not resolved at that point.
+inline constexpr double kUnresolvedDiscretisation = 0.1;
+
 FitTest fit_test(const FitTestInputs& in);
 
 }  // namespace scoleid::identify

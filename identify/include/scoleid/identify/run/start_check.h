@@ -40,7 +40,8 @@ struct StartFrf {
     double hz = 0.0, measured = 0.0, model = 0.0, ratio = 0.0, phase_deg = 0.0;
   };
   std::vector<Line> lines;
-  // Over every bin: the median of |H_record|/|H_model| and of |phase(H_record/H_model)| (deg), a
+  // Over the bins where the input carries at least a tenth of its largest amplitude: the median of
+  // |H_record|/|H_model| and of |phase(H_record/H_model)| (deg), a
   // scale and a sign less sensitive than a peak's, whose height also holds the start's damping
   // (a peak's height goes as 1/ζ).
   double median_ratio = 0.0, median_phase_deg = 0.0;
