@@ -75,12 +75,15 @@ FitTest fit_test(const FitTestInputs& in) {
   }
   A += 3.0 * std::sqrt(band_var);
   A_strict += 3.0 * std::sqrt(band_var);
-  // A discretisation estimate over a tenth of a sensor's signal says the model at this point is not
-  // resolved by its own mesh and step (a start or an estimate far stiffer than the step was chosen
-  // for): an allowance of twice that would pass any fit, so the fit is not tested — not explained.
+  // A residual over half a sensor's signal that passes only on a discretisation estimate over half
+  // too says the model at this point is not resolved by its own mesh and step (a start or an
+  // estimate far stiffer than the step was chosen for): an allowance of twice that would pass any
+  // fit, so the fit is not explained. (A small residual beside a large, conservative estimate — a
+  // hammer's pulse the step resolves coarsely — is a fit like any other.)
   const SensorFit* unresolved = nullptr;
   for (const auto& s : f.sensors)
     if (disc && s.rms_signal > 0 && s.discretisation > kUnresolvedDiscretisation * s.rms_signal &&
+        s.systematic > kUnresolvedDiscretisation * s.rms_signal &&
         (!unresolved || s.discretisation / s.rms_signal > unresolved->discretisation / unresolved->rms_signal))
       unresolved = &s;
   f.explains_data = finite && !unresolved && S <= A;
@@ -95,10 +98,11 @@ FitTest fit_test(const FitTestInputs& in) {
     f.message = "the model's outputs at the estimate are not finite";
   } else if (unresolved) {
     std::snprintf(buf, sizeof buf,
-                  "the model's own discretisation error at this point is %.3g %% of sensor %s's RMS signal (over %.0f %%): its mesh "
-                  "and step do not resolve it, and no fit can be tested against such an allowance (start nearer, or refine "
-                  "identification.elements or identification.time_step)",
-                  100.0 * unresolved->discretisation / unresolved->rms_signal, unresolved->name.c_str(), 100.0 * kUnresolvedDiscretisation);
+                  "sensor %s's residual (%.3g %% of its RMS signal) passes only on the model's own discretisation error at this "
+                  "point, %.3g %% (both over %.0f %%): its mesh and step do not resolve it, and no fit can be tested against such "
+                  "an allowance (start nearer, or refine identification.elements or identification.time_step)",
+                  unresolved->name.c_str(), 100.0 * unresolved->systematic / unresolved->rms_signal,
+                  100.0 * unresolved->discretisation / unresolved->rms_signal, 100.0 * kUnresolvedDiscretisation);
     f.message = buf;
   } else {
     // The sensor furthest beyond its own allowance, to say where the misfit is.
