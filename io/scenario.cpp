@@ -865,6 +865,15 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   id.restarts = r.integer("restarts", id.restarts, 0, 10);
   id.start = r.choice_of("start", id.start);
   id.model = r.choice_of("model", id.model);
+  id.initial_state = r.choice_of("initial_state", id.initial_state);
+  id.initial_state_modes = r.integer("initial_state_modes", id.initial_state_modes, 0, kMaxInitialStateModes);
+  if (id.initial_state == InitialState::Estimate && !id.band.empty())
+    fail_field(source, "identification.band",
+               "cannot be stated with initial_state: estimate (the filter's commutation with the model needs a record that "
+               "starts at rest; give band: none)",
+               "[" + format_value(id.band[0]) + ", " + format_value(id.band[1]) + "]");
+  if (id.initial_state == InitialState::Estimate && id.model == Model::Nonlinear)
+    fail_field(source, "identification.initial_state", "needs the linear model", "estimate");
   if (!id.band.empty() && id.model == Model::Nonlinear)
     fail_field(source, "identification.band", "needs the linear model (a filter commutes with a linear time-invariant model only)",
                "model: nonlinear");
@@ -1014,6 +1023,12 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
       sc.simulation.duration = s.positive("duration", sc.simulation.duration);
       sc.simulation.sample_interval = s.positive("sample_interval", sc.simulation.sample_interval);
       sc.simulation.seed = static_cast<unsigned>(s.integer("seed", 1, 0, 2147483647));
+      sc.simulation.record_start = s.nonneg("record_start", 0.0);
+      if (!(sc.simulation.record_start + 2.0 * sc.simulation.sample_interval <= sc.simulation.duration))
+        fail_field(source, "simulation.record_start",
+                   "must leave at least two sample intervals before simulation.duration (" +
+                       format_value(sc.simulation.duration) + ")",
+                   format_value(sc.simulation.record_start));
       if (sc.simulation.sample_interval > sc.simulation.duration)
         fail_field(source, "simulation.sample_interval", "must not exceed simulation.duration (" +
                                                              format_value(sc.simulation.duration) + ")",
@@ -1234,6 +1249,7 @@ nlohmann::json to_json(const Scenario& s) {
     if (se.conditioning.stated()) j["sensors"].back()["conditioning"] = conditioning_json(se.conditioning);
   }
   j["simulation"] = {{"duration", s.simulation.duration}, {"sample_interval", s.simulation.sample_interval},
+                     {"record_start", s.simulation.record_start},
                      {"seed", s.simulation.seed}};
   const auto& id = s.identification;
   j["identification"] = {{"parameterization", id.parameterization}, {"estimate", id.estimate},
@@ -1246,7 +1262,8 @@ nlohmann::json to_json(const Scenario& s) {
                          {"time_step", id.time_step}, {"step_rule", to_string(id.step_rule)}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
                          {"restarts", id.restarts}, {"start", to_string(id.start)}, {"model", to_string(id.model)},
-                         {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)}};
+                         {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)},
+                         {"initial_state", to_string(id.initial_state)}, {"initial_state_modes", id.initial_state_modes}};
   if (!id.uncertain.empty()) {
     json u = json::object();
     for (const auto& x : id.uncertain) u[x.field] = x.is_switch ? json(x.alternative) : json(x.tolerance);

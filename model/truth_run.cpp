@@ -397,6 +397,15 @@ namespace {
 // The acquisition's anti-alias filter (truth.anti_alias_hz): the record, sampled every dt, passes
 // an 8-pole Butterworth low-pass at f_c (io/band_filter.h) channel by channel, inputs and sensors
 // alike, and every m-th sample is kept (k = 0, m, 2m, …: the output's own grid).
+// simulation.record_start: the record keeps the samples at t >= t_rec (the run starts from rest at 0).
+void drop_before(io::DataTable& tab, double t_rec, double dt) {
+  if (!(t_rec > 0)) return;
+  std::size_t k = 0;
+  while (k < tab.t.size() && tab.t[k] < t_rec - 1e-9 * dt) ++k;
+  tab.t.erase(tab.t.begin(), tab.t.begin() + static_cast<std::ptrdiff_t>(k));
+  for (auto& c : tab.columns) c.erase(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(k));
+}
+
 void anti_alias(io::DataTable& tab, double f_c, double dt, int m) {
   const io::BandFilter lowpass(0.0, f_c, dt);
   auto keep = [m](const std::vector<double>& x) {
@@ -590,6 +599,7 @@ TruthResult run_truth(const io::Scenario& scenario, const TruthOptions& opt) {
 
   if (oversample > 1) anti_alias(tab, sc.truth.anti_alias_hz, so.sample_interval, oversample);
   add_sensor_noise(sc, tab);
+  drop_before(tab, sc.simulation.record_start, so.sample_interval * oversample);
   res.meta = truth_meta(scenario, sc, res, n, accuracy);
   return res;
 }

@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/objective.h"
 
 #include <algorithm>
+#include <Eigen/Eigenvalues>
 #include <array>
 #include <memory>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <thread>
 
 #include "scoleid/identify/inverse/coefficient_quadrature.h"
+#include "scoleid/identify/fe/modal.h"
 #include "scoleid/io/interrupt.h"
 
 namespace scoleid::identify {
@@ -141,6 +143,24 @@ void sort_grid(std::vector<double>& g) {
   g.erase(std::unique(g.begin(), g.end(), [](double a, double b) { return b - a <= 1e-12 * std::max(1.0, std::abs(a)); }),
           g.end());
 }
+
+// X = A⁺ B for a symmetric positive semidefinite A: scaled to unit diagonal, then the eigenvalues
+// above 1e-12 of the largest inverted and the others dropped (a direction the data do not see, such as
+// a mode with a node at every sensor, gets coefficient zero instead of an arbitrary one).
+MatrixXd pseudo_solve(const MatrixXd& A, const MatrixXd& B) {
+  const Eigen::Index m = A.rows();
+  VectorXd d(m);
+  for (Eigen::Index i = 0; i < m; ++i) d[i] = A(i, i) > 0 ? 1.0 / std::sqrt(A(i, i)) : 1.0;
+  const MatrixXd As = d.asDiagonal() * A * d.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<MatrixXd> es(0.5 * (As + As.transpose()));
+  const VectorXd& lam = es.eigenvalues();
+  const double top = lam.size() > 0 ? lam.maxCoeff() : 0.0;
+  VectorXd inv = VectorXd::Zero(m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (top > 0 && lam[i] > 1e-12 * top) inv[i] = 1.0 / lam[i];
+  const MatrixXd& V = es.eigenvectors();
+  return d.asDiagonal() * (V * inv.asDiagonal() * V.transpose()) * (d.asDiagonal() * B);
+}
 }  // namespace
 
 Objective::Objective(const StructuralModel& model, const Parameterization& params, std::vector<io::Signal> inputs,
@@ -170,6 +190,20 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
         if (std::abs(sig(data_.t[i])) > 0.05 * peak) onset = i;
     }
     if (onset < data_.t.size() && data_.t[onset] - t0 > 0.05 * (data_.t.back() - t0)) response_start_ = data_.t[onset];
+  }
+  if (options_.initial_state_modes > 0) {
+    // The initial state's basis: the model's lowest modes at the start values (docs/theory.md §6.9).
+    VectorXd c;
+    MatrixXd dcdq;
+    params_.coefficients(params_.initial(), c, dcdq);
+    const AssembledModel ops = assemble(model_, c);
+    // The rigid-body modes (below the floor) and the lowest initial_state_modes flexible ones.
+    const NaturalModes nm = natural_modes(ops.M, ops.K);
+    Eigen::Index rigid = 0;
+    while (rigid < nm.omega.size() && nm.omega[rigid] < nm.floor) ++rigid;
+    basis_ = nm.vectors.leftCols(std::min<Eigen::Index>(rigid + options_.initial_state_modes, nm.vectors.cols()));
+    basis_omega_ = nm.omega.head(basis_.cols());
+    response_start_ = t0;  // a moving start has no quiet pre-trigger to skip
   }
   const int ns = data_.sensors();
   noise_share();
@@ -293,7 +327,7 @@ VectorXd Objective::tangent_output_at(const SecondOrderSolver& solver, const Der
 Trajectory Objective::forward(const SecondOrderSolver& solver, const Setup& s, double t_end) {
   const auto t0 = Clock::now();
   SolverSummary sum;
-  Trajectory u = solver.solve(data_.t.front(), t_end, state_forcing(s), breakpoints_, &sum);
+  Trajectory u = solver.solve(data_.t.front(), t_end, state_forcing(s), breakpoints_, &sum, StepAnchor::Start, s.initial.get());
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(t0);
@@ -373,7 +407,7 @@ void Objective::forward_windows(const SecondOrderSolver& solver, const Setup& s,
   });
   SolverSummary sum;
   solver.stream(data_.t.front(), t_end, state_forcing(s), breakpoints_, [&](const SecondOrderSolver::Point& pt) { sink(pt); },
-                &sum);
+                &sum, nullptr, std::numeric_limits<double>::infinity(), StepAnchor::Start, s.initial.get());
   sink.finish();
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
@@ -465,8 +499,9 @@ void Objective::profile_window(const Setup& s, const SecondOrderSolver& solver, 
 }
 
 double Objective::interpolation_misfit(const VectorXd& q) {
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   // The whole record: the interpolant near T uses samples beyond it. The model's own samples first,
   // then the misfit against their interpolant: from one stored state when it fits the trajectory
   // budget, else from two streamed solves.
@@ -489,7 +524,7 @@ double Objective::interpolation_misfit(const VectorXd& q) {
                   [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
                     own.z.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
                   },
-                  &sum);
+                  &sum, 256, s.initial.get());
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(tf);
@@ -507,8 +542,9 @@ Objective::MisfitProfile Objective::misfit_profile(const Setup& s, const SecondO
 
 double Objective::cost(const VectorXd& q) {
   // Streamed: the misfit accumulates window by window, so no O(steps) array is kept.
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   double J = 0.0;
   forward_windows(solver, s, T_, [&](const Trajectory& w) { J += misfit_window(s, solver, w, data_, T_); });
   return J;
@@ -774,7 +810,12 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   const auto tc = Clock::now();
   SolverSummary sum;
   const SecondOrderSolver::Forcing g0 = [&](double tau, double* F) { src.force(tau, 0, F); };
-  const auto visit = [&](const SecondOrderSolver::Point& pt) { windows(pt); };
+  const bool boundary = s.initial && src.split_rule();
+  VectorXd p_t0 = VectorXd::Zero(n);  // the multiplier at t0: P at the costate's last point
+  const auto visit = [&](const SecondOrderSolver::Point& pt) {
+    windows(pt);
+    if (boundary) p_t0 = Eigen::Map<const VectorXd>(pt.x, n);
+  };
   if (m == 1) {
     solver.stream(0.0, T_ - t0, g0, bp_tau, visit, &sum, nullptr, std::numeric_limits<double>::infinity(),
                   StepAnchor::End);
@@ -785,6 +826,7 @@ double Objective::backward_checkpointed(const Setup& s, const SecondOrderSolver&
   }
   windows.finish();
   eq25.contract(gc);
+  if (boundary) add_initial_velocity_term(s, p_t0, gc);
   count_checkpointed_pass(counters_, sum, state, m, since(tc), quadrature, resolve);
   return J;
 }
@@ -850,13 +892,18 @@ double Objective::backward_stored(const Setup& s, const SecondOrderSolver& solve
     for_each_gauss_point(grid, point);
   }
   eq25.contract(gc);
+  if (s.initial && src.split_rule()) {
+    P.eval(T_ - data_.t.front(), c.data(), nullptr);
+    add_initial_velocity_term(s, c.head(n), gc);
+  }
   counters_.quadrature_seconds += since(tq);
   return J;
 }
 
 double Objective::cost_and_gradient(const VectorXd& q, VectorXd& gradient) {
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   VectorXd gc = VectorXd::Zero(model_.ncoef);
   const std::size_t L = checkpoint_spacing(solver);
   const double J = L > 0 ? gradient_checkpointed(s, solver, L, gc) : gradient_stored(s, solver, gc);
@@ -900,7 +947,7 @@ double Objective::gradient_checkpointed(const Setup& s, const SecondOrderSolver&
                   yd.tail(ns).noalias() = rt.A1 * a;
                   out.push(pt.t, y.data(), yd.data(), none.data());
                 },
-                &sum);
+                &sum, nullptr, std::numeric_limits<double>::infinity(), StepAnchor::Start, s.initial.get());
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(tf);
@@ -1088,7 +1135,9 @@ std::vector<Trajectory> Objective::solve_tangents(const SecondOrderSolver& solve
   if (solver.has_tangent_solve()) {
     const SecondOrderSolver::TangentForcing G = tangent_forcing(d);
     SolverSummary sum;
-    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), count, G, tangent_end, breakpoints_, &sum);
+    const auto start = run_start(s, d);
+    auto sol = solver.solve_tangent(data_.t.front(), state_end, state_forcing(s), count, G, tangent_end, breakpoints_, &sum,
+                                    StepAnchor::Start, start.get());
     counters_.solver.Accumulate(sum);
     ++counters_.forward_solves;
     u = std::move(sol.state);
@@ -1159,10 +1208,29 @@ double Objective::gradient_and_step_matrix(const VectorXd& q, VectorXd& gradient
 }
 
 double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, MatrixXd& H, MisfitProfile* profile) {
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   const int P = size(), n = model_.ndof, ns = data_.sensors();
   const double state_end = profile ? data_.t.back() : T_;
+  if (estimates_initial_state()) {
+    // The parameters' tangents and the initial state's, from the settled start; then the Schur
+    // complement: g and H of the parameters with the initial state's coefficients profiled out.
+    kept_ = {};
+    std::vector<Derivative> d;
+    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
+    VectorXd g_all;
+    MatrixXd H_all;
+    const double J = gauss_newton_streamed(s, solver, state_end, g_all, H_all, profile, nullptr, &d);
+    const int m = static_cast<int>(d.size()) - P;
+    const MatrixXd Hpa = H_all.topRightCorner(P, m);
+    const MatrixXd X = pseudo_solve(H_all.bottomRightCorner(m, m), Hpa.transpose());
+    H = H_all.topLeftCorner(P, P) - Hpa * X;
+    H = 0.5 * (H + H.transpose()).eval();
+    gradient = g_all.head(P) - X.transpose() * g_all.tail(m);
+    return J;
+  }
   if (solver.has_tangent_solve()) {
     kept_ = {};
     MatrixXd G;
@@ -1250,8 +1318,7 @@ void Objective::point_outputs(int cols, const double* x, const double* v, const 
   }
 }
 
-bool Objective::splits_sweep(double state_end) const {
-  const int P = size();
+bool Objective::splits_sweep(double state_end, int P) const {
   if (P < 2 || accelerations_ || options_.sweep_threads == 1 || !(options_.solver.step > 0)) return false;
   if (options_.sweep_threads == 0 && std::thread::hardware_concurrency() < 2) return false;
   // The recorded outputs of both groups: points × sensors × (P + 2 state columns) × (Yx, Yv).
@@ -1263,10 +1330,11 @@ bool Objective::splits_sweep(double state_end) const {
 void Objective::stream_outputs(const Setup& s, const SecondOrderSolver& solver, double state_end, double tangent_end,
                                const std::vector<Derivative>& d, const SecondOrderSolver::Sink& visit_state,
                                const OutputVisit& at, SolverSummary& sum) const {
-  const int P = size(), ns = data_.sensors(), m = 1 + P;
+  const int P = static_cast<int>(d.size()), ns = data_.sensors(), m = 1 + P;
   const double t0 = data_.t.front();
-  if (!splits_sweep(state_end)) {
+  if (!splits_sweep(state_end, P)) {
     const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
+    const auto start = run_start(s, d);
     MatrixXd Yx(ns, m), Yv(ns, m);
     solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, tangent_end, breakpoints_,
                           [&](const SecondOrderSolver::Point& pt) {
@@ -1274,7 +1342,7 @@ void Objective::stream_outputs(const Setup& s, const SecondOrderSolver& solver, 
                             if (pt.columns == m) point_outputs(m, pt.x, pt.v, pt.a, Yx, Yv);
                             at(pt.t, pt.columns == m ? m : 1, Yx, Yv);
                           },
-                          &sum);
+                          &sum, StepAnchor::Start, start.get());
     return;
   }
   // Two groups of tangents, [0, PA) here and [PA, P) on a worker, each with its own state column
@@ -1295,6 +1363,7 @@ void Objective::stream_outputs(const Setup& s, const SecondOrderSolver& solver, 
   auto run = [&](const SecondOrderSolver& sv, Record& r, const SecondOrderSolver::Sink* also) {
     const std::vector<Derivative> dg(d.begin() + r.first, d.begin() + r.first + r.count);
     const SecondOrderSolver::TangentForcing Gf = tangent_forcing(dg);
+    const auto start = run_start(s, dg);
     const int mg = 1 + r.count;
     MatrixXd Yx(ns, mg), Yv(ns, mg);
     sv.stream_tangent(t0, state_end, state_forcing(s), r.count, Gf, tangent_end, breakpoints_,
@@ -1307,7 +1376,7 @@ void Objective::stream_outputs(const Setup& s, const SecondOrderSolver& solver, 
                         r.y.insert(r.y.end(), Yx.data(), Yx.data() + Yx.size());
                         r.y.insert(r.y.end(), Yv.data(), Yv.data() + Yv.size());
                       },
-                      &r.sum);
+                      &r.sum, StepAnchor::Start, start.get());
   };
   std::exception_ptr worker_error;
   std::thread worker([&] {
@@ -1360,17 +1429,19 @@ bool Objective::keeps_sensitivities() const {
 }
 
 double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end,
-                                        VectorXd& gradient, MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows) {
+                                        VectorXd& gradient, MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows,
+                                        const std::vector<Derivative>* derivs) {
   // All P tangents stepped with the state in one pass (docs/theory.md §7.9); between consecutive
   // recorded points the union grid's intervals (the points' and the data's times, clipped to
   // [t0, T]) are integrated at once, with x, v and the tangents interpolated as Trajectory::eval
   // does: g, H and J accumulate on the fly, so memory is O(P · DOF + P²) whatever the record's
   // length, and the state is stored only for the misfit profile.
-  const int P = size(), n = model_.ndof, ns = data_.sensors(), m = 1 + P;
+  std::vector<Derivative> d;
+  if (derivs) d = *derivs;
+  else for (int i = 0; i < size(); ++i) d.push_back(derivative(s, i));
+  const int P = static_cast<int>(d.size()), n = model_.ndof, ns = data_.sensors(), m = 1 + P;
   const double t0 = data_.t.front();
   const auto ts = Clock::now();
-  std::vector<Derivative> d;
-  for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
@@ -1472,7 +1543,9 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
       t_prev = pt.t;
       have_prev = true;
     };
-    solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum);
+    const auto start = run_start(s, d);
+    solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum, StepAnchor::Start,
+                          start.get());
   }
   const auto tf = Clock::now();
   gn.finish();
@@ -1490,8 +1563,9 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
 }
 
 Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   ProfileSums sums(data_, noise_);
   forward_windows(solver, s, data_.t.back(), [&](const Trajectory& w) { profile_window(s, solver, w, sums); });
   return std::move(sums.prof);
@@ -1510,8 +1584,9 @@ VectorXd Objective::finite_difference_gradient(const VectorXd& q, double h) {
 }
 
 MatrixXd Objective::predict(const VectorXd& q) {
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
   // Streamed: only the outputs at the sample times are kept (the fit test predicts on a finer mesh
   // and step, whose whole state would be the largest array of the run).
   const auto t0 = Clock::now();
@@ -1521,7 +1596,7 @@ MatrixXd Objective::predict(const VectorXd& q) {
                   [&](std::size_t k, const VectorXd& x, const VectorXd& v) {
                     Y.row(static_cast<Eigen::Index>(k)) = output_at(s, solver, data_.t[k], x, v).transpose();
                   },
-                  &sum);
+                  &sum, 256, s.initial.get());
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.forward_seconds += since(t0);
@@ -1530,19 +1605,24 @@ MatrixXd Objective::predict(const VectorXd& q) {
 
 MatrixXd Objective::output_sensitivities(const VectorXd& q) {
   if (kept_.q.size() == q.size() && kept_.q == q) return kept_.G;
-  const Setup s = setup(q);
+  Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
-  const int P = size(), n = model_.ndof, ns = data_.sensors();
+  settle_initial_state(s, solver);
+  const int n = model_.ndof, ns = data_.sensors();
   const double t_end = data_.t.back();
-  MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
   VectorXd x(n), v(n), a(n), ux(n), uv(n);
   if (solver.has_tangent_solve()) {
     // Streamed (docs/theory.md §7.9): all P tangents stepped with the state in one pass, the
     // outputs at the sample times interpolated between consecutive points as Trajectory::eval
-    // does; memory O(P · DOF + samples · sensors · P), nothing O(steps).
+    // does; memory O(P · DOF + samples · sensors · P), nothing O(steps). With an estimated initial
+    // state its 2m tangents too, and the parameters' columns projected off theirs.
     const auto ts = Clock::now();
     std::vector<Derivative> d;
-    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+    for (int i = 0; i < size(); ++i) d.push_back(derivative(s, i));
+    if (estimates_initial_state())
+      for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
+    const int P = static_cast<int>(d.size());
+    MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
     const int m = 1 + P;
     double t_prev = 0.0;
     bool have_prev = false;
@@ -1565,7 +1645,7 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
       ++counters_.forward_solves;
       counters_.sensitivity_solves += P;
       counters_.sensitivity_seconds += since(ts);
-      return G;
+      return project_initial_state(G);
     }
     const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
     MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m);
@@ -1600,14 +1680,18 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
       t_prev = pt.t;
       have_prev = true;
     };
-    solver.stream_tangent(data_.t.front(), t_end, state_forcing(s), P, Gf, t_end, breakpoints_, visit, &sum);
+    const auto start = run_start(s, d);
+    solver.stream_tangent(data_.t.front(), t_end, state_forcing(s), P, Gf, t_end, breakpoints_, visit, &sum,
+                          StepAnchor::Start, start.get());
     counters_.solver.Accumulate(sum);
     ++counters_.forward_solves;
     counters_.sensitivity_solves += P;
     counters_.sensitivity_seconds += since(ts);
-    return G;
+    return project_initial_state(G);
   }
   // Without a tangent stepper: in blocks (as gauss_newton), memory O(block · steps · DOF + samples · sensors · P).
+  const int P = size();
+  MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
   const int B = sensitivity_block(t_end);
   for (int first = 0; first < P; first += B) {
     const int count = std::min(B, P - first);
@@ -1633,6 +1717,8 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   if (!has_matrix_free_products())
     throw std::logic_error("Objective::gauss_newton_product: velocity and acceleration sensors are not supported");
   if (v.size() != size()) throw std::invalid_argument("Objective::gauss_newton_product: v has the wrong size");
+  if (estimates_initial_state())
+    throw std::logic_error("Objective::gauss_newton_product: an estimated initial state takes the Gauss-Newton matrix");
   const Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   const int n = model_.ndof, ns = data_.sensors();
@@ -1678,6 +1764,97 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
       false);
   backward_stored(s, solver, u, src, Sv.times(), gc);
   return s.dcdq.transpose() * gc;
+}
+
+
+// ---- The initial state (docs/theory.md §6.9) ----
+
+std::vector<Objective::Derivative> Objective::initial_state_derivatives() const {
+  const MatrixXd& B = basis_;
+  const int n = model_.ndof;
+  std::vector<Derivative> d;
+  const Derivative none = derivative_along(VectorXd::Zero(model_.ncoef));
+  for (int kind = 0; kind < 2; ++kind)
+    for (Eigen::Index j = 0; j < B.cols(); ++j) {
+      Derivative dj = none;
+      dj.x0 = kind == 0 ? VectorXd(B.col(j)) : VectorXd(VectorXd::Zero(n));
+      dj.v0 = kind == 1 ? VectorXd(B.col(j)) : VectorXd(VectorXd::Zero(n));
+      d.push_back(std::move(dj));
+    }
+  return d;
+}
+
+std::unique_ptr<SecondOrderSolver::InitialState> Objective::run_start(const Setup& s, const std::vector<Derivative>& d) const {
+  bool any = s.initial != nullptr;
+  for (const Derivative& di : d) any = any || di.x0.size() > 0 || di.v0.size() > 0;
+  if (!any) return nullptr;
+  const int n = model_.ndof;
+  auto st = std::make_unique<SecondOrderSolver::InitialState>();
+  st->x = MatrixXd::Zero(n, 1 + static_cast<Eigen::Index>(d.size()));
+  st->v = MatrixXd::Zero(n, 1 + static_cast<Eigen::Index>(d.size()));
+  if (s.initial) {
+    st->x.col(0) = s.initial->x.col(0);
+    st->v.col(0) = s.initial->v.col(0);
+  }
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (d[i].x0.size() > 0) st->x.col(static_cast<Eigen::Index>(i) + 1) = d[i].x0;
+    if (d[i].v0.size() > 0) st->v.col(static_cast<Eigen::Index>(i) + 1) = d[i].v0;
+  }
+  return st;
+}
+
+void Objective::settle_initial_state(Setup& s, const SecondOrderSolver& solver) {
+  if (!estimates_initial_state()) return;
+  if (!solver.has_tangent_solve())
+    throw std::logic_error("Objective: an estimated initial state needs the esdirk integrator");
+  // J(a) is quadratic: from rest, g_a = ∂J/∂a and H_a = ∂²J/∂a² (the initial-state tangents are
+  // the exact derivatives of the discrete state, so this is the discrete cost's minimiser).
+  s.initial = nullptr;
+  const std::vector<Derivative> d = initial_state_derivatives();
+  VectorXd g;
+  MatrixXd H;
+  gauss_newton_streamed(s, solver, T_, g, H, nullptr, nullptr, &d);
+  const VectorXd ab = -pseudo_solve(H, g);
+  const MatrixXd& B = basis_;
+  const Eigen::Index m = B.cols();
+  auto st = std::make_shared<SecondOrderSolver::InitialState>();
+  st->x = B * ab.head(m);
+  st->v = B * ab.tail(m);
+  s.initial = std::move(st);
+  s.initial_coefficients = ab;
+}
+
+VectorXd Objective::initial_state_coefficients(const VectorXd& q) {
+  if (!estimates_initial_state()) return {};
+  Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
+  return s.initial_coefficients;
+}
+
+void Objective::add_initial_velocity_term(const Setup& s, const VectorXd& p0, VectorXd& gc) const {
+  // ∫ pᵀ M_j ü dt = [pᵀ M_j u̇]_{t0}^{T} − ∫ ṗᵀ M_j u̇ dt with p(T) = 0: the bracket is −p(t0)ᵀ M_j u̇(t0).
+  const VectorXd v0 = s.initial->v.col(0);
+  for (const OperatorTerm& t : model_.mass)
+    if (t.coefficient >= 0) gc[t.coefficient] -= p0.dot(t.matrix * v0);
+}
+
+MatrixXd Objective::project_initial_state(const MatrixXd& G) const {
+  const int P = size();
+  if (!estimates_initial_state()) return G;
+  const int ns = data_.sensors();
+  const Eigen::Index rows = G.rows(), m = G.cols() - P;
+  // Each row's weight: 1/σ² of its sensor where stated, else R (rows are sample-major).
+  VectorXd w(rows);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const auto k = static_cast<std::size_t>(r % ns);
+    const double sd = k < options_.noise_std.size() ? options_.noise_std[k] : 0.0;
+    w[r] = sd > 0 && std::isfinite(sd) ? 1.0 / (sd * sd) : R_[k];
+  }
+  const MatrixXd Ga = G.rightCols(m);
+  const MatrixXd WGa = w.asDiagonal() * Ga;
+  const MatrixXd X = pseudo_solve(Ga.transpose() * WGa, WGa.transpose() * G.leftCols(P));
+  return G.leftCols(P) - Ga * X;
 }
 
 }  // namespace scoleid::identify

@@ -226,6 +226,15 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     r.summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   estimate_modes(p, r);
+  if (obj.estimates_initial_state() && r.estimate.size() == p.params->size()) {
+    for (Eigen::Index j = 0; j < obj.initial_state_omega().size(); ++j)
+      r.initial_state_hz.push_back(obj.initial_state_omega()[j] / (2.0 * M_PI));
+    try {
+      r.initial_state_coefficients = obj.initial_state_coefficients(r.estimate);
+    } catch (const std::domain_error&) {
+      r.initial_state_coefficients = {};  // an estimate outside the positive range (an interrupted run's)
+    }
+  }
   if (r.predicted.size() != 0) r.residual_bands = residual_bands(p.data.t, p.data.z, r.predicted, r.modes, r.fit.explains_data);
   r.counters = obj.counters();
   r.counters.Accumulate(c.extra);

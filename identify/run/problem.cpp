@@ -39,7 +39,11 @@ std::vector<double> sample_times(const io::Scenario& sc) {
   std::vector<double> t;
   const double dt = sc.simulation.sample_interval, T = sc.simulation.duration;
   const long n = static_cast<long>(std::floor(T / dt + 1e-9));
-  for (long k = 0; k <= n; ++k) t.push_back(k * dt);
+  // simulation.record_start: the samples before it are not in the record (the simulation still
+  // starts from rest at t = 0).
+  const double t_rec = sc.simulation.record_start;
+  for (long k = 0; k <= n; ++k)
+    if (k * dt >= t_rec - 1e-9 * dt) t.push_back(k * dt);
   if (T - t.back() > 1e-9 * dt) t.push_back(T);
   return t;
 }
@@ -408,6 +412,9 @@ Measurements synthesize_nonlinear(const io::Scenario& sc, int elements, double s
   const ScoleNonlinear nl = scole_nonlinear(sc, elements);
   NonlinearForwardOptions o;
   o.max_step = step;
+  if (sc.simulation.record_start > 0)
+    fail_field(sc.source, "simulation.record_start", "is not available to the nonlinear model's synthesis (model: nonlinear)",
+               io::format_value(sc.simulation.record_start));
   Measurements m;
   m.t = sample_times(sc);
   m.z = simulate_nonlinear(nl.at(coefficients), scenario_signals(sc), m.t, o).outputs;
@@ -978,6 +985,8 @@ void choose_band(Problem& p) {
     return std::string(b);
   };
   auto none = [&](const std::string& why) { p.band_note = "auto: the whole record (" + why + ")"; };
+  if (id.initial_state == io::InitialState::Estimate)
+    return none("the initial state is estimated, and a band's filter commutes with the model only from rest");
   if (t.size() < 64) return none("fewer than 64 samples");
   for (std::size_t k = 0; k < p.noise_std.size(); ++k)
     if (!(p.noise_std[k] > 0)) return none("sensor '" + p.scenario.sensors[k].name + "' has no noise level; a band needs every sensor's");
@@ -1065,6 +1074,41 @@ void input_offsets(Problem& p) {
   }
 }
 
+// A record that starts moving (docs/theory.md §6.9): before any input acts, a sensor's samples
+// scatter by more than five times its stated noise and a twentieth of its record's RMS. The model
+// starts from rest, so the first part of such a record is a response it cannot make; the warning
+// names the sensor and initial_state: estimate.
+void moving_start(Problem& p) {
+  if (p.scenario.identification.initial_state != io::InitialState::Rest) return;
+  const auto& t = p.data.t;
+  const std::size_t N = t.size();
+  std::size_t quiet = std::max<std::size_t>(8, N / 100);
+  for (std::size_t i = 0; i < p.signals.size(); ++i) {
+    double peak = 0.0;
+    for (double ti : t) peak = std::max(peak, std::abs(p.signals[i](ti)));
+    if (!(peak > 0)) continue;
+    for (std::size_t k = 0; k < quiet && k < N; ++k)
+      if (std::abs(p.signals[i](t[k])) > 0.05 * peak) quiet = k;
+  }
+  if (quiet < 4 || quiet > N) return;
+  for (Eigen::Index j = 0; j < p.data.z.cols(); ++j) {
+    const auto col = p.data.z.col(j);
+    const double mean = col.head(static_cast<Eigen::Index>(quiet)).mean();
+    const double sd = std::sqrt((col.head(static_cast<Eigen::Index>(quiet)).array() - mean).square().mean());
+    const double rms = std::sqrt(col.squaredNorm() / static_cast<double>(N));
+    const double noise = static_cast<std::size_t>(j) < p.noise_std.size() ? p.noise_std[static_cast<std::size_t>(j)] : 0.0;
+    if (!(sd > 5.0 * noise && sd > 0.05 * rms)) continue;
+    char b[200];
+    std::snprintf(b, sizeof b, "sensor '%s' is moving at the record's start: its first %zu samples, before any input acts, scatter by %.3g %s (%.2g of its RMS)",
+                  p.scenario.sensors[static_cast<std::size_t>(j)].name.c_str(), quiet, sd,
+                  p.scenario.sensors[static_cast<std::size_t>(j)].unit.c_str(), sd / rms);
+    p.warnings.push_back(std::string(b) +
+                         "; the model starts from rest, and identification.initial_state: estimate fits the state the record "
+                         "starts in");
+    return;
+  }
+}
+
 // The solver's options, once the data are in: a record in which no sensor moves is refused (every
 // parameter fits it the same until the model moves, and then only worse).
 void finish_problem(Problem& p, const IdentifierStep& step, const std::string* csv) {
@@ -1112,6 +1156,7 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
                  io::format_value(p.noise_std.front()));
   }
   input_offsets(p);
+  moving_start(p);
   choose_band(p);
   apply_band(p);
   p.objective_options.solver.rtol = id.rtol;
@@ -1122,6 +1167,21 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
   p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                              : SolverOptions::Integrator::Esdirk;
+  if (id.initial_state == io::InitialState::Estimate) {
+    if (id.integrator != "esdirk")
+      fail_field(p.scenario.source, "identification.integrator",
+                 "must be esdirk with initial_state: estimate (its tangents carry the initial state's directions)",
+                 "'" + id.integrator + "'");
+    if (id.method == io::Method::GaussNewtonKrylov)
+      fail_field(p.scenario.source, "identification.method",
+                 "cannot be gauss-newton-krylov with initial_state: estimate (the initial state is profiled out of the "
+                 "explicit Gauss-Newton matrix)",
+                 "'gauss-newton-krylov'");
+    // The flexible modes the step resolves (the data's content, docs/theory.md §5.2), or as stated.
+    p.objective_options.initial_state_modes =
+        id.initial_state_modes > 0 ? id.initial_state_modes
+                                   : std::clamp(p.content.mode, 1, io::kMaxInitialStateModes);
+  }
 }
 
 // The record's times on their grid (io/time_grid.h): a stated data.sample_rate's (the times within

@@ -333,6 +333,25 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                                {"noise_gain", p.band_gain},
                                {"chosen", p.band_note.empty() ? "stated" : "auto"},
                                {"note", p.band_note.empty() ? "the scenario's identification.band" : p.band_note}}}};
+  if (p.scenario.identification.initial_state == io::InitialState::Estimate) {
+    const auto m = static_cast<Eigen::Index>(initial_state_hz.size());
+    std::vector<double> a, b;
+    if (initial_state_coefficients.size() == 2 * m)
+      for (Eigen::Index j = 0; j < m; ++j) {
+        a.push_back(initial_state_coefficients[j]);
+        b.push_back(initial_state_coefficients[m + j]);
+      }
+    out["initial_state"] = {{"estimated", true},
+                            {"modes", m},
+                            {"basis_hz", initial_state_hz},
+                            {"displacement", a},
+                            {"velocity", b},
+                            {"note", "x(t0) = sum of displacement[j] phi_j, x'(t0) = sum of velocity[j] phi_j, phi_j the start "
+                                     "model's M-orthonormal modes at basis_hz; profiled out of the fit, its unknowns counted in "
+                                     "every interval"}};
+  } else {
+    out["initial_state"] = {{"estimated", false}, {"note", "the structure at rest at the first sample"}};
+  }
   counts_json(*this, out);
   if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0) out["data_columns"] = data_columns_json(p.columns);
   if (!start_check.sensors.empty()) {
@@ -402,6 +421,13 @@ std::string RunResult::FullReport() const {
   s += correlation_table(*this);
   s += modes_table(modes);
   if (!residual_bands.summary.empty()) s += "\n" + residual_bands.summary + "\n";
+  if (!initial_state_hz.empty()) {
+    std::snprintf(line, sizeof line,
+                  "\ninitial state: estimated in the start model's %zu lowest modes (%.4g to %.4g Hz), %zu unknowns profiled out "
+                  "of the fit and counted in every interval\n",
+                  initial_state_hz.size(), initial_state_hz.front(), initial_state_hz.back(), 2 * initial_state_hz.size());
+    s += line;
+  }
   std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
                 summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
                 wall_seconds);

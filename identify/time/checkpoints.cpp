@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <limits>
 
 namespace scoleid::identify {
 
@@ -46,7 +47,7 @@ void WindowedSink::finish() {
 
 void sample_streamed(const SecondOrderSolver& solver, double t0, double t1, const SecondOrderSolver::Forcing& forcing,
                      const std::vector<double>& breakpoints, const std::vector<double>& times, const SampleVisit& at,
-                     SolverSummary* summary, std::size_t points) {
+                     SolverSummary* summary, std::size_t points, const SecondOrderSolver::InitialState* initial) {
   const int n = solver.dim();
   VectorXd x(n), v(n);
   std::size_t next = 0;
@@ -58,7 +59,8 @@ void sample_streamed(const SecondOrderSolver& solver, double t0, double t1, cons
       ++next;
     }
   });
-  solver.stream(t0, t1, forcing, breakpoints, [&](const SecondOrderSolver::Point& pt) { sink(pt); }, summary);
+  solver.stream(t0, t1, forcing, breakpoints, [&](const SecondOrderSolver::Point& pt) { sink(pt); }, summary, nullptr,
+                std::numeric_limits<double>::infinity(), StepAnchor::Start, initial);
   last = true;  // the final window also takes the times beyond the run (clamped)
   sink.finish();
 }

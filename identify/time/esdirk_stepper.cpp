@@ -76,7 +76,7 @@ EsdirkStepper::EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const
 
 EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const std::vector<double>& stops_in,
                                          const Forcing& forcing, int P, const TangentForcing* tangent,
-                                         double tangent_end, StepAnchor anchor) const {
+                                         double tangent_end, StepAnchor anchor, const InitialState* initial) const {
   const int n = static_cast<int>(M_.rows());
   Result res;
   res.state = Trajectory(n);
@@ -96,7 +96,7 @@ EsdirkStepper::Result EsdirkStepper::run(double t0, double t1, double h, const s
       res.tangents[static_cast<std::size_t>(i - 1)].push(pt.t, pt.x + i * stride, pt.v + i * stride, pt.a + i * stride);
   };
   res.counters = stream(t0, t1, h, stops_in, forcing, record, P, tangent, tangent_end, nullptr,
-                        std::numeric_limits<double>::infinity(), anchor);
+                        std::numeric_limits<double>::infinity(), anchor, initial);
   return res;
 }
 
@@ -126,6 +126,15 @@ public:
   }
 
   bool has_tangents() const { return m_ > 1; }
+
+  // Columns of `init` in place of rest (the rest stay zero); the caller then accelerates.
+  void set_initial(const InitialState& init) {
+    const auto c = std::min<Eigen::Index>(init.x.cols(), m_);
+    if (init.x.rows() != n_ || init.v.rows() != n_ || init.v.cols() != init.x.cols())
+      throw std::invalid_argument("EsdirkStepper: the initial state has the wrong shape");
+    x.leftCols(c) = init.x.leftCols(c);
+    v.leftCols(c) = init.v.leftCols(c);
+  }
 
   void resume(const Start& start) {
     x.col(0) = Eigen::Map<const VectorXd>(start.x, n_);
@@ -294,9 +303,11 @@ private:
 
 StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std::vector<double>& stops_in,
                                       const Forcing& forcing, const Sink& sink, int P, const TangentForcing* tangent,
-                                      double tangent_end, const Start* start, double until, StepAnchor anchor) const {
+                                      double tangent_end, const Start* start, double until, StepAnchor anchor,
+                                      const InitialState* initial) const {
   if (start) {
     if (P != 0) throw std::invalid_argument("EsdirkStepper: a resumed run steps the state only");
+    if (initial) throw std::invalid_argument("EsdirkStepper: a resumed run has its own start");
     if (h != start->h) throw std::invalid_argument("EsdirkStepper: a resumed run must keep its step");
     t0 = start->t;
   }
@@ -308,8 +319,12 @@ StepperCounters EsdirkStepper::stream(double t0, double t1, double h, const std:
   StepperCounters cnt;
   Sweep sw(*this, forcing, sink, P, tangent, h, cnt);
   sw.origin = t0;
-  if (start) sw.resume(*start);
-  else sw.accelerate(t0);
+  if (start) {
+    sw.resume(*start);
+  } else {
+    if (initial) sw.set_initial(*initial);
+    sw.accelerate(t0);
+  }
   sw.record(t0, true);
   if (t0 >= until) return cnt;
   bool tangents_on = sw.has_tangents();

@@ -280,13 +280,14 @@ void fill_summary(SolverSummary* summary, const StepperCounters& c, long factori
 SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, double t1, const Forcing& forcing, int P,
                                                                     const TangentForcing& tangent, double tangent_end,
                                                                     const std::vector<double>& breakpoints,
-                                                                    SolverSummary* summary, StepAnchor anchor) const {
+                                                                    SolverSummary* summary, StepAnchor anchor,
+                                                                    const InitialState* initial) const {
   const Impl& s = *impl_;
   if (!s.stepper) throw std::logic_error("solve_tangent: only the esdirk integrator steps tangents with the state");
   const auto wall0 = std::chrono::steady_clock::now();
   const long f0 = s.newton->factorizations();
   const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
-  EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, P, &tangent, tangent_end, anchor);
+  EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, P, &tangent, tangent_end, anchor, initial);
   fill_summary(summary, r.counters, s.newton->factorizations() - f0, wall0);
   return {std::move(r.state), std::move(r.tangents)};
 }
@@ -294,11 +295,11 @@ SecondOrderSolver::TangentSolution SecondOrderSolver::solve_tangent(double t0, d
 
 void SecondOrderSolver::stream(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
                                const Sink& sink, SolverSummary* summary, const Start* start, double until,
-                               StepAnchor anchor) const {
+                               StepAnchor anchor, const InitialState* initial) const {
   const Impl& s = *impl_;
   if (!s.stepper) {
     if (start) throw std::logic_error("SecondOrderSolver::stream: only the esdirk integrator resumes a run");
-    const Trajectory u = solve(t0, t1, forcing, breakpoints, summary, anchor);
+    const Trajectory u = solve(t0, t1, forcing, breakpoints, summary, anchor, initial);
     Point pt;
     pt.resumable = false;
     for (std::size_t k = 0; k < u.size(); ++k) {
@@ -315,13 +316,14 @@ void SecondOrderSolver::stream(double t0, double t1, const Forcing& forcing, con
   const auto wall0 = std::chrono::steady_clock::now();
   const long f0 = s.newton->factorizations();
   const double h = start ? start->h : (s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0);
-  const StepperCounters c = s.stepper->stream(t0, t1, h, breakpoints, forcing, sink, 0, nullptr, 0.0, start, until, anchor);
+  const StepperCounters c =
+      s.stepper->stream(t0, t1, h, breakpoints, forcing, sink, 0, nullptr, 0.0, start, until, anchor, initial);
   fill_summary(summary, c, s.newton->factorizations() - f0, wall0);
 }
 
 void SecondOrderSolver::stream_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
                                        double tangent_end, const std::vector<double>& breakpoints, const Sink& sink,
-                                       SolverSummary* summary, StepAnchor anchor) const {
+                                       SolverSummary* summary, StepAnchor anchor, const InitialState* initial) const {
   const Impl& s = *impl_;
   if (!s.stepper) throw std::logic_error("stream_tangent: only the esdirk integrator steps tangents with the state");
   io::check_interrupt();
@@ -329,7 +331,7 @@ void SecondOrderSolver::stream_tangent(double t0, double t1, const Forcing& forc
   const long f0 = s.newton->factorizations();
   const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
   const StepperCounters c = s.stepper->stream(t0, t1, h, breakpoints, forcing, sink, P, &tangent, tangent_end, nullptr,
-                                              std::numeric_limits<double>::infinity(), anchor);
+                                              std::numeric_limits<double>::infinity(), anchor, initial);
   fill_summary(summary, c, s.newton->factorizations() - f0, wall0);
 }
 
@@ -456,7 +458,7 @@ private:
 }  // namespace
 
 Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
-                                    SolverSummary* summary, StepAnchor anchor) const {
+                                    SolverSummary* summary, StepAnchor anchor, const InitialState* initial) const {
   io::check_interrupt();  // a SIGINT/SIGTERM ends the run between solves (io/interrupt.h)
   const auto wall0 = std::chrono::steady_clock::now();
   Impl& s = *impl_;
@@ -464,10 +466,11 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   const double h = s.opt.step > 0 ? s.opt.step : (t1 - t0) / 2000.0;
   if (s.stepper) {
     const long f0 = s.newton->factorizations();
-    EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, 0, nullptr, 0.0, anchor);
+    EsdirkStepper::Result r = s.stepper->run(t0, t1, h, breakpoints, forcing, 0, nullptr, 0.0, anchor, initial);
     fill_summary(summary, r.counters, s.newton->factorizations() - f0, wall0);
     return std::move(r.state);
   }
+  if (initial) throw std::logic_error("SecondOrderSolver::solve: only the esdirk integrator starts from a state other than rest");
   s.forcing = &forcing;
   s.linear_solves = 0;
   s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);

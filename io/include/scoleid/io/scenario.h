@@ -251,6 +251,9 @@ struct SensorSpec : PointSpec {
 struct SimulationSpec {
   double duration = 10.0;
   double sample_interval = 0.01;
+  // The record holds the samples at t >= record_start only (s): the structure is simulated from
+  // rest at t = 0, and what happened before is not in the record (a record started mid-motion).
+  double record_start = 0.0;
   unsigned seed = 1;
 };
 
@@ -325,7 +328,16 @@ struct IdentificationSpec {
   // default), < 0 ("discrepancy" in YAML) = β chosen by the discrepancy principle from the stated
   // sensor noise (docs/theory.md §7.8).
   double smoothness = 0.0;
+  // The structure's state at the record's first sample (docs/theory.md §6.9): "rest" (the default)
+  // or "estimate" — the initial displacement and velocity in the identifier's lowest modes at the
+  // start values, eliminated at every step by least squares (a record that begins already
+  // vibrating: a tap test whose pre-trigger rings, a record started mid-motion).
+  InitialState initial_state = InitialState::Rest;
+  // The modes that carry the estimated initial state: 0 = automatic (those below the highest
+  // frequency the data contain, at most kMaxInitialStateModes).
+  int initial_state_modes = 0;
 };
+inline constexpr int kMaxInitialStateModes = 24;
 
 // How a data file is read (docs/data.md): the time column by name ("" = the first column), and its
 // unit when the header does not state one ("" = seconds).

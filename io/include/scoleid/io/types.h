@@ -33,6 +33,7 @@ enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent
 enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
+enum class InitialState { Rest, Estimate };
 enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain, RelativeDisplacement };
 enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
 enum class InputKind { Force, Moment };
@@ -62,6 +63,11 @@ struct Names<Start> {
 template <>
 struct Names<Model> {
   static constexpr std::array<std::pair<Model, const char*>, 2> rows{{{Model::Linear, "linear"}, {Model::Nonlinear, "nonlinear"}}};
+};
+template <>
+struct Names<InitialState> {
+  static constexpr std::array<std::pair<InitialState, const char*>, 2> rows{
+      {{InitialState::Rest, "rest"}, {InitialState::Estimate, "estimate"}}};
 };
 template <>
 struct Names<StepRule> {

@@ -92,6 +92,15 @@ struct ObjectiveOptions {
   // interval), J and g on the solver's own. 1 = the same step (gradient_and_step_matrix is then
   // gauss_newton).
   double step_matrix_coarsening = kStepMatrixCoarsening;
+  // The initial state (docs/theory.md §6.9): 0 (the default) for a structure at rest at the first
+  // sample; m > 0 for a state in the model's m lowest modes at the parameterization's initial
+  // values (B, M-orthonormal, n × m): x(t0) = B a and ẋ(t0) = B b, the 2m coefficients (a, b)
+  // eliminated at every q. The outputs are affine in them, so they take their least-squares values
+  // there (variable projection), and cost, gradient, Gauss–Newton matrix and output sensitivities
+  // are those of the parameters with the initial state profiled out: the matrix and the
+  // sensitivities are projected off the initial state's directions, so the Fisher information and
+  // the intervals count its unknowns. esdirk only.
+  int initial_state_modes = 0;
 };
 
 struct ObjectiveCounters {
@@ -184,7 +193,15 @@ public:
   // place of the residual; the gradient formula (Eq. 25) on that costate is H v. Two solves
   // whatever the number of parameters. Displacement sensors only (has_matrix_free_products()).
   VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v) override;
-  bool has_matrix_free_products() const override { return C1_.size() == 0; }
+  bool has_matrix_free_products() const override { return C1_.size() == 0 && !estimates_initial_state(); }
+
+  // Whether the initial state is estimated (ObjectiveOptions::initial_state_basis), and its
+  // least-squares coefficients (a, b) at q (one pass of 2m tangents).
+  bool estimates_initial_state() const { return basis_.cols() > 0; }
+  const MatrixXd& initial_state_basis() const { return basis_; }
+  // The basis modes' angular frequencies at the start values [rad/s] (rigid-body modes ≈ 0).
+  const VectorXd& initial_state_omega() const { return basis_omega_; }
+  VectorXd initial_state_coefficients(const VectorXd& q);
 
   const ObjectiveCounters& counters() const { return counters_; }
   void reset_counters() { counters_ = {}; }
@@ -199,6 +216,9 @@ private:
     VectorXd c;
     MatrixXd dcdq;
     AssembledModel ops;
+    // The state at the first sample (null: rest) and its coefficients (a, b) in the basis.
+    std::shared_ptr<const SecondOrderSolver::InitialState> initial;
+    VectorXd initial_coefficients;
   };
   Setup setup(const VectorXd& q) const;
   Trajectory forward(const SecondOrderSolver& solver, const Setup& s, double t_end);
@@ -234,10 +254,25 @@ private:
   struct Derivative {
     SparseMatrix dM, dD, dK;
     std::vector<VectorXd> db;
+    VectorXd x0, v0;  // the tangent's start (empty: rest), for the initial state's directions
   };
   Derivative derivative(const Setup& s, int i) const;
   // Σ_j dc_j ∂M/∂c_j etc.: the derivative along a direction dc of the model coefficients.
   Derivative derivative_along(const VectorXd& dc) const;
+  // With an estimated initial state: its least-squares coefficients at s's parameters into s (a
+  // pass from rest with the 2m initial-state tangents), so that every later solve on s starts there.
+  void settle_initial_state(Setup& s, const SecondOrderSolver& solver);
+  // The 2m initial-state directions as tangents: no operator derivative, x(t0) = B_j or ẋ(t0) = B_j.
+  std::vector<Derivative> initial_state_derivatives() const;
+  // The start of a run of the state and the tangents d: column 0 s.initial, then each tangent's own
+  // (null when all start at rest).
+  std::unique_ptr<SecondOrderSolver::InitialState> run_start(const Setup& s, const std::vector<Derivative>& d) const;
+  // p(t0)ᵀ M_j ẋ(t0) of the mass term taken by parts (Eq. 25 with displacement sensors) when the
+  // state starts moving: subtracted from gc (docs/theory.md §6.9).
+  void add_initial_velocity_term(const Setup& s, const VectorXd& p0, VectorXd& gc) const;
+  // G's columns projected off the initial state's (the last 2m), in the Fisher information's
+  // weights (each sensor's stated noise, else R): (samples·sensors) × P.
+  MatrixXd project_initial_state(const MatrixXd& G) const;
   Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, const Derivative& d,
                          double t_end) const;
   // The tangents' forcing G_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) for the given derivatives
@@ -262,8 +297,10 @@ private:
   // Gauss–Newton with all tangents streamed (esdirk): g, H, J accumulated on the fly; with
   // `sample_rows` (horizon = the whole record, no acceleration sensors) also the output
   // sensitivities at the sample times, as output_sensitivities returns them.
+  // `derivs`: the tangents (default: the P parameters').
   double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
-                               MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows = nullptr);
+                               MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows = nullptr,
+                               const std::vector<Derivative>* derivs = nullptr);
   // cost_and_gradient's two ways into gc (the coefficient gradient): the state checkpointed every
   // L points, or stored whole, each with its backward pass.
   double gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc);
@@ -307,6 +344,8 @@ private:
   std::vector<io::Signal> inputs_;
   Measurements data_;
   ObjectiveOptions options_;
+  MatrixXd basis_;        // the initial state's modes (n × m; empty: rest)
+  VectorXd basis_omega_;  // their angular frequencies at the start values
   MatrixXd C_;            // rows on u
   Eigen::SparseMatrix<double, Eigen::RowMajor> Cs_;  // the nonzeros of C_ (a sensor reads a few dofs)
   MatrixXd C1_, C2_;      // rows on u̇ and ü (empty without velocity or acceleration sensors)
@@ -363,7 +402,7 @@ private:
   void point_outputs(int cols, const double* x, const double* v, const double* a, MatrixXd& Yx, MatrixXd& Yv) const;
   // Whether a pass over [t0, state_end] steps its tangents on two threads: sweep_threads, the
   // machine, P >= 2, and the recorded outputs within sensitivity_block_bytes.
-  bool splits_sweep(double state_end) const;
+  bool splits_sweep(double state_end, int P) const;
   // The state and all P tangents stepped over [t0, state_end] (the tangents to tangent_end), every
   // recorded point's outputs (point_outputs; sensors × (1 + P), or only the state's column once
   // the tangents have stopped) handed to `at` in time order. On one thread, or (splits_sweep) the

@@ -65,6 +65,11 @@ struct RunResult {
   Identifiability ident;
   UncertaintyInterval interval;
   FitTest fit;  // at the estimate
+  // identification.initial_state: estimate (docs/theory.md §6.9): the basis modes' frequencies at
+  // the start values [Hz], and the initial state's coefficients at the estimate in them (the m
+  // displacement coefficients, then the m velocity ones; M-orthonormal modes). Empty from rest.
+  std::vector<double> initial_state_hz;
+  VectorXd initial_state_coefficients;
   // The identified model's elastic modes, lowest first, with their propagated uncertainty
   // (inverse/modal_uncertainty.h); empty where the model has none below the data's Nyquist frequency.
   std::vector<ModalEstimate> modes;

@@ -63,7 +63,8 @@ private:
 using SampleVisit = std::function<void(std::size_t k, const Eigen::VectorXd& x, const Eigen::VectorXd& v)>;
 void sample_streamed(const SecondOrderSolver& solver, double t0, double t1, const SecondOrderSolver::Forcing& forcing,
                      const std::vector<double>& breakpoints, const std::vector<double>& times, const SampleVisit& at,
-                     SolverSummary* summary = nullptr, std::size_t points = 256);
+                     SolverSummary* summary = nullptr, std::size_t points = 256,
+                     const SecondOrderSolver::InitialState* initial = nullptr);
 
 // The state between checkpoints, re-solved on demand: cover(ta, tb) makes the segments that hold
 // [ta, tb] available, keeping only those (a backward pass moving to earlier windows then re-solves

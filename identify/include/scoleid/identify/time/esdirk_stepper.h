@@ -86,16 +86,23 @@ public:
   EsdirkStepper(const SparseMatrix& M, const SparseMatrix& D, const SparseMatrix& K, const BandedCholesky& mass,
                 NewtonMatrix& newton, ButcherTable table);
 
+  // A start other than rest (docs/theory.md §6.9): n × c, column 0 the state's x(t0) and ẋ(t0),
+  // columns 1 … c − 1 the first tangents' (the others, and every column when c = 0, start at rest).
+  // The accelerations follow from the equations at t0.
+  struct InitialState {
+    MatrixXd x, v;
+  };
+
   struct Result {
     Trajectory state;
     std::vector<Trajectory> tangents;
     StepperCounters counters;
   };
-  // Integrates from rest over [t0, t1] with step h; `stops` are the forcing breakpoints (any order,
-  // those outside (t0, t1) ignored). P tangents (0 = state only) up to tangent_end.
+  // Integrates from rest (or from `initial`) over [t0, t1] with step h; `stops` are the forcing
+  // breakpoints (any order, those outside (t0, t1) ignored). P tangents (0 = state only) up to tangent_end.
   Result run(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing, int P = 0,
              const TangentForcing* tangent = nullptr, double tangent_end = 0.0,
-             StepAnchor anchor = StepAnchor::Start) const;
+             StepAnchor anchor = StepAnchor::Start, const InitialState* initial = nullptr) const;
 
   // Streaming: every recorded point goes to `sink` instead of into trajectories, so a solve needs
   // memory for one step whatever its length. The point carries what a restart needs: the step
@@ -114,13 +121,13 @@ public:
     double t = 0.0, origin = 0.0, h = 0.0;
     const double *x = nullptr, *v = nullptr, *a = nullptr;
   };
-  // As run(), but the points go to `sink`; from rest at t0 or, with `start`, from start->t (then t0
-  // is ignored, h must equal start->h and P must be 0). The run ends early after the first
-  // resumable point at or beyond `until` (the grid is still that of [t0, t1]).
+  // As run(), but the points go to `sink`; from rest (or `initial`) at t0 or, with `start`, from
+  // start->t (then t0 is ignored, h must equal start->h, P must be 0 and `initial` null). The run
+  // ends early after the first resumable point at or beyond `until` (the grid is still that of [t0, t1]).
   StepperCounters stream(double t0, double t1, double h, const std::vector<double>& stops, const Forcing& forcing,
                          const Sink& sink, int P = 0, const TangentForcing* tangent = nullptr, double tangent_end = 0.0,
                          const Start* start = nullptr, double until = std::numeric_limits<double>::infinity(),
-                         StepAnchor anchor = StepAnchor::Start) const;
+                         StepAnchor anchor = StepAnchor::Start, const InitialState* initial = nullptr) const;
 
 private:
   class Sweep;  // one integration's workspace and steps (esdirk_stepper.cpp)

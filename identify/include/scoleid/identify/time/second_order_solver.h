@@ -88,11 +88,15 @@ public:
   SecondOrderSolver& operator=(const SecondOrderSolver&) = delete;
 
   int dim() const;
-  // Integrates over [t0, t1] from rest. Throws std::runtime_error if CVODES fails. `anchor`
+  // A start other than rest (esdirk only; the other integrators throw std::logic_error when given
+  // one): column 0 the state's x(t0), ẋ(t0), further columns the first tangents' (esdirk_stepper.h).
+  using InitialState = EsdirkStepper::InitialState;
+  // Integrates over [t0, t1] from rest (or `initial`). Throws std::runtime_error if CVODES fails. `anchor`
   // (esdirk; the other integrators choose their own steps): where the fixed steps are anchored in
   // each segment between breakpoints (esdirk_stepper.h; End for reversed-time costate runs).
   Trajectory solve(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints,
-                   SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start) const;
+                   SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start,
+                   const InitialState* initial = nullptr) const;
   // State and P tangents stepped together (esdirk only; see esdirk_stepper.h):
   //   M s̈_i + D ṡ_i + K s_i = G_i(t, x, ẋ, ẍ) at the state's own stage values.
   // The state is integrated over [t0, t1], the tangents up to the first step end >= tangent_end.
@@ -105,7 +109,8 @@ public:
   bool has_tangent_solve() const;
   TangentSolution solve_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
                                 double tangent_end, const std::vector<double>& breakpoints,
-                                SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start) const;
+                                SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start,
+                                const InitialState* initial = nullptr) const;
   // Streaming solves: every recorded point goes to `sink` and nothing is stored, so the memory is
   // that of one step (esdirk_stepper.h, Point). With esdirk a run can resume from a recorded
   // resumable point (`start`, state only) and end early at `until`, reproducing the original run's
@@ -117,11 +122,13 @@ public:
   bool can_resume() const { return has_tangent_solve(); }
   void stream(double t0, double t1, const Forcing& forcing, const std::vector<double>& breakpoints, const Sink& sink,
               SolverSummary* summary = nullptr, const Start* start = nullptr,
-              double until = std::numeric_limits<double>::infinity(), StepAnchor anchor = StepAnchor::Start) const;
+              double until = std::numeric_limits<double>::infinity(), StepAnchor anchor = StepAnchor::Start,
+              const InitialState* initial = nullptr) const;
   // State and P tangents streamed together (esdirk only, as solve_tangent).
   void stream_tangent(double t0, double t1, const Forcing& forcing, int P, const TangentForcing& tangent,
                       double tangent_end, const std::vector<double>& breakpoints, const Sink& sink,
-                      SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start) const;
+                      SolverSummary* summary = nullptr, StepAnchor anchor = StepAnchor::Start,
+                      const InitialState* initial = nullptr) const;
   // ẍ = M⁻¹ (F − D v − K x)
   void acceleration(const double* F, const double* x, const double* v, double* a) const;
 
