@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace scoleid::identify {
 
@@ -61,7 +62,7 @@ FisherInformation fisher_information(const Measurements& data, const MatrixXd& Y
   return id;
 }
 
-Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q) {
+Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q, const std::vector<std::string>* names) {
   Identifiability id;
   const int P = static_cast<int>(q.size());
   const MatrixXd& F = fi.F;
@@ -93,6 +94,31 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
     if (unseen_share[i] > 0.1) {
       id.identifiable[static_cast<std::size_t>(i)] = false;
       id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
+    }
+  // An unseen direction shared by exactly two parameters i, j (d log q = s (v_i, v_j)): the data fix
+  // the one combination it leaves unchanged, q_i / q_j^(v_i/v_j) (a free decay: EI/rho_A).
+  if (names && static_cast<int>(names->size()) == P)
+    for (int e = 0; e < P; ++e) {
+      if (es.eigenvalues()[e] > 1e-12 * lmax) continue;
+      const VectorXd v = es.eigenvectors().col(e);
+      std::vector<int> big;
+      for (int i = 0; i < P; ++i)
+        if (std::abs(v[i]) > 0.1) big.push_back(i);
+      if (big.size() != 2) continue;
+      const int i = big[0], j = big[1];
+      const double k = v[i] / v[j];
+      const std::string& ni = (*names)[static_cast<std::size_t>(i)];
+      const std::string& nj = (*names)[static_cast<std::size_t>(j)];
+      char comb[160];
+      if (std::abs(k - 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s/%s", ni.c_str(), nj.c_str());
+      else if (std::abs(k + 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s*%s", ni.c_str(), nj.c_str());
+      else std::snprintf(comb, sizeof comb, "%s/%s^%.3g", ni.c_str(), nj.c_str(), k);
+      for (int a : {i, j}) {
+        const std::string& other = a == i ? nj : ni;
+        id.reason[static_cast<std::size_t>(a)] = "moves with " + other +
+                                                 " along a direction the data cannot see (Fisher eigenvalue below 1e-12 of "
+                                                 "the largest): the data fix " + comb + " only";
+      }
     }
   // Without a stated noise level σ comes from the residual with ν = N − P degrees of freedom; below
   // ν = 10 that estimate is not a scale (at ν = 10 the level is within a factor 1.75 at 95 %, at

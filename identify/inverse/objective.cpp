@@ -192,17 +192,7 @@ Objective::Objective(const StructuralModel& model, const Parameterization& param
     if (onset < data_.t.size() && data_.t[onset] - t0 > 0.05 * (data_.t.back() - t0)) response_start_ = data_.t[onset];
   }
   if (options_.initial_state_modes > 0) {
-    // The initial state's basis: the model's lowest modes at the start values (docs/theory.md §6.9).
-    VectorXd c;
-    MatrixXd dcdq;
-    params_.coefficients(params_.initial(), c, dcdq);
-    const AssembledModel ops = assemble(model_, c);
-    // The rigid-body modes (below the floor) and the lowest initial_state_modes flexible ones.
-    const NaturalModes nm = natural_modes(ops.M, ops.K);
-    Eigen::Index rigid = 0;
-    while (rigid < nm.omega.size() && nm.omega[rigid] < nm.floor) ++rigid;
-    basis_ = nm.vectors.leftCols(std::min<Eigen::Index>(rigid + options_.initial_state_modes, nm.vectors.cols()));
-    basis_omega_ = nm.omega.head(basis_.cols());
+    make_initial_state_basis();
     response_start_ = t0;  // a moving start has no quiet pre-trigger to skip
   }
   const int ns = data_.sensors();
@@ -1768,6 +1758,21 @@ VectorXd Objective::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
 
 
 // ---- The initial state (docs/theory.md §6.9) ----
+
+void Objective::make_initial_state_basis() {
+  // The model's lowest modes at the start values, docs/theory.md §6.9:
+  // the rigid-body modes (below the floor) and the lowest initial_state_modes flexible ones.
+  VectorXd c;
+  MatrixXd dcdq;
+  params_.coefficients(params_.initial(), c, dcdq);
+  const AssembledModel ops = assemble(model_, c);
+  const NaturalModes nm = natural_modes(ops.M, ops.K);
+  Eigen::Index rigid = 0;
+  while (rigid < nm.omega.size() && nm.omega[rigid] < nm.floor) ++rigid;
+  basis_ = nm.vectors.leftCols(std::min<Eigen::Index>(rigid + options_.initial_state_modes, nm.vectors.cols()));
+  basis_omega_ = nm.omega.head(basis_.cols());
+}
+
 
 std::vector<Objective::Derivative> Objective::initial_state_derivatives() const {
   const MatrixXd& B = basis_;

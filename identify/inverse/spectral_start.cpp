@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <complex>
 #include <limits>
 
@@ -224,6 +225,16 @@ SpectralStart spectral_start(const StructuralModel& model, const Parameterizatio
   const VectorXd delta = J.transpose() * (JJ + 1e-10 * scale * MatrixXd::Identity(n, n)).ldlt().solve(rhs);
   if (!delta.allFinite()) {
     out.note = "the frequency change cannot be solved for";
+    return out;
+  }
+  // Nearly dependent rows of J (two modes that move alike but not quite) can ask a parameter for a
+  // change far beyond the frequencies' own: such a start is a guess of the solve, not of the record.
+  const double most = delta.cwiseAbs().maxCoeff();
+  if (most > 3.0 * std::abs(log_r) + 1e-12) {
+    char b[200];
+    std::snprintf(b, sizeof b, "lining the peaks up (x%.4g) would move a parameter by a factor %.3g: not used", match->ratio,
+                  std::exp(most));
+    out.note = b;
     return out;
   }
   out.q = q0.array() * delta.array().exp();

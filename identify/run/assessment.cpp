@@ -288,7 +288,8 @@ void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& o
   // (the outputs are the fit test's, when it kept them).
   const MatrixXd Y = r.predicted.size() > 0 ? r.predicted : obj.predict(r.estimate);
   const MatrixXd G = obj.output_sensitivities(r.estimate);
-  r.ident = identifiability_from(band_information(p, fisher_information(obj.data(), Y, G, sensors_with_noise(p))), r.estimate);
+  r.ident = identifiability_from(band_information(p, fisher_information(obj.data(), Y, G, sensors_with_noise(p))), r.estimate,
+                                 &p.params->names());
   flag_mirror_ambiguity(p, obj, r, Y);
   flag_other_minima(p, obj, r, Y);
   r.ident.noise_source = noise_origin(p, r.ident.noise_source);

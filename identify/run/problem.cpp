@@ -445,7 +445,10 @@ void set_true_values(Problem& p, const io::Scenario& truth_sc) {
 // The structure, its parameters, the scenario's signals and the stated noise levels.
 std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc) {
   if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
-  if (sc.inputs.empty()) fail_field(sc.source, "inputs", "must list at least one input", "none");
+  if (sc.inputs.empty() && sc.identification.initial_state != io::InitialState::Estimate)
+    fail_field(sc.source, "inputs",
+               "must list at least one input (a record with none, a free decay, needs identification.initial_state: estimate)",
+               "none");
   auto p = std::make_unique<Problem>();
   p->scenario = sc;
   p->structure = make_structure(sc, sc.identification.elements);

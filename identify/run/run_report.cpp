@@ -346,7 +346,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
                             {"basis_hz", initial_state_hz},
                             {"displacement", a},
                             {"velocity", b},
-                            {"note", "x(t0) = sum of displacement[j] phi_j, x'(t0) = sum of velocity[j] phi_j, phi_j the start "
+                            {"note", "x(t0) = sum of displacement[j] phi_j, x'(t0) = sum of velocity[j] phi_j, phi_j the basis "
                                      "model's M-orthonormal modes at basis_hz; profiled out of the fit, its unknowns counted in "
                                      "every interval"}};
   } else {
@@ -418,6 +418,9 @@ std::string RunResult::FullReport() const {
                     "-", sd.c_str(), res.c_str(), hw.c_str(), flag);
     s += line;
   }
+  // Why a flagged parameter is not identifiable, one line each (the table's flag alone says not what).
+  for (std::size_t i = 0; i < names.size() && i < ident.identifiable.size() && i < ident.reason.size(); ++i)
+    if (!ident.identifiable[i] && !ident.reason[i].empty()) s += "  " + names[i] + ": " + ident.reason[i] + "\n";
   s += correlation_table(*this);
   s += modes_table(modes);
   if (!residual_bands.summary.empty()) s += "\n" + residual_bands.summary + "\n";

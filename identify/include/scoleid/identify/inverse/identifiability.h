@@ -74,7 +74,10 @@ FisherInformation fisher_information(const Measurements& data, const MatrixXd& Y
                                      const std::vector<io::SensorSpec>& sensors);
 // std, resolution, condition number and the flags from a Fisher information (one experiment's or
 // a sum of several).
-Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q);
+// `names` (optional): the parameters' names, with which an unseen direction between two parameters
+// is described by the one combination the data fix (e.g. "EI/rho_A" of a free decay).
+Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q,
+                                     const std::vector<std::string>* names = nullptr);
 // fisher_information then identifiability_from.
 Identifiability analyse_identifiability(Objective& objective, const std::vector<io::SensorSpec>& sensors,
                                         const VectorXd& q);

@@ -199,6 +199,7 @@ public:
   // least-squares coefficients (a, b) at q (one pass of 2m tangents).
   bool estimates_initial_state() const { return basis_.cols() > 0; }
   const MatrixXd& initial_state_basis() const { return basis_; }
+
   // The basis modes' angular frequencies at the start values [rad/s] (rigid-body modes ≈ 0).
   const VectorXd& initial_state_omega() const { return basis_omega_; }
   VectorXd initial_state_coefficients(const VectorXd& q);
@@ -361,6 +362,7 @@ private:
   };
   NoiseShare noise_;
   void noise_share();  // noise_ from options_.noise_std and the sample times
+  void make_initial_state_basis();  // basis_ and basis_omega_ (options_.initial_state_modes > 0)
   double T_ = 0.0;  // horizon: end of the cost integral
   double response_start_ = 0.0;
   ObjectiveCounters counters_;
