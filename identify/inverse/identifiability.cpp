@@ -95,6 +95,22 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
       id.identifiable[static_cast<std::size_t>(i)] = false;
       id.reason[static_cast<std::size_t>(i)] = "loads a direction the data cannot see (Fisher eigenvalue below 1e-12 of the largest)";
     }
+  {
+    int k = 0;
+    for (int e = 0; e < P; ++e)
+      if (!(es.eigenvalues()[e] > 1e-12 * lmax)) ++k;
+    if (k > 0 && k < P) {
+      id.unseen.resize(P, k);
+      MatrixXd Cr = MatrixXd::Zero(P, P);
+      int c = 0;
+      for (int e = 0; e < P; ++e) {
+        const VectorXd v = es.eigenvectors().col(e);
+        if (!(es.eigenvalues()[e] > 1e-12 * lmax)) id.unseen.col(c++) = v;
+        else Cr += v * v.transpose() / es.eigenvalues()[e];
+      }
+      id.covariance_pinv = q.asDiagonal() * Cr * q.asDiagonal();
+    }
+  }
   // An unseen direction shared by exactly two parameters i, j (d log q = s (v_i, v_j)): the data fix
   // the one combination it leaves unchanged, q_i / q_j^(v_i/v_j) (a free decay: EI/rho_A).
   if (names && static_cast<int>(names->size()) == P)

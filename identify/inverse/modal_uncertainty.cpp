@@ -118,19 +118,43 @@ std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const P
                          std::abs(q[i]);
       const bool seen = static_cast<std::size_t>(i) < ident.identifiable.size() && ident.identifiable[static_cast<std::size_t>(i)] &&
                         std::isfinite(ident.covariance(i, i));
-      if (rel > 1e-8 && !seen) flagged = params.names()[static_cast<std::size_t>(i)];
+      if (rel > 1e-8 && !seen) flagged += (flagged.empty() ? "" : " and ") + params.names()[static_cast<std::size_t>(i)];
     }
-    if (!flagged.empty()) {
-      e.note = "depends on " + flagged + ", which is not identifiable";
+    // Unless it rests on them only through what the data fix: its log-q gradients orthogonal to
+    // every unseen direction (a free decay's frequencies and damping ratios depend on EI/rho_A,
+    // not on EI and rho_A apart); then its variance is gᵀ C⁺ g (identifiability.h).
+    bool through_fixed = false;
+    if (!flagged.empty() && ident.unseen.rows() == P && ident.covariance_pinv.rows() == P) {
+      const VectorXd df = Jf.row(k).transpose().cwiseProduct(q) / std::max(m0.f[k], 1e-300);
+      const VectorXd dz = m0.zeta[k] != 0.0 ? VectorXd(Jz.row(k).transpose().cwiseProduct(q) / std::abs(m0.zeta[k]))
+                                            : VectorXd(VectorXd::Zero(P));
+      through_fixed = (ident.unseen.transpose() * df).cwiseAbs().maxCoeff() <= 1e-6 * std::max(df.norm(), 1e-300) &&
+                      (ident.unseen.transpose() * dz).cwiseAbs().maxCoeff() <= 1e-6 * std::max(dz.norm(), 1e-300);
+      // and every flagged parameter it reads is flagged for the unseen direction alone
+      for (Eigen::Index i = 0; i < P && through_fixed; ++i) {
+        const bool seen = static_cast<std::size_t>(i) < ident.identifiable.size() && ident.identifiable[static_cast<std::size_t>(i)];
+        if (!seen && ident.unseen.row(i).norm() <= 0.1 && (std::abs(df[i]) > 1e-8 || std::abs(dz[i]) > 1e-8)) through_fixed = false;
+      }
+    }
+    if (!flagged.empty() && !through_fixed) {
+      e.note = "depends on " + flagged + (flagged.find(" and ") == std::string::npos ? ", which is" : ", which are") +
+               " not identifiable";
       continue;
     }
-    const Propagated pf = propagate(Jf.row(k).transpose(), ident, interval);
-    const Propagated pz = propagate(Jz.row(k).transpose(), ident, interval);
+    Identifiability pinv;
+    if (through_fixed) {
+      pinv = ident;
+      pinv.covariance = ident.covariance_pinv;
+    }
+    const Identifiability& use = through_fixed ? pinv : ident;
+    const Propagated pf = propagate(Jf.row(k).transpose(), use, interval);
+    const Propagated pz = propagate(Jz.row(k).transpose(), use, interval);
     e.frequency_std_hz = pf.std;
     e.frequency_half_width_hz = pf.half_width;
     e.damping_std = pz.std;
     e.damping_half_width = pz.half_width;
     if (!std::isfinite(pf.half_width)) e.note = "no half-record refit: interval not assessed";
+    else if (through_fixed) e.note = "from what the data fix (" + flagged + " not identifiable apart)";
   }
   return out;
 }

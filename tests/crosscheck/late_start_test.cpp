@@ -11,6 +11,7 @@
 #include <string>
 
 #include "scoleid/identify.h"
+#include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/truth.h"
 
 using namespace scoleid;
@@ -110,6 +111,17 @@ TEST(LateStart, APluckGivesWhatAFreeDecayCan) {
   EXPECT_FALSE(r.ident.identifiable[iEI] && r.ident.identifiable[irho]);
   EXPECT_TRUE(r.ident.identifiable[iz]) << r.ident.reason[iz];
   EXPECT_NE(r.ident.reason[iEI].find("EI/rho_A"), std::string::npos) << r.ident.reason[iEI];
+  // The frequencies rest on EI/rho_A alone: they keep their uncertainty, and their intervals hold
+  // the exact (transfer-matrix) frequencies of the strip.
+  const auto exact = identify::analytic::point_element_omegas(bare.beam, 3);
+  ASSERT_GE(r.modes.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double f = exact[k] / (2.0 * M_PI);
+    std::printf("  mode %zu: identified %.6f Hz ± %.3g, exact %.6f Hz\n", k + 1, r.modes[k].frequency_hz,
+                r.modes[k].frequency_half_width_hz, f);
+    ASSERT_TRUE(std::isfinite(r.modes[k].frequency_half_width_hz)) << r.modes[k].note;
+    EXPECT_LE(std::abs(r.modes[k].frequency_hz - f), r.modes[k].frequency_half_width_hz) << "mode " << k + 1;
+  }
 }
 
 // SCOLE on orbit, already vibrating (the built-in scole-ringing): paper Case II's pulses over the

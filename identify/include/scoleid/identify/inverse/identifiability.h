@@ -42,6 +42,12 @@ struct Identifiability {
   // The Cramér–Rao covariance of the parameters the Fisher test kept (P × P; NaN in the rows and
   // columns of the others), and the systematic share of χ² (resolution² = systematic · std²).
   MatrixXd covariance;
+  // Where the Fisher matrix has directions the data cannot see (eigenvalues below 1e-12 of the
+  // largest, in log q): those directions (P × k, unit columns in log q) and the pseudo-inverse's
+  // covariance (P × P, in q's units). A quantity whose log-q gradient is orthogonal to every unseen
+  // direction (a free decay's frequencies: EI/rho_A) has the variance gᵀ C⁺ g. Empty when there is none.
+  MatrixXd unseen;
+  MatrixXd covariance_pinv;
   double systematic = 0;
   std::vector<double> noise_std;  // σ_k used per sensor
   std::string noise_source;       // "scenario" | "residual" (identify_run refines "scenario" to where each level came from)
