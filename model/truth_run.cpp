@@ -415,7 +415,15 @@ void anti_alias(io::DataTable& tab, double f_c, double dt, int m) {
     return y;
   };
   tab.t = keep(tab.t);
-  for (auto& c : tab.columns) c = keep(lowpass.apply(c));
+  for (auto& c : tab.columns) {
+    // The filter's tail after a channel falls idle decays without end (1e-64 of it seconds later);
+    // below 1e-15 of the channel's largest value it is rounding, and an idle channel reads zero.
+    double peak = 0.0;
+    for (double v : c) peak = std::max(peak, std::abs(v));
+    c = keep(lowpass.apply(c));
+    for (double& v : c)
+      if (std::abs(v) < 1e-15 * peak) v = 0.0;
+  }
 }
 }  // namespace
 

@@ -194,6 +194,13 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   r.method = resolve_method(ro.method.value_or(id.method), p.params->size(), id.smoothness != 0.0,
                             obj.has_matrix_free_products());
+  // A method given on the command line meets the checks the scenario's field meets at the door.
+  if (r.method == io::Method::GaussNewtonKrylov && !obj.has_matrix_free_products())
+    throw io::InputError(std::string("method gauss-newton-krylov (--method or identification.method) needs matrix-free "
+                                     "Gauss-Newton products, which ") +
+                         (obj.estimates_initial_state() ? "an estimated initial state (identification.initial_state: estimate) does"
+                                                        : "velocity and acceleration sensors do") +
+                         " not offer; use gauss-newton or lbfgs");
   const auto chains = smoothness_chains(p, r.names);
   AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source),
                     ro.verbose};

@@ -860,6 +860,11 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
 IdentifierStep synthesize_data(Problem& p) {
   const auto& sc = p.scenario;
   const auto& id = sc.identification;
+  if (sc.inputs.empty())
+    fail_field(sc.source, "inputs",
+               "is empty and this run synthesises its data: from rest with no input nothing moves (a free decay's record "
+               "comes from a data file, --data)",
+               "[]");
   // Conditioning is for a data column; synthetic data have none to condition.
   for (std::size_t i = 0; i < sc.inputs.size(); ++i)
     if (sc.inputs[i].conditioning.stated())

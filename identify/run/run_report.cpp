@@ -425,10 +425,15 @@ std::string RunResult::FullReport() const {
   s += modes_table(modes);
   if (!residual_bands.summary.empty()) s += "\n" + residual_bands.summary + "\n";
   if (!initial_state_hz.empty()) {
+    char which[96];
+    if (initial_state_hz.size() == 1) std::snprintf(which, sizeof which, "lowest mode (%.4g Hz)", initial_state_hz.front());
+    else
+      std::snprintf(which, sizeof which, "%zu lowest modes (%.4g to %.4g Hz)", initial_state_hz.size(), initial_state_hz.front(),
+                    initial_state_hz.back());
     std::snprintf(line, sizeof line,
-                  "\ninitial state: estimated in the start model's %zu lowest modes (%.4g to %.4g Hz), %zu unknowns profiled out "
-                  "of the fit and counted in every interval\n",
-                  initial_state_hz.size(), initial_state_hz.front(), initial_state_hz.back(), 2 * initial_state_hz.size());
+                  "\ninitial state: estimated in the start model's %s, %zu unknowns profiled out of the fit and counted in "
+                  "every interval\n",
+                  which, 2 * initial_state_hz.size());
     s += line;
   }
   std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",

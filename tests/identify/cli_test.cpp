@@ -720,7 +720,8 @@ TEST(ScoleIdentifyHardening, SigtermAndSigintKeepTheLastIterateAsACompleteRunOrL
                   fs::exists(out) ? "written" : "none");
       EXPECT_EQ(code, 128 + sig);
       EXPECT_LT(after, 1.0);
-      if (delay < 0.5) EXPECT_FALSE(fs::exists(out));
+      // On a loaded machine the signal meant for 0.3 s can land after the first iterate: then the
+      // run must be a complete interrupted one; either way, nothing half-written.
       expect_interrupted_run(dir.path(), out, sig == SIGTERM ? "SIGTERM" : "SIGINT", fs::exists(out));
     }
   }
