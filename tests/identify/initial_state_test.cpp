@@ -72,7 +72,6 @@ TEST(InitialState, GradientWithRateSensors) { check_gradients(kRingingRates, 3.5
 
 TEST(InitialState, CheckpointedGradientIsTheStoredOne) {
   Case stored = make_case(kRinging, false);
-  auto sc = scoleid::io::parse_scenario(kRinging, "test");
   ObjectiveOptions o = stored.p->objective_options;
   o.checkpoint_points = 7;
   Objective ck(stored.p->model(), *stored.p->params, stored.p->signals, stored.p->data, o);
@@ -100,7 +99,4 @@ TEST(InitialState, TheProfiledStateExplainsTheRinging) {
               static_cast<long>(ab.size()));
   EXPECT_EQ(ab.size(), 2 * est.obj->initial_state_basis().cols());
   EXPECT_LT(J_est, 1e-3 * J_rest);
-  // The profiled cost is the least over the initial state: moving a coefficient raises it.
-  // (cost() re-solves from the settled state, so J_est is the minimum's value itself.)
-  EXPECT_GT(J_rest, J_est);
 }
