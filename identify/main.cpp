@@ -146,6 +146,7 @@ void print_problem(const identify::Problem& problem, bool from_file) {
   std::fprintf(stderr, "scole-identify: %s, %s model, %d elements, %d parameters, data: %s\n", sc.name.c_str(),
                io::to_string(sc.identification.model), problem.structure->elements(), problem.params->size(),
                problem.data_source.c_str());
+  if (problem.frf) std::fprintf(stderr, "scole-identify: frequency domain: %s\n", problem.frf_note.c_str());
   if (!from_file) return;
   auto list = [](const std::vector<std::string>& v) {
     std::string s;
@@ -233,7 +234,9 @@ int main(int argc, char** argv) {
       "Without --data the scenario synthesises its own measurements on a mesh at least twice as fine as\n"
       "the identifier's, so the identifier never fits its own discretisation. Writes DIR/identify.json\n"
       "(estimates, truth, std, iteration history, counts, timings, settings) and DIR/fit.csv\n"
-      "(measured, predicted, residual per sensor), and prints the iteration table.\n\n"
+      "(measured, predicted, residual per sensor), and prints the iteration table. With\n"
+      "identification.domain: frequency the fit compares frequency responses (made from the record, or read\n"
+      "from a UFF file of FRFs given as --data) and fit.csv holds them per line (docs/theory.md 6.10).\n\n"
       "Exit codes: 0 converged; 1 the run failed, did not converge, or stopped at a point that does not explain\n"
       "the data (the fit test: residual beyond noise, discretisation and identification.model_error; its outputs\n"
       "are written, marked \"converged\": false; also a run stopped at --max-wall-time); 2 bad usage or bad input\n"
@@ -251,7 +254,7 @@ int main(int argc, char** argv) {
   int max_iterations = -1;
   bool list = false, no_std = false, quiet = false;
   app.add_option("-s,--scenario", scenario, "built-in scenario name or YAML file")->capture_default_str();
-  app.add_option("-d,--data", data, "measured data CSV (header t,<columns>; sensors and inputs matched by name)");
+  app.add_option("-d,--data", data, "measured data: CSV (header t,<columns>; sensors and inputs matched by name), UFF, LVM, TDMS, MAT; with identification.domain: frequency also a UFF file of FRFs (function type 4)");
   app.add_option("-o,--out", out, "output directory (default: run/<scenario name>)");
   app.add_option("-m,--method", method, "optimiser: " + io::names_joined<io::Method>(" | ") + " (default: the scenario's)")
       ->check(CLI::IsMember(io::names<io::Method>()));
@@ -332,8 +335,11 @@ int main(int argc, char** argv) {
     run_dir.commit();
     if (staged_model && !interrupted) staged_model->commit();
     std::printf("\n%s", id.FullReport().c_str());
-    std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp%s (and fit.png, spectrum.png%s with gnuplot)\n", out.c_str(),
-                id.result().start_check.frf.empty() ? "" : ", start_frf.csv, start_frf.gp", id.result().start_check.frf.empty() ? "" : ", start_frf.png");
+    if (id.problem().frf)
+      std::printf("wrote %s/identify.json, fit.csv (FRFs: measured and model per line), fit.gp (and fit.png with gnuplot)\n", out.c_str());
+    else
+      std::printf("wrote %s/identify.json, fit.csv, fit.gp, spectrum.csv, spectrum.gp%s (and fit.png, spectrum.png%s with gnuplot)\n", out.c_str(),
+                  id.result().start_check.frf.empty() ? "" : ", start_frf.csv, start_frf.gp", id.result().start_check.frf.empty() ? "" : ", start_frf.png");
     for (const auto& w : id.warnings()) std::fprintf(stderr, "scole-identify: warning: %s\n", w.c_str());
     if (interrupted) {
       std::fprintf(stderr, "scole-identify: %s; outputs written, marked \"interrupted\" and \"converged\": false%s\n",

@@ -281,7 +281,7 @@ SignalTerm parse_signal_term(const YAML::Node& n, const std::string& source, con
   Reader r(n, source, path);
   SignalTerm s;
   const std::string type = r.choice("type", "step",
-                                    {"step", "pulse", "bangbang", "sine", "chirp", "haversine", "table"});
+                                    {"step", "pulse", "bangbang", "sine", "chirp", "haversine", "multisine", "table"});
   s.amplitude = r.num("amplitude", 0.0);
   s.t0 = r.num("t0", 0.0);
   if (type == "step") {
@@ -295,6 +295,16 @@ SignalTerm parse_signal_term(const YAML::Node& n, const std::string& source, con
     s.f0 = r.positive("frequency", 0.0);
     s.phase = r.num("phase", 0.0);
     s.duration = r.nonneg("duration", 0.0);
+  } else if (type == "multisine") {
+    s.type = SignalTerm::Type::Multisine;
+    s.width = r.positive("period", 0.0);
+    s.f0 = r.nonneg("f0", 0.0);
+    s.f1 = r.positive("f1", 0.0);
+    s.duration = r.nonneg("duration", 0.0);
+    if (multisine_lines(s).empty())
+      fail_field(source, r.field("f1"), "must leave at least one harmonic k/period (k >= 1) in [f0, f1]", format_value(s.f1));
+    if (multisine_lines(s).size() > 100000)
+      fail_field(source, r.field("period"), "gives more than 100000 lines in [f0, f1]", format_value(s.width));
   } else if (type == "chirp") {
     s.type = SignalTerm::Type::Chirp;
     s.f0 = r.nonneg("f0", 0.0);
@@ -803,6 +813,35 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
   }
 }
 
+// identification.frf (scenario.h FrfSpec).
+void parse_frf(Reader& parent, const std::string& source, FrfSpec& f) {
+  const YAML::Node n = parent.child("frf");
+  const std::string path = parent.field("frf");
+  if (!n.IsMap()) fail_field(source, path, "must be a map {estimator, segment, overlap, window, lines, stations, reference, relative_std, averages}", Reader::kind(n));
+  Reader r(n, source, path);
+  f.estimator = r.choice_of("estimator", f.estimator);
+  f.segment = r.nonneg("segment", f.segment);
+  f.overlap = r.nonneg("overlap", f.overlap);
+  if (!(f.overlap < 1.0)) fail_field(source, r.field("overlap"), "must be in [0, 1) (a fraction of a segment)", format_value(f.overlap));
+  f.window = r.choice_of("window", f.window);
+  f.lines = r.numbers("lines", {});
+  for (std::size_t i = 0; i < f.lines.size(); ++i)
+    if (!(std::isfinite(f.lines[i]) && f.lines[i] > 0.0) || (i > 0 && !(f.lines[i] > f.lines[i - 1])))
+      fail_field(source, r.field("lines") + "[" + std::to_string(i) + "]", "must be a frequency > 0 Hz above the one before", format_value(f.lines[i]));
+  if (r.has("stations")) {
+    const YAML::Node m = r.child("stations");
+    if (!m.IsMap()) fail_field(source, r.field("stations"), "must be a map sensor: \"<node><sign><axis>\"", Reader::kind(m));
+    for (const auto& kv : m) {
+      const std::string key = kv.first.as<std::string>();
+      if (!kv.second.IsScalar()) fail_field(source, r.field("stations") + "." + key, "must be a string such as \"12+Y\"", Reader::kind(kv.second));
+      f.stations.emplace_back(key, kv.second.Scalar());
+    }
+  }
+  f.reference = r.str("reference", "");
+  f.relative_std = r.nonneg("relative_std", 0.0);
+  f.averages = r.integer("averages", 0, 0, 1000000);
+}
+
 void parse_identification(const YAML::Node& n, const std::string& source, IdentificationSpec& id) {
   Reader r(n, source, "identification");
   id.parameterization = r.choice("parameterization", id.parameterization, {"physical", "paper"});
@@ -874,6 +913,14 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
                "[" + format_value(id.band[0]) + ", " + format_value(id.band[1]) + "]");
   if (id.initial_state == InitialState::Estimate && id.model == Model::Nonlinear)
     fail_field(source, "identification.initial_state", "needs the linear model", "estimate");
+  id.domain = r.choice_of("domain", id.domain);
+  if (r.has("frf")) parse_frf(r, source, id.frf);
+  if (id.domain == Domain::Frequency) {
+    if (id.model == Model::Nonlinear) fail_field(source, "identification.domain", "needs the linear model (a frequency response is a linear model's)", "frequency");
+    if (id.initial_state == InitialState::Estimate)
+      fail_field(source, "identification.initial_state",
+                 "is a time record's unknown; frequency responses of a steady state have none (give rest, or domain: time)", "estimate");
+  }
   if (!id.band.empty() && id.model == Model::Nonlinear)
     fail_field(source, "identification.band", "needs the linear model (a filter commutes with a linear time-invariant model only)",
                "model: nonlinear");
@@ -1132,6 +1179,13 @@ nlohmann::json signal_json(const Signal& sig) {
       j["phase"] = t.phase;
       j["duration"] = t.duration;
     }
+    if (t.type == SignalTerm::Type::Multisine) {
+      j.erase("width");
+      j["period"] = t.width;
+      j["f0"] = t.f0;
+      j["f1"] = t.f1;
+      j["duration"] = t.duration;
+    }
     if (t.type == SignalTerm::Type::Chirp) {
       j["f0"] = t.f0;
       j["f1"] = t.f1;
@@ -1263,7 +1317,21 @@ nlohmann::json to_json(const Scenario& s) {
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
                          {"restarts", id.restarts}, {"start", to_string(id.start)}, {"model", to_string(id.model)},
                          {"smoothness", id.smoothness < 0 ? json("discrepancy") : json(id.smoothness)},
-                         {"initial_state", to_string(id.initial_state)}, {"initial_state_modes", id.initial_state_modes}};
+                         {"initial_state", to_string(id.initial_state)}, {"initial_state_modes", id.initial_state_modes},
+                         {"domain", to_string(id.domain)}};
+  if (id.domain == Domain::Frequency) {
+    json f = {{"estimator", to_string(id.frf.estimator)}, {"segment", id.frf.segment}, {"overlap", id.frf.overlap},
+              {"window", to_string(id.frf.window)}, {"lines", id.frf.lines}};
+    if (!id.frf.stations.empty()) {
+      json st = json::object();
+      for (const auto& [sensor, station] : id.frf.stations) st[sensor] = station;
+      f["stations"] = st;
+    }
+    if (!id.frf.reference.empty()) f["reference"] = id.frf.reference;
+    if (id.frf.relative_std > 0) f["relative_std"] = id.frf.relative_std;
+    if (id.frf.averages > 0) f["averages"] = id.frf.averages;
+    j["identification"]["frf"] = f;
+  }
   if (!id.uncertain.empty()) {
     json u = json::object();
     for (const auto& x : id.uncertain) u[x.field] = x.is_switch ? json(x.alternative) : json(x.tolerance);

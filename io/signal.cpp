@@ -61,6 +61,31 @@ double cubic_table_value(const std::vector<double>& ts, const std::vector<double
   return f;
 }
 
+// The lowest harmonic k0 of a multisine (signal.h) and its lines' complex amplitudes a e^{iφ_k}.
+long multisine_first(const SignalTerm& s) { return std::max(1L, static_cast<long>(std::ceil(s.f0 * s.width - 1e-9))); }
+std::vector<std::complex<double>> multisine_amplitudes(const SignalTerm& s) {
+  std::vector<std::complex<double>> c;
+  if (!(s.width > 0.0)) return c;
+  const long k0 = multisine_first(s), k1 = static_cast<long>(std::floor(s.f1 * s.width + 1e-9));
+  if (k1 < k0) return c;
+  const double K = static_cast<double>(k1 - k0 + 1), a = s.amplitude * std::sqrt(2.0 / K);
+  for (long k = k0; k <= k1; ++k) {
+    const double rank = static_cast<double>(k - k0 + 1), phi = -kPi * rank * (rank - 1.0) / K;
+    c.emplace_back(a * std::cos(phi), a * std::sin(phi));
+  }
+  return c;
+}
+// Σ_k Re(c_k z^k), z = e^{i2πτ/T}: z^{k0} times the Horner sum of the amplitudes.
+double multisine_value(const SignalTerm& s, const std::vector<std::complex<double>>& c, double tau) {
+  if (tau < 0.0 || (s.duration > 0.0 && tau >= s.duration) || c.empty()) return 0.0;
+  const double theta = 2.0 * kPi * std::fmod(tau, s.width) / s.width;
+  const std::complex<double> z(std::cos(theta), std::sin(theta));
+  std::complex<double> h(0.0, 0.0);
+  for (auto it = c.rbegin(); it != c.rend(); ++it) h = h * z + *it;
+  const double t0 = theta * static_cast<double>(multisine_first(s));
+  return (h * std::complex<double>(std::cos(t0), std::sin(t0))).real();
+}
+
 double term_value(const SignalTerm& s, double t) {
   using T = SignalTerm::Type;
   const double tau = t - s.t0;
@@ -82,10 +107,20 @@ double term_value(const SignalTerm& s, double t) {
       return s.amplitude * 0.5 * (1.0 - std::cos(2.0 * kPi * tau / s.width));
     case T::Table: return linear_table_value(s.times, s.values, t);
     case T::CubicTable: return cubic_table_value(s.times, s.values, t);
+    case T::Multisine: return multisine_value(s, multisine_amplitudes(s), tau);  // Signal::operator() uses its cache
   }
   return 0.0;
 }
 }  // namespace
+
+std::vector<double> multisine_lines(const SignalTerm& s) {
+  std::vector<double> f;
+  if (!(s.width > 0.0)) return f;
+  const long k0 = std::max(1L, static_cast<long>(std::ceil(s.f0 * s.width - 1e-9)));
+  const long k1 = static_cast<long>(std::floor(s.f1 * s.width + 1e-9));
+  for (long k = k0; k <= k1; ++k) f.push_back(static_cast<double>(k) / s.width);
+  return f;
+}
 
 double linear_table_value(const std::vector<double>& ts, const std::vector<double>& vs, double t) {
   if (ts.empty()) return 0.0;
@@ -97,7 +132,10 @@ double linear_table_value(const std::vector<double>& ts, const std::vector<doubl
   return (1.0 - a) * vs[k - 1] + a * vs[k];
 }
 
-Signal::Signal(std::vector<SignalTerm> terms) : terms_(std::move(terms)) {}
+Signal::Signal(std::vector<SignalTerm> terms) : terms_(std::move(terms)) {
+  for (const auto& s : terms_)
+    multisine_.push_back(s.type == SignalTerm::Type::Multisine ? multisine_amplitudes(s) : std::vector<std::complex<double>>{});
+}
 
 Signal Signal::step(double amplitude, double t0) {
   SignalTerm s;
@@ -127,7 +165,8 @@ Signal Signal::table(std::vector<double> times, std::vector<double> values) {
 
 double Signal::operator()(double t) const {
   double f = 0.0;
-  for (const auto& s : terms_) f += term_value(s, t);
+  for (std::size_t i = 0; i < terms_.size(); ++i)
+    f += terms_[i].type == SignalTerm::Type::Multisine ? multisine_value(terms_[i], multisine_[i], t - terms_[i].t0) : term_value(terms_[i], t);
   return f;
 }
 
@@ -147,6 +186,10 @@ std::vector<double> Signal::breakpoints() const {
         if (s.duration > 0.0) b.push_back(s.t0 + s.duration);
         break;
       case T::Chirp: b.push_back(s.t0); b.push_back(s.t0 + s.duration); break;
+      case T::Multisine:
+        b.push_back(s.t0);
+        if (s.duration > 0.0) b.push_back(s.t0 + s.duration);
+        break;
       case T::Table:
       case T::CubicTable: b.insert(b.end(), s.times.begin(), s.times.end()); break;
     }
@@ -162,7 +205,23 @@ double Signal::highest_frequency() const {
   for (const auto& s : terms_) {
     if (s.type == T::Sine) f = std::max(f, std::abs(s.f0));
     if (s.type == T::Chirp) f = std::max({f, std::abs(s.f0), std::abs(s.f1)});
+    if (s.type == T::Multisine && !multisine_lines(s).empty()) f = std::max(f, multisine_lines(s).back());
   }
+  return f;
+}
+
+std::vector<double> Signal::lines(bool* only_lines) const {
+  using T = SignalTerm::Type;
+  std::vector<double> f;
+  bool only = !terms_.empty();
+  for (const auto& s : terms_) {
+    if (s.type == T::Sine) f.push_back(s.f0);
+    else if (s.type == T::Multisine) for (double x : multisine_lines(s)) f.push_back(x);
+    else only = false;
+  }
+  std::sort(f.begin(), f.end());
+  f.erase(std::unique(f.begin(), f.end()), f.end());
+  if (only_lines) *only_lines = only;
   return f;
 }
 
@@ -185,6 +244,7 @@ const char* to_string(SignalTerm::Type t) {
     case T::Haversine: return "haversine";
     case T::Table: return "table";
     case T::CubicTable: return "cubic-table";
+    case T::Multisine: return "multisine";
   }
   return "?";
 }

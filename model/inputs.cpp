@@ -30,6 +30,10 @@ double smooth_time_scale(const io::Signal& g, double t) {
       case T::Haversine:
         if (u < s.width) scale = std::min(scale, s.width);
         break;
+      case T::Multisine:
+        if ((s.duration <= 0.0 || u < s.duration) && !io::multisine_lines(s).empty())
+          scale = std::min(scale, 1.0 / io::multisine_lines(s).back());
+        break;
       default: break;  // step, pulse, bang-bang, table: linear between breakpoints
     }
   }

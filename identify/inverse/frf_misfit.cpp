@@ -1,6 +1,7 @@
 #include "scoleid/identify/inverse/frf_misfit.h"
 
 #include <Eigen/SparseLU>
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <stdexcept>
@@ -52,6 +53,12 @@ FrfMisfit::FrfMisfit(const StructuralModel& model, const Parameterization& param
       if (!(v > 0.0) || !std::isfinite(v)) throw std::logic_error("FrfMisfit: variances must be finite and > 0");
     orders_.push_back(model_.sensors[static_cast<std::size_t>(m)].order);
   }
+  active_ = data_.lines();
+}
+
+void FrfMisfit::set_horizon(double f) {
+  const auto end = std::upper_bound(data_.f_hz.begin(), data_.f_hz.end(), f * (1.0 + 1e-12));
+  active_ = std::max(1, static_cast<int>(end - data_.f_hz.begin()));
 }
 
 void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need need, int k0, int k1, Evaluation& e,
@@ -88,7 +95,7 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
       e.r[2 * (k * S + s)] = scale * d.real();
       e.r[2 * (k * S + s) + 1] = scale * d.imag();
     }
-    if (need == Need::Cost) continue;
+    if (need == Need::Cost || k >= e.active) continue;
     // b_j − Z_j U per coefficient.
     auto source = [&](int j) {
       ComplexVector v = -(Kj[static_cast<std::size_t>(j)].cast<Complex>() * U) + (w * w) * (Mj[static_cast<std::size_t>(j)].cast<Complex>() * U) -
@@ -121,7 +128,8 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
 }
 
 const FrfMisfit::Evaluation& FrfMisfit::evaluate(const VectorXd& q, Need need) {
-  if (have_last_ && last_.q.size() == q.size() && last_.q == q && static_cast<int>(last_.need) >= static_cast<int>(need))
+  if (have_last_ && last_.q.size() == q.size() && last_.q == q && last_.active == active_ &&
+      static_cast<int>(last_.need) >= static_cast<int>(need))
     return last_;
   VectorXd c;
   MatrixXd dcdq;
@@ -130,7 +138,8 @@ const FrfMisfit::Evaluation& FrfMisfit::evaluate(const VectorXd& q, Need need) {
   Evaluation e;
   e.q = q;
   e.need = need;
-  e.r.resize(data_points());
+  e.active = active_;
+  e.r.resize(2L * L * S);
   e.H.resize(L, S);
   if (need == Need::Jacobian) e.jacobian.resize(data_points(), P);
   const int threads = std::max(1, std::min(options_.threads, L / 8));
@@ -151,13 +160,13 @@ const FrfMisfit::Evaluation& FrfMisfit::evaluate(const VectorXd& q, Need need) {
     if (err) std::rethrow_exception(err);
   counters_.evaluations += 1;
   counters_.factorisations += L;
-  e.J = 0.5 * e.r.squaredNorm();
+  e.J = 0.5 * e.r.head(data_points()).squaredNorm();
   if (need == Need::Gradient) {
     VectorXd g_c = VectorXd::Zero(model_.ncoef);
     for (const auto& gt : g) g_c += gt;
     e.gradient = dcdq.transpose() * g_c;
   } else if (need == Need::Jacobian) {
-    e.gradient = e.jacobian.transpose() * e.r;
+    e.gradient = e.jacobian.transpose() * e.r.head(data_points());
   }
   last_ = std::move(e);
   have_last_ = true;
@@ -176,19 +185,28 @@ double FrfMisfit::gauss_newton(const VectorXd& q, VectorXd& gradient, MatrixXd& 
   const Evaluation& e = evaluate(q, Need::Jacobian);
   gradient = e.gradient;
   H = e.jacobian.transpose() * e.jacobian;
-  if (profile) {
-    profile->t = {1.0};
-    profile->misfit = {2.0 * e.J / static_cast<double>(std::max(1L, data_points()))};
-  }
+  if (profile) *profile = profile_of(e);
   return e.J;
 }
 
-Misfit::MisfitProfile FrfMisfit::misfit_profile(const VectorXd& q) {
+Misfit::MisfitProfile FrfMisfit::profile_of(const Evaluation& e) const {
+  const int L = data_.lines(), S = static_cast<int>(sensors_.size());
   MisfitProfile p;
-  p.t = {1.0};
-  p.misfit = {2.0 * evaluate(q, Need::Cost).J / static_cast<double>(std::max(1L, data_points()))};
+  p.t = data_.f_hz;
+  p.misfit.assign(static_cast<std::size_t>(L), 0.0);
+  for (int s = 0; s < S; ++s) {
+    const auto& ch = data_.channels[static_cast<std::size_t>(s)];
+    double misfit = 0.0, signal = 0.0;
+    for (int k = 0; k < L; ++k) {
+      misfit += 0.5 * (e.r[2 * (k * S + s)] * e.r[2 * (k * S + s)] + e.r[2 * (k * S + s) + 1] * e.r[2 * (k * S + s) + 1]);
+      signal += std::norm(ch.H[static_cast<std::size_t>(k)]) / ch.variance[static_cast<std::size_t>(k)];
+      p.misfit[static_cast<std::size_t>(k)] += std::max(0.0, misfit - (k + 1.0)) / std::max(signal, 1e-300) / S;
+    }
+  }
   return p;
 }
+
+Misfit::MisfitProfile FrfMisfit::misfit_profile(const VectorXd& q) { return profile_of(evaluate(q, Need::Cost)); }
 
 VectorXd FrfMisfit::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
   const Evaluation& e = evaluate(q, Need::Jacobian);
@@ -197,7 +215,7 @@ VectorXd FrfMisfit::gauss_newton_product(const VectorXd& q, const VectorXd& v) {
 
 double FrfMisfit::residuals(const VectorXd& q, VectorXd& r, MatrixXd* jacobian) {
   const Evaluation& e = evaluate(q, jacobian ? Need::Jacobian : Need::Cost);
-  r = e.r;
+  r = e.r.head(data_points());
   if (jacobian) *jacobian = e.jacobian;
   return e.J;
 }

@@ -17,6 +17,7 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
   u.terms = in.consider;
   const bool refit = in.half_record_estimate.size() == P;
   if (refit) u.half_record_delta = in.estimate - in.half_record_estimate;
+  if (!refit && !in.refit_applies) u.half_record_delta = VectorXd::Zero(P);  // no record to halve: the term is 0
   if (smoothing) u.smoothing_delta = in.estimate - in.smoothing_estimate;
   if (!refit && in.refit_applies) u.note = "no half-record refit: interval not assessed";
   else if (!in.half_record_converged) u.note = "the half-record refit did not converge: its shift is where it stopped";

@@ -13,6 +13,7 @@
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/attempts.h"
+#include "scoleid/identify/run/frf_run.h"
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
@@ -114,8 +115,11 @@ bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, lo
 void estimate_modes(const Problem& p, RunResult& r) {
   if (!r.estimate.allFinite()) return;
   ModalUncertaintyOptions o;
-  // Modes above the data's Nyquist frequency are not seen by the record (its median sample interval).
-  if (p.data.t.size() >= 2) {
+  // Modes above the data's Nyquist frequency are not seen by the record (its median sample interval),
+  // nor modes above the top line of FRFs.
+  if (p.frf) {
+    o.max_frequency_hz = p.frf->f_hz.back();  // the FRFs' top line
+  } else if (p.data.t.size() >= 2) {
     std::vector<double> dt(p.data.t.size() - 1);
     for (std::size_t i = 0; i + 1 < p.data.t.size(); ++i) dt[i] = p.data.t[i + 1] - p.data.t[i];
     std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
@@ -188,6 +192,7 @@ void keep_interrupted(const Problem& p, const AttemptsContext& c, RunResult& r, 
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
   if (p.scenario.identification.model == io::Model::Nonlinear) return run_nonlinear_identification(p, ro);
+  if (p.frf) return run_frf_identification(p, ro);
   const auto t0 = std::chrono::steady_clock::now();
   const auto& id = p.scenario.identification;
   RunResult r = start_result(p, io::Model::Linear);

@@ -1,5 +1,9 @@
 #include "scoleid/identify/run/problem.h"
 
+#include "scoleid/identify/run/frf_run.h"
+#include "scoleid/io/uff.h"
+#include "scoleid/io/uff_frf.h"
+
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/time/checkpoints.h"
 
@@ -1164,6 +1168,10 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
                  io::format_value(p.noise_std.front()));
   }
   input_offsets(p);
+  if (id.domain == io::Domain::Frequency) {  // FRFs of the record, no time-domain model (frf_run.h)
+    frf_from_record(p);
+    return;
+  }
   moving_start(p);
   choose_band(p);
   apply_band(p);
@@ -1278,7 +1286,8 @@ std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTa
     io::set_structure_parameters(truth_sc, meta_truth);
     set_true_values(*p, truth_sc);
   }
-  finish_problem(*p, measured_data_step(*p, source), &source);
+  const bool frequency = p->scenario.identification.domain == io::Domain::Frequency;
+  finish_problem(*p, frequency ? IdentifierStep{} : measured_data_step(*p, source), &source);
   return p;
 }
 
@@ -1294,6 +1303,25 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
   if (!data_csv) {
     finish_problem(*p, synthesize_data(*p), nullptr);
     return p;
+  }
+  if (sc.identification.domain == io::Domain::Frequency && io::is_uff_file(*data_csv)) {
+    const io::uff::File file = io::uff::read_file(*data_csv);
+    if (std::any_of(file.functions.begin(), file.functions.end(), [](const io::uff::Function& f) { return f.function_type == 4; })) {
+      io::UffFrfOptions o;
+      o.stations = sc.identification.frf.stations;
+      o.reference = sc.identification.frf.reference;
+      o.relative_std = sc.identification.frf.relative_std;
+      o.averages = sc.identification.frf.averages;
+      o.source = sc.source;
+      std::vector<int> orders;
+      io::FrfData d = io::frf_data_from_uff(file, *data_csv, o, &orders);
+      p->measured = true;
+      p->data_source = *data_csv;
+      p->data.names.clear();
+      for (const auto& s : sc.sensors) p->data.names.push_back(s.name);
+      frf_from_file(*p, std::move(d), orders);
+      return p;
+    }
   }
   const io::DataTable tab = io::read_data(*data_csv, {sc.data.time_column, sc.data.time_unit});
   // Truth metadata beside the CSV, when present, supplies the true values and the noise levels.

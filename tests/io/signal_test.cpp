@@ -109,3 +109,37 @@ TEST(Signal, CubicTableErrorsAreTheTablesOwn) {
   EXPECT_NEAR(cubic_table_error(0.119), 0.005, 5e-5);
   EXPECT_NEAR(cubic_table_gain_error(0.23), 0.054, 1e-3);
 }
+
+TEST(Signal, MultisineIsItsLinesWithSchroederPhasesAndTheStatedRms) {
+  SignalTerm s;
+  s.type = SignalTerm::Type::Multisine;
+  s.amplitude = 0.5;  // RMS
+  s.width = 2.0;      // period
+  s.f0 = 1.2;
+  s.f1 = 7.0;
+  s.t0 = 0.3;
+  const Signal sig({s});
+  // lines k/T in [f0, f1]: k = 3 … 14
+  bool only = false;
+  const auto lines = sig.lines(&only);
+  ASSERT_EQ(lines.size(), 12u);
+  EXPECT_TRUE(only);
+  EXPECT_DOUBLE_EQ(lines.front(), 1.5);
+  EXPECT_DOUBLE_EQ(lines.back(), 7.0);
+  const double K = 12.0, a = 0.5 * std::sqrt(2.0 / K);
+  double ms = 0.0;
+  const int n = 4000;
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.3 + 2.0 * i / n + 10.0;  // a period, five periods on
+    double direct = 0.0;
+    for (int k = 3; k <= 14; ++k) {
+      const double rank = k - 2.0;
+      direct += a * std::cos(2.0 * M_PI * k * (t - 0.3) / 2.0 - M_PI * rank * (rank - 1.0) / K);
+    }
+    EXPECT_NEAR(sig(t), direct, 1e-12);
+    ms += sig(t) * sig(t) / n;
+  }
+  EXPECT_NEAR(std::sqrt(ms), 0.5, 1e-12);
+  EXPECT_EQ(sig(0.2999), 0.0);  // before t0
+  EXPECT_NEAR(sig.highest_frequency(), 7.0, 0.0);
+}

@@ -268,6 +268,24 @@ struct UncertainSpec {
   bool alternative = false;    // switches: the other setting to consider
 };
 
+// identification.frf (docs/theory.md §6.10, docs/scenario.md): how frequency responses are made from
+// a time record, and how a UFF file's FRFs are read.
+struct FrfSpec {
+  // auto: lines when the input's scenario signal is made of sines (its lines known), else h1.
+  FrfEstimatorKind estimator = FrfEstimatorKind::Auto;
+  double segment = 0.0;   // Welch segment [s]; 0 = automatic (eight segments, a power of two samples)
+  double overlap = 0.5;   // Welch overlap, [0, 1)
+  FrfWindowKind window = FrfWindowKind::Hann;
+  std::vector<double> lines;  // Hz, for the lines estimator; empty = the input signal's sine frequencies
+  // A UFF file of FRFs: scenario sensor ← "<node><sign><axis>" of its response, the excitation's
+  // "<node><sign><axis>" ("" = the one reference of the file), and how well the values are known
+  // when the file does not say (relative_std of |H|, or averages with the file's coherence).
+  std::vector<std::pair<std::string, std::string>> stations;
+  std::string reference;
+  double relative_std = 0.0;
+  int averages = 0;
+};
+
 struct IdentificationSpec {
   // "physical": the structure's quantities by name (beam: rho_A, EI, EI_k (k = 1..N), zeta, c_kv;
   //             SCOLE: rho_A, EI, EI_roll, EI_pitch, GJ, rho_I_psi, zeta, m_reflector).
@@ -336,6 +354,11 @@ struct IdentificationSpec {
   // The modes that carry the estimated initial state: 0 = automatic (those below the highest
   // frequency the data contain, at most kMaxInitialStateModes).
   int initial_state_modes = 0;
+  // What the fit compares (docs/theory.md §6.10): "time" (the record itself, the default) or
+  // "frequency" — frequency response functions of the one input to every sensor, made from the
+  // record (identification.frf) or read from a UFF file of FRFs (--data), fitted line by line.
+  Domain domain = Domain::Time;
+  FrfSpec frf;
 };
 inline constexpr int kMaxInitialStateModes = 24;
 

@@ -10,11 +10,17 @@
 //   sine      f = A sin(2π f0 (t - t0) + φ)  on [t0, t0+duration)   (duration <= 0: forever)
 //   chirp     f = A sin(2π (f0 τ + (f1 - f0) τ² / (2 D))), τ = t - t0 in [0, D)  (linear sweep)
 //   haversine f = A (1 - cos(2π (t - t0)/w)) / 2 on [t0, t0+w)   (smooth pulse)
+//   multisine f = Σ_k a cos(2π k (t - t0)/T + φ_k) on [t0, t0+duration) (duration <= 0: forever):
+//             the harmonics k of the period T = width whose frequencies k/T lie in [f0, f1], K of
+//             them, of equal amplitude a = A √(2/K) (A the signal's RMS) and Schroeder's phases
+//             φ_k = −π k'(k'−1)/K (k' = 1…K their rank), which keep the crest factor low; periodic
+//             in T, so a record of whole periods in steady state holds every line without leakage
 //   table     piecewise linear through (t_k, f_k), constant beyond the ends
 //   cubic-table  the 4-point Lagrange cubic through the samples around t (a band-limited input's
 //             reading; built in code, not from a scenario), constant beyond the ends
 // Discontinuities (in f or its derivative) are exposed by breakpoints() so integrators can stop
 // there instead of stepping across them.
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -35,11 +41,11 @@ double cubic_table_gain_error(double x);
 double cubic_table_error(double x);
 
 struct SignalTerm {
-  enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table, CubicTable };
+  enum class Type { Step, Pulse, BangBang, Sine, Chirp, Haversine, Table, CubicTable, Multisine };
   Type type = Type::Step;
   double amplitude = 0.0;
   double t0 = 0.0;
-  double width = 0.0;      // pulse, bangbang, haversine
+  double width = 0.0;      // pulse, bangbang, haversine; a multisine's period
   double f0 = 0.0;         // sine frequency, chirp start frequency [Hz]
   double f1 = 0.0;         // chirp end frequency [Hz]
   double duration = 0.0;   // sine, chirp
@@ -61,6 +67,9 @@ public:
   // What a time grid must resolve: the highest frequency of a sine or chirp term (Hz; 0 = none),
   // and the shortest width of a pulse, haversine or bang-bang term (s; +inf = none).
   double highest_frequency() const;
+  // The frequencies of its sine terms and multisine lines, ascending (Hz); empty when it has none.
+  // `only_lines`: set to whether every term is a sine or a multisine (the signal is its lines).
+  std::vector<double> lines(bool* only_lines = nullptr) const;
   double shortest_width() const;
   bool is_zero() const { return terms_.empty(); }
   const std::vector<SignalTerm>& terms() const { return terms_; }
@@ -69,9 +78,14 @@ public:
 
 private:
   std::vector<SignalTerm> terms_;
+  // Per term, a multisine's complex line amplitudes a e^{iφ_k} (lowest first), so that the sum is
+  // one Horner pass in e^{i2πτ/T}; empty for other terms.
+  std::vector<std::vector<std::complex<double>>> multisine_;
 };
 
 const char* to_string(SignalTerm::Type t);
+// A multisine term's line frequencies k/T in [f0, f1] (Hz, ascending; k >= 1).
+std::vector<double> multisine_lines(const SignalTerm& s);
 
 // Piecewise-linear interpolation of the samples (ts, vs) at t (ts increasing), constant beyond the
 // ends; 0 without samples. A `table` signal's law and DataTable::interpolate.

@@ -8,6 +8,9 @@
 //   Start       identification.start                how the first attempt starts (docs/theory.md §7.6)
 //   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
 //   StepRule    identification.step_rule            the automatic time step's rule (§5.2)
+//   Domain      identification.domain               time records or frequency responses (§6.10)
+//   FrfEstimatorKind identification.frf.estimator   how FRFs are made from a time record (§6.10)
+//   FrfWindowKind    identification.frf.window      the Welch segments' window
 //   SensorKind  sensors[].kind                      what a sensor reads (§3.5, §6.1a)
 //   Site        inputs[].at, sensors[].at            the body a sensor or input is on (§3.5, §4)
 //   InputKind   inputs[].kind                        what an input applies: a force or a moment
@@ -34,6 +37,9 @@ enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
 enum class InitialState { Rest, Estimate };
+enum class Domain { Time, Frequency };
+enum class FrfEstimatorKind { Auto, H1, H2, Lines };
+enum class FrfWindowKind { Hann, Rectangular };
 enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain, RelativeDisplacement };
 enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
 enum class InputKind { Force, Moment };
@@ -68,6 +74,20 @@ template <>
 struct Names<InitialState> {
   static constexpr std::array<std::pair<InitialState, const char*>, 2> rows{
       {{InitialState::Rest, "rest"}, {InitialState::Estimate, "estimate"}}};
+};
+template <>
+struct Names<Domain> {
+  static constexpr std::array<std::pair<Domain, const char*>, 2> rows{{{Domain::Time, "time"}, {Domain::Frequency, "frequency"}}};
+};
+template <>
+struct Names<FrfEstimatorKind> {
+  static constexpr std::array<std::pair<FrfEstimatorKind, const char*>, 4> rows{
+      {{FrfEstimatorKind::Auto, "auto"}, {FrfEstimatorKind::H1, "h1"}, {FrfEstimatorKind::H2, "h2"}, {FrfEstimatorKind::Lines, "lines"}}};
+};
+template <>
+struct Names<FrfWindowKind> {
+  static constexpr std::array<std::pair<FrfWindowKind, const char*>, 2> rows{
+      {{FrfWindowKind::Hann, "hann"}, {FrfWindowKind::Rectangular, "rectangular"}}};
 };
 template <>
 struct Names<StepRule> {

@@ -22,7 +22,14 @@
 // channel, λ_s = Z⁻¹ C_sᵀ, on the same factorisation: ∂H_s/∂c_j = (iω)^{o_s} λ_sᵀ (b_j − Z_j U).
 // Lines are split between two threads.
 //
-// No time record: the horizon is fixed (misfit.h), the misfit profile the one point {1, 2J/N}.
+// Frequency continuation. The horizon (misfit.h) is a frequency: the fit takes the lines up to it,
+// and the optimiser's continuation (optimizers.h) lengthens it as the fit of the lines below
+// improves — the analogue of the time record's: far from the solution a model peak sits beside the
+// measured one and the cost between them has a valley at every peak slipped past, so the lowest
+// peaks are fitted first. data_start() and data_end() are the lowest and highest line. The misfit
+// profile at line i is, averaged over the channels, the weighted misfit of the lines up to it beyond
+// its noise's expected share, relative to their weighted signal:
+//   m_i = mean_s max(0, Σ_{k<=i} |Δ_ks|²/σ²_ks − (i + 1)) / Σ_{k<=i} |Ĥ_ks|²/σ²_ks.
 #include <complex>
 #include <vector>
 
@@ -52,12 +59,11 @@ public:
             int input, FrfMisfitOptions options = {});
 
   int size() const override { return params_.size(); }
-  double horizon() const override { return 1.0; }
-  double data_start() const override { return 0.0; }
-  double data_end() const override { return 1.0; }
-  void set_horizon(double) override {}
-  bool has_horizon() const override { return false; }
-  long data_points() const override { return 2L * data_.lines() * static_cast<long>(data_.channels.size()); }
+  double horizon() const override { return data_.f_hz[static_cast<std::size_t>(active_ - 1)]; }
+  double data_start() const override { return data_.f_hz.front(); }
+  double data_end() const override { return data_.f_hz.back(); }
+  void set_horizon(double f) override;
+  long data_points() const override { return 2L * active_ * static_cast<long>(data_.channels.size()); }
 
   double cost(const VectorXd& q) override;
   double cost_and_gradient(const VectorXd& q, VectorXd& gradient) override;  // adjoint per line
@@ -66,10 +72,10 @@ public:
   VectorXd gauss_newton_product(const VectorXd& q, const VectorXd& v) override;  // Jᵀ(J v) from the Jacobian
   bool has_matrix_free_products() const override { return false; }
 
-  // The weighted residuals r (data_points()) at q and J; with `jacobian`, ∂r/∂q (N × P). Rows in the
-  // order line-major: value (k, s) holds rows 2(k·S + s) (real) and 2(k·S + s) + 1 (imaginary).
+  // The weighted residuals r of the lines up to the horizon at q and J; with `jacobian`, ∂r/∂q
+  // (rows × P). Rows line-major: value (k, s) holds rows 2(k·S + s) (real) and 2(k·S + s) + 1 (imaginary).
   double residuals(const VectorXd& q, VectorXd& r, MatrixXd* jacobian = nullptr);
-  // The model's FRFs at q (lines × channels).
+  // The model's FRFs at q (every line × channels).
   ComplexMatrix predict(const VectorXd& q);
 
   const io::FrfData& data() const { return data_; }
@@ -81,9 +87,10 @@ private:
   enum class Need { Cost, Gradient, Jacobian };
   struct Evaluation {
     VectorXd q;
+    int active = 0;  // lines with derivatives and in J
     Need need = Need::Cost;
     double J = 0.0;
-    VectorXd r, gradient;
+    VectorXd r, gradient;  // r over every line; J, the gradient and the Jacobian over the active ones
     MatrixXd jacobian;
     ComplexMatrix H;
   };
@@ -91,6 +98,7 @@ private:
   // Lines [k0, k1) into e (their rows of r and the Jacobian, H) and their gradient share into g.
   void evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need need, int k0, int k1, Evaluation& e,
                       VectorXd& g_c) const;
+  MisfitProfile profile_of(const Evaluation& e) const;
 
   const StructuralModel& model_;
   const Parameterization& params_;
@@ -99,6 +107,7 @@ private:
   int input_ = 0;
   FrfMisfitOptions options_;
   std::vector<double> orders_;  // o_s per channel
+  int active_ = 0;              // lines up to the horizon
   Evaluation last_;
   bool have_last_ = false;
   FrfMisfitCounters counters_;

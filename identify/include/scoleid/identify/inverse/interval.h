@@ -64,7 +64,7 @@ struct UncertaintyInterval {
   VectorXd half_record_shift;   // |q̂ − q̂^(T/2)|
   VectorXd consider;            // Σ_j |shift_j|
   VectorXd smoothing_shift;     // |q̂ − q̂(β/10)|; 0 without a prior
-  VectorXd half_record_delta;   // q̂ − q̂^(T/2) and q̂ − q̂(β/10), signed (empty: no refit / no prior)
+  VectorXd half_record_delta;   // q̂ − q̂^(T/2) and q̂ − q̂(β/10), signed (empty: no refit / no prior; zero where no refit applies)
   VectorXd smoothing_delta;
   std::vector<ConsiderTerm> terms;  // the declared tolerances and their shifts
   std::vector<bool> too_wide;   // half-width > 0.5·|q̂|

@@ -138,6 +138,8 @@ struct RunResult {
   double wall_seconds = 0;
   double identifiability_seconds = 0;
   MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
+  Eigen::MatrixXcd frf_model;  // a frequency-domain run's model FRFs at the estimate (lines × sensors)
+  std::string frf_start_note;  // how its fit started (the peaks' start, run/frf_run.h)
   // The signal that ended the run (RunOptions::keep_interrupted; SIGALRM: the wall-time limit), 0
   // when it ran to its end; and where it stood then.
   int interrupted_by = 0;

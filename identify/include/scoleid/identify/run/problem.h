@@ -19,6 +19,7 @@
 #include "scoleid/identify/inverse/objective.h"
 #include "scoleid/identify/time/esdirk_stepper.h"
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/frf_data.h"
 #include "scoleid/io/time_grid.h"
 #include "scoleid/io/scenario.h"
 
@@ -130,6 +131,14 @@ struct Problem {
   // Inputs driven by their column that read with a static offset (the warning above): the input's
   // index and the column's mean, which the start check sets aside before it judges signs and scales.
   std::vector<std::pair<std::size_t, double>> static_offsets;
+  // identification.domain: frequency (run/frf_run.h): the FRFs fitted, each channel's model sensor,
+  // the model input they are per unit of, the degrees of freedom of their variances (0: known), and
+  // one line on how they were made.
+  std::optional<io::FrfData> frf;
+  std::vector<int> frf_sensors;
+  int frf_input = 0;
+  double frf_variance_dof = 0.0;
+  std::string frf_note;
   const StructuralModel& model() const { return structure->model(); }
   ObjectiveOptions objective_options;
 };
