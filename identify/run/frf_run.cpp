@@ -274,11 +274,17 @@ FitTest frf_fit_test(const Problem& p, FrfMisfit& m, const VectorXd& q) {
   f.within_noise_and_discretisation = excess <= allowed_d + band;
   f.ratio = std::sqrt(std::max(0.0, excess) / (allowed_d + m_err * m_err * allowed_m_unit + band));
   f.model_error_needed = allowed_m_unit > 0 ? std::sqrt(std::max(0.0, excess - allowed_d - band) / allowed_m_unit) : 0.0;
-  char msg[300];
-  std::snprintf(msg, sizeof msg, "%s: weighted chi2 %.6g over %.0f values (noise band %.3g, discretisation %.3g, model error %.3g)%s",
-                f.explains_data ? "explains the data" : "does not explain the data", excess + N, N, band, allowed_d,
-                m_err * m_err * allowed_m_unit,
-                f.explains_data || f.model_error_needed <= 0 ? "" : (", needs a model error of " + io::format_value(f.model_error_needed)).c_str());
+  char msg[400];
+  if (f.explains_data && !f.within_noise_and_discretisation)
+    std::snprintf(msg, sizeof msg,
+                  "passes only with the model-error allowance of %.3g %% (identification.model_error): the residual needs at least %.3g %%, "
+                  "beyond what noise and discretisation allow (weighted chi2 %.6g over %.0f values)",
+                  100.0 * m_err, 100.0 * f.model_error_needed, excess + N, N);
+  else
+    std::snprintf(msg, sizeof msg, "%s: weighted chi2 %.6g over %.0f values (noise band %.3g, discretisation %.3g, model error %.3g)%s",
+                  f.explains_data ? "explains the data" : "does not explain the data", excess + N, N, band, allowed_d,
+                  m_err * m_err * allowed_m_unit,
+                  f.explains_data || f.model_error_needed <= 0 ? "" : (", needs a model error of at least " + io::format_value(100.0 * f.model_error_needed) + " %").c_str());
   f.message = msg;
   return f;
 }
