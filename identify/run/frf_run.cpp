@@ -457,7 +457,10 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
   RunResult r = start_result(p, io::Model::Linear);
   FrfMisfit m(p.model(), *p.params, *p.frf, p.frf_sensors, p.frf_input);
   r.method = ro.method.value_or(id.method);
-  if (r.method == io::Method::Auto || r.method == io::Method::GaussNewtonKrylov) r.method = io::Method::GaussNewton;
+  if (r.method == io::Method::GaussNewtonKrylov)
+    throw io::InputError("method gauss-newton-krylov (--method or identification.method) needs matrix-free Gauss-Newton products, which a "
+                         "frequency-domain run does not offer (its Jacobian is explicit: one adjoint per sensor and line); use gauss-newton or lbfgs");
+  if (r.method == io::Method::Auto) r.method = io::Method::GaussNewton;
   OptimizerOptions o = optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source);
   std::vector<IterationRecord> iterates;
   auto on_iteration = [&](const IterationRecord& it) {

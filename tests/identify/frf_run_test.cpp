@@ -9,7 +9,7 @@
 //     short segments (leakage): zeta biased, and its interval wide enough to cover it;
 //   - three steady sines: EI and zeta fixed, the strip's and the fixture's masses mostly as one;
 //   - what the door refuses: two inputs, an estimated initial state, declared uncertainties, a band
-//     that keeps no line, a segment that leaves too few averages.
+//     that keeps no line, a segment that leaves too few averages, gauss-newton-krylov.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -189,6 +189,14 @@ TEST(FrfRun, TheDoorRefusesWhatAFrequencyRunCannotDo) {
     sc.identification.frf.estimator = scoleid::io::FrfEstimatorKind::H1;
     sc.identification.frf.segment = 4.0;  // three segments of an 8 s record
     expect_refused(sc, "identification.frf.segment");
+  }
+  // No matrix-free products: gauss-newton-krylov is refused, not replaced.
+  {
+    auto p = make_problem(multisine(), std::nullopt);
+    RunOptions o;
+    o.verbose = false;
+    o.method = scoleid::io::Method::GaussNewtonKrylov;
+    EXPECT_THROW(run_identification(*p, o), InputError);
   }
   // The scenario reader: an estimated initial state and the nonlinear model have no FRF.
   const std::string text = R"(
