@@ -16,6 +16,7 @@
 #include <chrono>
 #include <memory>
 #include <csignal>
+#include <exception>
 #include <pthread.h>
 #include <stdexcept>
 #include <mutex>
@@ -79,6 +80,17 @@ public:
   ~LibraryCall() {
     sigaction(SIGINT, &old_int_, nullptr);
     sigaction(SIGTERM, &old_term_, nullptr);
+    // A signal in the moment between finish() and here goes to Python's own handler (the next
+    // call's start would otherwise forget it); while an exception leaves the call it is that one's.
+    if (io::interrupt_signal() != 0 && std::uncaught_exceptions() == 0) {
+      io::clear_interrupt();
+      PyErr_SetInterrupt();
+    }
+  }
+  // After the call's work: a signal that came after its last check (the work finished all the
+  // same) still ends the call, as KeyboardInterrupt: Ctrl-C during a call is never lost.
+  void finish() {
+    if (const int s = io::interrupt_signal()) throw io::Interrupted(s);
   }
   LibraryCall(const LibraryCall&) = delete;
   LibraryCall& operator=(const LibraryCall&) = delete;
@@ -135,6 +147,7 @@ py::tuple truth(const std::string& yaml_text, const std::string& source, bool pr
   {
     LibraryCall call;
     tr = simulate_truth(sc, o);
+    call.finish();
   }
   return py::make_tuple(record(tr.table), io::to_json(tr.meta).dump());
 }
@@ -217,6 +230,7 @@ py::tuple identify_call(const std::string& yaml_text, const std::string& source,
   try {
     LibraryCall call;
     id.emplace(identify_parameters(sc, data, o));
+    call.finish();
   } catch (const io::Interrupted&) {
     progress.rethrow();  // the callback's own exception, when it was the callback that ended the run
     throw;
@@ -256,6 +270,7 @@ py::tuple fit_table(const Identification& id) {
   {
     LibraryCall call;
     tab = id.fit_table();
+    call.finish();
   }
   return record(tab);
 }
@@ -270,7 +285,9 @@ std::string crosscheck_modes(const std::string& yaml_text, const std::string& so
   std::string why;
   if (!o.IsValid(&why)) throw io::InputError("crosscheck_modes: " + why);
   LibraryCall call;
-  return crosscheck::to_json(crosscheck::compare_modes(sc, o)).dump();
+  std::string out = crosscheck::to_json(crosscheck::compare_modes(sc, o)).dump();
+  call.finish();
+  return out;
 }
 
 py::tuple crosscheck_trajectories(const std::string& yaml_text, const std::string& source, int segments, int levels, int elements,
@@ -286,6 +303,7 @@ py::tuple crosscheck_trajectories(const std::string& yaml_text, const std::strin
   {
     LibraryCall call;
     r = crosscheck::compare_trajectories(sc, o, truth_root);
+    call.finish();
   }
   py::array_t<double> t(static_cast<py::ssize_t>(r.t.size()));
   std::memcpy(t.mutable_data(), r.t.data(), r.t.size() * sizeof(double));
