@@ -97,9 +97,17 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
     }
     if (need == Need::Cost || k >= e.active) continue;
     // b_j − Z_j U per coefficient.
+    const VectorXd Ur = U.real(), Ui = U.imag();
+    // A real sparse matrix times U, without a complex copy of the matrix.
+    auto times_U = [&](const SparseMatrix& A) -> ComplexVector {
+      ComplexVector out(n);
+      out.real() = A * Ur;
+      out.imag() = A * Ui;
+      return out;
+    };
     auto source = [&](int j) {
-      ComplexVector v = -(Kj[static_cast<std::size_t>(j)].cast<Complex>() * U) + (w * w) * (Mj[static_cast<std::size_t>(j)].cast<Complex>() * U) -
-                        Complex(0.0, w) * (Dj[static_cast<std::size_t>(j)].cast<Complex>() * U);
+      const auto jj = static_cast<std::size_t>(j);
+      ComplexVector v = -times_U(Kj[jj]) + (w * w) * times_U(Mj[jj]) - Complex(0.0, w) * times_U(Dj[jj]);
       if (j == input_coefficient) v += b_unit.cast<Complex>();
       return v;
     };
