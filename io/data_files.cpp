@@ -167,13 +167,6 @@ std::size_t read_header(const std::vector<std::string>& header, const CsvOptions
   return time;
 }
 
-// One field's number (a decimal comma read as a point where the separator is not ',').
-bool parse_number(std::string f, bool decimal_comma, double& v) {
-  if (f.empty()) return false;
-  if (decimal_comma) std::replace(f.begin(), f.end(), ',', '.');
-  return scoleid::io::parse_number(std::string_view(f), v);
-}
-
 // t into seconds from the time column's unit.
 void time_in_seconds(DataTable& tab, const std::string& where) {
   if (tab.time_unit.empty() || tab.time_unit == "s") return;
@@ -192,52 +185,151 @@ void time_in_seconds(DataTable& tab, const std::string& where) {
 
 }  // namespace
 
-DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options) {
-  DataTable tab;
-  tab.source = path;
-  std::size_t lineno = 0;
-  std::string line = header_line(in, path, lineno);
-  const char sep = separator_of(line);
-  const bool decimal_comma = sep != ',';
-  auto header = split_csv_line(line, sep);
-  // Exports that end every line with the separator ("t;a;b;") have an empty last field throughout.
-  const bool trailing = header.size() > 2 && header.back().empty();
-  if (trailing) header.pop_back();
-  const std::size_t time = read_header(header, options, tab, "data file '" + path + "': line " + std::to_string(lineno));
-  tab.columns.assign(tab.names.size(), {});
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (lineno % 4096 == 0) check_interrupt();  // a DAQ export of millions of lines takes seconds
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    if (line[0] == '#') continue;
-    auto f = split_csv_line(line, sep);
-    if (trailing && f.size() == header.size() + 1 && f.back().empty()) f.pop_back();
-    if (f.size() != header.size())
-      throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": expected " +
-                       std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));
-    if (tab.t.size() >= static_cast<std::size_t>(limits::kMaxSamples))
-      throw InputError("data file '" + path + "': line " + std::to_string(lineno) + ": more than " +
-                       format_value(limits::kMaxSamples) + " samples (the limit of one record)");
-    for (std::size_t j = 0; j < f.size(); ++j) {
-      const std::string where = "data file '" + path + "': line " + std::to_string(lineno) + ", column '" + one_line(header[j]) + "'";
-      double v = 0.0;
-      if (!parse_number(f[j], decimal_comma, v)) throw InputError(where + ": not a number, got '" + one_line(f[j]) + "'");
-      if (!std::isfinite(v)) throw InputError(where + ": must be finite, got " + f[j]);
-      if (!(std::abs(v) <= limits::kMaxMagnitude))  // (tiny values are data; huge ones overflow the fit)
-        throw InputError(where + ": magnitude must be at most " + format_value(limits::kMaxMagnitude) + ", got " + format_value(v));
-      if (j == time) {
-        if (!tab.t.empty() && !(v > tab.t.back()))
-          throw InputError(where + ": time must be strictly increasing, got " + f[j] + " after " + format_value(tab.t.back()));
-        tab.t.push_back(v);
-      } else {
-        tab.columns[j < time ? j : j - 1].push_back(v);
+struct CsvReader::State {
+  std::unique_ptr<InputFileStream> own;  // the file, when the reader opened it
+  std::istream* in = nullptr;
+  DataTable head;
+  std::string path, line, number;
+  std::size_t lineno = 0, rows = 0, time = 0, fields = 0;
+  char sep = ',';
+  bool decimal_comma = false, trailing = false;
+  std::vector<std::string> header;
+  std::vector<std::string_view> view;  // the fields of the line being read
+  std::vector<std::string> quoted;     // their text when the line has quotes
+  double last_raw = 0, last_s = 0;     // the time before, in its stated unit and in seconds
+  bool to_seconds = false;
+  units::Conversion seconds;
+
+  std::string where() const { return "data file '" + path + "': line " + std::to_string(lineno); }
+  std::string where(std::size_t j) const { return where() + ", column '" + one_line(header[j]) + "'"; }
+
+  void start(const CsvOptions& options) {
+    head.source = path;
+    line = header_line(*in, path, lineno);
+    sep = separator_of(line);
+    decimal_comma = sep != ',';
+    header = split_csv_line(line, sep);
+    // Exports that end every line with the separator ("t;a;b;") have an empty last field throughout.
+    trailing = header.size() > 2 && header.back().empty();
+    if (trailing) header.pop_back();
+    time = read_header(header, options, head, where());
+    fields = header.size();
+    if (!head.time_unit.empty() && head.time_unit != "s") {
+      try {
+        seconds = units::conversion(head.time_unit, "s", units::Quantity::Time);
+      } catch (const std::invalid_argument& e) {
+        throw InputError("data file '" + path + "': time column '" + one_line(head.time_name) + "': unit " + e.what());
       }
+      to_seconds = true;
     }
   }
+
+  // The current line's fields into view (false: a blank or comment line).
+  bool split() {
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') return false;
+    view.clear();
+    if (line.find('"') != std::string::npos) {  // quoted fields: the general splitter
+      quoted = split_csv_line(line, sep);
+      for (const auto& f : quoted) view.emplace_back(f);
+    } else {
+      std::size_t b = 0;
+      for (;;) {
+        const std::size_t e = line.find(sep, b);
+        std::string_view f(line.data() + b, (e == std::string::npos ? line.size() : e) - b);
+        const auto l = f.find_first_not_of(" \t\r"), r = f.find_last_not_of(" \t\r");
+        view.push_back(l == std::string_view::npos ? std::string_view() : f.substr(l, r - l + 1));
+        if (e == std::string::npos) break;
+        b = e + 1;
+      }
+    }
+    if (trailing && view.size() == fields + 1 && view.back().empty()) view.pop_back();
+    if (view.size() != fields)
+      throw InputError(where() + ": expected " + std::to_string(fields) + " fields, got " + std::to_string(view.size()));
+    return true;
+  }
+
+  double value(std::size_t j) {
+    std::string_view f = view[j];
+    if (decimal_comma && f.find(',') != std::string_view::npos) {
+      number.assign(f);
+      std::replace(number.begin(), number.end(), ',', '.');
+      f = number;
+    }
+    double v = 0.0;
+    if (f.empty() || !parse_number(f, v)) throw InputError(where(j) + ": not a number, got '" + one_line(std::string(view[j])) + "'");
+    if (!std::isfinite(v)) throw InputError(where(j) + ": must be finite, got " + std::string(view[j]));
+    if (!(std::abs(v) <= limits::kMaxMagnitude))  // (tiny values are data; huge ones overflow the fit)
+      throw InputError(where(j) + ": magnitude must be at most " + format_value(limits::kMaxMagnitude) + ", got " + format_value(v));
+    return v;
+  }
+};
+
+CsvReader::CsvReader(const std::string& path, const CsvOptions& options) : s_(std::make_unique<State>()) {
+  s_->own = std::make_unique<InputFileStream>(path, "data file '" + path + "'");
+  s_->in = s_->own.get();
+  s_->path = path;
+  s_->start(options);
+}
+
+CsvReader::CsvReader(std::istream& in, const std::string& path, const CsvOptions& options) : s_(std::make_unique<State>()) {
+  s_->in = &in;
+  s_->path = path;
+  s_->start(options);
+}
+
+CsvReader::~CsvReader() = default;
+
+const DataTable& CsvReader::header() const { return s_->head; }
+std::size_t CsvReader::rows() const { return s_->rows; }
+
+std::size_t CsvReader::read(std::size_t max_rows, std::vector<double>& t, std::vector<std::vector<double>>& columns,
+                            double max_samples) {
+  State& s = *s_;
+  t.clear();
+  columns.resize(s.head.names.size());
+  for (auto& c : columns) c.clear();
+  while (t.size() < max_rows && std::getline(*s.in, s.line)) {
+    ++s.lineno;
+    if (s.lineno % 4096 == 0) check_interrupt();  // a DAQ export of millions of lines takes seconds
+    if (!s.split()) continue;
+    if (max_samples > 0 && static_cast<double>(s.rows) >= max_samples)
+      throw InputError(s.where() + ": more than " + format_value(max_samples) + " samples (the limit of one record)");
+    for (std::size_t j = 0; j < s.fields; ++j) {
+      const double v = s.value(j);
+      if (j != s.time) {
+        columns[j < s.time ? j : j - 1].push_back(v);
+        continue;
+      }
+      if (s.rows > 0 && !(v > s.last_raw))
+        throw InputError(s.where(j) + ": time must be strictly increasing, got " + std::string(s.view[j]) + " after " +
+                         format_value(s.last_raw));
+      const double sec = s.to_seconds ? s.seconds.apply(v) : v;
+      if (s.rows > 0 && !(sec > s.last_s))
+        throw InputError("data file '" + s.path + "': time column '" + one_line(s.head.time_name) + "': sample " +
+                         std::to_string(s.rows + 1) + " is not after the one before once converted from " + s.head.time_unit +
+                         " into s (" + format_value(sec) + ")");
+      s.last_raw = v;
+      s.last_s = sec;
+      t.push_back(sec);
+    }
+    ++s.rows;
+  }
   check_interrupt();  // a read cut short by a signal is no short file
+  return t.size();
+}
+
+DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options) {
+  CsvReader reader(in, path, options);
+  DataTable tab = reader.header();
+  tab.columns.assign(tab.names.size(), {});
+  std::vector<double> t;
+  std::vector<std::vector<double>> cols;
+  while (reader.read(std::size_t{1} << 16, t, cols, limits::kMaxSamples) > 0) {
+    tab.t.insert(tab.t.end(), t.begin(), t.end());
+    for (std::size_t j = 0; j < cols.size(); ++j) tab.columns[j].insert(tab.columns[j].end(), cols[j].begin(), cols[j].end());
+  }
   if (tab.t.size() < 2)
     throw InputError("data file '" + path + "': needs at least 2 data rows, got " + std::to_string(tab.t.size()));
-  time_in_seconds(tab, "data file '" + path + "'");
   return tab;
 }
 
@@ -322,8 +414,6 @@ void write_text_atomic(const std::string& path, const std::string& text) {
   }
 }
 
-namespace {
-
 // A header field as CSV writes it: quoted when it holds a separator, a quote or outer blanks.
 std::string csv_field(const std::string& name) {
   const bool plain = name.find_first_of(",;\"\t") == std::string::npos && !name.empty() && name.front() != ' ' &&
@@ -333,8 +423,6 @@ std::string csv_field(const std::string& name) {
   for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
 }
-
-}  // namespace
 
 void write_csv(const std::string& path, const DataTable& tab) {
   std::string out = csv_field(tab.time_name.empty() ? std::string("t") : tab.time_name);

@@ -8,6 +8,10 @@
 //   scole-data convert FILE --out OUT.tdms  the same record as an NI TDMS file (tdms.h)
 //   scole-data convert FILE --out OUT.uff   the same record as a Universal File, a binary 58 per
 //                                           channel (uff.h; .unv too)
+//   scole-data frf FILE --input F --out OUT.uff   frequency responses of the response columns to the
+//                                           force column F (Welch H1/H2 streamed, or harmonic lines;
+//                                           frf_record.h) as UFF 58 FRFs + coherence (uff_frf.h), or
+//                                           OUT.csv: per line f, then per response re, im, std, coherence
 // FILE is a Universal File (58/58b, 151, 164, 15, 2411, 55), a LabVIEW Measurement file (.lvm, one
 // segment), an NI TDMS file (.tdms, binary) or a CSV (DAQ dialects: comment lines, any time-column
 // name, quoted headers, ';' with decimal commas, units in brackets).
@@ -15,7 +19,10 @@
 // and value; nothing written), 130/143 interrupted.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <map>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -26,11 +33,14 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/frf_record.h"
+#include "scoleid/io/uff_frf.h"
 #include "scoleid/io/uff.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/lvm.h"
 #include "scoleid/io/output_paths.h"
 #include "scoleid/io/tdms.h"
+#include "scoleid/io/units.h"
 #include "scoleid/io/validation.h"
 
 namespace {
@@ -145,6 +155,127 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
                  tab.names.size() == 1 ? "" : "s", tab.t.size(), out.c_str(), meta.string().c_str());
 }
 
+// The FRFs of a record, written as OUT.uff/.unv (dataset 58, function types 4 and 6) or OUT.csv.
+struct FrfArgs {
+  io::RecordFrfOptions options;
+  std::vector<std::string> units, stations;
+  std::string reference, estimator = "h1", window = "hann";
+};
+
+// "NAME=VALUE" pairs of a repeated option.
+std::map<std::string, std::string> pairs(const std::vector<std::string>& items, const char* option) {
+  std::map<std::string, std::string> out;
+  for (const auto& it : items) {
+    const auto eq = it.rfind('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == it.size())
+      throw io::InputError(std::string("command line: ") + option + " must be COLUMN=VALUE, got '" + io::one_line(it) + "'");
+    if (!out.emplace(it.substr(0, eq), it.substr(eq + 1)).second)
+      throw io::InputError(std::string("command line: ") + option + " names column '" + io::one_line(it.substr(0, eq)) + "' twice");
+  }
+  return out;
+}
+
+void write_frf_csv(const std::string& out, const io::RecordFrf& r) {
+  std::string text = "f_hz";
+  for (const auto& ch : r.data.channels)
+    for (const char* part : {"re", "im", "std", "coherence"}) text += "," + io::csv_field(ch.sensor + " " + part);
+  text += "\n";
+  char buf[40];
+  for (std::size_t k = 0; k < r.data.f_hz.size(); ++k) {
+    std::snprintf(buf, sizeof buf, "%.17g", r.data.f_hz[k]);
+    text += buf;
+    for (const auto& ch : r.data.channels) {
+      const double coh = ch.coherence.empty() ? std::nan("") : ch.coherence[k];
+      for (double v : {ch.H[k].real(), ch.H[k].imag(), std::sqrt(ch.variance[k]), coh}) {
+        std::snprintf(buf, sizeof buf, ",%.17g", v);
+        text += std::isnan(v) ? std::string(",") : std::string(buf);
+      }
+    }
+    text += "\n";
+  }
+  io::write_text_atomic(out, text);
+}
+
+// A column's name as a UFF ID line 1 takes it (printable ASCII, no blanks): its unit suffix dropped
+// ("acc [g]" -> "acc"), blanks as '_', other characters left out; "response<k>" when nothing is left.
+std::string uff_name(const std::string& column, std::size_t k) {
+  std::string name = column;
+  const std::string unit = io::units::bracketed_unit(name);
+  if (!unit.empty()) {
+    const auto open = name.find_last_of(name.back() == ']' ? '[' : '(');
+    if (open != std::string::npos) name.erase(open);
+  }
+  std::string out;
+  for (char c : name) {
+    if (c == ' ' || c == '\t') out += '_';
+    else if (c > ' ' && c < 127) out += c;
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  while (!out.empty() && out.front() == '_') out.erase(0, 1);
+  if (out.size() > 60) out.resize(60);
+  return out.empty() ? "response" + std::to_string(k + 1) : out;
+}
+
+// How to read the UFF back: the stations and the averages behind its coherence.
+void summary_uff(const io::RecordFrf& r, const std::vector<std::pair<std::string, std::string>>& st) {
+  std::string map;
+  for (const auto& [name, station] : st) map += (map.empty() ? "" : ", ") + name + ": " + station;
+  if (r.segments > 0) {
+    const int averages = std::max(1, static_cast<int>(std::floor(r.effective_averages - 1.0)));
+    std::fprintf(stderr,
+                 "scole-data: to identify from it: identification.frf: {stations: {%s}, averages: %d} (the coherence and "
+                 "K_eff - 1 averages give each value's variance)\n",
+                 map.c_str(), averages);
+  } else {
+    std::fprintf(stderr,
+                 "scole-data: stations {%s}; the file holds no coherence for harmonic lines (their variance has no place in a "
+                 "UFF 58): write OUT.csv to keep each value's std, or state identification.frf.relative_std\n",
+                 map.c_str());
+  }
+}
+
+void frf(const std::string& file, const std::string& out, const io::CsvOptions& csv, FrfArgs a, bool quiet) {
+  io::check_output_file("--out", out, {file});
+  const std::string format = out_format(out);
+  if (format != "uff" && format != "csv")
+    throw io::InputError("command line: --out '" + out + "': frequency responses are written as OUT.uff (or .unv) or OUT.csv");
+  if (a.estimator == "h1") a.options.estimator = io::RecordFrfEstimator::H1;
+  else if (a.estimator == "h2") a.options.estimator = io::RecordFrfEstimator::H2;
+  else if (a.estimator == "lines") a.options.estimator = io::RecordFrfEstimator::Lines;
+  else throw io::InputError("command line: --estimator must be h1, h2 or lines, got '" + io::one_line(a.estimator) + "'");
+  if (a.window == "hann") a.options.window = io::FrfWindow::Hann;
+  else if (a.window == "rectangular") a.options.window = io::FrfWindow::Rectangular;
+  else throw io::InputError("command line: --window must be hann or rectangular, got '" + io::one_line(a.window) + "'");
+  a.options.units = pairs(a.units, "--unit");
+  const auto stations = pairs(a.stations, "--station");
+  if (!quiet)
+    a.options.progress = [](std::size_t n) { std::fprintf(stderr, "scole-data: %zu samples read\n", n); };
+  io::RecordFrf r = io::frf_of_record(file, csv, a.options);
+  for (const auto& [name, station] : stations)
+    if (std::none_of(r.data.channels.begin(), r.data.channels.end(), [&](const auto& c) { return c.sensor == name; }))
+      throw io::InputError("command line: --station names no response column, got '" + io::one_line(name) + "'");
+  std::vector<std::pair<std::string, std::string>> st;
+  if (format == "csv") {
+    write_frf_csv(out, r);
+  } else {
+    // In the UFF each FRF is named as ID line 1 allows; the stations go with those names.
+    for (std::size_t s = 0; s < r.data.channels.size(); ++s) {
+      auto& ch = r.data.channels[s];
+      const auto it = stations.find(ch.sensor);
+      ch.sensor = uff_name(ch.sensor, s);
+      for (std::size_t p = 0; p < s; ++p)
+        if (r.data.channels[p].sensor == ch.sensor) ch.sensor = "response" + std::to_string(s + 1);
+      st.emplace_back(ch.sensor, it != stations.end() ? it->second : std::to_string(s + 1) + "+Z");
+    }
+    io::write_uff_frf(out, r.data, st, a.reference, r.orders);
+  }
+  if (quiet) return;
+  std::fprintf(stderr, "scole-data: %zu samples at %.9g Hz; %s\n", r.samples, r.sample_rate, r.note.c_str());
+  std::fprintf(stderr, "scole-data: %zu FRF%s x %d lines -> %s\n", r.data.channels.size(), r.data.channels.size() == 1 ? "" : "s",
+               r.data.lines(), out.c_str());
+  if (format == "uff") summary_uff(r, st);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -171,7 +302,32 @@ int main(int argc, char** argv) {
                    "channel, doubles); every time and value reads back exactly")
       ->required();
   conv->add_flag("-q,--quiet", quiet, "no summary on stderr");
-  for (auto* sub : {info, conv}) {
+  FrfArgs fa;
+  auto* fr = app.add_subcommand("frf", "frequency response functions of response columns to a force column, the record streamed "
+                                       "(Welch H1/H2) or fitted at known lines, written as UFF 58 FRFs with coherence or a CSV");
+  fr->add_option("file", file, "data file (CSV read in chunks, any length; UFF, LVM or TDMS read whole)")->required();
+  fr->add_option("-o,--out", out,
+                 "OUT.uff / OUT.unv (ASCII dataset 58: FRFs in SI per N, function type 4, and coherence, type 6) or OUT.csv "
+                 "(f_hz, then per response: re, im, std, coherence)")
+      ->required();
+  fr->add_option("--input", fa.options.input, "the force column")->required();
+  fr->add_option("--response", fa.options.responses, "a response column, repeated (default: every column but the input)");
+  fr->add_option("--unit", fa.units, "COLUMN=UNIT for a column whose file states no unit (N, lbf, m/s^2, g, mm, ...)");
+  fr->add_option("--station", fa.stations,
+                 "COLUMN=<node><sign><axis> of a response in the UFF (e.g. acc_tip=3+Z; default: the k-th response at node k, +Z)");
+  fr->add_option("--reference", fa.reference, "<node><sign><axis> of the excitation in the UFF (default: node 0, scalar)");
+  fr->add_option("--estimator", fa.estimator, "h1 (noise on the responses; default), h2 (noise on the force), lines (steady sines)");
+  fr->add_option("--segment", fa.options.segment,
+                 "Welch segment length in s (default: the largest power of two of samples up to the record / 4.5: eight segments)");
+  fr->add_option("--overlap", fa.options.overlap, "Welch overlap of adjacent segments, in [0, 1) (default 0.5)");
+  fr->add_option("--window", fa.window, "Welch window: hann (default) or rectangular (a periodic input a whole number of periods per segment)");
+  fr->add_option("--f-min", fa.options.f_min, "lowest line kept, Hz (exclusive; default 0)");
+  fr->add_option("--f-max", fa.options.f_max, "highest line kept, Hz (default 0.8 of Nyquist)");
+  fr->add_option("--lines", fa.options.lines_hz, "the input's frequencies, Hz, for --estimator lines")->delimiter(',');
+  fr->add_option("--sample-rate", fa.options.sample_rate,
+                 "the DAQ's sample rate, Hz (default: from the time column, uniform within its written precision)");
+  fr->add_flag("-q,--quiet", quiet, "no summary on stderr");
+  for (auto* sub : {info, conv, fr}) {
     sub->add_option("--time-column", time_column, "CSV: the time column's header (default: the first column)");
     sub->add_option("--time-unit", time_unit, "CSV: the time column's unit when its header states none (default: s)");
   }
@@ -190,8 +346,10 @@ int main(int argc, char** argv) {
       } else {
         print_info(d);
       }
-    } else {
+    } else if (*conv) {
       convert(file, out, options, quiet);
+    } else {
+      frf(file, out, options, fa, quiet);
     }
     return 0;
   });

@@ -263,6 +263,21 @@ namespace {
 bool is_tdms_file(const std::string& path) { return looks_like_tdms(file_head(path, 4)); }
 }  // namespace
 
+bool is_csv_data(const std::string& path) { return !is_uff_file(path) && !is_lvm_file(path) && !is_tdms_file(path); }
+
+CsvData open_csv_data(const std::string& path, const CsvOptions& options) {
+  const nlohmann::json sidecar = sidecar_of(path);
+  CsvOptions own = options;
+  if (!sidecar.is_null()) own.time_unit.clear();  // a converted file's t is in seconds
+  CsvData d;
+  d.reader = std::make_unique<CsvReader>(path, own);
+  DataTable head = d.reader->header();
+  if (!sidecar.is_null()) units_from_sidecar(head, sidecar);
+  head.units.resize(head.names.size());
+  d.units = head.units;
+  return d;
+}
+
 DataTable read_data(const std::string& path, const CsvOptions& options) {
   if (is_uff_file(path)) return uff_table(uff::read_file(path));
   if (is_lvm_file(path)) return read_lvm(path);

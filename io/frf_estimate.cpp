@@ -503,6 +503,19 @@ std::vector<LineFit> fit_lines(const std::vector<const double*>& ch, std::size_t
 
 }  // namespace
 
+double welch_effective_averages(int segments, FrfWindow window, double overlap) {
+  const int N = 1024, D = static_cast<int>(std::lround((1.0 - overlap) * N));
+  std::vector<double> w(N);
+  for (int n = 0; n < N; ++n) w[static_cast<std::size_t>(n)] = window == FrfWindow::Hann ? 0.5 - 0.5 * std::cos(2.0 * kPi * n / N) : 1.0;
+  double num = 0.0, den = 0.0;
+  for (int n = 0; n < N; ++n) {
+    den += w[static_cast<std::size_t>(n)] * w[static_cast<std::size_t>(n)];
+    if (n + D < N) num += w[static_cast<std::size_t>(n)] * w[static_cast<std::size_t>(n + D)];
+  }
+  const double c = D < N ? num / den : 0.0;
+  return segments / (1.0 + 2.0 * c * c);
+}
+
 FrfData harmonic_frf(const double* input, const std::vector<const double*>& responses, std::size_t n,
                      const LinesOptions& options, const std::string& source, const std::string& input_name,
                      const std::vector<std::string>& response_names) {

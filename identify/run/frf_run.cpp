@@ -22,19 +22,9 @@ namespace {
 using io::fail_field;
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
-// Welch's overlap correlation c = Σ w[n] w[n + D] / Σ w² of the window at a shift of D = (1 − overlap)·N,
-// and the effective number of independent averages K / (1 + 2c²) (Welch 1967, adjacent segments).
 double effective_averages(int segments, io::FrfWindowKind window, double overlap) {
-  const int N = 1024, D = static_cast<int>(std::lround((1.0 - overlap) * N));
-  std::vector<double> w(N);
-  for (int n = 0; n < N; ++n) w[static_cast<std::size_t>(n)] = window == io::FrfWindowKind::Hann ? 0.5 - 0.5 * std::cos(kTwoPi * n / N) : 1.0;
-  double num = 0.0, den = 0.0;
-  for (int n = 0; n < N; ++n) {
-    den += w[static_cast<std::size_t>(n)] * w[static_cast<std::size_t>(n)];
-    if (n + D < N) num += w[static_cast<std::size_t>(n)] * w[static_cast<std::size_t>(n + D)];
-  }
-  const double c = D < N ? num / den : 0.0;
-  return segments / (1.0 + 2.0 * c * c);
+  return io::welch_effective_averages(segments, window == io::FrfWindowKind::Hann ? io::FrfWindow::Hann : io::FrfWindow::Rectangular,
+                                      overlap);
 }
 
 // The one input the FRFs are per unit of: the scenario's only input.
@@ -127,14 +117,20 @@ void frf_from_record(Problem& p) {
   const int input = frf_input_index(p);
   const double fs = uniform_rate(p);
   const std::size_t n = p.data.t.size();
-  std::vector<double> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = p.signals[static_cast<std::size_t>(input)](p.data.t[i]);
-  std::vector<std::vector<double>> y(static_cast<std::size_t>(p.data.sensors()), std::vector<double>(n));
-  std::vector<const double*> yp;
-  for (int s = 0; s < p.data.sensors(); ++s) {
-    for (std::size_t i = 0; i < n; ++i) y[static_cast<std::size_t>(s)][i] = p.data.z(static_cast<Eigen::Index>(i), s);
-    yp.push_back(y[static_cast<std::size_t>(s)].data());
-  }
+  // The input and responses of samples [b, e) as arrays (the whole record for the lines' fit, chunks
+  // for Welch, which streams).
+  std::vector<double> x;
+  std::vector<std::vector<double>> y(static_cast<std::size_t>(p.data.sensors()));
+  std::vector<const double*> yp(y.size());
+  const auto take = [&](std::size_t b, std::size_t e) {
+    x.resize(e - b);
+    for (std::size_t i = b; i < e; ++i) x[i - b] = p.signals[static_cast<std::size_t>(input)](p.data.t[i]);
+    for (std::size_t s = 0; s < y.size(); ++s) {
+      y[s].resize(e - b);
+      for (std::size_t i = b; i < e; ++i) y[s][i - b] = p.data.z(static_cast<Eigen::Index>(i), static_cast<int>(s));
+      yp[s] = y[s].data();
+    }
+  };
   bool only_lines = false;
   const std::vector<double> signal_lines = sc.inputs[static_cast<std::size_t>(input)].signal.lines(&only_lines);
   io::FrfEstimatorKind kind = spec.estimator;
@@ -152,6 +148,7 @@ void frf_from_record(Problem& p) {
         fail_field(sc.source, "identification.frf.lines", "must lie below the record's Nyquist frequency " + io::format_value(0.5 * fs) + " Hz",
                    io::format_value(f));
     io::FrfData d;
+    take(0, n);
     try {
       d = io::harmonic_frf(x.data(), yp, n, o, p.data_source, name, p.data.names);
     } catch (const std::invalid_argument& e) {
@@ -174,7 +171,11 @@ void frf_from_record(Problem& p) {
   o.segment = seg;
   o.f_max = 0.8 * 0.5 * fs;
   io::WelchFrf w(p.data.sensors(), o);
-  w.add(x.data(), yp, n);
+  for (std::size_t b = 0; b < n; b += std::size_t{1} << 16) {
+    const std::size_t e = std::min(n, b + (std::size_t{1} << 16));
+    take(b, e);
+    w.add(x.data(), yp, e - b);
+  }
   io::FrfData d;
   try {
     d = w.result(p.data_source, name, p.data.names);

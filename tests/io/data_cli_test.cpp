@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,8 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/frf_record.h"
+#include "scoleid/io/uff_frf.h"
 #include "scoleid/io/uff.h"
 
 #ifndef SCOLE_DATA_EXE
@@ -282,4 +285,77 @@ TEST(DataCli, ConvertRefusesWhatTheFormatCannotHoldAndItsOwnInput) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("is an input of this run"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(dir / "d.lvm"), lvm);
+}
+
+// `frf`: a record's FRFs written as UFF 58 (read back by the product's FRF reader with the
+// stations and averages the summary names, equal to the library's estimate to the 13 digits
+// written) and as CSV; a column the file lacks exits 2 writing nothing.
+TEST(DataCli, FrfWritesUffAndCsvThatReadBack) {
+  const fs::path dir = scratch();
+  DataTable tab;
+  tab.names = {"F [N]", "acc [m/s^2]", "vel [mm/s]"};
+  tab.columns.assign(3, {});
+  std::uint64_t state = 12345;
+  auto noise = [&] {  // a reproducible uniform (−0.5, 0.5)
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(state >> 11) / 9007199254740992.0 - 0.5;
+  };
+  double before = 0;
+  for (int i = 0; i < 40000; ++i) {
+    const double f = noise();
+    tab.t.push_back(i / 2048.0);
+    tab.columns[0].push_back(f);
+    tab.columns[1].push_back(0.7 * f - 0.2 * before + 0.05 * noise());
+    tab.columns[2].push_back(30 * f + 2 * noise());
+    before = f;
+  }
+  write_csv((dir / "r.csv").string(), tab);
+  const Result r = run({"frf", "r.csv", "--input", "F [N]", "--station", "vel [mm/s]=7-Y", "-o", "h.uff"}, dir);
+  ASSERT_EQ(r.code, 0) << slurp(dir / "stderr.txt");
+  const std::string err = slurp(dir / "stderr.txt");
+  EXPECT_NE(err.find("stations: {acc: 1+Z, vel: 7-Y}"), std::string::npos) << err;
+  const auto at = err.find("averages: ");
+  ASSERT_NE(at, std::string::npos) << err;
+  RecordFrfOptions o;
+  o.input = "F [N]";
+  const RecordFrf lib = frf_of_record((dir / "r.csv").string(), {}, o);
+  EXPECT_EQ(std::stoi(err.substr(at + 10)), static_cast<int>(std::floor(lib.effective_averages - 1)));
+  UffFrfOptions u;
+  u.stations = {{"a", "1+Z"}, {"v", "7-Y"}};
+  u.averages = std::stoi(err.substr(at + 10));
+  std::vector<int> orders;
+  const FrfData back = frf_data_from_uff(uff::read_file((dir / "h.uff").string()), "h.uff", u, &orders);
+  EXPECT_EQ(orders, (std::vector<int>{2, 1}));
+  ASSERT_EQ(back.f_hz.size(), lib.data.f_hz.size());
+  for (int s = 0; s < 2; ++s)
+    for (std::size_t k = 0; k < back.f_hz.size(); ++k) {
+      EXPECT_NEAR(std::abs(back.channels[s].H[k] - lib.data.channels[s].H[k]), 0, 1e-12 * std::abs(lib.data.channels[s].H[k]));
+      EXPECT_NEAR(back.channels[s].coherence[k], lib.data.channels[s].coherence[k], 1e-12);
+    }
+  // The velocity in mm/s is per N in m/s: |H| near 0.03.
+  EXPECT_NEAR(std::abs(lib.data.channels[1].H[3]), 0.03, 0.003);
+
+  const Result c = run({"frf", "r.csv", "--input", "F [N]", "-q", "-o", "h.csv"}, dir);
+  ASSERT_EQ(c.code, 0) << slurp(dir / "stderr.txt");
+  const DataTable csv = read_csv((dir / "h.csv").string());
+  EXPECT_EQ(csv.t, lib.data.f_hz);
+  ASSERT_EQ(csv.names.size(), 8u);
+  EXPECT_EQ(csv.names[2], "acc [m/s^2] std");
+  for (std::size_t k = 0; k < csv.t.size(); ++k) {
+    EXPECT_DOUBLE_EQ(csv.columns[4][k], lib.data.channels[1].H[k].real());
+    EXPECT_DOUBLE_EQ(csv.columns[6][k], std::sqrt(lib.data.channels[1].variance[k]));
+  }
+
+  const fs::path bad = dir / "bad";
+  fs::create_directories(bad);
+  fs::copy_file(dir / "r.csv", bad / "r.csv");
+  const Result n = run({"frf", "r.csv", "--input", "Force", "-o", "x.uff"}, bad);
+  EXPECT_EQ(n.code, 2);
+  const std::string msg = slurp(bad / "stderr.txt");
+  EXPECT_EQ(lines(msg), 1) << msg;
+  EXPECT_NE(msg.find("--input names no column of the file"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(bad / "x.uff"));
+  const Result self = run({"frf", "r.csv", "--input", "F [N]", "-o", "r.csv"}, bad);
+  EXPECT_EQ(self.code, 2);
+  EXPECT_EQ(tab.t.size() + 1, static_cast<std::size_t>(lines(slurp(bad / "r.csv"))));
 }

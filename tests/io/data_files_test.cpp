@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "common/cli_support.h"
 #include "scoleid/io/error.h"
@@ -274,4 +275,41 @@ TEST(DataFiles, ColumnsInMemoryAreReadAsACsvWithTheirHeader) {
   EXPECT_EQ(error_of({"t [m]", "a"}, {{0, 1}, {1, 2}}, {}), "data 'mem': time column 't [m]': unit 'm' is not a unit of time");
   EXPECT_EQ(error_of({"t", "a"}, {{1, 0}, {1, 2}}, {}), "data 'mem': time, sample 2: must be strictly increasing (after 1), got 0");
   EXPECT_EQ(error_of({"t", "t"}, {{0, 1}, {1, 2}}, {}), "data 'mem': duplicate column 't'");
+}
+
+// The chunked reader gives read_csv's table, chunk by chunk: comments, blank lines, a quoted
+// field, decimal commas and a time column in ms read alike whatever the chunk size.
+TEST(DataFiles, CsvReaderChunksGiveReadCsvsTable) {
+  const std::string text =
+      "# exported\nTime [ms];\"Acc, tip [g]\";F [N]\n0;1,5;-2\n0,5;2;3e-1\n\n# pause\n1;\"2,5\";4\n1,5;-1;0\n2;7;8\n";
+  const DataTable whole = read_csv_text(text, "x.csv");
+  for (std::size_t chunk : {1u, 2u, 3u, 100u}) {
+    std::istringstream in(text);
+    CsvReader r(in, "x.csv");
+    EXPECT_EQ(r.header().names, whole.names);
+    EXPECT_EQ(r.header().units, whole.units);
+    std::vector<double> t, all_t;
+    std::vector<std::vector<double>> cols, all(2);
+    while (r.read(chunk, t, cols) > 0) {
+      EXPECT_LE(t.size(), chunk);
+      all_t.insert(all_t.end(), t.begin(), t.end());
+      for (int j = 0; j < 2; ++j) all[j].insert(all[j].end(), cols[j].begin(), cols[j].end());
+    }
+    EXPECT_EQ(r.rows(), 5u);
+    EXPECT_EQ(all_t, whole.t) << "chunk " << chunk;
+    EXPECT_EQ(all, whole.columns) << "chunk " << chunk;
+  }
+  EXPECT_DOUBLE_EQ(whole.t[1], 0.5e-3);
+  EXPECT_DOUBLE_EQ(whole.columns[0][2], 2.5);
+  // The sample limit names the line of the first row beyond it.
+  std::istringstream in(text);
+  CsvReader r(in, "x.csv");
+  std::vector<double> t;
+  std::vector<std::vector<double>> cols;
+  try {
+    r.read(100, t, cols, 3);
+    ADD_FAILURE() << "a fourth row read under a limit of 3";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 8: more than 3 samples"), std::string::npos) << e.what();
+  }
 }

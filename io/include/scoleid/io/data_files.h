@@ -9,6 +9,7 @@
 // failed run never leaves a half-written output.
 #include <istream>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,34 @@ DataTable read_csv(const std::string& path, const CsvOptions& options = {});
 // The same on text already in memory / a stream; `path` names it in messages.
 DataTable read_csv_text(const std::string& text, const std::string& path, const CsvOptions& options = {});
 DataTable read_csv_stream(std::istream& in, const std::string& path, const CsvOptions& options = {});
+
+// A CSV read in chunks of rows, for a record longer than memory need hold (scole-data frf streams
+// one through the Welch estimator): the header as read_csv reads it, then the rows as they come,
+// each checked as read_csv checks it (field count, numbers, finite, magnitude, the time strictly
+// increasing in its stated unit and in seconds). read_csv is this reader read to the end, with
+// the record's sample limit.
+class CsvReader {
+ public:
+  // Reads the header of the file at `path` (or of `in`); InputError as read_csv.
+  explicit CsvReader(const std::string& path, const CsvOptions& options = {});
+  CsvReader(std::istream& in, const std::string& path, const CsvOptions& options = {});
+  ~CsvReader();
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
+  // names, units, time_name, time_unit and source of the table; no rows.
+  const DataTable& header() const;
+  // At most max_rows more rows: t (seconds) and columns[j] (sized to header().names) replaced by
+  // them. Returns the rows read, 0 at the end of the file. max_samples > 0 refuses a row beyond
+  // that many in all (naming its line).
+  std::size_t read(std::size_t max_rows, std::vector<double>& t, std::vector<std::vector<double>>& columns,
+                   double max_samples = 0);
+  // Rows read so far.
+  std::size_t rows() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
 // A table held as columns in memory (a program's arrays, a DataFrame), read as read_csv reads a
 // file with that header: the time column chosen by options (the first when none is named), each
 // column's unit from its name's bracketed suffix, the time converted into seconds, then
@@ -63,6 +92,9 @@ DataTable table_from_columns(const std::vector<std::string>& header, const std::
 // magnitude at most limits::kMaxMagnitude. The readers check as they read (naming the line);
 // this checks a table built elsewhere, naming the source, column and sample.
 void check_table(const DataTable& table);
+// A field as write_csv writes a header's: quoted ("" for a quote) when it holds a separator, a quote
+// or outer blanks, or starts a comment.
+std::string csv_field(const std::string& name);
 // 17 significant digits; atomic.
 void write_csv(const std::string& path, const DataTable& table);
 // The fields of one CSV line, each trimmed of blanks and double quotes ('\r' dropped); a quoted

@@ -8,6 +8,7 @@
 //   a file whose first line begins "LabVIEW Measurement": a LabVIEW Measurement file (lvm.h);
 //   anything else: a CSV (data_files.h), the DAQ dialects included.
 // Values stay in their file's units; each column's unit is in DataTable::units.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,17 @@ bool is_lvm_file(const std::string& path);
 
 // The record as a table. InputError naming the file (and record, line, field) on anything wrong.
 DataTable read_data(const std::string& path, const CsvOptions& options = {});
+
+// Whether read_data reads `path` as a CSV (it is no Universal, LabVIEW Measurement or TDMS file).
+bool is_csv_data(const std::string& path);
+// A CSV opened to be read in chunks as read_data reads it whole: the time unit and the columns'
+// units (the header's, else those of the column description beside a converted file) as
+// read_data's table has them.
+struct CsvData {
+  std::unique_ptr<CsvReader> reader;
+  std::vector<std::string> units;  // one per column of reader->header().names
+};
+CsvData open_csv_data(const std::string& path, const CsvOptions& options = {});
 
 // One channel of a data file, as `scole-data info` lists it.
 struct Channel {

@@ -100,6 +100,10 @@ class WelchFrf {
   std::unique_ptr<State> state_;
 };
 
+// Welch's effective number of independent averages of K segments, counting the correlation of
+// adjacent segments only: K / (1 + 2c²), c the window's overlap correlation at the hop (Welch 1967).
+double welch_effective_averages(int segments, FrfWindow window, double overlap);
+
 struct LinesOptions {
   double sample_rate = 0;         // Hz, > 0
   std::vector<double> lines_hz;   // strictly increasing, in (0, fs/2)
