@@ -124,11 +124,11 @@ TEST(LateStart, APluckGivesWhatAFreeDecayCan) {
   }
 }
 
-// SCOLE on orbit, already vibrating (the built-in scole-ringing): paper Case II's pulses over the
-// first 2 s, the record from 3 s to 23 s with no input in it. With the initial state estimated
-// (the rigid-body modes among its basis: the pulses leave the structure drifting), EI within 1e-3
-// and ρA within 3e-3 of the truth, every parameter called identifiable covered by its interval,
-// and ρI_ψ flagged as from rest (paper-scole-2 flags it too).
+// SCOLE on orbit, already vibrating (the built-in scole-ringing): pulses of a tenth of paper Case
+// II's over the first 2 s, the record from 3 s to 23 s with no input in it. With the initial state
+// estimated (the rigid-body modes among its basis: the pulses leave the structure drifting), EI and
+// ρA within 1e-3 of the truth (the chain's lumping level, as paper-scole-2 from rest), every
+// parameter called identifiable covered by its interval.
 TEST(LateStart, ScoleRingingOnOrbit) {
   const io::Scenario sc = io::load_scenario("scole-ringing");
   const Truth truth = simulate_truth(sc);
@@ -140,9 +140,11 @@ TEST(LateStart, ScoleRingingOnOrbit) {
   for (std::size_t i = 0; i < r.names.size(); ++i) {
     const auto e = static_cast<Eigen::Index>(i);
     const double t = r.truth.at(r.names[i]);
-    if (r.names[i] == "EI") EXPECT_LT(std::abs(r.estimate[e] / t - 1.0), 1e-3);
-    if (r.names[i] == "rho_A") EXPECT_LT(std::abs(r.estimate[e] / t - 1.0), 3e-3);
-    if (r.names[i] == "rho_I_psi") EXPECT_FALSE(r.ident.identifiable[i]);
+    std::printf("%-10s %+.3e %s\n", r.names[i].c_str(), r.estimate[e] / t - 1.0, r.ident.identifiable[i] ? "" : "not identifiable");
+    if (r.names[i] == "EI" || r.names[i] == "rho_A") {
+      EXPECT_TRUE(r.ident.identifiable[i]) << r.names[i];
+      EXPECT_LT(std::abs(r.estimate[e] / t - 1.0), 1e-3) << r.names[i];
+    }
     if (r.ident.identifiable[i]) EXPECT_LE(std::abs(r.estimate[e] - t), r.interval.half_width[e]) << r.names[i];
   }
   // The basis holds the rigid-body modes (at 0 Hz) below the flexible ones.
