@@ -523,6 +523,8 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
     m.set_horizon(m.data_end());
     r.frf_model = m.predict(r.estimate);
   }
+  r.frf_passes = m.counters().evaluations;
+  r.frf_factorisations = m.counters().factorisations;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.summary.wall_seconds = r.wall_seconds;
   return r;

@@ -312,7 +312,8 @@ nlohmann::json frf_json(const Problem& p, const RunResult& r) {
   return {{"estimator", d.estimator}, {"input", p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name}, {"lines", d.lines()},
           {"f_min_hz", d.f_hz.front()}, {"f_max_hz", d.f_hz.back()}, {"averages", d.averages},
           {"variance_degrees_of_freedom", p.frf_variance_dof > 0 ? nlohmann::json(p.frf_variance_dof) : nlohmann::json("known")},
-          {"note", p.frf_note}, {"start", r.frf_start_note}, {"sensors", sensors}};
+          {"note", p.frf_note}, {"start", r.frf_start_note}, {"passes", r.frf_passes}, {"factorisations", r.frf_factorisations},
+          {"sensors", sensors}};
 }
 }  // namespace
 
@@ -342,7 +343,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"attempts", attempts_json(*this)},
            {"cost", summary.cost},
            {"smoothness", smoothness_json(*this)},
-           {"integrator", integrator_json(*this, p)},
+           {"integrator", p.frf ? json(nullptr) : integrator_json(*this, p)},  // a frequency-domain run integrates nothing
            {"data_source", p.data_source},
            {"elements", p.structure->elements()},
            {"settings", io::to_json(p.scenario)},
@@ -458,9 +459,13 @@ std::string RunResult::FullReport() const {
                   which, 2 * initial_state_hz.size());
     s += line;
   }
-  std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
-                summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
-                wall_seconds);
+  if (frf_passes > 0)  // a frequency-domain run integrates nothing: its work is the lines' complex factorisations
+    std::snprintf(line, sizeof line, "\n%s; %ld passes over the lines, %ld complex factorisations; %.3f s\n",
+                  summary.BriefReport().c_str(), frf_passes, frf_factorisations, wall_seconds);
+  else
+    std::snprintf(line, sizeof line, "\n%s; %ld forward, %ld costate, %ld sensitivity solves; %.3f s\n",
+                  summary.BriefReport().c_str(), counters.forward_solves, counters.costate_solves, counters.sensitivity_solves,
+                  wall_seconds);
   return s + line;
 }
 

@@ -179,11 +179,11 @@ TEST_F(ScoleTruthCli, SigtermMidRunLeavesNoOutputAndExits143) {
       ::dup2(fileno(devnull), 1);
       ::dup2(fileno(devnull), 2);
     }
-    ::execl(SCOLE_TRUTH_EXE, SCOLE_TRUTH_EXE, "--scenario", "paper-scole-1", "--out", out.c_str(), "--quiet",
+    ::execl(SCOLE_TRUTH_EXE, SCOLE_TRUTH_EXE, "--scenario", "paper-scole-1", "--segments", "160", "--out", out.c_str(), "--quiet",
             static_cast<char*>(nullptr));
     ::_exit(98);
   }
-  ::usleep(800000);  // the 40-segment SCOLE truth takes seconds; the signal lands mid-run
+  ::usleep(800000);  // a 160-segment SCOLE truth takes about ten seconds; the signal lands mid-run
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);

@@ -140,6 +140,7 @@ struct RunResult {
   MatrixXd predicted;  // the model's outputs at the estimate, when the run kept them (nonlinear)
   Eigen::MatrixXcd frf_model;  // a frequency-domain run's model FRFs at the estimate (lines × sensors)
   std::string frf_start_note;  // how its fit started (the peaks' start, run/frf_run.h)
+  long frf_passes = 0, frf_factorisations = 0;  // its work: passes over the lines, complex LU factorisations
   // The signal that ended the run (RunOptions::keep_interrupted; SIGALRM: the wall-time limit), 0
   // when it ran to its end; and where it stood then.
   int interrupted_by = 0;
