@@ -76,6 +76,29 @@ void print_info(const io::DataFileInfo& info) {
   for (const auto& n : info.notes) std::printf("  %s\n", n.c_str());
 }
 
+// A truth.csv's columns state no unit in their header; the truth.json beside it (scole-truth's)
+// states each one. Units the table already has are kept; a JSON that is no truth.json is ignored.
+io::DataTable with_truth_units(io::DataTable tab, const std::string& file) {
+  std::filesystem::path meta(file);
+  if (meta.extension() != ".csv") return tab;
+  meta.replace_extension(".json");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(meta, ec)) return tab;
+  io::TruthMeta truth;
+  try {
+    const json j = io::read_json(meta.string());
+    if (!j.is_object() || !j.contains("true_parameters") || !j.contains("columns")) return tab;
+    truth = io::truth_meta_from_json(j, meta.string());
+  } catch (const io::InputError&) {
+    return tab;
+  }
+  tab.units.resize(tab.names.size());
+  for (std::size_t k = 0; k < tab.names.size(); ++k)
+    for (const auto& c : truth.columns)
+      if (c.name == tab.names[k] && tab.units[k].empty()) tab.units[k] = c.unit;
+  return tab;
+}
+
 // The format OUT's extension asks for (any case): "lvm", "tdms", "uff" (.uff, .unv), else
 // "csv" (.csv, or any other name, as before).
 std::string out_format(const std::string& out) {
@@ -91,7 +114,7 @@ std::string out_format(const std::string& out) {
 void convert_to(const std::string& format, const std::string& file, const std::string& out, const io::CsvOptions& options,
                 bool quiet) {
   io::check_output_file("--out", out, {file});
-  const io::DataTable tab = io::read_data(file, options);
+  const io::DataTable tab = with_truth_units(io::read_data(file, options), file);
   if (format == "lvm") io::write_lvm(tab, out);
   else if (format == "uff") io::uff::write_file(tab, out);
   else io::write_tdms(tab, out);
@@ -114,7 +137,7 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
     io::check_output_file("--out", out, {file});
     io::check_output_file("--out", m.string(), {file});
   }
-  io::DataTable tab = io::read_data(file, options);
+  io::DataTable tab = with_truth_units(io::read_data(file, options), file);
   const io::DataFileInfo info = io::describe_data(file, options);
   json cols = json::array();
   for (std::size_t j = 0; j < tab.names.size(); ++j) {

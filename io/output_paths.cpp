@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "scoleid/io/error.h"
+#include "scoleid/io/run_directory.h"
 #include "scoleid/io/validation.h"
 
 namespace scoleid::io {
@@ -60,6 +61,8 @@ void check_output_file(const std::string& option, const std::string& path, const
   const fs::path p(path);
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw InputError(where + ": directory '" + dir.string() + "' does not exist");
+  // Not into a directory another run or a campaign is writing (its commit or resume would meet it).
+  check_not_inside_running(path, "command line: " + option);
   if (::access(dir.c_str(), W_OK | X_OK) != 0)
     throw InputError(where + ": directory '" + dir.string() + "' is not writable (" + std::strerror(errno) + ")");
   // access() answers yes to root everywhere: a file made and removed proves the directory takes one.

@@ -235,6 +235,13 @@ std::string one_line(const std::string& message) {
       char b[8];
       std::snprintf(b, sizeof b, "\\x%02X", c);
       out += b;
+    } else if (c == 0xC2 && i + 1 < end && static_cast<unsigned char>(m[i + 1]) >= 0x80 &&
+               static_cast<unsigned char>(m[i + 1]) <= 0x9F) {
+      // A C1 control (U+0080..U+009F, UTF-8 C2 80..C2 9F): U+0085 is a line break to many terminals.
+      char b[10];
+      std::snprintf(b, sizeof b, "\\u%04X", static_cast<unsigned char>(m[i + 1]));
+      out += b;
+      ++i;
     } else {
       out += static_cast<char>(c);
     }

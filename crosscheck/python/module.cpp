@@ -7,6 +7,7 @@
 // Errors: io::InputError becomes scoleid.InputError (a ValueError) with the same one-line message;
 // SIGINT during a call ends the solve under way (the library's interrupt checks) and raises
 // KeyboardInterrupt. Long calls release the GIL.
+#include <pybind11/complex.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,6 +15,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <complex>
+#include <map>
 #include <memory>
 #include <csignal>
 #include <exception>
@@ -28,7 +31,9 @@
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/crosscheck/trajectories.h"
 #include "scoleid/identify.h"
+#include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/frf_record.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/progress.h"
 #include "scoleid/io/builtin.h"
@@ -310,6 +315,75 @@ py::tuple crosscheck_trajectories(const std::string& yaml_text, const std::strin
   return py::make_tuple(crosscheck::to_json(r).dump(), t, Eigen::MatrixXd(r.chain), Eigen::MatrixXd(r.fe));
 }
 
+// A data file as read_data reads it (scole-identify --data): (names, units, t, values).
+py::tuple read_data_file(const std::string& path, const std::string& time_column, const std::string& time_unit) {
+  io::DataTable tab;
+  {
+    LibraryCall call;
+    tab = io::read_data(path, io::CsvOptions{time_column, time_unit});
+    call.finish();
+  }
+  std::vector<std::string> units = tab.units;
+  units.resize(tab.names.size());
+  const py::tuple r = record(tab);
+  return py::make_tuple(r[0], units, r[1], r[2]);
+}
+
+// A record's FRFs (io/frf_record.h, scole-data frf): (f, names, H, variance, coherence or None,
+// orders, sample_rate, samples, segments, effective_averages, note).
+py::tuple frf_of_file(const std::string& path, const std::string& input, const std::vector<std::string>& responses,
+                      const std::map<std::string, std::string>& units, double sample_rate, const std::string& estimator,
+                      double segment, double overlap, const std::string& window, double f_min, double f_max,
+                      const std::vector<double>& lines, const std::string& time_column, const std::string& time_unit) {
+  io::RecordFrfOptions o;
+  o.input = input;
+  o.responses = responses;
+  o.units = units;
+  o.sample_rate = sample_rate;
+  if (estimator == "h1") o.estimator = io::RecordFrfEstimator::H1;
+  else if (estimator == "h2") o.estimator = io::RecordFrfEstimator::H2;
+  else if (estimator == "lines") o.estimator = io::RecordFrfEstimator::Lines;
+  else throw io::InputError("frf: estimator must be 'h1', 'h2' or 'lines', got '" + io::one_line(estimator) + "'");
+  if (window == "hann") o.window = io::FrfWindow::Hann;
+  else if (window == "rectangular") o.window = io::FrfWindow::Rectangular;
+  else throw io::InputError("frf: window must be 'hann' or 'rectangular', got '" + io::one_line(window) + "'");
+  o.segment = segment;
+  o.overlap = overlap;
+  o.f_min = f_min;
+  o.f_max = f_max;
+  o.lines_hz = lines;
+  io::RecordFrf r;
+  {
+    LibraryCall call;
+    r = io::frf_of_record(path, io::CsvOptions{time_column, time_unit}, o);
+    call.finish();
+  }
+  const auto L = static_cast<py::ssize_t>(r.data.f_hz.size()), S = static_cast<py::ssize_t>(r.data.channels.size());
+  py::array_t<double> f(L);
+  std::memcpy(f.mutable_data(), r.data.f_hz.data(), r.data.f_hz.size() * sizeof(double));
+  py::array_t<std::complex<double>> H({L, S});
+  py::array_t<double> var({L, S});
+  auto h = H.mutable_unchecked<2>();
+  auto v = var.mutable_unchecked<2>();
+  bool coherent = S > 0;
+  std::vector<std::string> names;
+  for (py::ssize_t s = 0; s < S; ++s) {
+    const auto& ch = r.data.channels[static_cast<std::size_t>(s)];
+    names.push_back(ch.sensor);
+    coherent = coherent && !ch.coherence.empty();
+    for (py::ssize_t k = 0; k < L; ++k) h(k, s) = ch.H[static_cast<std::size_t>(k)], v(k, s) = ch.variance[static_cast<std::size_t>(k)];
+  }
+  py::object coherence = py::none();
+  if (coherent) {
+    py::array_t<double> c({L, S});
+    auto w = c.mutable_unchecked<2>();
+    for (py::ssize_t s = 0; s < S; ++s)
+      for (py::ssize_t k = 0; k < L; ++k) w(k, s) = r.data.channels[static_cast<std::size_t>(s)].coherence[static_cast<std::size_t>(k)];
+    coherence = c;
+  }
+  return py::make_tuple(f, names, H, var, coherence, r.orders, r.sample_rate, r.samples, r.segments, r.effective_averages, r.note);
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -361,6 +435,8 @@ PYBIND11_MODULE(_core, m) {
       .def("fit_table", &fit_table)
       .def("write", [](const Identification& id, const std::string& dir) { id.write(dir); });
   m.def("identify", &identify_call, py::arg("yaml"), py::arg("source"), py::arg("args"));
+  m.def("read_data", &read_data_file);
+  m.def("frf", &frf_of_file);
   m.def("crosscheck_modes", &crosscheck_modes);
   m.def("crosscheck_trajectories", &crosscheck_trajectories);
 }

@@ -65,6 +65,7 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
     const char* name;
     std::vector<std::string> argv;
     bool keeps_out;  // a resumable campaign keeps the cases it stored
+    double delay = 1.5;  // s before SIGTERM: mid-run
   };
   const std::vector<Case> cases = {
       {"scole-truth", {truth, "--scenario", "paper-scole-1", "--segments", "80", "--out", "out", "-q"}, false},
@@ -75,19 +76,21 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
       {"crosscheck all", {xc, "all", "--scenario", "paper-scole-1", "--out", "out"}, false},
       {"crosscheck suite", {xc, "suite", "--only", family, "--out", "out", "-q"}, false},
       {"crosscheck campaign", {xc, "campaign", "camp.yaml", "--out", "out"}, true},
-      // A DAQ export of two channels in g, 3·10⁶ samples each (120 MB: seconds of parsing).
-      {"scole-data info", {data, "info", "daq.csv"}, false},
-      {"scole-data convert", {data, "convert", "daq.csv", "--out", "out.csv", "-q"}, false},
+      // A DAQ export of a force and two channels in g, 3·10⁶ samples each (160 MB: about a second
+      // of parsing, so the signal comes at 0.25 s).
+      {"scole-data info", {data, "info", "daq.csv"}, false, 0.25},
+      {"scole-data convert", {data, "convert", "daq.csv", "--out", "out.csv", "-q"}, false, 0.25},
+      {"scole-data frf", {data, "frf", "daq.csv", "--input", "F [N]", "--out", "out.uff", "-q"}, false, 0.25},
   };
   const auto inputs = [](const fs::path& d, bool daq) {
     std::ofstream(d / "camp.yaml") << "campaign: c\nscenarios: [paper-scole-1]\ngrid: {truth.segments: [80, 160]}\n";
     if (!daq) return;
     std::FILE* f = std::fopen((d / "daq.csv").c_str(), "w");
     ASSERT_NE(f, nullptr);
-    std::fprintf(f, "# exported by a DAQ\ntime [s],acc1 [g],acc2 [g]\n");
+    std::fprintf(f, "# exported by a DAQ\ntime [s],F [N],acc1 [g],acc2 [g]\n");
     for (long k = 0; k < 3000000; ++k) {
       const double t = 1e-4 * static_cast<double>(k);
-      std::fprintf(f, "%.6e,%.6e,%.6e\n", t, 0.01 * std::sin(6.0 * t), 0.02 * std::cos(6.0 * t));
+      std::fprintf(f, "%.6e,%.6e,%.6e,%.6e\n", t, std::sin(60.0 * t), 0.01 * std::sin(6.0 * t), 0.02 * std::cos(6.0 * t));
     }
     ASSERT_EQ(std::fclose(f), 0);
   };
@@ -97,7 +100,7 @@ TEST(Signals, EveryProgramAndVerbEndsWithinASecondOfSigtermLeavingNothingBesideO
       if (ch == ' ') ch = '-';
     const fs::path d = scoleid::test::scratch("xc-signal", tag);
     inputs(d, tag.rfind("scole-data", 0) == 0);
-    const Outcome o = run_and_terminate(c.argv, d, 1.5);
+    const Outcome o = run_and_terminate(c.argv, d, c.delay);
     std::printf("  %-24s exit %d, %.3f s after SIGTERM\n", c.name, o.code, o.after);
     EXPECT_EQ(o.code, 128 + SIGTERM) << c.name;
     EXPECT_LT(o.after, 1.0) << c.name;

@@ -359,3 +359,29 @@ TEST(DataCli, FrfWritesUffAndCsvThatReadBack) {
   EXPECT_EQ(self.code, 2);
   EXPECT_EQ(tab.t.size() + 1, static_cast<std::size_t>(lines(slurp(bad / "r.csv"))));
 }
+
+// `convert` of a truth.csv takes each column's unit from the truth.json beside it (the header
+// states none): the UFF written carries them.
+TEST(DataCli, ConvertTakesATruthCsvsUnitsFromItsTruthJson) {
+  const fs::path dir = scratch();
+  DataTable tab;
+  tab.names = {"F", "roll_tip"};
+  tab.t = {0.0, 0.01, 0.02};
+  tab.columns = {{1, 2, 3}, {0.1, 0.2, 0.3}};
+  write_csv((dir / "truth.csv").string(), tab);
+  TruthMeta m;
+  m.scenario = "x";
+  m.structure = "scole";
+  ColumnMeta f, r;
+  f.name = "F", f.unit = "lb", f.kind = "input", f.quantity = "force";
+  r.name = "roll_tip", r.unit = "ft", r.kind = "output", r.quantity = "displacement";
+  m.columns = {f, r};
+  m.true_parameters = {{"EI", 4e7}};
+  write_json_atomic((dir / "truth.json").string(), to_json(m));
+  const Result c = run({"convert", "truth.csv", "-o", "x.uff", "-q"}, dir);
+  ASSERT_EQ(c.code, 0) << slurp(dir / "stderr.txt");
+  const DataTable back = read_data((dir / "x.uff").string());
+  ASSERT_EQ(back.names.size(), 2u);
+  EXPECT_EQ(back.unit(0), "lb");
+  EXPECT_EQ(back.unit(1), "ft");
+}

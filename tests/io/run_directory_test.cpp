@@ -2,6 +2,7 @@
 // run is replaced whole; a run that fails or is interrupted changes nothing and leaves no
 // staging directory; a directory holding anything else is refused before any work.
 #include "scoleid/io/run_directory.h"
+#include "scoleid/io/output_paths.h"
 
 #include <gtest/gtest.h>
 #include <fcntl.h>
@@ -296,6 +297,15 @@ TEST_F(RunDirectoryTest, ARunInsideARunningCampaignIsRefusedUnlessThisProcessWor
   }
   // The shared check says the same for any other writer (a campaign inside a campaign).
   EXPECT_THROW(check_not_inside_running((cam / "inner").string(), "campaign output directory"), InputError);
+  // And of a single output file (--export-model, scole-data convert -o), naming the option.
+  try {
+    check_output_file("--export-model", (cam / "m.json").string(), {});
+    ADD_FAILURE() << "a single output file inside a running campaign was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("command line: --export-model '" + (cam / "m.json").string() + "': lies inside"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(cam / "m.json"));
   // The lock released: accepted.
   ::close(fd);
   {

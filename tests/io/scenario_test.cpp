@@ -341,6 +341,25 @@ identification:
         "scenario 'x.yaml': identification.uncertain.scole.bending_rotary_inertia must name the alternative to the "
         "model's setting, got true"}});
   EXPECT_NE(error_of(head + "[1, 2]\n").find("identification.uncertain must be a map"), std::string::npos);
+  // An estimated quantity is refused at the door, naming the parameter that sets it (EI sets both
+  // bending planes' stiffness); one the fit holds fixed is accepted.
+  EXPECT_EQ(error_of(head + "{scole.EI_roll: 1e5}\n"),
+            "scenario 'x.yaml': identification.uncertain.scole.EI_roll is estimated (identification.estimate names EI): a quantity is "
+            "estimated or declared uncertain, not both, got 100000");
+  EXPECT_NO_THROW(parse_scenario(head + "{scole.GJ: 1e5}\n", "scenario 'x.yaml'"));
+  const std::string beam = R"(structure: beam
+beam: {length: 0.5, rho_A: 0.6, EI: 11, attachments: [{name: shaker, location: 0.4, mass: 0.06}]}
+inputs:
+  - {name: F, location: 0.4, signal: {type: step, amplitude: 1}}
+sensors:
+  - {name: a, location: 0.45}
+identification:
+  estimate: [EI, attachments.shaker.mass]
+  uncertain: )";
+  EXPECT_NE(error_of(beam + "{beam.attachments.shaker.mass: 0.001}\n").find("is estimated (identification.estimate names attachments.shaker.mass)"),
+            std::string::npos)
+      << error_of(beam + "{beam.attachments.shaker.mass: 0.001}\n");
+  EXPECT_NO_THROW(parse_scenario(beam + "{beam.attachments.shaker.location: 0.002, beam.rho_A: 0.01}\n", "scenario 'x.yaml'"));
 }
 
 TEST(Scenario, ModelErrorAndRestartsAreReadAndChecked) {

@@ -155,6 +155,9 @@ TEST(Counts, OverridesGoThroughTheSameChecks) {
 TEST(OneLine, ControlCharactersAreShownNotPrinted) {
   EXPECT_EQ(one_line("a\nb\tc\x01\n"), "a\\nb\\tc\\x01");
   EXPECT_EQ(one_line("plain"), "plain");
+  // C1 controls (U+0085, a line break to many terminals) shown as \uNNNN; other text as it is.
+  EXPECT_EQ(one_line("a\xC2\x85" "b\xC2\x80"), "a\\u0085b\\u0080");
+  EXPECT_EQ(one_line("caf\xC3\xA9 \xC2\xA0x"), "caf\xC3\xA9 \xC2\xA0x");
   // A huge echo is cut in the middle, never inside a UTF-8 sequence; the ends stay.
   const std::string huge = "file.yaml: field runs[0].name must be at most 64 characters, got '" + std::string(1000000, 'x') +
                            std::string("\xC3\xA9", 2) + std::string(50000, 'y') + "' (end)";

@@ -274,3 +274,42 @@ def test_results_handed_out_are_copies_and_truth_metadata_is_named_when_stale(be
     del df.attrs["meta"]
     for k, v in scoleid.identify("paper-beam-1", data=df).estimates.items():
         assert v == pytest.approx(scoleid.identify("paper-beam-1", data=beam_record).estimates[k], rel=1e-9)
+
+
+def test_read_data_and_frf_give_what_the_programs_give(tmp_path):
+    # A record as a DAQ writes it: units in brackets; acc = 0.5 F (in g per N) plus noise.
+    rng = np.random.default_rng(3)
+    n, fs = 40000, 2048.0
+    force = rng.normal(size=n)
+    acc = 0.5 * force + 0.01 * rng.normal(size=n)
+    df = pd.DataFrame({"F [N]": force, "acc [g]": acc}, index=pd.Index(np.arange(n) / fs, name="t [s]"))
+    path = tmp_path / "r.csv"
+    df.to_csv(path)
+    back = scoleid.read_data(path)
+    assert back.attrs["units"] == {"F [N]": "N", "acc [g]": "g"}
+    np.testing.assert_allclose(back["acc [g]"].to_numpy(), acc, rtol=1e-15)
+    np.testing.assert_allclose(back.index.to_numpy(), np.arange(n) / fs, rtol=1e-15)
+
+    r = scoleid.frf(path, "F [N]")
+    assert r.orders == {"acc [g]": 2}
+    # Within the F law's 1e-9 level of the exact 0.5 g/N = 4.903325 (m/s^2)/N (frf_estimate.h).
+    K = r.segments
+    z = np.abs(r.H["acc [g]"].to_numpy() - 0.5 * 9.80665) ** 2 / r.std["acc [g]"].to_numpy() ** 2
+    assert z.max() < (K - 1) * (1e-9 ** (-1.0 / (K - 1)) - 1), (K, z.max())
+    assert r.coherence is not None and (r.coherence["acc [g]"] > 0.99).all()
+    # The same numbers as scole-data frf writes.
+    subprocess.run([os.path.join(BUILD, "io", "scole-data"), "frf", str(path), "--input", "F [N]", "-q", "-o", str(tmp_path / "h.csv")],
+                   check=True)
+    cli = pd.read_csv(tmp_path / "h.csv", float_precision="round_trip")
+    np.testing.assert_array_equal(cli["f_hz"].to_numpy(), r.H.index.to_numpy())
+    np.testing.assert_array_equal(cli["acc [g] re"].to_numpy(), r.H["acc [g]"].to_numpy().real)
+    np.testing.assert_array_equal(cli["acc [g] std"].to_numpy(), r.std["acc [g]"].to_numpy())
+
+    with pytest.raises(scoleid.InputError, match="names no column of the file"):
+        scoleid.frf(path, "nope")
+    with pytest.raises(scoleid.InputError, match="estimator must be"):
+        scoleid.frf(path, "F [N]", estimator="h3")
+    with pytest.raises(TypeError, match="input must be a str"):
+        scoleid.frf(path, 3)
+    with pytest.raises(TypeError, match="path must be a path"):
+        scoleid.read_data(3)

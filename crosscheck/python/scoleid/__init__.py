@@ -22,6 +22,10 @@ sensor or input reads is left out. Column names are read as a CSV header is: a b
 (``Timedelta``) time is taken in seconds. A record's truth.json (true values, noise levels) travels
 as ``TruthRecord.meta`` or a DataFrame's ``attrs["meta"]``.
 
+Files. ``read_data(path)`` reads a lab's record (CSV, UFF, LVM, TDMS) into a DataFrame as
+``--data`` reads it; ``frf(path, input="F [N]")`` turns a record of any length into frequency
+responses as ``scole-data frf`` does (Welch streamed, or harmonic lines), in SI with each value's std.
+
 Results. The numbers are those of the programs (scole-truth, scole-identify, scole-crosscheck), bit
 for bit. What the user must know of a run (nothing identifiable, not converged) is also emitted as a
 ``ScoleidWarning``; progress lines go to ``progress=``, to ``sys.stdout`` with ``verbose=True``, and
@@ -58,7 +62,7 @@ InputError.__doc__ = ("Bad input (a scenario field, a data column, a file): the 
 
 __all__ = ["__version__", "InputError", "ScoleidWarning", "builtin_scenarios", "builtin_scenario", "load_scenario",
            "truth", "identify", "Identification", "TruthRecord", "StateSpace", "crosscheck_modes",
-           "crosscheck_trajectories"]
+           "crosscheck_trajectories", "read_data", "frf", "Frf"]
 
 _log = _logging.getLogger("scoleid")
 
@@ -185,6 +189,129 @@ def truth(scenario, progress=False):
     for j, n in enumerate(names):
         cols[n] = _np.ascontiguousarray(values[:, j])
     return TruthRecord(cols, _json.loads(meta))
+
+
+def _path(name, value):
+    """A file path argument (str or os.PathLike); TypeError for anything else."""
+    if isinstance(value, (str, _os.PathLike)):
+        return _os.fspath(value)
+    raise TypeError("%s must be a path (str or os.PathLike), got %s %r" % (name, type(value).__name__, value))
+
+
+def _text(name, value, allow_none=True):
+    if value is None and allow_none:
+        return ""
+    if not isinstance(value, str):
+        raise TypeError("%s must be a str, got %s %r" % (name, type(value).__name__, value))
+    return value
+
+
+def _number(name, value, default):
+    if value is None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, (int, float, _np.integer, _np.floating)):
+        raise TypeError("%s must be a number, got %s %r" % (name, type(value).__name__, value))
+    return float(value)
+
+
+def read_data(path, *, time_column=None, time_unit=None):
+    """A measured record as ``scole-identify --data`` reads it: a CSV (DAQ dialects), a Universal
+    File (58/58b time responses), a LabVIEW LVM or an NI TDMS file.
+
+    Args:
+        path (str | os.PathLike): the data file.
+        time_column (str): a CSV's time column header (default: the first column).
+        time_unit (str): a CSV time column's unit when its header states none (default: s).
+
+    Returns:
+        pandas.DataFrame: one column per channel in the file's order, values in the file's units,
+        indexed by ``t`` in seconds; ``attrs["units"]`` maps each column to its unit as the file
+        states it ("" where it states none) and ``attrs["source"]`` is the path.
+
+    Raises:
+        InputError: the file cannot be read (one line naming it, the line or record, field and value).
+    """
+    import pandas as pd
+    path = _path("path", path)
+    names, units, t, values = _core.read_data(path, _text("time_column", time_column), _text("time_unit", time_unit))
+    df = pd.DataFrame(values, columns=names, index=pd.Index(t, name="t"))
+    df.attrs["units"] = dict(zip(names, units))
+    df.attrs["source"] = path
+    return df
+
+
+class Frf:
+    """Frequency responses of a record's responses to its force (``scoleid.frf``), in SI per N.
+
+    Attributes:
+        H (pandas.DataFrame): complex H per response column, indexed by ``f_hz``.
+        std (pandas.DataFrame): each value's standard deviation, sqrt(E|Ĥ − H|²).
+        coherence (pandas.DataFrame | None): γ² per value (Welch), None for harmonic lines.
+        orders (dict): per response 0 displacement, 1 velocity, 2 acceleration (its unit's).
+        sample_rate (float), samples (int), segments (int, 0 for lines),
+        effective_averages (float), note (str): how they were made.
+    """
+
+    def __init__(self, H, std, coherence, orders, sample_rate, samples, segments, effective_averages, note):
+        self.H, self.std, self.coherence, self.orders = H, std, coherence, orders
+        self.sample_rate, self.samples, self.segments = sample_rate, samples, segments
+        self.effective_averages, self.note = effective_averages, note
+
+    def __repr__(self):
+        return "<scoleid.Frf %d responses x %d lines: %s>" % (self.H.shape[1], self.H.shape[0], self.note)
+
+
+def frf(path, input, responses=None, *, units=None, sample_rate=None, estimator="h1", segment=None, overlap=0.5,
+        window="hann", f_min=None, f_max=None, lines=None, time_column=None, time_unit=None):
+    """Frequency response functions of a data file's response columns to its force column, as
+    ``scole-data frf`` makes them (docs/data.md §1.7): Welch H1/H2 with the record streamed (a CSV
+    of any length is never held whole), or the harmonic fit of known lines.
+
+    Args:
+        path (str | os.PathLike): the record (CSV, UFF, LVM or TDMS).
+        input (str): the force column's name.
+        responses (list[str]): response columns (default: every column but the input).
+        units (dict): column -> unit, for columns whose file states none.
+        sample_rate (float): the DAQ's rate in Hz (default: from the time column).
+        estimator (str): "h1" (default), "h2" or "lines".
+        segment (float): Welch segment in s (default: a power of two of samples near the record / 4.5).
+        overlap (float): Welch overlap in [0, 1) (default 0.5).
+        window (str): "hann" (default) or "rectangular".
+        f_min, f_max (float): the lines kept, f_min < f <= f_max (default 0 to 0.8 of Nyquist).
+        lines (list[float]): the input's frequencies in Hz, for estimator "lines".
+        time_column, time_unit (str): as ``read_data``.
+
+    Returns:
+        Frf: H, std and coherence as DataFrames indexed by ``f_hz``, and how they were made.
+
+    Raises:
+        InputError: a bad file, column, unit, clock or option (one line naming it).
+        TypeError: an argument of the wrong type.
+    """
+    import pandas as pd
+    path = _path("path", path)
+    input = _text("input", input, allow_none=False)
+    if responses is None:
+        responses = []
+    elif isinstance(responses, str) or not all(isinstance(r, str) for r in responses):
+        raise TypeError("responses must be a list of column names, got %r" % (responses,))
+    if units is None:
+        units = {}
+    elif not hasattr(units, "items") or not all(isinstance(k, str) and isinstance(v, str) for k, v in units.items()):
+        raise TypeError("units must be a dict of column name -> unit text, got %r" % (units,))
+    if lines is None:
+        lines = []
+    else:
+        lines = [_number("lines[%d]" % i, f, None) for i, f in enumerate(lines)]
+    f, names, H, var, coh, orders, rate, samples, segments, keff, note = _core.frf(
+        path, input, list(responses), dict(units), _number("sample_rate", sample_rate, 0.0),
+        _text("estimator", estimator, allow_none=False), _number("segment", segment, 0.0), _number("overlap", overlap, 0.5),
+        _text("window", window, allow_none=False), _number("f_min", f_min, 0.0), _number("f_max", f_max, 0.0), lines,
+        _text("time_column", time_column), _text("time_unit", time_unit))
+    index = pd.Index(f, name="f_hz")
+    return Frf(pd.DataFrame(H, columns=names, index=index), pd.DataFrame(_np.sqrt(var), columns=names, index=index),
+               None if coh is None else pd.DataFrame(coh, columns=names, index=index), dict(zip(names, orders)), rate, samples,
+               segments, keff, note)
 
 
 def _dtype_kind(values):

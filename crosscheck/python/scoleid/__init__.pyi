@@ -85,3 +85,22 @@ def crosscheck_modes(scenario: ScenarioLike, count: int = ..., segments: int = .
                      levels: int = ...) -> Dict[str, Any]: ...
 def crosscheck_trajectories(scenario: ScenarioLike, truth_dir: Union[str, "os.PathLike[str]"], segments: int = ...,
                             levels: int = ..., elements: int = ...) -> Dict[str, Any]: ...
+
+def read_data(path: Union[str, "os.PathLike[str]"], *, time_column: Optional[str] = ..., time_unit: Optional[str] = ...) -> pandas.DataFrame: ...
+
+class Frf:
+    H: pandas.DataFrame
+    std: pandas.DataFrame
+    coherence: Optional[pandas.DataFrame]
+    orders: Dict[str, int]
+    sample_rate: float
+    samples: int
+    segments: int
+    effective_averages: float
+    note: str
+
+def frf(path: Union[str, "os.PathLike[str]"], input: str, responses: Optional[Sequence[str]] = ..., *,
+        units: Optional[Mapping[str, str]] = ..., sample_rate: Optional[float] = ..., estimator: str = ...,
+        segment: Optional[float] = ..., overlap: float = ..., window: str = ..., f_min: Optional[float] = ...,
+        f_max: Optional[float] = ..., lines: Optional[Sequence[float]] = ..., time_column: Optional[str] = ...,
+        time_unit: Optional[str] = ...) -> Frf: ...

@@ -35,7 +35,8 @@ double sample_count(double duration, double interval);
 // calls it; a program that overrides fields from its command line calls it again.
 void validate_scenario(const Scenario& scenario);
 
-// A message as one line: line breaks and other control characters shown as \n, \t, \xNN, and
+// A message as one line: line breaks and other control characters shown as \n, \t, \xNN (C1
+// controls, U+0085 among them, as \uNNNN), and
 // a message over about 640 characters cut in the middle (its first 400 and last 160 kept, at UTF-8
 // boundaries, with the count left out). Every program prints its errors through this (a library's
 // multi-line text, a path holding a newline, a 50 MB name echoed back).
