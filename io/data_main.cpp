@@ -335,7 +335,7 @@ int main(int argc, char** argv) {
       ->required();
   fr->add_option("--input", fa.options.input, "the force column")->required();
   fr->add_option("--response", fa.options.responses, "a response column, repeated (default: every column but the input)");
-  fr->add_option("--unit", fa.units, "COLUMN=UNIT for a column whose file states no unit (N, lbf, m/s^2, g, mm, ...)");
+  fr->add_option("--unit", fa.units, "COLUMN=UNIT for a column whose file states no unit, or states a wrong one (N, lbf, m/s^2, g, mm, ...)");
   fr->add_option("--station", fa.stations,
                  "COLUMN=<node><sign><axis> of a response in the UFF (e.g. acc_tip=3+Z; default: the k-th response at node k, +Z)");
   fr->add_option("--reference", fa.reference, "<node><sign><axis> of the excitation in the UFF (default: node 0, scalar)");

@@ -39,7 +39,10 @@ std::size_t count_lines(const std::string& path) {
 struct Column {
   int index = -1;
   double scale = 1.0;
-  int order = 0;  // responses: 0 displacement, 1 velocity, 2 acceleration
+  int order = 0;         // responses: 0 displacement, 1 velocity, 2 acceleration
+  std::string name;      // the column's
+  std::string unit;      // the unit read
+  std::string replaced;  // the file's unit, when --unit replaced it
 };
 
 Column column(const std::string& source, const std::vector<std::string>& names, const std::vector<std::string>& units,
@@ -52,15 +55,20 @@ Column column(const std::string& source, const std::vector<std::string>& names, 
     throw InputError(source + ": " + option + " names no column of the file (its columns: " + list + "), got '" + one_line(name) + "'");
   }
   c.index = static_cast<int>(it - names.begin());
+  c.name = name;
   std::string unit = units[static_cast<std::size_t>(c.index)];
+  // A unit given with --unit is the user's statement: it replaces the file's (a LabVIEW channel
+  // left at its default label "g" that holds a force), and the note says so.
   const auto stated = o.units.find(name);
-  if (unit.empty() && stated != o.units.end()) unit = stated->second;
+  if (stated != o.units.end()) {
+    if (!unit.empty() && unit != stated->second) c.replaced = unit;
+    unit = stated->second;
+  }
   const std::string what = source + ": column '" + one_line(name) + "' (" + option + ")";
   if (unit.empty())
     throw InputError(what + ": the file states no unit; give it in the header ('" + one_line(name) + " [N]') or with --unit '" +
                      one_line(name) + "=UNIT'");
-  if (stated != o.units.end() && stated->second != unit)
-    throw InputError(what + ": --unit says " + one_line(stated->second) + " but the file states " + one_line(unit));
+  c.unit = unit;
   using units::Quantity;
   if (force) {
     if (const auto why = units::problem_with(unit, Quantity::Force))
@@ -187,6 +195,13 @@ class Feed {
       throw InputError(source_ + ": " + e.what());
     }
     r.note = note;
+    for (const Column* c : [&] {
+           std::vector<const Column*> all{&in_};
+           for (const auto& x : resp_) all.push_back(&x);
+           return all;
+         }())
+      if (!c->replaced.empty())
+        r.note += "; column '" + one_line(c->name) + "' read in " + c->unit + " (--unit; the file says " + c->replaced + ")";
     // Into SI: the estimators are linear in each column.
     for (std::size_t s = 0; s < resp_.size(); ++s) {
       const double c = resp_[s].scale / in_.scale;

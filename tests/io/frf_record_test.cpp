@@ -202,6 +202,13 @@ TEST(FrfRecord, RefusesWithOneLine) {
   o = options();
   o.input = "acc [g]";
   refuse((d / "r.csv").string(), o, "the input must be a force");
+  // --unit replaces a unit the file states wrongly (a force channel labelled g), and says so.
+  o = options();
+  o.input = "acc [g]";
+  o.responses = {"disp [mm]"};
+  o.units = {{"acc [g]", "N"}};
+  const RecordFrf relabelled = frf_of_record((d / "r.csv").string(), {}, o);
+  EXPECT_NE(relabelled.note.find("column 'acc [g]' read in N (--unit; the file says g)"), std::string::npos) << relabelled.note;
   o = options();
   o.responses = {"nope"};
   refuse((d / "r.csv").string(), o, "--response names no column of the file");

@@ -18,7 +18,8 @@
 // Units. The input column must hold a force, each response a displacement, velocity or
 // acceleration (its response order 0, 1, 2), each with its unit from the file (a header's
 // "[unit]", the column description beside a converted CSV, the UFF record, LVM/TDMS properties)
-// or from `units` where the file states none. The estimators are linear, so the values are read
+// or from `units`, which also replaces a unit the file states wrongly (a LabVIEW channel left at its
+// default label), the note naming the replacement. The estimators are linear, so the values are read
 // in their own units and each H turned into SI once: H_SI = H · c_response / c_force, its
 // variance by the square (c the units' scale factors into m, m/s, m/s², N).
 //
@@ -45,7 +46,7 @@ enum class RecordFrfEstimator { H1, H2, Lines };
 struct RecordFrfOptions {
   std::string input;                          // the force column's name
   std::vector<std::string> responses;         // response columns (empty: every column but the input)
-  std::map<std::string, std::string> units;   // column -> unit, for columns whose file states none
+  std::map<std::string, std::string> units;   // column -> unit: where the file states none, or replacing its (noted)
   double sample_rate = 0;                     // Hz; 0: from the time column
   RecordFrfEstimator estimator = RecordFrfEstimator::H1;
   double segment = 0;                         // s; 0: the default above
