@@ -90,11 +90,17 @@ Column column(const std::string& source, const std::vector<std::string>& names, 
 // The sample clock: the rate and t0 from the first chunk, each later time checked against them.
 class Clock {
  public:
-  Clock(std::string source, double stated) : source_(std::move(source)), stated_(stated) {}
+  // `step`, `rounding`: a step the file states for its times (DataTable::stated_step), or 0.
+  Clock(std::string source, double stated, double step = 0, double rounding = 0)
+      : source_(std::move(source)), stated_(stated), file_step_(step), file_rounding_(rounding) {}
 
   void add(const std::vector<double>& t) {
     if (t.empty()) return;
     if (step_ == 0) start(t);
+    if (replaces_) {
+      k_ += t.size();
+      return;
+    }
     const double tol = (stated_ > 0 ? 0.5 : 0.25) * step_;
     for (std::size_t i = 0; i < t.size(); ++i, ++k_) {
       const double off = t[i] - (t0_ + static_cast<double>(k_) * step_);
@@ -112,10 +118,12 @@ class Clock {
     if (t.size() < 2) throw InputError(source_ + ": needs at least 2 samples, got " + std::to_string(t.size()));
     if (stated_ > 0) {
       std::string why;
-      const auto g = stated_grid(t, stated_, &why);
+      const auto g = stated_grid(t, stated_, &why, file_step_, file_rounding_);
       if (!g) throw InputError(source_ + ": --sample-rate " + format_value(stated_) + ": " + why);
       t0_ = g->t0, step_ = g->step;
       basis_ = "(the stated rate)";
+      // The file's own times t0 + k·(its written step): the rate replaces them, every sample.
+      replaces_ = file_step_ > 0 && g->precision != "stated rate";
       return;
     }
     const TimeGrid g = uniform_grid(t);
@@ -128,15 +136,18 @@ class Clock {
   }
 
   std::string source_, basis_;
-  double stated_ = 0, t0_ = 0, step_ = 0;
+  double stated_ = 0, file_step_ = 0, file_rounding_ = 0, t0_ = 0, step_ = 0;
+  bool replaces_ = false;
   std::size_t k_ = 0;
 };
 
 // The estimator fed chunk by chunk: Welch streams, lines keeps the samples.
 class Feed {
  public:
-  Feed(std::string source, const RecordFrfOptions& o, std::size_t expected, std::vector<Column> responses, Column input)
-      : source_(std::move(source)), o_(o), expected_(expected), resp_(std::move(responses)), in_(input), clock_(source_, o.sample_rate) {
+  Feed(std::string source, const RecordFrfOptions& o, std::size_t expected, std::vector<Column> responses, Column input,
+       double file_step = 0, double file_rounding = 0)
+      : source_(std::move(source)), o_(o), expected_(expected), resp_(std::move(responses)), in_(input),
+        clock_(source_, o.sample_rate, file_step, file_rounding) {
     x_.resize(resp_.size());
   }
 
@@ -307,7 +318,7 @@ RecordFrf frf_of_record(const std::string& path, const CsvOptions& csv, const Re
   std::vector<std::string> units = tab.units;
   units.resize(tab.names.size());
   const Column in = roles(tab.names, units, resp, resp_names);
-  Feed feed(source, o, tab.t.size(), resp, in);
+  Feed feed(source, o, tab.t.size(), resp, in, tab.stated_step, tab.stated_step_rounding);
   std::vector<double> t;
   std::vector<std::vector<double>> cols(tab.names.size());
   for (std::size_t b = 0; b < tab.t.size(); b += kChunk) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -84,6 +85,18 @@ bool number(const Lvm& f, std::string cell, double& v) {
   cell = trim(cell);
   if (f.decimal == ',') std::replace(cell.begin(), cell.end(), ',', '.');
   return parse_number(cell, v);
+}
+
+// Half a unit of the last digit a number is written to: "0.000977" → 5e-7, "9.765625E-4" → 5e-11,
+// "1E-3" → 5e-4 (a decimal comma counts as the point).
+double written_rounding(std::string cell) {
+  cell = trim(cell);
+  const auto e = cell.find_first_of("eE");
+  const std::string mantissa = cell.substr(0, e);
+  const int exponent = e == std::string::npos ? 0 : std::atoi(cell.c_str() + e + 1);
+  const auto point = mantissa.find_first_of(".,");
+  const int decimals = point == std::string::npos ? 0 : static_cast<int>(mantissa.size() - point - 1);
+  return 0.5 * std::pow(10.0, exponent - decimals);
 }
 
 // The same on a trimmed cell of a data row.
@@ -276,6 +289,8 @@ Lvm parse_stream(std::istream& in, const std::string& path) {
     if (!have_dx) fail(f, lineno, "X_Columns No needs a Delta_X > 0 for channel '" + f.names[first] + "'");
     tab.t.resize(n);
     for (std::size_t k = 0; k < n; ++k) tab.t[k] = x0 + static_cast<double>(k) * dx;
+    tab.stated_step = dx;  // the times are the file's Delta_X, as written
+    tab.stated_step_rounding = written_rounding(seg_value(f, "Delta_X", first));
   } else {
     const std::vector<double>& t = x[f.x_columns == "Multi" ? static_cast<std::size_t>(first) : 0];
     for (std::size_t k = 0; k < n; ++k)

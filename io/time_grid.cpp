@@ -96,11 +96,22 @@ TimeGrid uniform_grid(const std::vector<double>& t) {
   return g;
 }
 
-std::optional<TimeGrid> stated_grid(const std::vector<double>& t, double rate, std::string* why) {
+std::optional<TimeGrid> stated_grid(const std::vector<double>& t, double rate, std::string* why, double stated_step,
+                                     double rounding) {
   TimeGrid g;
   g.step = 1.0 / rate;
   g.t0 = t.front();
   g.precision = "stated rate";
+  if (stated_step > 0 && std::abs(g.step - stated_step) <= rounding * (1 + 1e-12)) {
+    // The file's own times are t0 + k·stated_step: the rate is what that written step rounds.
+    g.precision = "stated rate (the file's step " + format_value(stated_step) + " s as written)";
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      const double shift = std::abs(t[k] - (g.t0 + static_cast<double>(k) * g.step));
+      if (shift > g.max_shift) g.max_shift = shift, g.worst = k;
+    }
+    g.uniform = true;
+    return g;
+  }
   for (std::size_t k = 0; k < t.size(); ++k) {
     const double shift = std::abs(t[k] - (g.t0 + static_cast<double>(k) * g.step));
     if (shift > g.max_shift) {

@@ -1206,7 +1206,7 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
 void regularise_time(const io::Scenario& sc, io::DataTable& tab, const std::string& source, ColumnUse& use) {
   if (sc.data.sample_rate > 0) {
     std::string why;
-    const auto g = io::stated_grid(tab.t, sc.data.sample_rate, &why);
+    const auto g = io::stated_grid(tab.t, sc.data.sample_rate, &why, tab.stated_step, tab.stated_step_rounding);
     if (!g)
       fail_field(sc.source, "data.sample_rate", "disagrees with the time column '" + tab.time_name + "' of data file '" + source + "': " + why,
                  io::format_value(sc.data.sample_rate));

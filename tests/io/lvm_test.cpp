@@ -12,6 +12,8 @@
 #include <functional>
 
 #include "scoleid/io/data_source.h"
+#include "scoleid/io/frf_record.h"
+#include "scoleid/io/time_grid.h"
 #include "common/test_data.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/units.h"
@@ -138,4 +140,28 @@ TEST(Lvm, AFileWithoutTheColumnNamesKeepsEveryRow) {
   const DataTable t = read_data(write_lvm("nonames.lvm", text).string());
   EXPECT_EQ(t.names, (std::vector<std::string>{"Untitled", "Untitled 1"}));
   EXPECT_EQ(t.t, (std::vector<double>{0.5, 1.5, 2.5}));
+}
+
+// A LabVIEW file without a time column states its step as Delta_X, written to few digits
+// (0.000977 for 1/1024 s: the times 1023.54 Hz): a stated rate within that writing's rounding
+// replaces it, one that is not is refused as before.
+TEST(Lvm, AStatedRateReplacesADeltaXWrittenToFewDigits) {
+  const std::string file = (kData / "long_single_header_multi_ch.lvm").string();
+  const DataTable l = read_data(file);
+  EXPECT_EQ(l.stated_step, 0.000977);
+  EXPECT_DOUBLE_EQ(l.stated_step_rounding, 5e-7);
+  std::string why;
+  EXPECT_FALSE(stated_grid(l.t, 1024.0, &why)) << "without the written step the per-sample check refuses 1024 Hz";
+  const auto g = stated_grid(l.t, 1024.0, &why, l.stated_step, l.stated_step_rounding);
+  ASSERT_TRUE(g);
+  EXPECT_EQ(g->step, 1.0 / 1024);
+  EXPECT_FALSE(stated_grid(l.t, 1000.0, &why, l.stated_step, l.stated_step_rounding)) << "1000 Hz is not what 0.000977 rounds";
+  RecordFrfOptions o;
+  o.input = "F";
+  o.units = {{"F", "N"}};
+  EXPECT_NEAR(frf_of_record(file, {}, o).sample_rate, 1.0 / 0.000977, 1e-6);
+  o.sample_rate = 1024;
+  const RecordFrf r = frf_of_record(file, {}, o);
+  EXPECT_EQ(r.sample_rate, 1024.0);
+  EXPECT_EQ(r.data.f_hz.front(), 1024.0 / 2048);
 }

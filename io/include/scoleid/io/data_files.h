@@ -27,6 +27,11 @@ struct DataTable {
   std::vector<std::string> units;
   std::string time_name = "t";                // the time column's header
   std::string time_unit;                      // its stated unit ("" = s); t is in seconds
+  // Times the file does not hold but states as t0 + k·step (an LVM with X_Columns No: its Delta_X):
+  // that step [s] and half a unit of its last written digit (0.000977 → 5e-7); 0 when the times are
+  // read from a column. A stated sample rate within that rounding of the step replaces it
+  // (time_grid.h stated_grid).
+  double stated_step = 0.0, stated_step_rounding = 0.0;
   // The unit of column j ("" when none is stated).
   std::string unit(int j) const;
 

@@ -34,7 +34,11 @@ struct TimeGrid {
 TimeGrid uniform_grid(const std::vector<double>& t);
 
 // A stated rate [Hz]: the grid t[0] + k/rate; std::nullopt with `why` (the sample, how far off) when
-// a sample lies half a step or more off it.
-std::optional<TimeGrid> stated_grid(const std::vector<double>& t, double rate, std::string* why);
+// a sample lies half a step or more off it. Times that the file itself made as t0 + k·step from a
+// step written to few digits (stated_step > 0, rounding: half a unit of its last digit; an LVM's
+// Delta_X 0.000977 for 1/1024 s) are replaced by the stated rate's grid when 1/rate lies within that
+// rounding of the step: the rate is what the written step rounds; otherwise as above.
+std::optional<TimeGrid> stated_grid(const std::vector<double>& t, double rate, std::string* why, double stated_step = 0,
+                                     double rounding = 0);
 
 }  // namespace scoleid::io
