@@ -503,6 +503,55 @@ std::vector<LineFit> fit_lines(const std::vector<const double*>& ch, std::size_t
 
 }  // namespace
 
+FrfData impact_frf(const double* input, const std::vector<const double*>& responses, std::size_t n, const ImpactOptions& o,
+                   const std::string& source, const std::string& input_name, const std::vector<std::string>& response_names) {
+  if (!(o.sample_rate > 0) || !std::isfinite(o.sample_rate)) throw std::invalid_argument("the sample rate must be > 0");
+  if (!(o.decay >= 0) || !std::isfinite(o.decay)) throw std::invalid_argument("the window's decay must be >= 0 (1/s)");
+  if (n < 16) throw std::invalid_argument("an impact record needs at least 16 samples, got " + std::to_string(n));
+  if (o.response_std.size() != responses.size() || response_names.size() != responses.size())
+    throw std::invalid_argument("one noise level and one name per response");
+  for (double s : o.response_std)
+    if (!(s > 0) || !std::isfinite(s)) throw std::invalid_argument("each response's noise level must be > 0");
+  if (!(o.input_std >= 0)) throw std::invalid_argument("the force's noise level must be >= 0");
+  const double fs = o.sample_rate, f_max = o.f_max > 0 ? std::min(o.f_max, 0.5 * fs) : 0.5 * fs;
+  std::vector<double> w(n);
+  double w2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) w[i] = std::exp(-o.decay * double(i) / fs), w2 += w[i] * w[i];
+  Fft fft(n);
+  std::vector<cd> X(n), Y(n);
+  auto transform = [&](const double* x, std::vector<cd>& out) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(x[i])) throw std::invalid_argument("sample " + std::to_string(i + 1) + " is not finite");
+      out[i] = cd(w[i] * x[i], 0.0);
+    }
+    fft.forward(out.data());
+  };
+  transform(input, X);
+  FrfData d;
+  d.source = source;
+  d.input = input_name;
+  d.estimator = "impact";
+  d.averages = 1;
+  d.decay = o.decay;
+  const std::size_t k_hi = static_cast<std::size_t>(std::floor(f_max * double(n) / fs + 1e-9));
+  for (std::size_t k = 1; k <= k_hi && k < n; ++k) d.f_hz.push_back(double(k) * fs / double(n));
+  if (d.f_hz.empty()) throw std::invalid_argument("no line between 0 and " + std::to_string(f_max) + " Hz");
+  for (std::size_t s = 0; s < responses.size(); ++s) {
+    transform(responses[s], Y);
+    FrfData::Channel ch;
+    ch.sensor = response_names[s];
+    for (std::size_t k = 1; k <= d.f_hz.size(); ++k) {
+      const double xx = std::norm(X[k]);
+      if (!(xx > 0)) throw std::invalid_argument("the force has no content at " + std::to_string(double(k) * fs / double(n)) + " Hz");
+      const cd h = Y[k] / X[k];
+      ch.H.push_back(h);
+      ch.variance.push_back((o.response_std[s] * o.response_std[s] + std::norm(h) * o.input_std * o.input_std) * w2 / xx);
+    }
+    d.channels.push_back(std::move(ch));
+  }
+  return d;
+}
+
 double welch_effective_averages(int segments, FrfWindow window, double overlap) {
   const int N = 1024, D = static_cast<int>(std::lround((1.0 - overlap) * N));
   std::vector<double> w(N);

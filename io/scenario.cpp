@@ -818,7 +818,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
 void parse_frf(Reader& parent, const std::string& source, FrfSpec& f) {
   const YAML::Node n = parent.child("frf");
   const std::string path = parent.field("frf");
-  if (!n.IsMap()) fail_field(source, path, "must be a map {estimator, segment, overlap, window, lines, stations, reference, relative_std, averages}", Reader::kind(n));
+  if (!n.IsMap()) fail_field(source, path, "must be a map {estimator, segment, overlap, window, lines, decay, stations, reference, relative_std, averages}", Reader::kind(n));
   Reader r(n, source, path);
   f.estimator = r.choice_of("estimator", f.estimator);
   f.segment = r.nonneg("segment", f.segment);
@@ -837,6 +837,11 @@ void parse_frf(Reader& parent, const std::string& source, FrfSpec& f) {
       if (!kv.second.IsScalar()) fail_field(source, r.field("stations") + "." + key, "must be a string such as \"12+Y\"", Reader::kind(kv.second));
       f.stations.emplace_back(key, kv.second.Scalar());
     }
+  }
+  if (r.has("decay")) {
+    f.decay = r.nonneg("decay", 0.0);
+    if (f.estimator != FrfEstimatorKind::Impact)
+      fail_field(source, r.field("decay"), "is the impact estimator's exponential window (estimator: impact)", format_value(f.decay));
   }
   f.reference = r.str("reference", "");
   f.relative_std = r.nonneg("relative_std", 0.0);
@@ -1348,6 +1353,7 @@ nlohmann::json to_json(const Scenario& s) {
   if (id.domain == Domain::Frequency) {
     json f = {{"estimator", to_string(id.frf.estimator)}, {"segment", id.frf.segment}, {"overlap", id.frf.overlap},
               {"window", to_string(id.frf.window)}, {"lines", id.frf.lines}};
+    if (id.frf.decay >= 0) f["decay"] = id.frf.decay;
     if (!id.frf.stations.empty()) {
       json st = json::object();
       for (const auto& [sensor, station] : id.frf.stations) st[sensor] = station;

@@ -506,6 +506,8 @@ void write_uff_frf(const std::string& path, const FrfData& data,
   const std::vector<double>& f = data.f_hz;
   const std::size_t n = f.size();
   if (n == 0) refuse("the FRFs have no line");
+  if (data.decay != 0)  // a reader would take them for H(iω)
+    refuse("the FRFs are H(s) at s = " + format_value(data.decay) + " + iω (an exponential window), which a dataset 58 cannot say");
   if (static_cast<double>(n) > limits::kMaxSamples)
     refuse(std::to_string(n) + " lines, more than " + format_value(limits::kMaxSamples));
   for (std::size_t k = 0; k < n; ++k)

@@ -26,10 +26,11 @@ std::vector<SparseMatrix> per_coefficient(const std::vector<OperatorTerm>& terms
 }
 
 // (iω)^o
-Complex rate_factor(double w, double order) {
+// s^order: a displacement, velocity or acceleration per force (s = a + iω; iω without a window).
+Complex rate_factor(Complex s, double order) {
   const int o = static_cast<int>(order);
   Complex f(1.0, 0.0);
-  for (int i = 0; i < o; ++i) f *= Complex(0.0, w);
+  for (int i = 0; i < o; ++i) f *= s;
   return f;
 }
 
@@ -77,8 +78,9 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
   g_c = VectorXd::Zero(ncoef);
   Eigen::MatrixXcd dHdc(S, ncoef);
   for (int k = k0; k < k1; ++k) {
-    const double w = kTwoPi * data_.f_hz[static_cast<std::size_t>(k)];
-    ComplexSparse Z = Kc - (w * w) * Mc + Complex(0.0, w) * Dc;
+    // The complex frequency s = a + iω (a: the data's exponential window, frf_data.h decay).
+    const Complex sk(data_.decay, kTwoPi * data_.f_hz[static_cast<std::size_t>(k)]);
+    ComplexSparse Z = Kc + (sk * sk) * Mc + sk * Dc;
     lu.compute(Z);
     if (lu.info() != Eigen::Success)
       throw std::domain_error("FrfMisfit: the model's dynamic stiffness is singular at " + std::to_string(data_.f_hz[static_cast<std::size_t>(k)]) + " Hz");
@@ -86,7 +88,7 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
     std::vector<Complex> factor(static_cast<std::size_t>(S)), delta(static_cast<std::size_t>(S));
     for (int s = 0; s < S; ++s) {
       const auto& ch = data_.channels[static_cast<std::size_t>(s)];
-      factor[static_cast<std::size_t>(s)] = rate_factor(w, orders_[static_cast<std::size_t>(s)]);
+      factor[static_cast<std::size_t>(s)] = rate_factor(sk, orders_[static_cast<std::size_t>(s)]);
       const Complex H = factor[static_cast<std::size_t>(s)] * Ct.col(s).transpose() * U;
       e.H(k, s) = H;
       const Complex d = H - ch.H[static_cast<std::size_t>(k)];
@@ -107,7 +109,7 @@ void FrfMisfit::evaluate_lines(const VectorXd& c, const MatrixXd& dcdq, Need nee
     };
     auto source = [&](int j) {
       const auto jj = static_cast<std::size_t>(j);
-      ComplexVector v = -times_U(Kj[jj]) + (w * w) * times_U(Mj[jj]) - Complex(0.0, w) * times_U(Dj[jj]);
+      ComplexVector v = -times_U(Kj[jj]) - (sk * sk) * times_U(Mj[jj]) - sk * times_U(Dj[jj]);
       if (j == input_coefficient) v += b_unit.cast<Complex>();
       return v;
     };

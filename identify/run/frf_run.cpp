@@ -158,6 +158,39 @@ void frf_from_record(Problem& p) {
     finish_frf(p, std::move(d), 0.0);
     return;
   }
+  if (kind == io::FrfEstimatorKind::Impact) {
+    // One segment of the whole record under an exponential window on force and responses: the FRF
+    // at s = a + iω, weighted by the sensors' noise levels (io/frf_estimate.h impact_frf).
+    io::ImpactOptions o;
+    o.sample_rate = fs;
+    const double T = static_cast<double>(n) / fs;
+    o.decay = spec.decay >= 0 ? spec.decay : std::log(100.0) / T;
+    o.f_max = 0.8 * 0.5 * fs;
+    for (int s = 0; s < p.data.sensors(); ++s) {
+      const double sd = p.noise_std[static_cast<std::size_t>(s)];
+      if (!(sd > 0))
+        fail_field(sc.source, "sensors." + p.data.names[static_cast<std::size_t>(s)] + ".noise_std",
+                   "must be stated (or found in the record's quiet start) for identification.frf.estimator impact: one hit's "
+                   "FRF has no scatter of its own to weigh it by",
+                   io::format_value(sd));
+      o.response_std.push_back(sd);
+    }
+    take(0, n);
+    io::FrfData d;
+    try {
+      d = io::impact_frf(x.data(), yp, n, o, p.data_source, name, p.data.names);
+    } catch (const std::invalid_argument& e) {
+      throw io::InputError(p.data_source + ": identification.frf (impact): " + e.what());
+    }
+    char note[240];
+    std::snprintf(note, sizeof note,
+                  "impact FRFs of input '%s': one segment of %.4g s under e^{-%.4g t} (%.3g at its end), lines every %.4g Hz up to %.4g Hz, "
+                  "compared with the model at s = %.4g + i omega",
+                  name.c_str(), T, o.decay, std::exp(-o.decay * T), fs / static_cast<double>(n), d.f_hz.back(), o.decay);
+    p.frf_note = note;
+    finish_frf(p, std::move(d), 0.0);
+    return;
+  }
   io::WelchOptions o;
   o.sample_rate = fs;
   o.overlap = spec.overlap;

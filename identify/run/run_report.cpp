@@ -310,7 +310,7 @@ nlohmann::json frf_json(const Problem& p, const RunResult& r) {
                        {"values", 2 * d.lines()}});
   }
   return {{"estimator", d.estimator}, {"input", p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name}, {"lines", d.lines()},
-          {"f_min_hz", d.f_hz.front()}, {"f_max_hz", d.f_hz.back()}, {"averages", d.averages},
+          {"f_min_hz", d.f_hz.front()}, {"f_max_hz", d.f_hz.back()}, {"averages", d.averages}, {"decay", d.decay},
           {"variance_degrees_of_freedom", p.frf_variance_dof > 0 ? nlohmann::json(p.frf_variance_dof) : nlohmann::json("known")},
           {"note", p.frf_note}, {"start", r.frf_start_note}, {"passes", r.frf_passes}, {"factorisations", r.frf_factorisations},
           {"sensors", sensors}};
@@ -588,7 +588,8 @@ std::string frf_plot_script(const Problem& p, const RunResult& r) {
   const auto S = d.channels.size();
   std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * S + 60) +
                    " noenhanced\nset output 'fit.png'\nset datafile separator ','\nset multiplot layout " + std::to_string(S) +
-                   ",2 title " + gnuplot_quote(plot_title(r) + " (FRFs per unit of '" + p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name + "')") +
+                   ",2 title " + gnuplot_quote(plot_title(r) + " (FRFs per unit of '" + p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name + "'" +
+                                 (p.frf->decay > 0 ? ", at s = " + io::format_value(std::round(p.frf->decay * 1e3) / 1e3) + "/s + i omega: windowed" : std::string()) + ")") +
                    "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\nset xrange [" +
                    io::format_value(d.f_hz.front()) + ":" + io::format_value(d.f_hz.back()) + "]\n";
   for (std::size_t s = 0; s < S; ++s) {

@@ -10,6 +10,8 @@
 //   - three steady sines: EI and zeta fixed, the strip's and the fixture's masses mostly as one;
 //   - three steady sines below the first resonance, lightly damped: EI and rho_A identified (the
 //     latter loosely), zeta flagged: three such lines cannot give it;
+//   - a hammer tap through the impact estimator (exponential window, the model at s = a + iω):
+//     zeta unbiased, and biased by a/ω when the window is not told;
 //   - what the door refuses: two inputs, an estimated initial state, declared uncertainties, a band
 //     that keeps no line, a segment that leaves too few averages, gauss-newton-krylov.
 #include <gtest/gtest.h>
@@ -18,6 +20,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/cli_support.h"
 #include "scoleid/identify/run/frf_run.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
@@ -29,6 +32,8 @@ using namespace scoleid::identify;
 using scoleid::io::InputError;
 
 namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 // The fit explains the data, and each parameter called identifiable lies within its interval
 // (each printed with its truth, interval and flag).
@@ -263,4 +268,53 @@ TEST(FrfRun, ThreeLinesBelowResonanceFlagTheDamping) {
     }
   // rho_A is seen only through the mass correction below resonance: identified, but loosely.
   EXPECT_GT(r.interval.half_width[1] / r.truth.at("rho_A"), 0.05) << "rho_A called known to 5 % from three lines below resonance";
+}
+
+// A hammer tap, the impact estimator: one segment under the automatic exponential window, the model
+// compared at s = a + iω. EI, rho_A and zeta each within its interval; the same FRFs read as H(iω)
+// (the window not told) put zeta a/ω₁ ≈ 0.02 high, outside its interval.
+TEST(FrfRun, AnImpactUnderAnExponentialWindowLeavesZetaUnbiased) {
+  const auto sc = scoleid::io::load_scenario(std::string(SCOLEID_TEST_DATA_DIR) + "/scenarios/frf_run_test/impact.yaml");
+  auto p = make_problem(sc, std::nullopt);
+  EXPECT_EQ(p->frf->estimator, "impact");
+  const double a = p->frf->decay;
+  EXPECT_NEAR(a, std::log(100.0) / 4.0, 1e-3);
+  const RunResult r = identify(*p);
+  expect_fit_and_covering_intervals(r);
+  for (std::size_t i = 0; i < r.names.size(); ++i) EXPECT_TRUE(r.ident.identifiable[i]) << r.names[i];
+  const double zeta_told = r.estimate[2];
+  auto q = make_problem(sc, std::nullopt);
+  q->frf->decay = 0.0;  // the window read as damping
+  const RunResult u = identify(*q);
+  std::printf("zeta: window told %.5f, not told %.5f (truth 0.01, a/omega_1 = %.4f)\n", zeta_told, u.estimate[2],
+              a / (kTwoPi * r.modes.front().frequency_hz));
+  EXPECT_GT(u.estimate[2] - 0.01, 3.0 * std::abs(zeta_told - 0.01)) << "the untold window should bias zeta";
+  EXPECT_GT(std::abs(u.estimate[2] - 0.01), r.interval.half_width[2]);
+}
+
+// The impact estimator's door: a window's decay only with it; a sensor without a noise level (stated,
+// or a quiet start to read it from) refused, naming the sensor.
+TEST(FrfRun, TheImpactEstimatorsDoor) {
+  std::string text = scoleid::test::slurp(std::string(SCOLEID_TEST_DATA_DIR) + "/scenarios/frf_run_test/impact.yaml");
+  const auto swap = [](std::string s, const std::string& from, const std::string& to) {
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? s : s.replace(at, from.size(), to);
+  };
+  try {
+    scoleid::io::parse_scenario(swap(text, "frf: {estimator: impact}", "frf: {estimator: h1, decay: 2}"), "x.yaml");
+    ADD_FAILURE() << "decay without the impact estimator accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("identification.frf.decay is the impact estimator's exponential window"), std::string::npos)
+        << e.what();
+  }
+  // No noise level for acc_mid, and the pulse at the record's first sample: no quiet start either.
+  std::string bare = swap(text, "location: 0.25, unit: m/s^2, noise_std: 0.02}", "location: 0.25, unit: m/s^2}");
+  bare = swap(bare, "t0: 0.05, width: 0.006", "t0: 0, width: 0.006");
+  try {
+    make_problem(scoleid::io::parse_scenario(bare, "x.yaml"), std::nullopt);
+    ADD_FAILURE() << "an impact run without acc_mid's noise level accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sensors.acc_mid.noise_std must be stated"), std::string::npos) << e.what();
+  }
 }

@@ -24,6 +24,9 @@ struct FrfData {
   std::string estimator;               // "H1", "H2", "lines", or "file"
   std::vector<double> f_hz;            // lines, strictly increasing, > 0
   int averages = 0;                    // segments averaged (Welch), periods (lines); 0 unknown
+  // An exponential window e^{-decay t} on the force and the responses alike (impact_frf,
+  // frf_estimate.h): the values are then H at s = decay + iω, not at iω [1/s]; 0 = none.
+  double decay = 0.0;
   struct Channel {
     std::string sensor;                          // the scenario sensor it belongs to
     std::vector<std::complex<double>> H;         // one per line

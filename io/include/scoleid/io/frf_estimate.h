@@ -55,7 +55,20 @@
 //    and to first order, the input's and the response's noise independent,
 //      E|Ĥ − H|² ≈ (E|δA_y|² + |H|² E|δA_x|²) / |A_x|².
 //
-// Both refuse bad arguments with std::invalid_argument (the caller names the source and turns it
+// 3. Impact (impact_frf): a hammer hit (or any input) recorded from rest to the response's decay,
+//    one segment of the whole record. An exponential window w[n] = e^{−a n/fs} on the force and on
+//    every response alike: since e^{−at} (h ∗ x)(t) = ((e^{−at} h) ∗ (e^{−at} x))(t), the windowed
+//    transforms' ratio is the FRF at the complex frequency s = a + iω,
+//      H_k = Y_k / X_k = H(a + iω_k),   Y_k = Σ_n w[n] y[n] e^{−iω_k n/fs}
+//    (exact for a system at rest at the first sample whose windowed response has died out by the
+//    last). A model told a (frf_data.h decay) is compared at s = a + iω and ζ stays unbiased; read as
+//    iω, the window would add a/ω_j to each mode's damping ratio. Lines k = 1 … at fs/N spacing.
+//    Noise: a response noise white of std σ_y gives E|δY_k|² = σ_y² Σ w², so
+//      E|Ĥ − H|² = (σ_y² + |H|² σ_x²) Σ_n w[n]² / |X_k|²
+//    (σ_x the force's noise, 0 when unknown): the levels are the caller's (stated, or a quiet
+//    start's), not the record's scatter — one hit has none.
+//
+// All refuse bad arguments with std::invalid_argument (the caller names the source and turns it
 // into an input error): a sample rate that is not positive, a segment shorter than 2 samples or
 // longer than the record, overlap outside [0, 1), samples that are not finite, lines outside
 // (0, fs/2), fewer than 2 segments, a line without input.
@@ -116,5 +129,17 @@ struct LinesOptions {
 FrfData harmonic_frf(const double* input, const std::vector<const double*>& responses, std::size_t n,
                      const LinesOptions& options, const std::string& source, const std::string& input_name,
                      const std::vector<std::string>& response_names);
+
+struct ImpactOptions {
+  double sample_rate = 0;              // Hz, > 0
+  double decay = 0;                    // a [1/s], >= 0
+  double f_max = 0;                    // lines kept f <= f_max (0: fs/2)
+  std::vector<double> response_std;    // σ_y per response, > 0
+  double input_std = 0;                // σ_x of the force, >= 0
+};
+
+// The record's FRFs at s = decay + iω (estimator "impact", averages 1, decay set).
+FrfData impact_frf(const double* input, const std::vector<const double*>& responses, std::size_t n, const ImpactOptions& options,
+                   const std::string& source, const std::string& input_name, const std::vector<std::string>& response_names);
 
 }  // namespace scoleid::io

@@ -277,6 +277,9 @@ struct FrfSpec {
   double overlap = 0.5;   // Welch overlap, [0, 1)
   FrfWindowKind window = FrfWindowKind::Hann;
   std::vector<double> lines;  // Hz, for the lines estimator; empty = the input signal's sine frequencies
+  // impact: the exponential window e^{-decay (t - t_0)} on the force and every response [1/s];
+  // < 0 = automatic (ln 100 / the record's length: 1 % at its end), 0 = none.
+  double decay = -1.0;
   // A UFF file of FRFs: scenario sensor ← "<node><sign><axis>" of its response, the excitation's
   // "<node><sign><axis>" ("" = the one reference of the file), and how well the values are known
   // when the file does not say (relative_std of |H|, or averages with the file's coherence).

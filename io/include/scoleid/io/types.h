@@ -38,7 +38,7 @@ enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
 enum class InitialState { Rest, Estimate };
 enum class Domain { Time, Frequency };
-enum class FrfEstimatorKind { Auto, H1, H2, Lines };
+enum class FrfEstimatorKind { Auto, H1, H2, Lines, Impact };
 enum class FrfWindowKind { Hann, Rectangular };
 enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain, RelativeDisplacement };
 enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
@@ -81,8 +81,9 @@ struct Names<Domain> {
 };
 template <>
 struct Names<FrfEstimatorKind> {
-  static constexpr std::array<std::pair<FrfEstimatorKind, const char*>, 4> rows{
-      {{FrfEstimatorKind::Auto, "auto"}, {FrfEstimatorKind::H1, "h1"}, {FrfEstimatorKind::H2, "h2"}, {FrfEstimatorKind::Lines, "lines"}}};
+  static constexpr std::array<std::pair<FrfEstimatorKind, const char*>, 5> rows{
+      {{FrfEstimatorKind::Auto, "auto"}, {FrfEstimatorKind::H1, "h1"}, {FrfEstimatorKind::H2, "h2"}, {FrfEstimatorKind::Lines, "lines"},
+       {FrfEstimatorKind::Impact, "impact"}}};
 };
 template <>
 struct Names<FrfWindowKind> {

@@ -7,6 +7,9 @@
 //   Z(ω) U = b,   Z(ω) = K − ω² M + iω D,
 // and sensor s (row C_s on the o_s-th derivative of u) reads H_s(ω) = (iω)^{o_s} C_s Z(ω)⁻¹ b: the
 // receptance, mobility or accelerance per unit input. One sparse complex factorisation per line.
+// Data made under an exponential window e^{−at} (io/frf_data.h decay a > 0, an impact record) are
+// the FRF at the complex frequency s = a + iω: Z(s) = K + s² M + s D and H_s = s^{o_s} C_s Z(s)⁻¹ b,
+// with iω → s everywhere below (Z(s) stays complex symmetric, so the adjoint is unchanged).
 //
 // Misfit. Per line k and channel s, Δ_ks = H_s(ω_k; q) − Ĥ_ks, weighted by the measured value's
 // variance σ²_ks = E|Ĥ − H|² (its real and imaginary parts each carry σ²/2, independent):
