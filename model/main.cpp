@@ -47,8 +47,8 @@ int main(int argc, char** argv) {
                  "cpodes, cpodes-bdf2, verlet, semi-explicit-euler2");
   app.add_option("--accuracy", accuracy,
                  "override truth.accuracy: local error per step (trapezoidal: on the fundamental mode, "
-                 "step <= (12 accuracy)^(1/3) / omega_1; the default 1e-9 keeps the energy drift below 1e-6 over 50 "
-                 "periods; gauss-legendre: step <= (720 accuracy)^(1/5) / omega_1)");
+                 "step <= (12 accuracy)^(1/3) / omega_ref (omega_ref: the fundamental mode, or a higher mode the inputs excite weighed by its share of the record, docs/theory.md 9.5); the default 1e-9 keeps the energy drift below 1e-6 over 50 "
+                 "periods; gauss-legendre: step <= (720 accuracy)^(1/5) / omega_ref)");
   app.add_flag("--list-scenarios", list, "list the built-in scenarios and exit");
   std::string print_name;
   app.add_option("--print-scenario", print_name,

@@ -39,8 +39,9 @@
 // round-off and end the step (counted in the summary). A step whose iteration still fails is
 // taken as two halves (down to 1/64 of it, counted), and only then does the run fail.
 //
-// Step: h_max = (720 accuracy)^(1/5) / omega_1, the step whose phase error on the fundamental
-// flexible mode omega_1 is `accuracy` per step; steps land on every requested time, so
+// Step: h_max = (720 accuracy)^(1/5) / omega_1, the step whose phase error on omega_1 is
+// `accuracy` per step (omega_1: the caller's reference, truth_run.h; the fundamental flexible mode,
+// or a higher mode the inputs excite, weighed by its share of the record); steps land on every requested time, so
 // h <= h_max is the interval over the smallest integer that satisfies it. The stages lie inside
 // the step, so an input that jumps at t1 is never evaluated there; y1 is realized at t1 (the
 // input's right limit).

@@ -73,7 +73,7 @@ struct SimulateOptions {
   bool progress = false;             // percent and real-time factor on stderr
   double wall_limit = 0.0;           // seconds; > 0: stop early (Termination::WallLimit)
   double max_step = 0.0;             // trapezoidal, gauss-legendre: step bound, 0 = from accuracy
-  double reference_omega = 0.0;      // trapezoidal, gauss-legendre: omega_1 of the step rule, 0 = from the initial state
+  double reference_omega = 0.0;      // trapezoidal, gauss-legendre: omega of the step rule (the fundamental, or the fastest mode the inputs excite, weighed: docs/theory.md §9.5), 0 = from the initial state
   // The stage on_sample reads (Velocity when no sensor reads accelerations): gauss-legendre then
   // realizes its step ends no further. The other methods deliver Acceleration always.
   SimTK::Stage sample_stage = SimTK::Stage::Acceleration;
