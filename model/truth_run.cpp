@@ -545,8 +545,8 @@ SimulateOptions simulation_plan(const io::Scenario& sc, Structure& structure, St
     if (!modes.empty()) so.reference_omega = modes.front().omega;
     // ... and the fastest sine the inputs drive it with, whose forced response it must follow alike.
     so.reference_omega = std::max(so.reference_omega, 2 * Pi * f_input);
-    // ... and every higher mode below the samples' Nyquist frequency as far as the inputs excite it
-    // (a hammer's pulse rings the modes up to about 2 / its width).
+    // ... and every higher mode that reaches the record, as far as the inputs excite it (a hammer's
+    // pulse rings the modes up to about 2 / its width).
     const double p_exp = so.integrator == "trapezoidal" ? 3.0 : 5.0;
     // Without an anti-alias filter the modes up to the sample rate fold into the record; behind one
     // those above twice its corner reach it 48 dB down or more (8 poles), and are not followed.
