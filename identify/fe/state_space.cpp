@@ -77,6 +77,7 @@ ModalModel modal_model(const StructuralModel& model, const VectorXd& c) {
   mm.output_shapes.resize(static_cast<Eigen::Index>(model.sensors.size()), modes);
   for (std::size_t j = 0; j < model.sensors.size(); ++j) mm.output_shapes.row(static_cast<Eigen::Index>(j)) = model.sensors[j].row * phi;
   mm.input_shapes = d.B0.transpose() * phi;
+  mm.mass_shapes = d.M * phi;
   mm.inputs = input_names(model);
   mm.outputs = output_names(model);
   return mm;

@@ -55,6 +55,43 @@ Propagated propagate(const VectorXd& g, const Identifiability& id, const Uncerta
   return out;
 }
 
+// The record's own frequency and damping of mode e (record_modes.h): m + J Δq + the freed
+// coordinate's share, its std from the step's covariance; where it differs from the model's by
+// more than `threshold` of that std, the miss plus twice the std widens the half-width.
+void add_record_mode(const RecordModes& rec, ModalEstimate& e, const VectorXd& jf, const VectorXd& jz, double threshold) {
+  const int j = rec.index_of(e.mode);
+  const auto P = jf.size();
+  if (j < 0 || rec.dq.size() != P || rec.covariance.rows() != P + 2 * static_cast<Eigen::Index>(rec.modes.size())) return;
+  auto spread = [&](const VectorXd& h) {  // hᵀ C h over the finite entries
+    double var = 0.0;
+    for (Eigen::Index a = 0; a < h.size(); ++a)
+      for (Eigen::Index b = 0; b < h.size(); ++b)
+        if (h[a] != 0.0 && h[b] != 0.0 && std::isfinite(rec.covariance(a, b))) var += h[a] * rec.covariance(a, b) * h[b];
+    return std::sqrt(std::max(var, 0.0));
+  };
+  VectorXd hf = VectorXd::Zero(rec.covariance.rows()), hz = hf;
+  hf.head(P) = jf;
+  hz.head(P) = jz;
+  hf[P + 2 * j] = 0.5 * e.frequency_hz;
+  hz[P + 2 * j + 1] = 1.0;
+  const double df = jf.dot(rec.dq) + 0.5 * e.frequency_hz * rec.eps[j];
+  const double dz = jz.dot(rec.dq) + rec.eta[j];
+  const double sf = spread(hf), sz = spread(hz);
+  if (!std::isfinite(df) || !std::isfinite(dz) || !(sf > 0) || !(sz > 0)) return;
+  e.record_frequency_hz = e.frequency_hz + df;
+  e.record_frequency_std_hz = sf;
+  e.record_damping_ratio = e.damping_ratio + dz;
+  e.record_damping_std = sz;
+  if (std::abs(df) > threshold * sf) {
+    e.frequency_model_form_hz = std::abs(df) + 2.0 * sf;
+    if (std::isfinite(e.frequency_half_width_hz)) e.frequency_half_width_hz += e.frequency_model_form_hz;
+  }
+  if (std::abs(dz) > threshold * sz) {
+    e.damping_model_form = std::abs(dz) + 2.0 * sz;
+    if (std::isfinite(e.damping_half_width)) e.damping_half_width += e.damping_model_form;
+  }
+}
+
 }  // namespace
 
 std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const Parameterization& params, const VectorXd& q,
@@ -155,6 +192,7 @@ std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const P
     e.damping_half_width = pz.half_width;
     if (!std::isfinite(pf.half_width)) e.note = "no half-record refit: interval not assessed";
     else if (through_fixed) e.note = "from what the data fix (" + flagged + " not identifiable apart)";
+    if (o.record) add_record_mode(*o.record, e, Jf.row(k).transpose(), Jz.row(k).transpose(), o.model_form_threshold);
   }
   return out;
 }

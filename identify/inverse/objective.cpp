@@ -304,6 +304,7 @@ VectorXd Objective::tangent_output_at(const SecondOrderSolver& solver, const Der
     // S̈ from the sensitivity equation M S̈ + D Ṡ + K S = −(∂M ü + ∂D u̇ + ∂K u − ∂b f).
     const int n = model_.ndof;
     VectorXd G = -(d.dM * a + d.dD * v + d.dK * x), acc(n);
+    if (d.rank_one.w.size() == n) G -= (d.rank_one.d * d.rank_one.w.dot(v) + d.rank_one.k * d.rank_one.w.dot(x)) * d.rank_one.w;
     for (std::size_t k = 0; k < d.db.size(); ++k) {
       const double fk = inputs_[k](t);
       if (fk != 0.0) G += fk * d.db[k];
@@ -1002,7 +1003,10 @@ Objective::Derivative Objective::derivative_along(const VectorXd& dcol) const {
       if (t.coefficient >= 0 && dcol[t.coefficient] != 0.0) A += dcol[t.coefficient] * t.matrix;
     return A;
   };
-  Derivative d{only_coef(model_.mass), only_coef(model_.damping), only_coef(model_.stiffness), {}};
+  Derivative d;
+  d.dM = only_coef(model_.mass);
+  d.dD = only_coef(model_.damping);
+  d.dK = only_coef(model_.stiffness);
   for (const auto& in : model_.inputs)
     d.db.push_back(in.coefficient >= 0 ? VectorXd(dcol[in.coefficient] * in.vector) : VectorXd(VectorXd::Zero(n)));
   return d;
@@ -1019,6 +1023,7 @@ Trajectory Objective::sensitivity(const SecondOrderSolver& solver, const Setup& 
     solver.acceleration(Fe.data(), x.data(), v.data(), a.data());
     Eigen::Map<VectorXd> Fm(F, n);
     Fm = -(d.dM * a + d.dD * v + d.dK * x);
+    if (d.rank_one.w.size() == n) Fm -= (d.rank_one.d * d.rank_one.w.dot(v) + d.rank_one.k * d.rank_one.w.dot(x)) * d.rank_one.w;
     for (std::size_t k = 0; k < d.db.size(); ++k) Fm += inputs_[k](t) * d.db[k];
   };
   return solver.solve(data_.t.front(), t_end, f, breakpoints_, nullptr);
@@ -1059,6 +1064,7 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
     std::vector<std::vector<int>> cols;
     std::vector<std::vector<double>> values;
     std::vector<std::vector<VectorXd>> db;
+    std::vector<RankOneDirection> rank_one;
   };
   auto L = std::make_shared<Lists>();
   L->rows.resize(d.size());
@@ -1092,6 +1098,7 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
       L->rows[i].push_back(row);
     }
     L->db.push_back(d[i].db);
+    L->rank_one.push_back(d[i].rank_one);
   }
   // (The inputs' values go into this thread's scratch: copies of the function may run on two threads.)
   return [this, n, L](double t, const double* x, const double* v, const double* a, double* Gp) {
@@ -1111,8 +1118,13 @@ SecondOrderSolver::TangentForcing Objective::tangent_forcing(const std::vector<D
         Gi[row.row] = g;
       }
       Eigen::Map<VectorXd> Gm(Gi, n);
-      for (std::size_t k = 0; k < f.size(); ++k)
-        if (f[k] != 0.0) Gm += f[k] * L->db[i][k];
+      const std::vector<VectorXd>& dbi = L->db[i];
+      for (std::size_t k = 0; k < f.size() && k < dbi.size(); ++k)
+        if (f[k] != 0.0) Gm += f[k] * dbi[k];
+      if (const RankOneDirection& r1 = L->rank_one[i]; r1.w.size() == n) {
+        const Eigen::Map<const VectorXd> xm(x, n), vm(v, n);
+        Gm -= (r1.d * r1.w.dot(vm) + r1.k * r1.w.dot(xm)) * r1.w;
+      }
     }
   };
 }
@@ -1606,78 +1618,11 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
     // outputs at the sample times interpolated between consecutive points as Trajectory::eval
     // does; memory O(P · DOF + samples · sensors · P), nothing O(steps). With an estimated initial
     // state its 2m tangents too, and the parameters' columns projected off theirs.
-    const auto ts = Clock::now();
     std::vector<Derivative> d;
     for (int i = 0; i < size(); ++i) d.push_back(derivative(s, i));
     if (estimates_initial_state())
       for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
-    const int P = static_cast<int>(d.size());
-    MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
-    const int m = 1 + P;
-    double t_prev = 0.0;
-    bool have_prev = false;
-    std::size_t next = 0;
-    SolverSummary sum;
-    if (!accelerations_) {
-      // In output space, as the Gauss–Newton sweep (sample_output_rows), on one thread or two.
-      MatrixXd Yx0(ns, m), Yv0(ns, m), Ys(ns, m);
-      stream_outputs(s, solver, t_end, t_end, d, nullptr,
-                     [&](double t1, int cols, const MatrixXd& Yx1, const MatrixXd& Yv1) {
-                       if (cols < m) throw std::logic_error("output_sensitivities: the tangents stopped early");
-                       sample_output_rows(data_.t, next, have_prev, t_prev, t1, Yx0, Yv0, Yx1, Yv1, Ys, G);
-                       Yx0 = Yx1;
-                       Yv0 = Yv1;
-                       t_prev = t1;
-                       have_prev = true;
-                     },
-                     sum);
-      counters_.solver.Accumulate(sum);
-      ++counters_.forward_solves;
-      counters_.sensitivity_solves += P;
-      counters_.sensitivity_seconds += since(ts);
-      return project_initial_state(G);
-    }
-    const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
-    MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m);
-    auto visit = [&](const SecondOrderSolver::Point& pt) {
-      if (pt.columns < m) throw std::logic_error("output_sensitivities: the tangents stopped early");
-      const Eigen::Map<const MatrixXd> X1(pt.x, n, m), V1(pt.v, n, m), A1(pt.a, n, m);
-      while (next < data_.t.size() && data_.t[next] <= pt.t) {
-        const double t = data_.t[next];
-        const double h = have_prev ? pt.t - t_prev : 0.0;
-        if (h > 0) {
-          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
-          Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
-          Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
-        } else {
-          Xs = X1;
-          Vs = V1;
-        }
-        ux = Xs.col(0);
-        uv = Vs.col(0);
-        if (accelerations_) output_at(s, solver, t, ux, uv, &a);
-        for (int i = 0; i < P; ++i) {
-          x = Xs.col(1 + i);
-          v = Vs.col(1 + i);
-          G.block(static_cast<Eigen::Index>(next) * ns, i, ns, 1) =
-              tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, ux, uv, a, x, v);
-        }
-        ++next;
-      }
-      X0 = X1;
-      V0 = V1;
-      A0 = A1;
-      t_prev = pt.t;
-      have_prev = true;
-    };
-    const auto start = run_start(s, d);
-    solver.stream_tangent(data_.t.front(), t_end, state_forcing(s), P, Gf, t_end, breakpoints_, visit, &sum,
-                          StepAnchor::Start, start.get());
-    counters_.solver.Accumulate(sum);
-    ++counters_.forward_solves;
-    counters_.sensitivity_solves += P;
-    counters_.sensitivity_seconds += since(ts);
-    return project_initial_state(G);
+    return streamed_output_sensitivities(s, solver, d, size());
   }
   // Without a tangent stepper: in blocks (as gauss_newton), memory O(block · steps · DOF + samples · sensors · P).
   const int P = size();
@@ -1698,6 +1643,124 @@ MatrixXd Objective::output_sensitivities(const VectorXd& q) {
         }
         G.block(static_cast<Eigen::Index>(k) * ns, first + i, ns, 1) = tangent_output_at(solver, d, t, ux, uv, a, x, v);
       }
+    }
+  }
+  return G;
+}
+
+MatrixXd Objective::streamed_output_sensitivities(const Setup& s, const SecondOrderSolver& solver,
+                                                  const std::vector<Derivative>& d, int leading) {
+  const int n = model_.ndof, ns = data_.sensors();
+  const double t_end = data_.t.back();
+  VectorXd x(n), v(n), a(n), ux(n), uv(n);
+  const auto ts = Clock::now();
+  const int P = static_cast<int>(d.size());
+  MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, P);
+  const int m = 1 + P;
+  double t_prev = 0.0;
+  bool have_prev = false;
+  std::size_t next = 0;
+  SolverSummary sum;
+  if (!accelerations_) {
+    // In output space, as the Gauss–Newton sweep (sample_output_rows), on one thread or two.
+    MatrixXd Yx0(ns, m), Yv0(ns, m), Ys(ns, m);
+    stream_outputs(s, solver, t_end, t_end, d, nullptr,
+                   [&](double t1, int cols, const MatrixXd& Yx1, const MatrixXd& Yv1) {
+                     if (cols < m) throw std::logic_error("output_sensitivities: the tangents stopped early");
+                     sample_output_rows(data_.t, next, have_prev, t_prev, t1, Yx0, Yv0, Yx1, Yv1, Ys, G);
+                     Yx0 = Yx1;
+                     Yv0 = Yv1;
+                     t_prev = t1;
+                     have_prev = true;
+                   },
+                   sum);
+    counters_.solver.Accumulate(sum);
+    ++counters_.forward_solves;
+    counters_.sensitivity_solves += P;
+    counters_.sensitivity_seconds += since(ts);
+    return project_initial_state(G, leading);
+  }
+  const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
+  MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m);
+  auto visit = [&](const SecondOrderSolver::Point& pt) {
+    if (pt.columns < m) throw std::logic_error("output_sensitivities: the tangents stopped early");
+    const Eigen::Map<const MatrixXd> X1(pt.x, n, m), V1(pt.v, n, m), A1(pt.a, n, m);
+    while (next < data_.t.size() && data_.t[next] <= pt.t) {
+      const double t = data_.t[next];
+      const double h = have_prev ? pt.t - t_prev : 0.0;
+      if (h > 0) {
+        const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
+        Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
+        Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
+      } else {
+        Xs = X1;
+        Vs = V1;
+      }
+      ux = Xs.col(0);
+      uv = Vs.col(0);
+      if (accelerations_) output_at(s, solver, t, ux, uv, &a);
+      for (int i = 0; i < P; ++i) {
+        x = Xs.col(1 + i);
+        v = Vs.col(1 + i);
+        G.block(static_cast<Eigen::Index>(next) * ns, i, ns, 1) =
+            tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, ux, uv, a, x, v);
+      }
+      ++next;
+    }
+    X0 = X1;
+    V0 = V1;
+    A0 = A1;
+    t_prev = pt.t;
+    have_prev = true;
+  };
+  const auto start = run_start(s, d);
+  solver.stream_tangent(data_.t.front(), t_end, state_forcing(s), P, Gf, t_end, breakpoints_, visit, &sum,
+                        StepAnchor::Start, start.get());
+  counters_.solver.Accumulate(sum);
+  ++counters_.forward_solves;
+  counters_.sensitivity_solves += P;
+  counters_.sensitivity_seconds += since(ts);
+  return project_initial_state(G, leading);
+}
+
+MatrixXd Objective::output_sensitivities_with(const VectorXd& q, const std::vector<RankOneDirection>& extra) {
+  if (extra.empty()) return output_sensitivities(q);
+  Setup s = setup(q);
+  SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
+  settle_initial_state(s, solver);
+  const int n = model_.ndof, ns = data_.sensors();
+  std::vector<Derivative> d;
+  for (int i = 0; i < size(); ++i) d.push_back(derivative(s, i));
+  for (const RankOneDirection& e : extra) {
+    if (e.w.size() != n) throw std::logic_error("Objective::output_sensitivities_with: a direction of the wrong size");
+    Derivative di;
+    di.dM = di.dD = di.dK = SparseMatrix(n, n);
+    di.rank_one = e;
+    d.push_back(std::move(di));
+  }
+  const int leading = static_cast<int>(d.size());
+  if (solver.has_tangent_solve()) {
+    if (estimates_initial_state())
+      for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
+    return streamed_output_sensitivities(s, solver, d, leading);
+  }
+  if (estimates_initial_state()) return {};  // its projection needs the streamed tangents
+  // Without a tangent stepper: the state, then each tangent on it.
+  Trajectory u;
+  const double t_end = data_.t.back();
+  const std::vector<Trajectory> S = solve_tangents(solver, s, t_end, t_end, u, d);
+  MatrixXd G(static_cast<Eigen::Index>(data_.t.size()) * ns, leading);
+  VectorXd x(n), v(n), a(n), ux(n), uv(n);
+  for (std::size_t k = 0; k < data_.t.size(); ++k) {
+    const double t = data_.t[k];
+    if (accelerations_) {
+      u.eval(t, ux.data(), uv.data());
+      output_at(s, solver, t, ux, uv, &a);
+    }
+    for (int i = 0; i < leading; ++i) {
+      S[static_cast<std::size_t>(i)].eval(t, x.data(), v.data());
+      G.block(static_cast<Eigen::Index>(k) * ns, i, ns, 1) =
+          tangent_output_at(solver, accelerations_ ? d[static_cast<std::size_t>(i)] : Derivative{}, t, ux, uv, a, x, v);
     }
   }
   return G;
@@ -1844,8 +1907,8 @@ void Objective::add_initial_velocity_term(const Setup& s, const VectorXd& p0, Ve
     if (t.coefficient >= 0) gc[t.coefficient] -= p0.dot(t.matrix * v0);
 }
 
-MatrixXd Objective::project_initial_state(const MatrixXd& G) const {
-  const int P = size();
+MatrixXd Objective::project_initial_state(const MatrixXd& G, int leading) const {
+  const int P = leading >= 0 ? leading : size();
   if (!estimates_initial_state()) return G;
   const int ns = data_.sensors();
   const Eigen::Index rows = G.rows(), m = G.cols() - P;

@@ -224,6 +224,29 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
     r.ident.reason[u] = buf;
   }
 }
+// The record's own modes (record_modes.h) in the fitted band, else below the data's Nyquist
+// frequency; none without stated noise levels (the significance of a miss rests on them).
+RecordModes own_modes(const Problem& p, Objective& obj, const RunResult& r, const MatrixXd& Y, double information_scale,
+                      bool stated_noise) {
+  const Measurements& data = obj.data();
+  if (!stated_noise || data.t.size() < 3 || r.ident.std.size() != static_cast<std::size_t>(r.estimate.size())) return {};
+  RecordModesOptions o;
+  o.information_scale = information_scale;
+  o.f_hi_hz = 0.5 * static_cast<double>(data.t.size() - 1) / (data.t.back() - data.t.front());
+  if (const auto& band = p.scenario.identification.band; band.size() == 2 && band[1] > 0) {
+    o.f_lo_hz = band[0];
+    o.f_hi_hz = std::min(o.f_hi_hz, band[1]);
+  }
+  std::vector<bool> kept;
+  for (double sd : r.ident.std) kept.push_back(std::isfinite(sd));
+  try {
+    return record_modes(obj, p.model(), *p.params, r.estimate, Y, r.ident.noise_std, kept, o);
+  } catch (const io::Interrupted&) {
+    throw;
+  } catch (const std::runtime_error&) {
+    return {};  // the model at the estimate cannot be stepped with the modes freed
+  }
+}
 }  // namespace
 
 IntervalInputs assessment_refits(const Problem& p, Objective& obj, const OptimizerOptions& oo, const VectorXd& estimate,
@@ -288,8 +311,9 @@ void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& o
   // (the outputs are the fit test's, when it kept them).
   const MatrixXd Y = r.predicted.size() > 0 ? r.predicted : obj.predict(r.estimate);
   const MatrixXd G = obj.output_sensitivities(r.estimate);
-  r.ident = identifiability_from(band_information(p, fisher_information(obj.data(), Y, G, sensors_with_noise(p))), r.estimate,
-                                 &p.params->names());
+  const FisherInformation fi = fisher_information(obj.data(), Y, G, sensors_with_noise(p));
+  const bool band_scaled = p.band_gain < 1.0 && fi.stated_noise;
+  r.ident = identifiability_from(band_information(p, fi), r.estimate, &p.params->names());
   flag_mirror_ambiguity(p, obj, r, Y);
   flag_other_minima(p, obj, r, Y);
   r.ident.noise_source = noise_origin(p, r.ident.noise_source);
@@ -304,6 +328,7 @@ void assess_estimate(const Problem& p, Objective& obj, const OptimizerOptions& o
   ii.consider = consider_terms(p, r.ident, r.estimate, Y, G, r.fit.discretisation);
   r.interval = uncertainty_interval(r.ident, ii);
   flag_wide_intervals(r);
+  r.record_modes = own_modes(p, obj, r, Y, band_scaled ? p.band_gain : 1.0, fi.stated_noise);
   r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();
 }
 

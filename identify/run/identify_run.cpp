@@ -125,6 +125,7 @@ void estimate_modes(const Problem& p, RunResult& r) {
     std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
     if (dt[dt.size() / 2] > 0) o.max_frequency_hz = 0.5 / dt[dt.size() / 2];
   }
+  if (!r.record_modes.modes.empty()) o.record = &r.record_modes;
   try {
     r.modes = modal_estimates(p.model(), *p.params, r.estimate, r.ident, r.interval, o);
   } catch (const io::Interrupted&) {

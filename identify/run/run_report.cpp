@@ -176,6 +176,14 @@ json modes_json(const RunResult& r) {
            {"damping_ratio_std", finite_or_null(m.damping_std)},
            {"damping_ratio_interval", finite_or_null(m.damping_half_width)}};
     if (!m.note.empty()) e["uncertainty_not_given_because"] = m.note;
+    // The record's own mode (inverse/record_modes.h), and the model-form terms it added.
+    if (std::isfinite(m.record_frequency_hz))
+      e["record"] = {{"frequency_hz", m.record_frequency_hz},
+                     {"frequency_std_hz", m.record_frequency_std_hz},
+                     {"damping_ratio", m.record_damping_ratio},
+                     {"damping_ratio_std", m.record_damping_std},
+                     {"frequency_model_form_hz", m.frequency_model_form_hz},
+                     {"damping_ratio_model_form", m.damping_model_form}};
     modes.push_back(e);
   }
   return modes;
@@ -240,7 +248,8 @@ json counts_json(const RunResult& r, json& out) {
                            {"sensitivity", c.sensitivity_seconds},
                            {"quadrature", c.quadrature_seconds},
                            {"optimizer_total", r.summary.wall_seconds},
-                           {"identifiability", r.identifiability_seconds}};
+                           {"identifiability", r.identifiability_seconds},
+                           {"record_modes", r.record_modes.seconds}};
   return out;
 }
 
@@ -290,6 +299,26 @@ std::string modes_table(const std::vector<ModalEstimate>& modes) {
                   cell(m.damping_ratio, "%.5g").c_str(), cell(m.damping_std, "%.3e").c_str(),
                   cell(m.damping_half_width, "%.3e").c_str(), m.note.empty() ? "" : "  ", m.note.c_str());
     s += line;
+  }
+  // Where the record places a mode away from the model's (record_modes.h): the model's form, in
+  // the interval above.
+  for (const auto& m : modes) {
+    if (m.frequency_model_form_hz > 0) {
+      std::snprintf(line, sizeof line,
+                    "mode %d: the record has it at %.7g Hz (std %.2e), %.3g std from the model's: the model's form cannot place "
+                    "it there; its interval holds the miss\n",
+                    m.mode, m.record_frequency_hz, m.record_frequency_std_hz,
+                    std::abs(m.record_frequency_hz - m.frequency_hz) / m.record_frequency_std_hz);
+      s += line;
+    }
+    if (m.damping_model_form > 0) {
+      std::snprintf(line, sizeof line,
+                    "mode %d: the record's damping ratio is %.5g (std %.2e), %.3g std from the model's: the model's form cannot "
+                    "give it; its interval holds the miss\n",
+                    m.mode, m.record_damping_ratio, m.record_damping_std,
+                    std::abs(m.record_damping_ratio - m.damping_ratio) / m.record_damping_std);
+      s += line;
+    }
   }
   return s;
 }

@@ -106,6 +106,16 @@ def test_modes_and_correlation_follow_the_modal_model_and_the_std():
     f1 = modes.loc[1]
     print("f1 %.7f Hz, std %.3e (closed form %.3e)" % (f1["frequency_hz"], f1["frequency_std_hz"], f1["frequency_hz"] * s1 / (2 * q1)))
     assert f1["frequency_std_hz"] == pytest.approx(f1["frequency_hz"] * s1 / (2 * q1), rel=1e-5)
+    # The record's own modes (docs/theory.md §8.4), as identify.json gives them: within 3 of their
+    # std of the model's, or a model-form term that makes the interval hold them.
+    rec = modes[np.isfinite(modes["record_frequency_hz"])]
+    assert 1 in rec.index
+    miss = (rec["record_frequency_hz"] - rec["frequency_hz"]).abs()
+    flagged = rec["frequency_model_form_hz"] > 0
+    assert (miss[~flagged] <= 3 * rec["record_frequency_std_hz"][~flagged]).all()
+    assert (miss[flagged] < (rec["frequency_high_hz"] - rec["frequency_hz"])[flagged]).all()
+    for k, m in idn._dict["modes"][0]["record"].items():
+        assert rec.loc[1, k if k.endswith("model_form") or k.endswith("form_hz") else "record_" + k] == m
     r = idn.correlation
     assert set(r) == {"q1", "q2"}
     assert r["q1"]["q1"] == pytest.approx(1.0) and r["q1"]["q2"] == pytest.approx(r["q2"]["q1"])

@@ -637,7 +637,11 @@ class Identification:
         """The identified model's elastic modes, lowest first, as a DataFrame indexed by mode number:
         frequency_hz, frequency_std_hz, frequency_low_hz, frequency_high_hz (the uncertainty interval),
         damping_ratio, damping_ratio_std, damping_ratio_low, damping_ratio_high; NaN where not
-        assessed, with the reason in ``uncertainty_not_given_because`` (docs/theory.md §8.3).
+        assessed, with the reason in ``uncertainty_not_given_because`` (docs/theory.md §8.3). The
+        record's own mode (§8.4: where the record places it, freed from the model's form):
+        record_frequency_hz, record_frequency_std_hz, record_damping_ratio, record_damping_ratio_std,
+        and the model-form terms the interval holds, frequency_model_form_hz and
+        damping_ratio_model_form (0 where none; NaN where the mode was not freed).
         Rigid-body modes are not listed (``modal_model()`` flags them)."""
         import pandas as pd
         rows = []
@@ -651,8 +655,17 @@ class Identification:
                          "damping_ratio": z, "damping_ratio_std": num("damping_ratio_std"),
                          "damping_ratio_low": z - zhw, "damping_ratio_high": z + zhw,
                          "uncertainty_not_given_because": m.get("uncertainty_not_given_because", "")})
+            rec = m.get("record") or {}
+            for k in ("frequency_hz", "frequency_std_hz", "damping_ratio", "damping_ratio_std"):
+                v = rec.get(k)
+                rows[-1]["record_" + k] = _math.nan if v is None else float(v)
+            for k in ("frequency_model_form_hz", "damping_ratio_model_form"):
+                v = rec.get(k)
+                rows[-1][k] = _math.nan if v is None else float(v)
         cols = ["frequency_hz", "frequency_std_hz", "frequency_low_hz", "frequency_high_hz", "damping_ratio",
-                "damping_ratio_std", "damping_ratio_low", "damping_ratio_high", "uncertainty_not_given_because"]
+                "damping_ratio_std", "damping_ratio_low", "damping_ratio_high", "uncertainty_not_given_because",
+                "record_frequency_hz", "record_frequency_std_hz", "record_damping_ratio", "record_damping_ratio_std",
+                "frequency_model_form_hz", "damping_ratio_model_form"]
         if not rows:
             return pd.DataFrame(columns=cols, index=pd.Index([], name="mode"))
         return pd.DataFrame(rows).set_index("mode")[cols]

@@ -36,6 +36,7 @@ struct ModalModel {
   Eigen::VectorXd zeta;           // modal damping ratio (NaN for rigid-body modes)
   Eigen::MatrixXd output_shapes;  // outputs × modes: the sensor's reading per unit modal coordinate
   Eigen::MatrixXd input_shapes;   // inputs × modes: γ_i b_iᵀ φ
+  Eigen::MatrixXd mass_shapes;    // DOF × modes: M φ (φ mass-normalised, φᵀ M φ = 1)
   std::vector<std::string> inputs, outputs;
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// The identified model's modes and their uncertainty (docs/theory.md §8.4).
+// The identified model's modes and their uncertainty (docs/theory.md §8.3; the record's own, §8.4).
 //
 // What a test engineer reports is not EI and ρA but the structure's natural frequencies f_n and
 // modal damping ratios ζ_n. They are functions of the estimated parameters, m(q) (fe/state_space.h,
@@ -12,6 +12,8 @@
 //                 + |J (q̂ − q̂^(T/2))|                    the half-record refit's shift
 //                 + Σ_j |J shift_j|                      the consider terms
 //                 + |J (q̂ − q̂(β/10))|                    the smoothing shift
+//                 + (|m_rec − m| + 2 std(m_rec))         the model's form, where |m_rec − m| > 3 std(m_rec)
+//                                                        (m_rec: the record's own mode, record_modes.h)
 //
 // — the parameter interval's terms (interval.h), each carried through J as a vector rather than
 // bounded term by term, so that correlated errors that cancel in a frequency (EI and ρA each
@@ -21,12 +23,14 @@
 //
 // A mode depending on a parameter the identifiability test flagged (relative sensitivity above
 // 10⁻⁸) gets none either: its std would rest on a number the data do not hold.
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/inverse/record_modes.h"
 
 namespace scoleid::identify {
 
@@ -37,12 +41,23 @@ struct ModalEstimate {
   double frequency_std_hz = 0, frequency_half_width_hz = 0;
   double damping_std = 0, damping_half_width = 0;
   std::string note;                // why the uncertainty is missing, "" when it is given
+  // The record's own mode (record_modes.h): its frequency and damping ratio with the mode freed
+  // from the model's form, and their std (NaN where not freed). Where the record's differs from the
+  // model's by more than 3 of its std, the model's form misses it: that miss plus twice the std
+  // is the model-form term, added to the half-width (0 otherwise).
+  double record_frequency_hz = std::numeric_limits<double>::quiet_NaN();
+  double record_frequency_std_hz = std::numeric_limits<double>::quiet_NaN();
+  double record_damping_ratio = std::numeric_limits<double>::quiet_NaN();
+  double record_damping_std = std::numeric_limits<double>::quiet_NaN();
+  double frequency_model_form_hz = 0, damping_model_form = 0;
 };
 
 struct ModalUncertaintyOptions {
   int max_modes = 10;              // the lowest elastic modes reported
   double max_frequency_hz = 0;     // > 0: only modes below it (the data's Nyquist frequency)
   double relative_step = 1e-4;     // central-difference step of each parameter
+  const RecordModes* record = nullptr;  // the record's own modes (record_modes.h), if assessed
+  double model_form_threshold = 3.0;    // in the record's std: a larger difference is the model's form
 };
 
 // The elastic modes (rigid-body modes, ω below 10⁻⁶ of the highest, left out) of the model at q̂,

@@ -188,6 +188,17 @@ public:
   // acceleration sensors, within sensitivity_block_bytes) keeps its own at its q: asked at that
   // same q, they are returned without a solve (the same numbers: one interpolation for both).
   MatrixXd output_sensitivities(const VectorXd& q);
+  // A direction of the operators that no parameter spans: ∂K = k w wᵀ, ∂D = d w wᵀ (with w = Mφ of a
+  // mass-normalised mode φ, one mode's stiffness or damping alone: the record's own modes,
+  // inverse/record_modes.h).
+  struct RankOneDirection {
+    VectorXd w;
+    double d = 0.0, k = 0.0;
+  };
+  // As output_sensitivities, with one more column per direction after the parameters' (one pass
+  // of P + extra tangents; never kept). Empty where it cannot be formed (an estimated initial
+  // state without the esdirk tangents).
+  MatrixXd output_sensitivities_with(const VectorXd& q, const std::vector<RankOneDirection>& extra);
   // The Gauss–Newton matrix times v without forming it (docs/theory.md §7.7): one tangent solve
   // along v (with the state) and one costate solve whose source is the tangent's output C S v in
   // place of the residual; the gradient formula (Eq. 25) on that costate is H v. Two solves
@@ -256,6 +267,7 @@ private:
     SparseMatrix dM, dD, dK;
     std::vector<VectorXd> db;
     VectorXd x0, v0;  // the tangent's start (empty: rest), for the initial state's directions
+    RankOneDirection rank_one;  // added to ∂D and ∂K (empty w: none)
   };
   Derivative derivative(const Setup& s, int i) const;
   // Σ_j dc_j ∂M/∂c_j etc.: the derivative along a direction dc of the model coefficients.
@@ -273,7 +285,12 @@ private:
   void add_initial_velocity_term(const Setup& s, const VectorXd& p0, VectorXd& gc) const;
   // G's columns projected off the initial state's (the last 2m), in the Fisher information's
   // weights (each sensor's stated noise, else R): (samples·sensors) × P.
-  MatrixXd project_initial_state(const MatrixXd& G) const;
+  // (leading ≥ 0: G's first `leading` columns are projected, the rest are the initial state's.)
+  MatrixXd project_initial_state(const MatrixXd& G, int leading = -1) const;
+  // The output sensitivities of the tangents d (the last ones may be the initial state's, after the
+  // first `leading`), streamed with the state in one pass, projected off the initial state's.
+  MatrixXd streamed_output_sensitivities(const Setup& s, const SecondOrderSolver& solver, const std::vector<Derivative>& d,
+                                         int leading);
   Trajectory sensitivity(const SecondOrderSolver& solver, const Setup& s, const Trajectory& u, const Derivative& d,
                          double t_end) const;
   // The tangents' forcing G_i = −(∂_i M ü + ∂_i D u̇ + ∂_i K u − ∂_i B f) for the given derivatives

@@ -73,6 +73,8 @@ struct RunResult {
   // The identified model's elastic modes, lowest first, with their propagated uncertainty
   // (inverse/modal_uncertainty.h); empty where the model has none below the data's Nyquist frequency.
   std::vector<ModalEstimate> modes;
+  // The record's own modes at the estimate (inverse/record_modes.h; empty where not assessed).
+  RecordModes record_modes;
   struct Attempt {
     std::string strategy;
     io::Method method = io::Method::GaussNewton;  // the optimiser of its last stage
