@@ -34,6 +34,7 @@
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/frf_record.h"
+#include "scoleid/io/number.h"
 #include "scoleid/io/uff_frf.h"
 #include "scoleid/io/uff.h"
 #include "scoleid/io/interrupt.h"
@@ -181,7 +182,7 @@ void convert(const std::string& file, const std::string& out, const io::CsvOptio
 // The FRFs of a record, written as OUT.uff/.unv (dataset 58, function types 4 and 6) or OUT.csv.
 struct FrfArgs {
   io::RecordFrfOptions options;
-  std::vector<std::string> units, stations;
+  std::vector<std::string> units, stations, noise;
   std::string reference, estimator = "h1", window = "hann";
 };
 
@@ -198,8 +199,11 @@ std::map<std::string, std::string> pairs(const std::vector<std::string>& items, 
   return out;
 }
 
+// f_hz (and, for impact FRFs, decay_per_s: the values are H at s = decay + iω), then per response
+// re, im, std, coherence.
 void write_frf_csv(const std::string& out, const io::RecordFrf& r) {
-  std::string text = "f_hz";
+  const bool windowed = r.data.decay != 0;
+  std::string text = windowed ? "f_hz,decay_per_s" : "f_hz";
   for (const auto& ch : r.data.channels)
     for (const char* part : {"re", "im", "std", "coherence"}) text += "," + io::csv_field(ch.sensor + " " + part);
   text += "\n";
@@ -207,6 +211,10 @@ void write_frf_csv(const std::string& out, const io::RecordFrf& r) {
   for (std::size_t k = 0; k < r.data.f_hz.size(); ++k) {
     std::snprintf(buf, sizeof buf, "%.17g", r.data.f_hz[k]);
     text += buf;
+    if (windowed) {
+      std::snprintf(buf, sizeof buf, ",%.17g", r.data.decay);
+      text += buf;
+    }
     for (const auto& ch : r.data.channels) {
       const double coh = ch.coherence.empty() ? std::nan("") : ch.coherence[k];
       for (double v : {ch.H[k].real(), ch.H[k].imag(), std::sqrt(ch.variance[k]), coh}) {
@@ -265,7 +273,17 @@ void frf(const std::string& file, const std::string& out, const io::CsvOptions& 
   if (a.estimator == "h1") a.options.estimator = io::RecordFrfEstimator::H1;
   else if (a.estimator == "h2") a.options.estimator = io::RecordFrfEstimator::H2;
   else if (a.estimator == "lines") a.options.estimator = io::RecordFrfEstimator::Lines;
-  else throw io::InputError("command line: --estimator must be h1, h2 or lines, got '" + io::one_line(a.estimator) + "'");
+  else if (a.estimator == "impact") a.options.estimator = io::RecordFrfEstimator::Impact;
+  else throw io::InputError("command line: --estimator must be h1, h2, lines or impact, got '" + io::one_line(a.estimator) + "'");
+  if (a.options.estimator == io::RecordFrfEstimator::Impact && format == "uff")
+    throw io::InputError("command line: --out '" + out + "': impact FRFs are H at s = decay + i omega (an exponential window), "
+                         "which a Universal File's dataset 58 cannot state; write OUT.csv");
+  for (const auto& [name, value] : pairs(a.noise, "--noise")) {
+    double v = 0;
+    if (!io::parse_decimal(value, v))
+      throw io::InputError("command line: --noise '" + io::one_line(name) + "' must be a decimal number, got '" + io::one_line(value) + "'");
+    a.options.noise[name] = v;
+  }
   if (a.window == "hann") a.options.window = io::FrfWindow::Hann;
   else if (a.window == "rectangular") a.options.window = io::FrfWindow::Rectangular;
   else throw io::InputError("command line: --window must be hann or rectangular, got '" + io::one_line(a.window) + "'");
@@ -331,7 +349,7 @@ int main(int argc, char** argv) {
   fr->add_option("file", file, "data file (CSV read in chunks, any length; UFF, LVM or TDMS read whole)")->required();
   fr->add_option("-o,--out", out,
                  "OUT.uff / OUT.unv (ASCII dataset 58: FRFs in SI per N, function type 4, and coherence, type 6) or OUT.csv "
-                 "(f_hz, then per response: re, im, std, coherence)")
+                 "(f_hz [, decay_per_s for impact], then per response: re, im, std, coherence)")
       ->required();
   fr->add_option("--input", fa.options.input, "the force column")->required();
   fr->add_option("--response", fa.options.responses, "a response column, repeated (default: every column but the input)");
@@ -339,7 +357,13 @@ int main(int argc, char** argv) {
   fr->add_option("--station", fa.stations,
                  "COLUMN=<node><sign><axis> of a response in the UFF (e.g. acc_tip=3+Z; default: the k-th response at node k, +Z)");
   fr->add_option("--reference", fa.reference, "<node><sign><axis> of the excitation in the UFF (default: node 0, scalar)");
-  fr->add_option("--estimator", fa.estimator, "h1 (noise on the responses; default), h2 (noise on the force), lines (steady sines)");
+  fr->add_option("--estimator", fa.estimator,
+                 "h1 (noise on the responses; default), h2 (noise on the force), lines (steady sines), impact (one hit from rest: "
+                 "the record one segment under e^{-decay t}, H at s = decay + i omega; OUT.csv only)");
+  fr->add_option("--decay", fa.options.decay, "impact: the exponential window's rate, 1/s (default ln(100)/T: a hundredth at the end)");
+  fr->add_option("--noise", fa.noise,
+                 "COLUMN=SIGMA, impact: a response's noise level in its column's unit (the input's: the force's); default: the "
+                 "record's quiet start before the hit");
   fr->add_option("--segment", fa.options.segment,
                  "Welch segment length in s (default: the largest power of two of samples up to the record / 4.5: eight segments)");
   fr->add_option("--overlap", fa.options.overlap, "Welch overlap of adjacent segments, in [0, 1) (default 0.5)");

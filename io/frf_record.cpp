@@ -11,6 +11,7 @@
 #include "scoleid/io/input_file.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/quiet_start.h"
 #include "scoleid/io/time_grid.h"
 #include "scoleid/io/units.h"
 #include "scoleid/io/validation.h"
@@ -158,10 +159,11 @@ class Feed {
     const std::vector<double>& x = cols[static_cast<std::size_t>(in_.index)];
     std::vector<const double*> y;
     for (const auto& r : resp_) y.push_back(cols[static_cast<std::size_t>(r.index)].data());
-    if (o_.estimator == RecordFrfEstimator::Lines) {
+    if (o_.estimator == RecordFrfEstimator::Lines || o_.estimator == RecordFrfEstimator::Impact) {
       if (static_cast<double>(samples_ + n) > limits::kMaxSamples)
-        throw InputError(source_ + ": more than " + format_value(limits::kMaxSamples) +
-                         " samples, the limit of a record the lines estimator holds whole (Welch streams any length)");
+        throw InputError(source_ + ": more than " + format_value(limits::kMaxSamples) + " samples, the limit of a record the " +
+                         (o_.estimator == RecordFrfEstimator::Lines ? "lines" : "impact") +
+                         " estimator holds whole (Welch streams any length)");
       input_.insert(input_.end(), x.begin(), x.end());
       for (std::size_t s = 0; s < resp_.size(); ++s) x_[s].insert(x_[s].end(), y[s], y[s] + n);
     } else {
@@ -191,6 +193,8 @@ class Feed {
         r.effective_averages = r.data.averages;
         std::snprintf(note, sizeof note, "%d lines fitted harmonically over %.6g s at %.6g Hz", r.data.lines(),
                       static_cast<double>(samples_) / fs, fs);
+      } else if (o_.estimator == RecordFrfEstimator::Impact) {
+        impact(r, input_name, names, note, sizeof note);
       } else {
         if (!welch_) start_welch();
         r.data = welch_->result(source_, input_name, names);
@@ -246,6 +250,60 @@ class Feed {
     }
   }
 
+  // The impact estimator on the samples kept: each response's noise stated or its quiet start's.
+  void impact(RecordFrf& r, const std::string& input_name, const std::vector<std::string>& names, char* note, std::size_t size) {
+    const double fs = r.sample_rate;
+    const double T = static_cast<double>(samples_) / fs;
+    ImpactOptions io;
+    io.sample_rate = fs;
+    io.decay = o_.decay >= 0 ? o_.decay : std::log(100.0) / T;
+    io.f_max = o_.f_max > 0 ? o_.f_max : 0.8 * 0.5 * fs;
+    const std::size_t trigger = trigger_sample(input_.data(), samples_), quiet = quiet_samples(trigger);
+    int estimated = 0;
+    for (std::size_t s = 0; s < resp_.size(); ++s) {
+      const auto it = o_.noise.find(names[s]);
+      double sd = it != o_.noise.end() ? it->second : quiet_start_noise(x_[s].data(), quiet);
+      if (!(sd > 0)) {
+        const std::string why =
+            trigger >= samples_ ? "the input never acts"
+            : quiet == 0 ? std::to_string(trigger) + " samples precede the hit (at t = " + format_value(static_cast<double>(trigger) / fs) +
+                               " s after the first), fewer than " + std::to_string(kQuietSamples + kQuietMargin)
+                         : "its quiet start reads exactly zero";
+        throw InputError(source_ + ": column '" + one_line(names[s]) +
+                         "' has no noise level for the impact estimator (one hit's FRF has no scatter to weigh it by) and its quiet start "
+                         "gives none (" + why + "); state --noise '" + one_line(names[s]) + "=SIGMA' in the column's unit");
+      }
+      if (it == o_.noise.end()) ++estimated;
+      io.response_std.push_back(sd);
+    }
+    if (const auto it = o_.noise.find(input_name); it != o_.noise.end()) io.input_std = it->second;
+    std::vector<const double*> y;
+    for (const auto& v : x_) y.push_back(v.data());
+    r.data = impact_frf(input_.data(), y, samples_, io, source_, input_name, names);
+    if (o_.f_min > 0) drop_lines_below(r.data, o_.f_min);
+    r.effective_averages = 1;
+    std::snprintf(note, size,
+                  "impact: one segment of %.6g s under e^{-%.6g t} (%.3g at its end), H at s = %.6g + i omega, lines every %.6g Hz up to "
+                  "%.6g Hz; %d of %zu noise levels from the quiet start (%zu samples)",
+                  T, io.decay, std::exp(-io.decay * T), io.decay, fs / static_cast<double>(samples_),
+                  r.data.f_hz.empty() ? 0.0 : r.data.f_hz.back(), estimated, resp_.size(), quiet);
+  }
+
+  // Lines at or below f_min removed (the impact estimator keeps every line from fs/N).
+  static void drop_lines_below(FrfData& d, double f_min) {
+    std::size_t k = 0;
+    while (k < d.f_hz.size() && !(d.f_hz[k] > f_min)) ++k;
+    const auto cut = [k](auto& v) {
+      if (v.size() >= k) v.erase(v.begin(), v.begin() + static_cast<long>(k));
+    };
+    cut(d.f_hz);
+    for (auto& ch : d.channels) {
+      cut(ch.H);
+      cut(ch.variance);
+      if (!ch.coherence.empty()) cut(ch.coherence);
+    }
+  }
+
   std::string source_;
   const RecordFrfOptions& o_;
   std::size_t expected_, samples_ = 0;
@@ -276,6 +334,15 @@ void check_options(const RecordFrfOptions& o) {
   } else if (!o.lines_hz.empty()) {
     throw InputError("command line: --lines is for --estimator lines");
   }
+  if (o.estimator == RecordFrfEstimator::Impact) {
+    if (!std::isfinite(o.decay) || (o.decay < 0 && o.decay != -1.0))
+      throw InputError("command line: --decay must be a rate >= 0 (1/s), got " + format_value(o.decay));
+    for (const auto& [name, sd] : o.noise)
+      if (!(sd > 0) || !std::isfinite(sd))
+        throw InputError("command line: --noise '" + one_line(name) + "' must be a positive level, got " + format_value(sd));
+  } else if (o.decay != -1.0 || !o.noise.empty()) {
+    throw InputError(std::string("command line: ") + (o.decay != -1.0 ? "--decay" : "--noise") + " is for --estimator impact");
+  }
 }
 
 }  // namespace
@@ -288,6 +355,9 @@ RecordFrf frf_of_record(const std::string& path, const CsvOptions& csv, const Re
     for (const auto& [name, unit] : o.units)
       if (std::find(names.begin(), names.end(), name) == names.end())
         throw InputError("command line: --unit names no column of " + source + ", got '" + one_line(name) + "'");
+    for (const auto& [name, sd] : o.noise)
+      if (std::find(names.begin(), names.end(), name) == names.end())
+        throw InputError("command line: --noise names no column of " + source + ", got '" + one_line(name) + "'");
     const Column in = column(source, names, units, o, o.input, "--input", true);
     resp_names = o.responses;
     if (resp_names.empty())

@@ -330,11 +330,12 @@ py::tuple read_data_file(const std::string& path, const std::string& time_column
 }
 
 // A record's FRFs (io/frf_record.h, scole-data frf): (f, names, H, variance, coherence or None,
-// orders, sample_rate, samples, segments, effective_averages, note).
+// orders, sample_rate, samples, segments, effective_averages, note, decay).
 py::tuple frf_of_file(const std::string& path, const std::string& input, const std::vector<std::string>& responses,
                       const std::map<std::string, std::string>& units, double sample_rate, const std::string& estimator,
                       double segment, double overlap, const std::string& window, double f_min, double f_max,
-                      const std::vector<double>& lines, const std::string& time_column, const std::string& time_unit) {
+                      const std::vector<double>& lines, const std::string& time_column, const std::string& time_unit,
+                      double decay, const std::map<std::string, double>& noise) {
   io::RecordFrfOptions o;
   o.input = input;
   o.responses = responses;
@@ -343,7 +344,10 @@ py::tuple frf_of_file(const std::string& path, const std::string& input, const s
   if (estimator == "h1") o.estimator = io::RecordFrfEstimator::H1;
   else if (estimator == "h2") o.estimator = io::RecordFrfEstimator::H2;
   else if (estimator == "lines") o.estimator = io::RecordFrfEstimator::Lines;
-  else throw io::InputError("frf: estimator must be 'h1', 'h2' or 'lines', got '" + io::one_line(estimator) + "'");
+  else if (estimator == "impact") o.estimator = io::RecordFrfEstimator::Impact;
+  else throw io::InputError("frf: estimator must be 'h1', 'h2', 'lines' or 'impact', got '" + io::one_line(estimator) + "'");
+  o.decay = decay;
+  o.noise = noise;
   if (window == "hann") o.window = io::FrfWindow::Hann;
   else if (window == "rectangular") o.window = io::FrfWindow::Rectangular;
   else throw io::InputError("frf: window must be 'hann' or 'rectangular', got '" + io::one_line(window) + "'");
@@ -381,7 +385,8 @@ py::tuple frf_of_file(const std::string& path, const std::string& input, const s
       for (py::ssize_t k = 0; k < L; ++k) w(k, s) = r.data.channels[static_cast<std::size_t>(s)].coherence[static_cast<std::size_t>(k)];
     coherence = c;
   }
-  return py::make_tuple(f, names, H, var, coherence, r.orders, r.sample_rate, r.samples, r.segments, r.effective_averages, r.note);
+  return py::make_tuple(f, names, H, var, coherence, r.orders, r.sample_rate, r.samples, r.segments, r.effective_averages, r.note,
+                        r.data.decay);
 }
 
 }  // namespace

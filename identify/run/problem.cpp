@@ -20,6 +20,7 @@
 #include "scoleid/identify/fe/scole_model.h"
 #include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/quiet_start.h"
 #include "scoleid/io/limits.h"
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/io/data_source.h"
@@ -1222,45 +1223,27 @@ void regularise_time(const io::Scenario& sc, io::DataTable& tab, const std::stri
   }
 }
 
-// Noise levels a lab does not state, from the record's quiet start (docs/data.md §2). A record
-// starts at rest; until the first input acts — the earliest sample at which an input (its column or
-// the scenario's signal) exceeds a twentieth of its peak — a sensor reads its noise (and an offset).
-// With at least kQuiet samples before that, less a margin of kMargin samples (a DAQ filter's
-// pre-ringing), a sensor without a stated level gets
-//     σ̂² = min( variance about the mean ,  mean square first difference / 2 ),
-// both σ² for white noise; the second is the smaller for a slow drift or a ringing start, so a
-// start that is not quiet can only lower σ̂ (a stricter fit test), never raise it. A quiet start
-// that reads exactly zero (a clean simulation) says nothing of the noise and is not used.
+// Noise levels a lab does not state, from the record's quiet start (docs/data.md §2; the
+// estimator io/quiet_start.h). The trigger is the earliest sample at which an input (its column or
+// the scenario's signal) exceeds a twentieth of its peak; a sensor without a stated level gets the
+// quiet start's σ̂ where it is usable.
 void noise_from_quiet_start(Problem& p) {
-  constexpr int kQuiet = 50, kMargin = 4;
   const auto& t = p.data.t;
   const std::size_t n = t.size();
-  if (n < static_cast<std::size_t>(kQuiet + kMargin) || p.signals.empty()) return;
+  if (n < static_cast<std::size_t>(io::kQuietSamples + io::kQuietMargin) || p.signals.empty()) return;
   std::size_t trigger = n;
+  std::vector<double> x(n);
   for (const auto& sig : p.signals) {
-    double peak = 0.0;
-    for (std::size_t i = 0; i < n; ++i) peak = std::max(peak, std::abs(sig(t[i])));
-    if (!(peak > 0)) continue;
-    for (std::size_t i = 0; i < n && i < trigger; ++i)
-      if (std::abs(sig(t[i])) > 0.05 * peak) {
-        trigger = i;
-        break;
-      }
+    for (std::size_t i = 0; i < n; ++i) x[i] = sig(t[i]);
+    trigger = std::min(trigger, io::trigger_sample(x.data(), n));
   }
-  if (trigger >= n || trigger < static_cast<std::size_t>(kQuiet + kMargin)) return;
-  const std::size_t quiet = trigger - kMargin;
+  const std::size_t quiet = io::quiet_samples(trigger);
+  if (trigger >= n || quiet == 0) return;
   bool used = false;
   for (std::size_t j = 0; j < p.noise_std.size(); ++j) {
     if (p.noise_std[j] > 0) continue;
-    const auto col = p.data.z.col(static_cast<Eigen::Index>(j));
-    double mean = 0.0;
-    for (std::size_t i = 0; i < quiet; ++i) mean += col[static_cast<Eigen::Index>(i)] / static_cast<double>(quiet);
-    double var = 0.0, diff = 0.0;
-    for (std::size_t i = 0; i < quiet; ++i) var += std::pow(col[static_cast<Eigen::Index>(i)] - mean, 2) / static_cast<double>(quiet - 1);
-    for (std::size_t i = 1; i < quiet; ++i)
-      diff += std::pow(col[static_cast<Eigen::Index>(i)] - col[static_cast<Eigen::Index>(i - 1)], 2) / (2.0 * static_cast<double>(quiet - 1));
-    const double sd = std::sqrt(std::min(var, diff));
-    if (!(sd > 0) || !std::isfinite(sd)) continue;
+    const double sd = io::quiet_start_noise(p.data.z.col(static_cast<Eigen::Index>(j)).data(), quiet);
+    if (!(sd > 0)) continue;
     p.noise_std[j] = sd;
     p.noise_origin[j] = "pre-trigger";
     used = true;

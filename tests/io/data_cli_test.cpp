@@ -358,6 +358,39 @@ TEST(DataCli, FrfWritesUffAndCsvThatReadBack) {
   const Result self = run({"frf", "r.csv", "--input", "F [N]", "-o", "r.csv"}, bad);
   EXPECT_EQ(self.code, 2);
   EXPECT_EQ(tab.t.size() + 1, static_cast<std::size_t>(lines(slurp(bad / "r.csv"))));
+
+  // --estimator impact: a CSV whose second column is the window's decay (the values are H at
+  // s = decay + iω), each value as the library gives it; a UFF cannot say s: refused, nothing written.
+  const Result im = run({"frf", "r.csv", "--input", "F [N]", "--estimator", "impact", "--decay", "3", "--noise", "acc [m/s^2]=0.05",
+                         "--noise", "vel [mm/s]=2", "-q", "-o", "i.csv"}, dir);
+  ASSERT_EQ(im.code, 0) << slurp(dir / "stderr.txt");
+  o.estimator = RecordFrfEstimator::Impact;
+  o.decay = 3;
+  o.noise = {{"acc [m/s^2]", 0.05}, {"vel [mm/s]", 2}};
+  const RecordFrf imp = frf_of_record((dir / "r.csv").string(), {}, o);
+  // (One hit has no coherence: those fields are empty.)
+  std::istringstream icsv(slurp(dir / "i.csv"));
+  std::string row;
+  std::getline(icsv, row);
+  EXPECT_EQ(row.rfind("f_hz,decay_per_s,acc [m/s^2] re,acc [m/s^2] im,acc [m/s^2] std,acc [m/s^2] coherence,", 0), 0u) << row;
+  for (std::size_t k = 0; std::getline(icsv, row); ++k) {
+    ASSERT_LT(k, imp.data.f_hz.size());
+    std::vector<std::string> cell;
+    std::istringstream fields(row);
+    for (std::string c; std::getline(fields, c, ',');) cell.push_back(c);
+    ASSERT_GE(cell.size(), 5u) << row;
+    EXPECT_EQ(std::stod(cell[0]), imp.data.f_hz[k]);
+    EXPECT_EQ(std::stod(cell[1]), 3.0);
+    EXPECT_EQ(std::stod(cell[2]), imp.data.channels[0].H[k].real());
+    EXPECT_EQ(std::stod(cell[4]), std::sqrt(imp.data.channels[0].variance[k]));
+    EXPECT_TRUE(cell[5].empty()) << row;
+  }
+  const Result iu = run({"frf", "r.csv", "--input", "F [N]", "--estimator", "impact", "-o", "i.uff"}, bad);
+  EXPECT_EQ(iu.code, 2);
+  const std::string ium = slurp(bad / "stderr.txt");
+  EXPECT_EQ(lines(ium), 1) << ium;
+  EXPECT_NE(ium.find("dataset 58 cannot state"), std::string::npos) << ium;
+  EXPECT_FALSE(fs::exists(bad / "i.uff"));
 }
 
 // `convert` of a truth.csv takes each column's unit from the truth.json beside it (the header

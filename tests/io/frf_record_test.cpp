@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/frf_estimate.h"
+#include "scoleid/io/quiet_start.h"
 #include "scoleid/io/tdms.h"
 
 namespace fs = std::filesystem;
@@ -212,4 +214,119 @@ TEST(FrfRecord, RefusesWithOneLine) {
   o = options();
   o.responses = {"nope"};
   refuse((d / "r.csv").string(), o, "--response names no column of the file");
+}
+
+// The quiet start's noise (quiet_start.h): white noise's σ from its samples; a drift or a start
+// already ringing lowers the estimate (the first difference's), never raises it; zero says nothing.
+TEST(QuietStart, TheNoiseBeforeTheHit) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, 0.02);
+  std::vector<double> y(400), drift(400), zero(400, 0.0);
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    y[i] = g(rng);
+    drift[i] = y[i] + 0.5 * double(i) / 400.0;  // a slow drift of 25 sigma
+  }
+  const double s = quiet_start_noise(y.data(), y.size()), sd = quiet_start_noise(drift.data(), drift.size());
+  std::printf("white: %.4f (0.02), with a drift: %.4f\n", s, sd);
+  EXPECT_NEAR(s, 0.02, 0.1 * 0.02);  // 400 samples: about 4 % sampling error
+  EXPECT_NEAR(sd, 0.02, 0.1 * 0.02);
+  EXPECT_EQ(quiet_start_noise(zero.data(), zero.size()), 0.0);
+  // The trigger: the first sample above a twentieth of the peak, and 4 samples of margin.
+  std::vector<double> x(300, 0.0);
+  x[120] = 0.04;
+  x[121] = 1.0;
+  EXPECT_EQ(trigger_sample(x.data(), x.size()), 121u);
+  EXPECT_EQ(quiet_samples(121), 117u);
+  EXPECT_EQ(quiet_samples(53), 0u);
+  EXPECT_EQ(trigger_sample(zero.data(), zero.size()), zero.size());
+}
+
+// Impact (frf_record.h): a hit from rest through a resonator, written as a CSV in lbf and g. The FRFs
+// are the resonator's transfer function at z = e^{(a + iω)/fs} in SI; each value's variance rests on
+// the response's noise read off the quiet start (|Ĥ − H|² / variance averages 1 over the lines); a
+// stated level replaces it; a record whose hit comes too early for a quiet start, stated nothing,
+// is refused naming the column.
+TEST(FrfRecord, AnImpactFromItsQuietStart) {
+  const fs::path d = scratch();
+  const double fs = 1000, r = 0.999, theta = 2 * kPi * 40 / fs, sigma = 0.01;
+  const std::size_t n = 4000, hit = 300;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g(0.0, sigma);
+  DataTable tab;
+  tab.names = {"F [lbf]", "acc [g]"};
+  tab.units = {"lbf", "g"};
+  tab.columns.assign(2, std::vector<double>(n, 0.0));
+  for (std::size_t i = 0; i < 6; ++i) tab.columns[0][hit + i] = 5.0 * std::sin(kPi * double(i + 1) / 7.0);  // a 6-sample pulse
+  double y1 = 0, y2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    tab.t.push_back(double(i) / fs);
+    const double y = 2 * r * std::cos(theta) * y1 - r * r * y2 + tab.columns[0][i];
+    tab.columns[1][i] = y + g(rng);
+    y2 = y1;
+    y1 = y;
+  }
+  write_csv((d / "hit.csv").string(), tab);
+  RecordFrfOptions o;
+  o.input = "F [lbf]";
+  o.estimator = RecordFrfEstimator::Impact;
+  // The default window leaves a hundredth at the end: ln 100 / T.
+  EXPECT_DOUBLE_EQ(frf_of_record((d / "hit.csv").string(), {}, o).data.decay, std::log(100.0) / (double(n) / fs));
+  // e^{-5 t}: the response left at the end, windowed, 2e-9 of its start (below the noise).
+  const double a = 5.0;
+  o.decay = a;
+  const RecordFrf f = frf_of_record((d / "hit.csv").string(), {}, o);
+  EXPECT_DOUBLE_EQ(f.data.decay, a);
+  EXPECT_NE(f.note.find("1 of 1 noise levels from the quiet start (296 samples)"), std::string::npos) << f.note;
+  const double sigma_hat = quiet_start_noise(tab.columns[1].data(), 296);
+  double mean = 0, worst = 0, w2 = 0, var_error = 0;
+  for (std::size_t i = 0; i < n; ++i) w2 += std::exp(-2 * a * double(i) / fs);
+  const std::size_t lines = f.data.f_hz.size();
+  for (std::size_t k = 0; k < lines; ++k) {
+    const cd z1 = std::exp(-cd(a, 2 * kPi * f.data.f_hz[k]) / fs);
+    const cd exact = 1.0 / (1.0 - 2 * r * std::cos(theta) * z1 + r * r * z1 * z1) * kG / kLbf;  // g/lbf in SI
+    const double z = std::norm(f.data.channels[0].H[k] - exact) / f.data.channels[0].variance[k];
+    mean += z / double(lines);
+    worst = std::max(worst, z);
+    // The variance: σ̂² Σw² / |X_k|² in the file's units, times the square of the units' ratio.
+    cd X = 0;
+    for (std::size_t i = hit; i < hit + 6; ++i)
+      X += std::exp(-a * double(i) / fs) * tab.columns[0][i] * std::polar(1.0, -2 * kPi * double(k + 1) * double(i) / double(n));
+    const double v = sigma_hat * sigma_hat * w2 / std::norm(X) * std::pow(kG / kLbf, 2);
+    var_error = std::max(var_error, std::abs(f.data.channels[0].variance[k] / v - 1));
+  }
+  std::printf("sigma from the quiet start %.5f (true %.5f); %zu lines: |H - H_true|^2 / variance mean %.3f, worst %.1f; variance vs "
+              "sigma^2 sum w^2 / |X|^2: %.1e\n",
+              sigma_hat, sigma, lines, mean, worst, var_error);
+  EXPECT_NEAR(sigma_hat, sigma, 0.15 * sigma);
+  EXPECT_LT(var_error, 1e-9);
+  // Each |δH|²/variance is (σ/σ̂)² times an exponential of mean 1; the window correlates lines within
+  // about a/π Hz, so their mean scatters widely, but none lies beyond e^-30.
+  EXPECT_LT(worst, 30.0);
+  EXPECT_GT(mean, 0.4);
+  EXPECT_LT(mean, 2.5);
+  // A stated level (in the column's unit, g) is used as stated: the variance scales by its square.
+  o.noise = {{"acc [g]", 2 * sigma_hat}};
+  const RecordFrf stated = frf_of_record((d / "hit.csv").string(), {}, o);
+  EXPECT_NE(stated.note.find("0 of 1 noise levels"), std::string::npos) << stated.note;
+  EXPECT_NEAR(stated.data.channels[0].variance[10], 4 * f.data.channels[0].variance[10], 1e-9 * stated.data.channels[0].variance[10]);
+  // The hit at sample 30: no quiet start, nothing stated: refused, naming the column.
+  DataTable early = tab;
+  std::rotate(early.columns[0].begin(), early.columns[0].begin() + 270, early.columns[0].end());
+  std::rotate(early.columns[1].begin(), early.columns[1].begin() + 270, early.columns[1].end());
+  write_csv((d / "early.csv").string(), early);
+  o.noise.clear();
+  try {
+    frf_of_record((d / "early.csv").string(), {}, o);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("column 'acc [g]' has no noise level"), std::string::npos) << m;
+    EXPECT_NE(m.find("30 samples precede the hit"), std::string::npos) << m;
+    EXPECT_NE(m.find("--noise"), std::string::npos) << m;
+  }
+  // --decay and --noise belong to the impact estimator.
+  RecordFrfOptions welch = options();
+  welch.input = "F [lbf]";
+  welch.decay = 2;
+  EXPECT_THROW(frf_of_record((d / "hit.csv").string(), {}, welch), InputError);
 }

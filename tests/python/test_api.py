@@ -305,6 +305,22 @@ def test_read_data_and_frf_give_what_the_programs_give(tmp_path):
     np.testing.assert_array_equal(cli["acc [g] re"].to_numpy(), r.H["acc [g]"].to_numpy().real)
     np.testing.assert_array_equal(cli["acc [g] std"].to_numpy(), r.std["acc [g]"].to_numpy())
 
+    # The impact estimator, the same record taken as one segment: H at s = decay + iω (a constant
+    # H here), the noise stated in the column's unit; the numbers and the decay column as the CLI's.
+    imp = scoleid.frf(path, "F [N]", estimator="impact", decay=2.0, noise={"acc [g]": 0.01})
+    assert imp.decay == 2.0 and imp.segments == 0 and "impact" in imp.note
+    zi = np.abs(imp.H["acc [g]"].to_numpy() - 0.5 * 9.80665) ** 2 / imp.std["acc [g]"].to_numpy() ** 2
+    assert zi.max() < 30, zi.max()
+    subprocess.run([os.path.join(BUILD, "io", "scole-data"), "frf", str(path), "--input", "F [N]", "--estimator", "impact",
+                    "--decay", "2", "--noise", "acc [g]=0.01", "-q", "-o", str(tmp_path / "i.csv")], check=True)
+    icli = pd.read_csv(tmp_path / "i.csv", float_precision="round_trip")
+    assert (icli["decay_per_s"] == 2.0).all()
+    np.testing.assert_array_equal(icli["acc [g] re"].to_numpy(), imp.H["acc [g]"].to_numpy().real)
+    with pytest.raises(scoleid.InputError, match="no noise level for the impact estimator"):
+        scoleid.frf(path, "F [N]", estimator="impact")  # the force acts from the first sample: no quiet start
+    with pytest.raises(TypeError, match="noise must be a dict"):
+        scoleid.frf(path, "F [N]", estimator="impact", noise=0.01)
+
     with pytest.raises(scoleid.InputError, match="names no column of the file"):
         scoleid.frf(path, "nope")
     with pytest.raises(scoleid.InputError, match="estimator must be"):

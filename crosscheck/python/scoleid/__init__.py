@@ -248,24 +248,27 @@ class Frf:
         std (pandas.DataFrame): each value's standard deviation, sqrt(E|Ĥ − H|²).
         coherence (pandas.DataFrame | None): γ² per value (Welch), None for harmonic lines.
         orders (dict): per response 0 displacement, 1 velocity, 2 acceleration (its unit's).
-        sample_rate (float), samples (int), segments (int, 0 for lines),
+        sample_rate (float), samples (int), segments (int, 0 for lines and impact),
         effective_averages (float), note (str): how they were made.
+        decay (float): the impact estimator's exponential window, 1/s: the values are H at
+            s = decay + iω (0 for the others: at iω).
     """
 
-    def __init__(self, H, std, coherence, orders, sample_rate, samples, segments, effective_averages, note):
+    def __init__(self, H, std, coherence, orders, sample_rate, samples, segments, effective_averages, note, decay=0.0):
         self.H, self.std, self.coherence, self.orders = H, std, coherence, orders
         self.sample_rate, self.samples, self.segments = sample_rate, samples, segments
-        self.effective_averages, self.note = effective_averages, note
+        self.effective_averages, self.note, self.decay = effective_averages, note, decay
 
     def __repr__(self):
         return "<scoleid.Frf %d responses x %d lines: %s>" % (self.H.shape[1], self.H.shape[0], self.note)
 
 
 def frf(path, input, responses=None, *, units=None, sample_rate=None, estimator="h1", segment=None, overlap=0.5,
-        window="hann", f_min=None, f_max=None, lines=None, time_column=None, time_unit=None):
+        window="hann", f_min=None, f_max=None, lines=None, time_column=None, time_unit=None, decay=None, noise=None):
     """Frequency response functions of a data file's response columns to its force column, as
     ``scole-data frf`` makes them (docs/data.md §1.7): Welch H1/H2 with the record streamed (a CSV
-    of any length is never held whole), or the harmonic fit of known lines.
+    of any length is never held whole), the harmonic fit of known lines, or one hit's FRF under an
+    exponential window (impact).
 
     Args:
         path (str | os.PathLike): the record (CSV, UFF, LVM or TDMS).
@@ -273,13 +276,17 @@ def frf(path, input, responses=None, *, units=None, sample_rate=None, estimator=
         responses (list[str]): response columns (default: every column but the input).
         units (dict): column -> unit, for columns whose file states none.
         sample_rate (float): the DAQ's rate in Hz (default: from the time column).
-        estimator (str): "h1" (default), "h2" or "lines".
+        estimator (str): "h1" (default), "h2", "lines" or "impact" (one hit from rest, the record one
+            segment under e^{-decay t}: H at s = decay + iω, ``Frf.decay``).
         segment (float): Welch segment in s (default: a power of two of samples near the record / 4.5).
         overlap (float): Welch overlap in [0, 1) (default 0.5).
         window (str): "hann" (default) or "rectangular".
         f_min, f_max (float): the lines kept, f_min < f <= f_max (default 0 to 0.8 of Nyquist).
         lines (list[float]): the input's frequencies in Hz, for estimator "lines".
         time_column, time_unit (str): as ``read_data``.
+        decay (float): impact: the window's rate in 1/s (default ln(100)/T, a hundredth at the end).
+        noise (dict): impact: column -> noise level in the column's own unit (default: the record's
+            quiet start before the hit; refused when it has none).
 
     Returns:
         Frf: H, std and coherence as DataFrames indexed by ``f_hz``, and how they were made.
@@ -303,15 +310,20 @@ def frf(path, input, responses=None, *, units=None, sample_rate=None, estimator=
         lines = []
     else:
         lines = [_number("lines[%d]" % i, f, None) for i, f in enumerate(lines)]
-    f, names, H, var, coh, orders, rate, samples, segments, keff, note = _core.frf(
+    if noise is None:
+        noise = {}
+    elif not hasattr(noise, "items") or not all(isinstance(k, str) for k in noise):
+        raise TypeError("noise must be a dict of column name -> noise level, got %r" % (noise,))
+    noise = {k: _number("noise[%r]" % k, v, float("nan")) for k, v in noise.items()}
+    f, names, H, var, coh, orders, rate, samples, segments, keff, note, decay_used = _core.frf(
         path, input, list(responses), dict(units), _number("sample_rate", sample_rate, 0.0),
         _text("estimator", estimator, allow_none=False), _number("segment", segment, 0.0), _number("overlap", overlap, 0.5),
         _text("window", window, allow_none=False), _number("f_min", f_min, 0.0), _number("f_max", f_max, 0.0), lines,
-        _text("time_column", time_column), _text("time_unit", time_unit))
+        _text("time_column", time_column), _text("time_unit", time_unit), _number("decay", decay, -1.0), noise)
     index = pd.Index(f, name="f_hz")
     return Frf(pd.DataFrame(H, columns=names, index=index), pd.DataFrame(_np.sqrt(var), columns=names, index=index),
                None if coh is None else pd.DataFrame(coh, columns=names, index=index), dict(zip(names, orders)), rate, samples,
-               segments, keff, note)
+               segments, keff, note, decay_used)
 
 
 def _dtype_kind(values):

@@ -98,9 +98,11 @@ class Frf:
     segments: int
     effective_averages: float
     note: str
+    decay: float
 
 def frf(path: Union[str, "os.PathLike[str]"], input: str, responses: Optional[Sequence[str]] = ..., *,
         units: Optional[Mapping[str, str]] = ..., sample_rate: Optional[float] = ..., estimator: str = ...,
         segment: Optional[float] = ..., overlap: float = ..., window: str = ..., f_min: Optional[float] = ...,
         f_max: Optional[float] = ..., lines: Optional[Sequence[float]] = ..., time_column: Optional[str] = ...,
-        time_unit: Optional[str] = ...) -> Frf: ...
+        time_unit: Optional[str] = ..., decay: Optional[float] = ...,
+        noise: Optional[Mapping[str, float]] = ...) -> Frf: ...

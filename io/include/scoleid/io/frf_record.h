@@ -23,6 +23,10 @@
 // in their own units and each H turned into SI once: H_SI = H · c_response / c_force, its
 // variance by the square (c the units' scale factors into m, m/s, m/s², N).
 //
+// Impact. The record is read whole (its sample limit holds) and taken as one segment under an
+// exponential window: the FRFs are H at s = decay + iω (FrfData::decay), which a UFF dataset 58
+// cannot state (write_uff_frf refuses them), with each value's variance from the responses' noise.
+//
 // Defaults. Segment: the largest power of two of samples not above the record's length / 4.5
 // (eight Hann segments at 50 % overlap; the CSV's length counted from its line breaks before it is
 // read), as scole-identify's frequency path takes it. Lines kept up to 0.8 of Nyquist (above it a
@@ -41,7 +45,7 @@
 
 namespace scoleid::io {
 
-enum class RecordFrfEstimator { H1, H2, Lines };
+enum class RecordFrfEstimator { H1, H2, Lines, Impact };
 
 struct RecordFrfOptions {
   std::string input;                          // the force column's name
@@ -54,6 +58,12 @@ struct RecordFrfOptions {
   FrfWindow window = FrfWindow::Hann;
   double f_min = 0, f_max = 0;                // lines kept f_min < f <= f_max (0: 0.8 of Nyquist)
   std::vector<double> lines_hz;               // the lines estimator's frequencies
+  // Impact (frf_estimate.h impact_frf): one hit from rest, the whole record one segment under
+  // e^{-decay t} (decay < 0: ln 100 / T, a hundredth at the end); each response's noise level in
+  // its column's own unit (column -> σ; the input's, if named, is σ_x), else its quiet start's
+  // (quiet_start.h, before the force first exceeds a twentieth of its peak), else refused.
+  double decay = -1.0;
+  std::map<std::string, double> noise;
   // Called every 2^20 samples read, with the count so far (progress of a long file).
   std::function<void(std::size_t)> progress;
 };
