@@ -157,6 +157,9 @@ void print_problem(const identify::Problem& problem, bool from_file) {
   std::fprintf(stderr, "scole-identify: data columns: sensors %s; inputs from data %s; inputs from the scenario %s; unused %s\n",
                list(c.sensors).c_str(), list(c.inputs_from_data).c_str(), list(c.inputs_from_scenario).c_str(),
                list(c.unused).c_str());
+  if (c.window.size() == 2)
+    std::fprintf(stderr, "scole-identify: fit window (data.window): the samples from %s to %s s, the model starting at the first\n",
+                 io::format_value(c.window[0]).c_str(), io::format_value(c.window[1]).c_str());
   for (const auto& x : c.sources) {
     if (x.column != x.name || !x.from_unit.empty())
       std::fprintf(stderr, "scole-identify: %s <- column '%s'%s\n", x.name.c_str(), x.column.c_str(),

@@ -1113,6 +1113,16 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
       sc.data.time_column = d.str("time_column", "");
       sc.data.time_unit = d.str("time_unit", "");
       if (d.has("sample_rate")) sc.data.sample_rate = d.positive("sample_rate", 0.0);  // (absent: not stated)
+      sc.data.window = d.numbers("window", {});
+      if (!sc.data.window.empty()) {
+        if (sc.data.window.size() != 2)
+          fail_field(source, "data.window", "must be [t_start, t_end] in s (two numbers)", std::to_string(sc.data.window.size()) + " numbers");
+        if (!(std::isfinite(sc.data.window[0]) && sc.data.window[0] >= 0.0))
+          fail_field(source, "data.window[0]", "must be a time >= 0 s", format_value(sc.data.window[0]));
+        if (!(std::isfinite(sc.data.window[1]) && sc.data.window[1] > sc.data.window[0]))
+          fail_field(source, "data.window[1]", "must be a finite time after data.window[0] = " + format_value(sc.data.window[0]) + " s",
+                     format_value(sc.data.window[1]));
+      }
       if (!sc.data.time_unit.empty())
         if (const auto why = units::problem_with(sc.data.time_unit, units::Quantity::Time))
           fail_field(source, "data.time_unit", "must be a unit of time (" + *why + ")", "'" + sc.data.time_unit + "'");
@@ -1245,9 +1255,10 @@ nlohmann::json to_json(const Scenario& s) {
   j["source"] = s.source;
   j["structure"] = to_string(s.structure);
   if (s.units != units::System::None) j["units"] = units::system_name(s.units);
-  if (!s.data.time_column.empty() || !s.data.time_unit.empty() || s.data.sample_rate > 0) {
+  if (!s.data.time_column.empty() || !s.data.time_unit.empty() || s.data.sample_rate > 0 || !s.data.window.empty()) {
     j["data"] = {{"time_column", s.data.time_column}, {"time_unit", s.data.time_unit}};
     if (s.data.sample_rate > 0) j["data"]["sample_rate"] = s.data.sample_rate;
+    if (!s.data.window.empty()) j["data"]["window"] = s.data.window;
   }
   auto beam = [](const BeamSpec& b) {
     json j{{"length", b.length}, {"left", to_string(b.left)}, {"right", to_string(b.right)},

@@ -1223,6 +1223,30 @@ void regularise_time(const io::Scenario& sc, io::DataTable& tab, const std::stri
   }
 }
 
+// data.window: only the samples within [t_start, t_end] are fitted, the model starting at the first
+// of them (at rest, or from the state identification.initial_state: estimate finds). The columns
+// are read, converted and conditioned whole before (an offset's pre-trigger, a force window's
+// noise), and the inputs stay functions of the record's time; a window holding fewer than 3
+// samples is refused naming the record's span.
+void fit_window(Problem& p, const std::string& source) {
+  const auto& w = p.scenario.data.window;
+  if (w.size() != 2) return;
+  const auto& t = p.data.t;
+  std::size_t first = 0, last = t.size();
+  while (first < t.size() && t[first] < w[0]) ++first;
+  while (last > first && t[last - 1] > w[1]) --last;
+  if (last - first < 3)
+    fail_field(p.scenario.source, "data.window",
+               "holds " + std::to_string(last - first) + " samples of data file '" + source + "' (its times run from " +
+                   io::format_value(t.front()) + " to " + io::format_value(t.back()) + " s); at least 3 are needed",
+               "[" + io::format_value(w[0]) + ", " + io::format_value(w[1]) + "]");
+  if (first == 0 && last == t.size()) return;
+  const auto rows = static_cast<Eigen::Index>(last - first);
+  p.data.t = std::vector<double>(t.begin() + static_cast<std::ptrdiff_t>(first), t.begin() + static_cast<std::ptrdiff_t>(last));
+  p.data.z = MatrixXd(p.data.z.middleRows(static_cast<Eigen::Index>(first), rows));
+  p.columns.window = {p.data.t.front(), p.data.t.back()};
+}
+
 // Noise levels a lab does not state, from the record's quiet start (docs/data.md §2; the
 // estimator io/quiet_start.h). The trigger is the earliest sample at which an input (its column or
 // the scenario's signal) exceeds a twentieth of its peak; a sensor without a stated level gets the
@@ -1263,6 +1287,7 @@ std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTa
   std::map<std::string, double> meta_truth;
   if (meta) meta_truth = apply_truth_meta(*p, tab, source, *meta, meta_source);
   measurements_from_table(*p, tab, source);
+  fit_window(*p, source);
   noise_from_quiet_start(*p);
   if (!meta_truth.empty()) {
     io::Scenario truth_sc = p->scenario;

@@ -227,7 +227,8 @@ json data_columns_json(const ColumnUse& c) {
             {"largest_shift_to_grid", c.time.max_shift},
             {"placed_on_grid", c.time_regularised}}},
           {"quiet_start",
-           c.quiet_samples > 0 ? json{{"trigger_time", c.trigger_time}, {"samples", c.quiet_samples}} : json(nullptr)}};
+           c.quiet_samples > 0 ? json{{"trigger_time", c.trigger_time}, {"samples", c.quiet_samples}} : json(nullptr)},
+          {"fit_window", c.window.size() == 2 ? json(c.window) : json(nullptr)}};
 }
 
 json counts_json(const RunResult& r, json& out) {

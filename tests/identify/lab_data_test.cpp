@@ -392,3 +392,52 @@ TEST(LabData, AnImpactForceIsWindowedByDefaultAndADoubleHitIsNamed) {
   EXPECT_NEAR(st2.hits[1].first - st2.hits[0].first, 0.004, 0.0006);
   EXPECT_NEAR(st2.hits[1].second, 0.4, 0.05);
 }
+
+// data.window: a record that holds, after the test, a knock while the strip was handled (a burst
+// the hammer did not cause). Fitted whole, the model is driven to explain it; within the window
+// the estimates are the strip's. A window that holds no sample is refused, naming the field and
+// the record's span.
+TEST(LabData, AFitWindowLeavesOutWhatTheRecordHoldsAfterTheTest) {
+  std::string yaml = kStrip;
+  yaml.replace(yaml.find("t0: 0.002, width: 0.002"), 23, "t0: 0.05, width: 0.004");
+  yaml.replace(yaml.find("duration: 0.25"), 14, "duration: 0.5");
+  io::Scenario sc = without_columns(io::parse_scenario(yaml, "strip.yaml"));
+  sc.identification.elements = 16;
+  sc.identification.band = {5.0, 300.0};
+  const identify::Measurements m = identify::synthesize(sc, 4 * sc.identification.elements, 1e-8, 2.5e-5, true);
+  io::DataTable tab;
+  tab.source = "knock.csv";
+  tab.t = m.t;
+  tab.names = {"hammer", "acc1", "acc2"};
+  tab.columns.assign(3, {});
+  for (std::size_t k = 0; k < m.t.size(); ++k) {
+    const double t = m.t[k];
+    // The knock: 0.4 s in, a 90 Hz burst of 5 m/s^2 under a Gaussian envelope of 10 ms at both sensors.
+    const double knock = 5.0 * std::exp(-std::pow((t - 0.42) / 0.01, 2)) * std::sin(2 * M_PI * 90 * t);
+    tab.columns[0].push_back(sc.inputs[0].signal(t));
+    for (int j = 0; j < 2; ++j) tab.columns[static_cast<std::size_t>(j + 1)].push_back(m.z(static_cast<Eigen::Index>(k), j) + knock);
+  }
+  const Identification whole = identify_parameters(sc, DataSource::in_memory(tab, "knock.csv"), {});
+  io::Scenario windowed_sc = sc;
+  windowed_sc.data.window = {0.0, 0.38};
+  const Identification windowed = identify_parameters(windowed_sc, DataSource::in_memory(tab, "knock.csv"), {});
+  const auto& w = windowed.problem().columns.window;
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_EQ(w[0], 0.0);
+  EXPECT_NEAR(w[1], 0.38, 0.0005);
+  EXPECT_EQ(windowed.problem().data.t.back(), w[1]);
+  std::printf("  whole record: EI %.5g rho_A %.5g (%s); window [0, 0.38]: EI %.5g rho_A %.5g (%s)\n", whole.estimate()[0],
+              whole.estimate()[1], whole.converged() ? "converged" : "not converged", windowed.estimate()[0], windowed.estimate()[1],
+              windowed.converged() ? "converged" : "not converged");
+  EXPECT_FALSE(whole.converged() && std::abs(whole.estimate()[0] / 30.0 - 1.0) < 0.01 && std::abs(whole.estimate()[1] / 0.4 - 1.0) < 0.01)
+      << "the knock left no mark: the test shows nothing";
+  EXPECT_TRUE(windowed.converged()) << windowed.verdict();
+  EXPECT_NEAR(windowed.estimate()[0] / 30.0, 1.0, 0.01);
+  EXPECT_NEAR(windowed.estimate()[1] / 0.4, 1.0, 0.01);
+  io::Scenario outside = sc;
+  outside.data.window = {2.0, 3.0};
+  const std::string why = test::input_error_of([&] { prepare(outside, DataSource::in_memory(tab, "knock.csv")); });
+  EXPECT_NE(why.find("data.window"), std::string::npos) << why;
+  EXPECT_NE(why.find("holds 0 samples"), std::string::npos) << why;
+  EXPECT_NE(why.find("from 0 to 0.5 s"), std::string::npos) << why;
+}

@@ -372,6 +372,9 @@ struct DataSpec {
   std::string time_unit;
   // The DAQ's sample rate [Hz] (0 = not stated): the times become t0 + k/rate (io/time_grid.h).
   double sample_rate = 0.0;
+  // The fit window [t_start, t_end] in s (empty: the whole record): the samples fitted; the model
+  // starts at the first of them (identify/run/problem.cpp fit_window).
+  std::vector<double> window;
 };
 
 struct TruthModelSpec {

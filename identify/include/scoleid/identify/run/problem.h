@@ -99,6 +99,8 @@ struct ColumnUse {
   // input acts, from which sensors without a stated noise level get one. 0 samples: none used.
   double trigger_time = 0.0;
   int quiet_samples = 0;
+  // data.window (fit_window in problem.cpp): the first and last times fitted; empty: the whole record.
+  std::vector<double> window;
 };
 
 struct Problem {
