@@ -44,6 +44,9 @@ RecordModes record_modes(Objective& obj, const StructuralModel& model, const Par
     dirs.push_back({w, 2.0 * mm.omega[k], 0.0});          // η: ∂D = 2ω w wᵀ
   }
   if (out.modes.empty()) return out;
+  // G and its weighted copy and singular vectors are held at once: a record too long for that
+  // budget is not assessed.
+  if (static_cast<double>(data.t.size()) * ns * static_cast<double>(P + static_cast<Eigen::Index>(dirs.size())) > kMaxValues) return {};
   const MatrixXd G = obj.output_sensitivities_with(q, dirs);
   if (G.cols() != P + static_cast<Eigen::Index>(dirs.size())) return {};
   // The columns in the step: the kept parameters, then every direction.
@@ -89,11 +92,10 @@ RecordModes record_modes(Objective& obj, const StructuralModel& model, const Par
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.dq = VectorXd::Zero(P);
   out.covariance = MatrixXd::Constant(P + m, P + m, nan);
-  std::vector<Eigen::Index> at(static_cast<std::size_t>(n));  // each step column's place in the covariance
-  for (Eigen::Index a = 0; a < n; ++a) at[static_cast<std::size_t>(a)] = cols[static_cast<std::size_t>(a)];
-  for (Eigen::Index a = 0; a < n; ++a) {
-    if (at[static_cast<std::size_t>(a)] < P) out.dq[at[static_cast<std::size_t>(a)]] = theta[a];
-    for (Eigen::Index bcol = 0; bcol < n; ++bcol) out.covariance(at[static_cast<std::size_t>(a)], at[static_cast<std::size_t>(bcol)]) = C(a, bcol);
+  for (Eigen::Index a = 0; a < n; ++a) {  // each step column's place: cols[a]
+    const Eigen::Index ia = cols[static_cast<std::size_t>(a)];
+    if (ia < P) out.dq[ia] = theta[a];
+    for (Eigen::Index b = 0; b < n; ++b) out.covariance(ia, cols[static_cast<std::size_t>(b)]) = C(a, b);
   }
   out.eps.resize(static_cast<Eigen::Index>(out.modes.size()));
   out.eta.resize(out.eps.size());

@@ -27,7 +27,9 @@
 // largest of the column-scaled matrix dropped; by the singular values of W^½ G) keeps what is estimable: with every mode in the band
 // freed, the parameters' common frequency scale is nearly spanned by the ε's, but each mode's own
 // frequency is not. Only the modes in the fitted band (or below the data's Nyquist frequency) are
-// freed, at most `max_modes`; one pass of P + 2m tangents.
+// freed, at most `max_modes`; one pass of P + 2m tangents. A record whose sensitivities would hold
+// more than kMaxValues numbers (samples · sensors · (P + 2m); three such matrices are held at
+// once) is not assessed.
 #include <vector>
 
 #include "scoleid/identify/fe/structural_model.h"
@@ -35,6 +37,8 @@
 #include "scoleid/identify/inverse/parameterization.h"
 
 namespace scoleid::identify {
+
+constexpr double kMaxValues = 4e7;  // 320 MB per matrix
 
 struct RecordModesOptions {
   int max_modes = 10;          // the lowest elastic modes freed (as modal_estimates reports)
