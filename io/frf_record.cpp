@@ -258,7 +258,13 @@ class Feed {
     io.sample_rate = fs;
     io.decay = o_.decay >= 0 ? o_.decay : std::log(100.0) / T;
     io.f_max = o_.f_max > 0 ? o_.f_max : 0.8 * 0.5 * fs;
-    const std::size_t trigger = trigger_sample(input_.data(), samples_), quiet = quiet_samples(trigger);
+    // The trigger about the force's median (a hammer's record is mostly rest: its median is the
+    // channel's static offset, which would otherwise count toward a twentieth of the peak).
+    std::vector<double> about = input_;
+    std::nth_element(about.begin(), about.begin() + static_cast<std::ptrdiff_t>(samples_ / 2), about.end());
+    const double median = about[samples_ / 2];
+    for (std::size_t i = 0; i < samples_; ++i) about[i] = input_[i] - median;
+    const std::size_t trigger = trigger_sample(about.data(), samples_), quiet = quiet_samples(trigger);
     int estimated = 0;
     for (std::size_t s = 0; s < resp_.size(); ++s) {
       const auto it = o_.noise.find(names[s]);
@@ -277,6 +283,18 @@ class Feed {
       io.response_std.push_back(sd);
     }
     if (const auto it = o_.noise.find(input_name); it != o_.noise.end()) io.input_std = it->second;
+    // A channel's static offset (a load cell's, a converter's) would be read as force or response over
+    // the whole window, and under e^{-at} it dominates the low lines: with a quiet start, each
+    // channel's mean there is removed first.
+    auto remove_offset = [quiet](std::vector<double>& v) {
+      double mean = 0.0;
+      for (std::size_t i = 0; i < quiet; ++i) mean += v[i] / static_cast<double>(quiet);
+      for (double& x : v) x -= mean;
+    };
+    if (quiet > 0) {
+      remove_offset(input_);
+      for (auto& v : x_) remove_offset(v);
+    }
     std::vector<const double*> y;
     for (const auto& v : x_) y.push_back(v.data());
     r.data = impact_frf(input_.data(), y, samples_, io, source_, input_name, names);
@@ -284,9 +302,10 @@ class Feed {
     r.effective_averages = 1;
     std::snprintf(note, size,
                   "impact: one segment of %.6g s under e^{-%.6g t} (%.3g at its end), H at s = %.6g + i omega, lines every %.6g Hz up to "
-                  "%.6g Hz; %d of %zu noise levels from the quiet start (%zu samples)",
+                  "%.6g Hz; %d of %zu noise levels from the quiet start (%zu samples)%s",
                   T, io.decay, std::exp(-io.decay * T), io.decay, fs / static_cast<double>(samples_),
-                  r.data.f_hz.empty() ? 0.0 : r.data.f_hz.back(), estimated, resp_.size(), quiet);
+                  r.data.f_hz.empty() ? 0.0 : r.data.f_hz.back(), estimated, resp_.size(), quiet,
+                  quiet > 0 ? ", each channel's mean there removed" : ", no quiet start: offsets kept");
   }
 
   // Lines at or below f_min removed (the impact estimator keeps every line from fs/N).

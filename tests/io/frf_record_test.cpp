@@ -304,6 +304,20 @@ TEST(FrfRecord, AnImpactFromItsQuietStart) {
   EXPECT_LT(worst, 30.0);
   EXPECT_GT(mean, 0.4);
   EXPECT_LT(mean, 2.5);
+  // Static offsets on both channels (a load cell's 0.3 lbf, an accelerometer's 0.05 g) are the quiet
+  // start's means: removed, the FRFs are those of the clean record to rounding.
+  DataTable offset = tab;
+  for (double& v : offset.columns[0]) v += 0.3;
+  for (double& v : offset.columns[1]) v += 0.05;
+  write_csv((d / "offset.csv").string(), offset);
+  const RecordFrf fo = frf_of_record((d / "offset.csv").string(), {}, o);
+  EXPECT_NE(fo.note.find("each channel's mean there removed"), std::string::npos) << fo.note;
+  double offset_error = 0;
+  for (std::size_t k = 0; k < lines; ++k)
+    offset_error = std::max(offset_error, std::abs(fo.data.channels[0].H[k] - f.data.channels[0].H[k]) /
+                                              std::sqrt(f.data.channels[0].variance[k]));
+  std::printf("offsets removed: largest change %.2e of a value's std\n", offset_error);
+  EXPECT_LT(offset_error, 0.05);  // the quiet start's mean carries its noise: 0.01 g / sqrt(296) against the std
   // A stated level (in the column's unit, g) is used as stated: the variance scales by its square.
   o.noise = {{"acc [g]", 2 * sigma_hat}};
   const RecordFrf stated = frf_of_record((d / "hit.csv").string(), {}, o);

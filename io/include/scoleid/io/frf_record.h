@@ -26,6 +26,9 @@
 // Impact. The record is read whole (its sample limit holds) and taken as one segment under an
 // exponential window: the FRFs are H at s = decay + iω (FrfData::decay), which a UFF dataset 58
 // cannot state (write_uff_frf refuses them), with each value's variance from the responses' noise.
+// The quiet start (quiet_start.h) ends where the force first departs from its median (its static
+// offset) by a twentieth of its peak; each channel's mean there — its offset — is removed first:
+// under e^{-at} an offset would dominate the lowest lines.
 //
 // Defaults. Segment: the largest power of two of samples not above the record's length / 4.5
 // (eight Hann segments at 50 % overlap; the CSV's length counted from its line breaks before it is
