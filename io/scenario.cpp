@@ -616,6 +616,52 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   for (std::size_t i = 0; i < 3; ++i) check_offset(source, r.field("mast_root") + "[" + std::to_string(i) + "]", s.mast_root[i], L);
 }
 
+// A per-storey list: one value for every storey, or one per storey (`what` in messages).
+std::vector<double> per_storey(Reader& r, const std::string& key, const std::vector<double>& dflt, std::size_t storeys,
+                               const std::string& source, bool positive) {
+  std::vector<double> v = r.numbers(key, dflt);
+  if (v.size() == 1 && storeys > 1) v.assign(storeys, v[0]);
+  if (v.size() != storeys)
+    fail_field(source, r.field(key), "must hold one value, or one per storey (" + std::to_string(storeys) + ")",
+               std::to_string(v.size()) + " values");
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!(positive ? v[i] > 0.0 : v[i] >= 0.0) || !std::isfinite(v[i]))
+      fail_field(source, r.field(key) + "[" + std::to_string(i) + "]", positive ? "must be > 0" : "must be >= 0",
+                 format_value(v[i]));
+  return v;
+}
+
+void parse_frame(const YAML::Node& n, const std::string& source, FrameSpec& f, const std::string& path = "frame") {
+  Reader r(n, source, path);
+  f.heights = r.numbers("heights", f.heights);
+  if (f.heights.empty() || f.heights.size() > 64)
+    fail_field(source, r.field("heights"), "must hold 1 to 64 storey heights, bottom to top", std::to_string(f.heights.size()) + " values");
+  f.heights = per_storey(r, "heights", f.heights, f.heights.size(), source, true);
+  const std::size_t n_storeys = f.heights.size();
+  f.columns = r.integer("columns", f.columns, 1, 16);
+  f.bay = r.positive("bay", f.bay);
+  f.rho_A = r.positive("rho_A", f.rho_A);
+  f.EI = per_storey(r, "EI", f.EI.size() == n_storeys || f.EI.size() == 1 ? f.EI : std::vector<double>{f.EI.front()}, n_storeys,
+                    source, true);
+  f.floor_mass = per_storey(r, "floor_mass", f.floor_mass.size() == n_storeys || f.floor_mass.size() == 1
+                                                 ? f.floor_mass : std::vector<double>{f.floor_mass.front()},
+                            n_storeys, source, true);
+  f.zeta = r.nonneg("zeta", f.zeta);
+  if (f.zeta > 1.0) fail_field(source, r.field("zeta"), "must be at most 1: a damping ratio, and above 1 every mode is overdamped: no ringing structure this models", format_value(f.zeta));
+  f.tau = r.nonneg("tau", f.tau);
+  // The storeys' heights within 1e3 of each other, the floors' masses within the range a mass
+  // matrix resolves against the columns'.
+  const double H = f.height(), m = f.rho_A * H * f.columns;
+  if (!(f.bay <= 100.0 * H && f.bay >= 1e-3 * H))
+    fail_field(source, r.field("bay"), "must lie within 1e-3 and 100 times the frame's height " + format_value(H), format_value(f.bay));
+  for (std::size_t i = 0; i < n_storeys; ++i) {
+    if (!(f.heights[i] >= 1e-3 * H))
+      fail_field(source, r.field("heights") + "[" + std::to_string(i) + "]",
+                 "must be at least 1e-3 of the frame's height " + format_value(H), format_value(f.heights[i]));
+    check_attached_mass(source, r.field("floor_mass") + "[" + std::to_string(i) + "]", f.floor_mass[i], m, false);
+  }
+}
+
 double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
 
 // A sensor kind the structure's models read (types.h, reads).
@@ -726,7 +772,8 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     InputSpec in;
     in.name = r.str("name", "u" + std::to_string(i + 1));
     if (!names.insert(in.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + in.name + "'");
-    in.at = r.choice_of("at", sc.structure == Structure::Scole ? Site::Reflector : Site::Beam);
+    in.at = r.choice_of("at", sc.structure == Structure::Scole ? Site::Reflector
+                              : sc.structure == Structure::Frame ? Site::Frame : Site::Beam);
     in.kind = r.choice_of("kind", InputKind::Force);
     in.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), in.at, in.location);
@@ -788,8 +835,9 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
     SensorSpec s;
     s.name = r.str("name", "y" + std::to_string(i + 1));
     if (!names.insert(s.name).second) fail_field(sc.source, r.field("name"), "must be unique", "'" + s.name + "'");
-    s.at = r.choice_among("at", sc.structure == Structure::Scole ? Site::Mast : Site::Beam,
-                          {Site::Beam, Site::Mast, Site::Reflector, Site::Shuttle});
+    s.at = r.choice_among("at", sc.structure == Structure::Scole ? Site::Mast
+                                : sc.structure == Structure::Frame ? Site::Frame : Site::Beam,
+                          {Site::Beam, Site::Mast, Site::Reflector, Site::Shuttle, Site::Frame});
     s.kind = r.choice_of("kind", SensorKind::Displacement);
     check_sensor_kind(sc, r.field("kind"), s.kind);
     s.location = r.num("location", 0.0);
@@ -1028,8 +1076,8 @@ void parse_sensor_overrides(const YAML::Node& n, const std::string& source, Scen
       check_location(t, r.field("location"), se.at, se.location, source);
     }
     if (r.has("direction")) {
-      if (t.structure == Structure::Beam)
-        fail_field(source, r.field("direction"), "does not apply to a beam sensor (it measures w or w_s)",
+      if (t.structure != Structure::Scole)
+        fail_field(source, r.field("direction"), "does not apply to a " + std::string(to_string(t.structure)) + " sensor (it measures w or w_s)",
                    Reader::kind(r.child("direction")));
       se.direction = parse_direction(r, "direction");
     }
@@ -1088,7 +1136,11 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     if (r.has("scole") && sc.structure != Structure::Scole)
       fail_field(source, "scole", "describes SCOLE, but the scenario's structure is " + std::string(to_string(sc.structure)) +
                                       " (remove the section, or set structure: scole)", "a scole section");
+    if (r.has("frame") && sc.structure != Structure::Frame)
+      fail_field(source, "frame", "describes a frame, but the scenario's structure is " + std::string(to_string(sc.structure)) +
+                                      " (remove the section, or set structure: frame)", "a frame section");
     if (r.has("beam")) parse_beam(r.child("beam"), source, sc.beam);
+    if (r.has("frame")) parse_frame(r.child("frame"), source, sc.frame);
     if (r.has("scole")) parse_scole(r.child("scole"), source, sc.scole);
     {
       Reader s(r.child("simulation"), source, "simulation");
@@ -1174,6 +1226,13 @@ Scenario truth_scenario(const Scenario& s) {
     if (o.has("beam")) {
       if (s.structure != Structure::Beam) fail_field(source, "truth.overrides.beam", "must match the structure", "'" + std::string(to_string(s.structure)) + "'");
       parse_beam(o.child("beam"), source, t.beam, "truth.overrides.beam");
+    }
+    if (o.has("frame")) {
+      if (s.structure != Structure::Frame) fail_field(source, "truth.overrides.frame", "must match the structure", "'" + std::string(to_string(s.structure)) + "'");
+      parse_frame(o.child("frame"), source, t.frame, "truth.overrides.frame");
+      if (t.frame.storeys() != s.frame.storeys())
+        fail_field(source, "truth.overrides.frame.heights", "must keep the scenario's " + std::to_string(s.frame.storeys()) + " storeys",
+                   std::to_string(t.frame.storeys()) + " values");
     }
     if (o.has("scole")) {
       if (s.structure != Structure::Scole) fail_field(source, "truth.overrides.scole", "must match the structure", "'" + std::string(to_string(s.structure)) + "'");
@@ -1303,6 +1362,13 @@ nlohmann::json to_json(const Scenario& s) {
   if (s.structure == Structure::Beam) {
     structure = beam(s.beam);
     truth_structure = beam(ts.beam);
+  } else if (s.structure == Structure::Frame) {
+    const auto frame = [](const FrameSpec& f) {
+      return json{{"heights", f.heights}, {"columns", f.columns}, {"bay", f.bay}, {"rho_A", f.rho_A},
+                  {"EI", f.EI},           {"floor_mass", f.floor_mass}, {"zeta", f.zeta}, {"tau", f.tau}};
+    };
+    structure = frame(s.frame);
+    truth_structure = frame(ts.frame);
   } else {
     structure = scole(s.scole);
     truth_structure = scole(ts.scole);

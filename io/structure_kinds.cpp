@@ -6,11 +6,12 @@ const KindTable& kind_table(Structure kind) {
   switch (kind) {
     case Structure::Beam: return beam_kind();
     case Structure::Scole: return scole_kind();
+    case Structure::Frame: return frame_kind();
   }
   return beam_kind();
 }
 
-std::vector<const KindTable*> kind_tables() { return {&beam_kind(), &scole_kind()}; }
+std::vector<const KindTable*> kind_tables() { return {&beam_kind(), &scole_kind(), &frame_kind()}; }
 
 ShapeSensor shape_sensor(const std::string& name, Site at, SensorKind kind, double s, std::vector<double> direction,
                          double scale) {

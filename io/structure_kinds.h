@@ -42,6 +42,7 @@ const KindTable& kind_table(Structure kind);  // structure_kinds.cpp
 std::vector<const KindTable*> kind_tables();  // every kind's
 const KindTable& beam_kind();                 // beam_kind.cpp
 const KindTable& scole_kind();                // scole_kind.cpp
+const KindTable& frame_kind();                // frame_kind.cpp
 
 // A shape sensor at arc position s (shape_sensors).
 ShapeSensor shape_sensor(const std::string& name, Site at, SensorKind kind, double s, std::vector<double> direction,

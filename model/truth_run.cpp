@@ -98,6 +98,11 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Syste
 }
 
 std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
+  if (sc.structure == io::Structure::Frame)
+    io::fail_field(sc.source, "structure",
+                   "has no Simbody truth in this version (the frame's model is the identifier's finite-element one; "
+                   "docs/theory.md §2.6): identify a frame from measured records or modes",
+                   "'frame'");
   if (sc.structure == io::Structure::Scole && !sc.scole.bending_rotary_inertia)
     io::fail_field(sc.source, "scole.bending_rotary_inertia",
                    "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "

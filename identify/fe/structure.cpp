@@ -5,6 +5,7 @@
 #include <map>
 
 #include "scoleid/identify/fe/beam_model.h"
+#include "scoleid/identify/fe/frame_model.h"
 #include "scoleid/identify/fe/scole_model.h"
 #include "scoleid/io/error.h"
 
@@ -55,6 +56,28 @@ private:
   ScoleFE fe_;
 };
 
+class FrameStructure final : public FEStructure {
+public:
+  FrameStructure(const io::Scenario& sc, int elements)
+      : fe_((check(sc), build_frame(sc.frame, elements, sc.inputs, sc.sensors, sc.source))) {}
+  const StructuralModel& model() const override { return fe_.model; }
+  int elements() const override { return fe_.elements; }
+  double length() const override { return fe_.height; }
+  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
+    return std::make_unique<PhysicalParameterization>(frame_parameter_space(fe_, sc.frame), sc.identification, sc.source);
+  }
+  VectorXd coefficients(const io::Scenario& sc) const override { return frame_coefficients(fe_, sc.frame); }
+
+private:
+  static int check(const io::Scenario& sc) {
+    if (sc.identification.sections > 1)
+      io::fail_field(sc.source, "identification.sections", "must be 0 or 1 for a frame (its storeys are its sections)",
+                     std::to_string(sc.identification.sections));
+    return 0;
+  }
+  FrameFE fe_;
+};
+
 using Factory = std::function<std::unique_ptr<FEStructure>(const io::Scenario&, int)>;
 
 template <class S>
@@ -65,7 +88,8 @@ Factory factory() {
 // The registry: scenario.structure -> its FE model.
 const std::map<std::string, Factory>& registry() {
   static const std::map<std::string, Factory> r = {{"beam", factory<BeamStructure>()},
-                                                   {"scole", factory<ScoleStructure>()}};
+                                                   {"scole", factory<ScoleStructure>()},
+                                                   {"frame", factory<FrameStructure>()}};
   return r;
 }
 

@@ -9,7 +9,7 @@
 // one or more paths in backticks (`beam.supports.left.k_w`, `beam.supports.right.k_w`).
 // docs/scenario.md writes two families once: a signal term's fields as `inputs[].signal.FIELD`,
 // whether the signal is one term or a list of them (`inputs[].signal[].FIELD`), and the fields of
-// truth.overrides.beam and truth.overrides.scole as those of beam and scole.
+// truth.overrides.beam, .scole and .frame as those of beam, scole and frame.
 #include "common/test_data.h"
 #include "scoleid/io/builtin.h"
 #include "scoleid/io/error.h"
@@ -170,7 +170,7 @@ std::string documented_form(std::string path) {
   const std::string term = ".signal[].";
   if (const auto at = path.find(term); at != std::string::npos) path.replace(at, term.size(), ".signal.");
   const std::string overrides = "truth.overrides.";
-  for (const char* section : {"beam.", "scole."})
+  for (const char* section : {"beam.", "scole.", "frame."})
     if (path.rfind(overrides + section, 0) == 0) path.erase(0, overrides.size());
   return path;
 }

@@ -102,6 +102,31 @@ struct BeamSpec {
   std::vector<PointElement> attachments;
 };
 
+// A planar frame of storeys (docs/theory.md §2.6): each storey `columns` identical vertical
+// Euler–Bernoulli columns (mass per length rho_A, bending stiffness EI[k]) of height heights[k],
+// clamped into a rigid floor block of mass floor_mass[k] at the top and into the floor below (the
+// ground for the first storey) at the bottom; the columns inextensible. Motion in the frame's plane:
+// w(s) the horizontal displacement at height s of a column, s from the ground. Stations (sensors'
+// and inputs' `location`) are heights on the first column; at a floor's height, the floor's.
+// Damping: square-root d = 2ζ√(ρA·EI[k]) on each column, as on a beam, and Kelvin–Voigt
+// c = τ·EI[k] (stiffness-proportional: mode j's damping ratio τω_j/2).
+struct FrameSpec {
+  std::vector<double> heights = {0.3, 0.3, 0.3, 0.3};  // storey heights, bottom to top
+  int columns = 2;                                     // columns per storey
+  double bay = 0.2;                                    // distance between neighbouring columns (the truth's geometry)
+  double rho_A = 0.3925;                               // a column's mass per length
+  std::vector<double> EI = {3.333};                    // a column's EI per storey (one value: every storey)
+  std::vector<double> floor_mass = {1.0, 1.0, 1.0, 1.0};  // each floor block's mass, bottom to top
+  double zeta = 0.0;  // square-root (Chen–Russell) damping ratio of the columns
+  double tau = 0.0;   // Kelvin–Voigt time constant: each column's c = tau·EI; mode j damped by tau·ω_j/2
+  double height() const {
+    double H = 0.0;
+    for (double h : heights) H += h;
+    return H;
+  }
+  int storeys() const { return static_cast<int>(heights.size()); }
+};
+
 struct RigidBodySpec {
   double mass = 0.0;
   double Ixx = 0.0, Iyy = 0.0, Izz = 0.0, Ixy = 0.0, Ixz = 0.0, Iyz = 0.0;  // about its CM
@@ -414,6 +439,7 @@ struct Scenario {
   units::System units = units::System::None;
   BeamSpec beam;
   ScoleSpec scole;
+  FrameSpec frame;
   std::vector<InputSpec> inputs;
   std::vector<SensorSpec> sensors;
   SimulationSpec simulation;

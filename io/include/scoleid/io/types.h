@@ -3,7 +3,7 @@
 // the edge: the scenario reader, the command lines and the JSON writers convert with the one table
 // per type below; everything inside compares enums.
 //
-//   Structure   structure                           the structure kind (beam | scole)
+//   Structure   structure                           the structure kind (beam | scole | frame)
 //   Method      identification.method, --method     the optimiser (identify/inverse/optimizers.h)
 //   Start       identification.start                how the first attempt starts (docs/theory.md §7.6)
 //   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
@@ -31,7 +31,7 @@
 
 namespace scoleid::io {
 
-enum class Structure { Beam, Scole };
+enum class Structure { Beam, Scole, Frame };
 enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent };
 enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
@@ -41,7 +41,7 @@ enum class Domain { Time, Frequency };
 enum class FrfEstimatorKind { Auto, H1, H2, Lines, Impact };
 enum class FrfWindowKind { Hann, Rectangular };
 enum class SensorKind { Displacement, Rotation, Velocity, Acceleration, LineOfSight, Strain, RelativeDisplacement };
-enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2 };
+enum class Site { Beam, Mast, Shuttle, Reflector, Actuator1, Actuator2, Frame };
 enum class InputKind { Force, Moment };
 enum class SignalFrom { Auto, Data, Scenario };
 enum class Interpolation { Auto, Linear, Cubic };
@@ -51,7 +51,8 @@ template <class E>
 struct Names;
 template <>
 struct Names<Structure> {
-  static constexpr std::array<std::pair<Structure, const char*>, 2> rows{{{Structure::Beam, "beam"}, {Structure::Scole, "scole"}}};
+  static constexpr std::array<std::pair<Structure, const char*>, 3> rows{
+      {{Structure::Beam, "beam"}, {Structure::Scole, "scole"}, {Structure::Frame, "frame"}}};
 };
 template <>
 struct Names<Method> {
@@ -110,12 +111,13 @@ struct Names<SensorKind> {
 
 template <>
 struct Names<Site> {
-  static constexpr std::array<std::pair<Site, const char*>, 6> rows{{{Site::Beam, "beam"},
+  static constexpr std::array<std::pair<Site, const char*>, 7> rows{{{Site::Beam, "beam"},
                                                                     {Site::Mast, "mast"},
                                                                     {Site::Shuttle, "shuttle"},
                                                                     {Site::Reflector, "reflector"},
                                                                     {Site::Actuator1, "actuator1"},
-                                                                    {Site::Actuator2, "actuator2"}}};
+                                                                    {Site::Actuator2, "actuator2"},
+                                                                    {Site::Frame, "frame"}}};
 };
 template <>
 struct Names<InputKind> {
@@ -134,7 +136,7 @@ struct Names<Interpolation> {
 };
 
 // A site along which a location is measured: the beam or the mast (a station s ∈ [0, L]).
-constexpr bool has_station(Site s) { return s == Site::Beam || s == Site::Mast; }
+constexpr bool has_station(Site s) { return s == Site::Beam || s == Site::Mast || s == Site::Frame; }
 // The proof-mass actuator a site names (0, 1), or -1.
 constexpr int actuator_index(Site s) { return s == Site::Actuator1 ? 0 : s == Site::Actuator2 ? 1 : -1; }
 

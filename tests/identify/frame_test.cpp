@@ -1,0 +1,279 @@
+// The planar frame (fe/frame_model.h, docs/theory.md §2.6):
+//  - its natural frequencies against the exact solution of the columns' equation (the storeys'
+//    dynamic stiffness, independent of the finite elements), with the rate of convergence;
+//  - the shear-building limit (massless columns: storey stiffness 12·columns·EI/h³);
+//  - the storeys' stiffnesses identified from four noisy natural frequencies with the masses
+//    known, the intervals covering over 40 noise draws;
+//  - the scenario's inputs and sensors on the frame, and its errors.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <unistd.h>
+
+#include "common/test_data.h"
+#include "scoleid/identify/fe/frame_model.h"
+#include "scoleid/identify/fe/modal.h"
+#include "scoleid/identify/fe/structure.h"
+#include "scoleid/identify/run/experiments.h"
+#include "scoleid/io/error.h"
+#include "scoleid/io/modal_data.h"
+#include "scoleid/io/scenario.h"
+
+using namespace scoleid;
+using namespace scoleid::identify;
+
+namespace {
+
+const std::string kFrame = test::test_data_path("scenarios/frame_test/four-storey.yaml");
+
+// Exact dynamic stiffness of one column of height h with both ends held from turning:
+// the end forces (F1, F2) for end sways (u1, u2) at frequency ω, from the solution of
+// EI w'''' = ρA ω² w with w(0) = u1, w'(0) = 0, w(h) = u2, w'(h) = 0; F1 = EI w'''(0),
+// F2 = −EI w'''(h) (the static limit is 12EI/h³ [[1, −1], [−1, 1]]).
+Eigen::Matrix2d column_dynamic_stiffness(double EI, double rho_A, double h, double omega) {
+  const double beta = std::pow(rho_A * omega * omega / EI, 0.25);
+  // The Krylov functions S, T, U, V of z = βx (sums of z^(4k+i)/(4k+i)!, i = 0..3, all terms
+  // positive: no cancellation at small z); each derivative maps S→βV, T→βS, U→βT, V→βU, so the
+  // d-th derivative of function i is β^d times function (i + 3d) mod 4.
+  const auto basis = [beta](double x, int d) {
+    const double z = beta * x;
+    double f[4] = {0, 0, 0, 0};
+    double term = 1.0;  // z^j / j!
+    for (int j = 0; j < 200; ++j) {
+      f[j % 4] += term;
+      term *= z / (j + 1);
+      if (term < 1e-30 * f[0] && j > 8) break;
+    }
+    Eigen::RowVector4d r;
+    for (int i = 0; i < 4; ++i) r[i] = std::pow(beta, d) * f[(i + 3 * d) % 4];
+    return r;
+  };
+  Eigen::Matrix4d A;
+  A << basis(0, 0), basis(0, 1), basis(h, 0), basis(h, 1);
+  Eigen::Matrix2d K;
+  for (int j = 0; j < 2; ++j) {
+    Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+    rhs[2 * j] = 1.0;
+    const Eigen::Vector4d a = A.fullPivLu().solve(rhs);
+    K(0, j) = EI * basis(0, 3).dot(a);
+    K(1, j) = -EI * basis(h, 3).dot(a);
+  }
+  return K;
+}
+
+// det of the floors' dynamic stiffness Σ_storeys (columns × column stiffness) − ω² diag(m).
+double frame_determinant(const io::FrameSpec& f, double omega) {
+  const int n = f.storeys();
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Matrix2d K = f.columns * column_dynamic_stiffness(f.EI[k], f.rho_A, f.heights[k], omega);
+    const int lo = k - 1, hi = k;  // floor indices (−1: the ground)
+    D(hi, hi) += K(1, 1);
+    if (lo >= 0) {
+      D(lo, lo) += K(0, 0);
+      D(lo, hi) += K(0, 1);
+      D(hi, lo) += K(1, 0);
+    }
+    D(hi, hi) -= omega * omega * f.floor_mass[k];
+  }
+  return D.determinant();
+}
+
+// The frame's sway frequencies [Hz] below the first clamped–clamped column frequency (where the
+// dynamic stiffness has its first pole), by sign changes of the determinant and bisection.
+std::vector<double> exact_frequencies(const io::FrameSpec& f, int count) {
+  double pole = INFINITY;
+  for (int k = 0; k < f.storeys(); ++k)
+    pole = std::min(pole, std::pow(4.730040745 / f.heights[k], 2) * std::sqrt(f.EI[k] / f.rho_A));
+  std::vector<double> out;
+  const int steps = 20000;
+  double a = 1e-6 * pole, fa = frame_determinant(f, a);
+  for (int i = 1; i <= steps && static_cast<int>(out.size()) < count; ++i) {
+    double b = pole * i / (steps + 1.0), fb = frame_determinant(f, b);
+    if ((fa < 0) != (fb < 0)) {
+      double lo = a, hi = b, flo = fa;
+      for (int it = 0; it < 100; ++it) {
+        const double mid = 0.5 * (lo + hi), fm = frame_determinant(f, mid);
+        if ((fm < 0) == (flo < 0)) lo = mid, flo = fm;
+        else hi = mid;
+      }
+      out.push_back(0.5 * (lo + hi) / (2 * M_PI));
+    }
+    a = b;
+    fa = fb;
+  }
+  return out;
+}
+
+std::vector<double> fe_frequencies(const io::Scenario& sc, int elements) {
+  const auto st = make_structure(sc, elements);
+  const VectorXd c = st->coefficients(sc);
+  const auto& m = st->model();
+  const NaturalModes nm = natural_modes(m.assemble(m.mass, c), m.assemble(m.stiffness, c));
+  std::vector<double> f;
+  for (Eigen::Index k = 0; k < nm.omega.size(); ++k) f.push_back(nm.omega[k] / (2 * M_PI));
+  return f;
+}
+
+}  // namespace
+
+TEST(Frame, ColumnDynamicStiffnessHasTheStaticLimit) {
+  const double EI = 3.0, rho_A = 0.4, h = 0.3;
+  const Eigen::Matrix2d K = column_dynamic_stiffness(EI, rho_A, h, 1e-3);
+  const double k0 = 12 * EI / (h * h * h);
+  EXPECT_NEAR(K(0, 0), k0, 1e-9 * k0);
+  EXPECT_NEAR(K(0, 1), -k0, 1e-9 * k0);
+  EXPECT_NEAR(K(1, 1), k0, 1e-9 * k0);
+}
+
+TEST(Frame, FrequenciesConvergeToTheColumnsExactSolution) {
+  const io::Scenario sc = io::truth_scenario(io::load_scenario(kFrame));
+  const std::vector<double> exact = exact_frequencies(sc.frame, 4);
+  ASSERT_EQ(exact.size(), 4u);
+  std::printf("  exact (dynamic stiffness): %.6f %.6f %.6f %.6f Hz\n", exact[0], exact[1], exact[2], exact[3]);
+  std::vector<double> err_prev;
+  for (int elements : {4, 8, 16, 32}) {
+    const std::vector<double> f = fe_frequencies(sc, elements);
+    std::vector<double> err;
+    std::printf("  %2d elements:", elements);
+    for (int k = 0; k < 4; ++k) {
+      err.push_back(std::abs(f[k] / exact[k] - 1.0));
+      std::printf("  %.6f Hz (%.2e)", f[k], err.back());
+    }
+    std::printf("\n");
+    for (int k = 0; k < 4; ++k) {
+      // One element per column already within 0.5 % (the columns' own modes lie far above).
+      EXPECT_LT(err[k], 5e-3) << "mode " << k + 1 << ", " << elements << " elements";
+      // Hermite elements: the error falls as h⁴.
+      if (elements >= 16 && err_prev[k] > 1e-11) {  // (one element per column is not yet asymptotic)
+        std::printf("    mode %d rate %.2f\n", k + 1, std::log2(err_prev[k] / err[k]));
+        EXPECT_GT(err_prev[k] / err[k], 12.0) << "mode " << k + 1;
+      }
+    }
+    err_prev = err;
+  }
+}
+
+TEST(Frame, MasslessColumnsGiveTheShearBuilding) {
+  io::Scenario sc = io::load_scenario(kFrame);
+  sc.frame.rho_A = 1e-9;
+  const int n = sc.frame.storeys();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, n), M = Eigen::MatrixXd::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    const double ks = 12.0 * sc.frame.columns * sc.frame.EI[k] / std::pow(sc.frame.heights[k], 3);
+    K(k, k) += ks;
+    if (k > 0) K(k - 1, k - 1) += ks, K(k - 1, k) -= ks, K(k, k - 1) -= ks;
+    M(k, k) = sc.frame.floor_mass[k];
+  }
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(K, M);
+  const std::vector<double> f = fe_frequencies(sc, 8);
+  for (int k = 0; k < n; ++k) {
+    const double ref = std::sqrt(es.eigenvalues()[k]) / (2 * M_PI);
+    std::printf("  mode %d: FE %.8f Hz, shear building %.8f Hz\n", k + 1, f[k], ref);
+    EXPECT_NEAR(f[k], ref, 1e-7 * ref);
+  }
+}
+
+// Four natural frequencies with 0.2 % noise (the exact solution at the truth's storey stiffnesses),
+// the column section and floor masses known: the four storeys' EI from a uniform start.
+TEST(Frame, StoreyStiffnessesFromFourNoisyFrequencies) {
+  const io::Scenario sc = io::load_scenario(kFrame);
+  const io::Scenario truth = io::truth_scenario(sc);
+  const std::vector<double> exact = exact_frequencies(truth.frame, 4);
+  const auto dir = std::filesystem::temp_directory_path() / ("scoleid-frame-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kFrame, dir / "frame.yaml", std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(dir / "e.yaml") << "experiments: frame\nmodes: {file: m.csv, scenario: frame.yaml}\n";
+  const double rel = 2e-3;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const int draws = 40;
+  std::vector<int> covered(4, 0);
+  int converged = 0;
+  double worst = 0.0;
+  for (int d = 0; d < draws; ++d) {
+    io::ModalData md;
+    md.source = "draw";
+    for (int k = 0; k < 4; ++k) {
+      io::ModalData::Mode m;
+      m.label = k + 1;
+      m.frequency_hz = exact[k] * (1.0 + rel * noise(rng));
+      m.frequency_std_hz = rel * exact[k];
+      md.modes.push_back(m);
+    }
+    io::write_modal_data((dir / "m.csv").string(), md);
+    auto ep = make_experiments(load_experiments((dir / "e.yaml").string()));
+    ExperimentsOptions eo;
+    eo.verbose = false;
+    const ExperimentsResult r = run_experiments(*ep, eo);
+    converged += r.converged();
+    ASSERT_EQ(r.interval.half_width.size(), 4);
+    std::printf("  draw %2d:", d);
+    for (int k = 0; k < 4; ++k) {
+      const double t = truth.frame.EI[k], e = r.estimate[k], hw = r.interval.half_width[k];
+      ASSERT_TRUE(std::isfinite(e) && std::isfinite(hw)) << "draw " << d << ", EI_" << k + 1;
+      covered[k] += std::abs(e - t) <= hw;
+      worst = std::max(worst, std::abs(e / t - 1.0));
+      std::printf("  EI_%d %.4f ± %.4f", k + 1, e, hw);
+    }
+    std::printf("  %s\n", r.converged() ? "converged" : "NOT converged");
+  }
+  std::filesystem::remove_all(dir);
+  std::printf("  coverage: %d %d %d %d of %d; converged %d; largest error %.2f %%\n", covered[0], covered[1], covered[2],
+              covered[3], draws, converged, 100 * worst);
+  EXPECT_EQ(converged, draws);
+  for (int k = 0; k < 4; ++k) EXPECT_GE(covered[k], 36) << "EI_" << k + 1 << " (90 % of 40 draws)";
+}
+
+TEST(Frame, InputsAndSensorsAreHeightsOnTheFrame) {
+  io::Scenario sc = io::load_scenario(kFrame);
+  const auto st = make_structure(sc, 16);
+  const auto& m = st->model();
+  ASSERT_EQ(m.sensors.size(), 2u);
+  // At a floor's height a sensor reads the floor's sway, an input loads it.
+  const auto* fe = &m;
+  EXPECT_EQ((fe->sensors[0].row.array() != 0.0).count(), 1);
+  EXPECT_DOUBLE_EQ(fe->sensors[0].row[3], 1.0);  // floor 4
+  EXPECT_DOUBLE_EQ(fe->sensors[1].row[1], 1.0);  // floor 2
+  EXPECT_DOUBLE_EQ(fe->inputs[0].vector[3], 1.0);
+  // Bad input: one line naming the field and the value.
+  const auto error_of = [](const std::string& yaml) {
+    try {
+      io::parse_scenario(yaml, "f.yaml");
+    } catch (const io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no InputError)");
+  };
+  const std::string head = "structure: frame\nsensors: [{name: a, at: frame, kind: displacement, location: 0.3}]\n";
+  EXPECT_EQ(error_of(head + "frame: {heights: [0.3, 0.3], EI: [1, 2, 3]}\n"),
+            "f.yaml: frame.EI must hold one value, or one per storey (2), got 3 values");
+  EXPECT_EQ(error_of(head + "frame: {heights: [0.3, -0.3]}\n").substr(0, 42), "f.yaml: frame.heights[1] must be > 0, got ");
+  EXPECT_EQ(error_of(head + "frame: {heights: [0.3], floor_mass: [1, 0]}\n"),
+            "f.yaml: frame.floor_mass must hold one value, or one per storey (1), got 2 values");
+  EXPECT_NE(error_of("structure: frame\nsensors: [{name: a, at: frame, kind: displacement, location: 2}]\n").find("sensors[0].location"),
+            std::string::npos);
+  EXPECT_NE(error_of("structure: frame\nbeam: {length: 1}\n").find("f.yaml: beam describes a beam"), std::string::npos);
+  EXPECT_NE(error_of("structure: beam\nframe: {columns: 2}\n").find("f.yaml: frame describes a frame"), std::string::npos);
+}
+
+// Kelvin–Voigt damping with one time constant is stiffness-proportional: mode j's ratio τω_j/2.
+TEST(Frame, KelvinVoigtDampsEachModeByTauOmegaOverTwo) {
+  io::Scenario sc = io::load_scenario(kFrame);
+  ASSERT_GT(sc.frame.tau, 0.0);
+  ASSERT_EQ(sc.frame.zeta, 0.0);
+  const auto st = make_structure(sc, 8);
+  const VectorXd c = st->coefficients(sc);
+  const auto& m = st->model();
+  const auto modes = damped_modes(MatrixXd(m.assemble(m.mass, c)), MatrixXd(m.assemble(m.damping, c)), MatrixXd(m.assemble(m.stiffness, c)));
+  for (int j = 0; j < 4; ++j) {
+    const double expect = sc.frame.tau * modes[j].omega / 2;
+    std::printf("  mode %d: %.6f Hz, zeta %.6e (tau omega / 2 = %.6e)\n", j + 1, modes[j].omega / (2 * M_PI), modes[j].zeta, expect);
+    EXPECT_NEAR(modes[j].zeta, expect, 1e-9 * expect);
+  }
+}
