@@ -7,6 +7,7 @@
 
 #include "scoleid/crosscheck/richardson.h"
 #include "scoleid/identify/fe/analytic_beam.h"
+#include "scoleid/identify/fe/analytic_frame.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
@@ -131,6 +132,12 @@ SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scal
 // Analytic Euler–Bernoulli frequencies [Hz] of a uniform beam, or empty; `what` describes them.
 std::vector<double> analytic_hz(const io::Scenario& sc, int count, std::string& what) {
   what.clear();
+  if (sc.structure == io::Structure::Frame) {
+    what = "the columns' exact dynamic stiffness on the floors' sways (undamped, below the first column mode)";
+    std::vector<double> hz;
+    for (double w : identify::analytic::frame_omegas(sc.frame, count)) hz.push_back(w / kTwoPi);
+    return hz;
+  }
   if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1) return {};
   using io::EndCondition;
   namespace an = identify::analytic;

@@ -50,7 +50,7 @@ std::vector<ShapeSensor> shape_stations(const Scenario& sc, int count) {
   const int m = 2 * count + 2;
   const double H = sc.frame.height();
   for (int k = 1; k <= m; ++k)
-    out.push_back(shape_sensor("w" + std::to_string(k), Site::Frame, SensorKind::Displacement, H * k / m, {1, 0, 0}, 1.0));
+    out.push_back(shape_sensor("w" + std::to_string(k), Site::Frame, SensorKind::Displacement, k == m ? H : H * k / m, {0, 1, 0}, 1.0));
   return out;
 }
 

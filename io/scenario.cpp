@@ -616,7 +616,7 @@ void parse_scole(const YAML::Node& n, const std::string& source, ScoleSpec& s, c
   for (std::size_t i = 0; i < 3; ++i) check_offset(source, r.field("mast_root") + "[" + std::to_string(i) + "]", s.mast_root[i], L);
 }
 
-// A per-storey list: one value for every storey, or one per storey (`what` in messages).
+// A per-storey list: one value for every storey, or one per storey.
 std::vector<double> per_storey(Reader& r, const std::string& key, const std::vector<double>& dflt, std::size_t storeys,
                                const std::string& source, bool positive) {
   std::vector<double> v = r.numbers(key, dflt);
@@ -638,7 +638,9 @@ void parse_frame(const YAML::Node& n, const std::string& source, FrameSpec& f, c
     fail_field(source, r.field("heights"), "must hold 1 to 64 storey heights, bottom to top", std::to_string(f.heights.size()) + " values");
   f.heights = per_storey(r, "heights", f.heights, f.heights.size(), source, true);
   const std::size_t n_storeys = f.heights.size();
-  f.columns = r.integer("columns", f.columns, 1, 16);
+  // Two columns or more hold a rigid floor from turning (docs/theory.md §2.6); one would let it
+  // turn at first order, which the frame's model leaves out.
+  f.columns = r.integer("columns", f.columns, 2, 16);
   f.bay = r.positive("bay", f.bay);
   f.rho_A = r.positive("rho_A", f.rho_A);
   f.EI = per_storey(r, "EI", f.EI.size() == n_storeys || f.EI.size() == 1 ? f.EI : std::vector<double>{f.EI.front()}, n_storeys,
@@ -679,7 +681,9 @@ void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind 
 
 void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "") {
   if (!has_station(at)) return;
-  const double L = structure_length(sc);
+  // A frame's height is a sum of storey heights, which may round below the top floor's height as
+  // written (0.7 + 0.1 < 0.8): its top is met within 1e-12 of the height.
+  const double L = structure_length(sc) * (at == Site::Frame ? 1.0 + 1e-12 : 1.0);
   if (!(loc >= 0.0 && loc <= L))
     fail_field(source.empty() ? sc.source : source, field,
                "must lie on the " + std::string(to_string(at)) + " [0, " + format_value(L) + "]", format_value(loc));

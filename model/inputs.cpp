@@ -136,8 +136,8 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
     a.kind = in.kind == io::InputKind::Moment ? AppliedInput::Kind::Moment : AppliedInput::Kind::Force;
     const Vec3 d(in.direction[0], in.direction[1], in.direction[2]);
     if (planar) {
-      if (in.at != io::Site::Beam)
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a " + kind + " structure", io::quoted(in.at));
+      if (in.at != st.planar_site())
+        io::fail_field(sc.source, field + ".at", "must be '" + std::string(io::to_string(st.planar_site())) + "' for a " + kind + " structure", io::quoted(in.at));
       a.station = st.station_at(in.location);
       a.d_R = a.kind == AppliedInput::Kind::Moment ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
     } else if (in.at == io::Site::Beam) {

@@ -8,9 +8,9 @@ using namespace SimTK;
 
 JointForces::JointForces(const SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
                          std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative,
-                         std::vector<PointSpring> points)
+                         std::vector<PointSpring> points, std::vector<RelativeSpring> relative_springs)
     : matter_(matter), joints_(std::move(joints)), anchors_(std::move(anchors)), relative_(std::move(relative)),
-      points_(std::move(points)) {}
+      points_(std::move(points)), relative_springs_(std::move(relative_springs)) {}
 
 namespace {
 double planar_angle(const Rotation& R_GB) { return std::atan2(R_GB[1][0], R_GB[0][0]); }
@@ -40,6 +40,15 @@ void JointForces::calcForce(const State& state, Vector_<SpatialVec>& body_forces
     const Real theta = planar_angle(b.getBodyRotation(state));
     const Real omega = b.getBodyAngularVelocity(state)[2];
     b.applyBodyTorque(state, Vec3(0, 0, -a.k * theta - a.c * omega), body_forces);
+  }
+  for (const auto& p : relative_springs_) {
+    const MobilizedBody& b = matter_.getMobilizedBody(p.body);
+    const MobilizedBody& o = matter_.getMobilizedBody(p.other);
+    const Real dtheta = planar_angle(b.getBodyRotation(state)) - planar_angle(o.getBodyRotation(state));
+    const Real domega = b.getBodyAngularVelocity(state)[2] - o.getBodyAngularVelocity(state)[2];
+    const Vec3 torque(0, 0, -p.k * dtheta - p.c * domega);
+    b.applyBodyTorque(state, torque, body_forces);
+    o.applyBodyTorque(state, -torque, body_forces);
   }
   for (const auto& d : relative_) {
     const MobilizedBody& b = matter_.getMobilizedBody(d.body);
@@ -73,6 +82,11 @@ Real JointForces::calcPotentialEnergy(const State& state) const {
   for (const auto& a : anchors_) {
     const Real theta = planar_angle(matter_.getMobilizedBody(a.body).getBodyRotation(state));
     e += 0.5 * a.k * theta * theta;
+  }
+  for (const auto& p : relative_springs_) {
+    const Real dtheta = planar_angle(matter_.getMobilizedBody(p.body).getBodyRotation(state)) -
+                        planar_angle(matter_.getMobilizedBody(p.other).getBodyRotation(state));
+    e += 0.5 * p.k * dtheta * dtheta;
   }
   for (const auto& p : points_) {
     Real y = matter_.getMobilizedBody(p.body).findStationLocationInGround(state, p.station)[1];

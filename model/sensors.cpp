@@ -17,7 +17,7 @@ namespace {
 void interpolate_rotation(const Structure& st, double s, ResolvedSensor& r) {
   const int n = st.segments();
   const double h = st.length() / n;
-  const double c = s / h - 0.5;
+  const double c = st.centre_coordinate(s);
   int i = static_cast<int>(std::floor(c));
   const auto& seg = st.segment_bodies();
   if (i < 0) {
@@ -101,8 +101,8 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
     r.root_R = st.station_at(0.0).p_RS0;
     const Vec3 d(se.direction[0], se.direction[1], se.direction[2]);
     if (planar) {
-      if (se.at != io::Site::Beam)
-        io::fail_field(sc.source, field + ".at", "must be 'beam' for a " + kind + " structure", io::quoted(se.at));
+      if (se.at != st.planar_site())
+        io::fail_field(sc.source, field + ".at", "must be '" + std::string(io::to_string(st.planar_site())) + "' for a " + kind + " structure", io::quoted(se.at));
       if (!io::reads(st.kind(), r.kind))
         io::fail_field(sc.source, field + ".kind", "is not defined for a " + kind + " structure", io::quoted(r.kind));
       r.station = st.station_at(se.location);

@@ -19,6 +19,7 @@
 #include "scoleid/io/limits.h"
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/model/beam_chain.h"
+#include "scoleid/model/frame_system.h"
 #include "scoleid/model/inputs.h"
 #include "scoleid/model/linearisation.h"
 #include "scoleid/model/scole_system.h"
@@ -98,11 +99,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Syste
 }
 
 std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
-  if (sc.structure == io::Structure::Frame)
-    io::fail_field(sc.source, "structure",
-                   "has no Simbody truth in this version (the frame's model is the identifier's finite-element one; "
-                   "docs/theory.md §2.6): identify a frame from measured records or modes",
-                   "'frame'");
+  if (sc.structure == io::Structure::Frame) return std::make_unique<FrameSystem>(sc.frame, segments);
   if (sc.structure == io::Structure::Scole && !sc.scole.bending_rotary_inertia)
     io::fail_field(sc.source, "scole.bending_rotary_inertia",
                    "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "
@@ -253,8 +250,11 @@ void simulate_simbody(const MultibodySystem& system, const State& initial, const
         if (integ->isSimulationOver() && integ->getTerminationReason() != Integrator::ReachedFinalTime)
           throw std::runtime_error("integration failed at t = " + io::format_value(integ->getTime()) + ": " +
                                    Integrator::getTerminationReasonString(integ->getTerminationReason()));
-        // Restart the method at the input discontinuity (no history carried across it).
-        if (st == Integrator::ReachedScheduledEvent) integ->reinitialize(Stage::Time, false);
+        // Restart the method at the input discontinuity (no history carried across it), also where
+        // the breakpoint is a sample time too (reported as the report time reached): a method that
+        // kept the long steps of a structure at rest would step over the load.
+        const bool at_breakpoint = std::isfinite(tb) && integ->getTime() >= tb - 1e-12 * std::max(1.0, std::abs(tb));
+        if (st == Integrator::ReachedScheduledEvent || at_breakpoint) integ->reinitialize(Stage::Time, false);
       },
       [&] { return integ->getTime(); },
       [&]() -> const State& {
@@ -340,10 +340,11 @@ public:
     if (ref != GroundIndex) rotations_.push_back({ref, GroundIndex, "shuttle attitude (relative to the inertial frame)"});
     const int n = st.segments();
     const double h = st.length() / n;
+    const bool frame = st.kind() == io::Structure::Frame;  // its storeys' segments differ in length
     for (int i = 0; i < n; ++i)
       rotations_.push_back({st.segment_bodies()[static_cast<std::size_t>(i)], ref,
-                            std::string(scole ? "mast" : "beam") + " segment " + std::to_string(i + 1) + " of " +
-                                std::to_string(n) + " (s = " + g6(i * h) + " to " + g6((i + 1) * h) + ") " + rel});
+                            std::string(scole ? "mast" : frame ? "frame's first column," : "beam") + " segment " + std::to_string(i + 1) +
+                                " of " + std::to_string(n) + (frame ? " " : " (s = " + g6(i * h) + " to " + g6((i + 1) * h) + ") ") + rel});
     if (st.tip_body().isValid())
       rotations_.push_back({st.tip_body(), ref, std::string(scole ? "reflector " : "tip body ") + rel});
   }

@@ -112,7 +112,7 @@ FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<
     const auto& in = inputs[i];
     const std::string f = "inputs[" + std::to_string(i) + "]";
     if (in.at != io::Site::Frame) fail_field(source, f + ".at", "must be 'frame' for a frame structure", io::quoted(in.at));
-    if (!(in.location >= 0.0 && in.location <= fe.height))
+    if (!(in.location >= 0.0 && in.location <= fe.height * (1.0 + 1e-12)))
       fail_field(source, f + ".location", "must be a height on the frame [0, " + format_value(fe.height) + "]", format_value(in.location));
     ModelInput mi;
     mi.name = in.name;
@@ -126,7 +126,7 @@ FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<
     if (!io::reads(io::Structure::Frame, se.kind))
       fail_field(source, f + ".kind", "is not supported by the frame identifier (" + io::sensor_kinds_read_by(io::Structure::Frame) + ")",
                  io::quoted(se.kind));
-    if (!(se.location >= 0.0 && se.location <= fe.height))
+    if (!(se.location >= 0.0 && se.location <= fe.height * (1.0 + 1e-12)))
       fail_field(source, f + ".location", "must be a height on the frame [0, " + format_value(fe.height) + "]", format_value(se.location));
     ModelSensor ms;
     ms.name = se.name;

@@ -1,6 +1,7 @@
 // The planar frame (fe/frame_model.h, docs/theory.md §2.6):
 //  - its natural frequencies against the exact solution of the columns' equation (the storeys'
-//    dynamic stiffness, independent of the finite elements), with the rate of convergence;
+//    dynamic stiffness, fe/analytic_frame.h, independent of the finite elements), with the rate
+//    of convergence;
 //  - the shear-building limit (massless columns: storey stiffness 12·columns·EI/h³);
 //  - the storeys' stiffnesses identified from four noisy natural frequencies with the masses
 //    known, the intervals covering over 40 noise draws;
@@ -16,6 +17,7 @@
 #include <unistd.h>
 
 #include "common/test_data.h"
+#include "scoleid/identify/fe/analytic_frame.h"
 #include "scoleid/identify/fe/frame_model.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
@@ -31,83 +33,10 @@ namespace {
 
 const std::string kFrame = test::test_data_path("scenarios/frame_test/four-storey.yaml");
 
-// Exact dynamic stiffness of one column of height h with both ends held from turning:
-// the end forces (F1, F2) for end sways (u1, u2) at frequency ω, from the solution of
-// EI w'''' = ρA ω² w with w(0) = u1, w'(0) = 0, w(h) = u2, w'(h) = 0; F1 = EI w'''(0),
-// F2 = −EI w'''(h) (the static limit is 12EI/h³ [[1, −1], [−1, 1]]).
-Eigen::Matrix2d column_dynamic_stiffness(double EI, double rho_A, double h, double omega) {
-  const double beta = std::pow(rho_A * omega * omega / EI, 0.25);
-  // The Krylov functions S, T, U, V of z = βx (sums of z^(4k+i)/(4k+i)!, i = 0..3, all terms
-  // positive: no cancellation at small z); each derivative maps S→βV, T→βS, U→βT, V→βU, so the
-  // d-th derivative of function i is β^d times function (i + 3d) mod 4.
-  const auto basis = [beta](double x, int d) {
-    const double z = beta * x;
-    double f[4] = {0, 0, 0, 0};
-    double term = 1.0;  // z^j / j!
-    for (int j = 0; j < 200; ++j) {
-      f[j % 4] += term;
-      term *= z / (j + 1);
-      if (term < 1e-30 * f[0] && j > 8) break;
-    }
-    Eigen::RowVector4d r;
-    for (int i = 0; i < 4; ++i) r[i] = std::pow(beta, d) * f[(i + 3 * d) % 4];
-    return r;
-  };
-  Eigen::Matrix4d A;
-  A << basis(0, 0), basis(0, 1), basis(h, 0), basis(h, 1);
-  Eigen::Matrix2d K;
-  for (int j = 0; j < 2; ++j) {
-    Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-    rhs[2 * j] = 1.0;
-    const Eigen::Vector4d a = A.fullPivLu().solve(rhs);
-    K(0, j) = EI * basis(0, 3).dot(a);
-    K(1, j) = -EI * basis(h, 3).dot(a);
-  }
-  return K;
-}
-
-// det of the floors' dynamic stiffness Σ_storeys (columns × column stiffness) − ω² diag(m).
-double frame_determinant(const io::FrameSpec& f, double omega) {
-  const int n = f.storeys();
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Matrix2d K = f.columns * column_dynamic_stiffness(f.EI[k], f.rho_A, f.heights[k], omega);
-    const int lo = k - 1, hi = k;  // floor indices (−1: the ground)
-    D(hi, hi) += K(1, 1);
-    if (lo >= 0) {
-      D(lo, lo) += K(0, 0);
-      D(lo, hi) += K(0, 1);
-      D(hi, lo) += K(1, 0);
-    }
-    D(hi, hi) -= omega * omega * f.floor_mass[k];
-  }
-  return D.determinant();
-}
-
-// The frame's sway frequencies [Hz] below the first clamped–clamped column frequency (where the
-// dynamic stiffness has its first pole), by sign changes of the determinant and bisection.
 std::vector<double> exact_frequencies(const io::FrameSpec& f, int count) {
-  double pole = INFINITY;
-  for (int k = 0; k < f.storeys(); ++k)
-    pole = std::min(pole, std::pow(4.730040745 / f.heights[k], 2) * std::sqrt(f.EI[k] / f.rho_A));
-  std::vector<double> out;
-  const int steps = 20000;
-  double a = 1e-6 * pole, fa = frame_determinant(f, a);
-  for (int i = 1; i <= steps && static_cast<int>(out.size()) < count; ++i) {
-    double b = pole * i / (steps + 1.0), fb = frame_determinant(f, b);
-    if ((fa < 0) != (fb < 0)) {
-      double lo = a, hi = b, flo = fa;
-      for (int it = 0; it < 100; ++it) {
-        const double mid = 0.5 * (lo + hi), fm = frame_determinant(f, mid);
-        if ((fm < 0) == (flo < 0)) lo = mid, flo = fm;
-        else hi = mid;
-      }
-      out.push_back(0.5 * (lo + hi) / (2 * M_PI));
-    }
-    a = b;
-    fa = fb;
-  }
-  return out;
+  std::vector<double> hz;
+  for (double w : analytic::frame_omegas(f, count)) hz.push_back(w / (2 * M_PI));
+  return hz;
 }
 
 std::vector<double> fe_frequencies(const io::Scenario& sc, int elements) {
@@ -124,7 +53,7 @@ std::vector<double> fe_frequencies(const io::Scenario& sc, int elements) {
 
 TEST(Frame, ColumnDynamicStiffnessHasTheStaticLimit) {
   const double EI = 3.0, rho_A = 0.4, h = 0.3;
-  const Eigen::Matrix2d K = column_dynamic_stiffness(EI, rho_A, h, 1e-3);
+  const Eigen::Matrix2d K = analytic::column_dynamic_stiffness(EI, rho_A, h, 1e-3);
   const double k0 = 12 * EI / (h * h * h);
   EXPECT_NEAR(K(0, 0), k0, 1e-9 * k0);
   EXPECT_NEAR(K(0, 1), -k0, 1e-9 * k0);
@@ -260,6 +189,19 @@ TEST(Frame, InputsAndSensorsAreHeightsOnTheFrame) {
             std::string::npos);
   EXPECT_NE(error_of("structure: frame\nbeam: {length: 1}\n").find("f.yaml: beam describes a beam"), std::string::npos);
   EXPECT_NE(error_of("structure: beam\nframe: {columns: 2}\n").find("f.yaml: frame describes a frame"), std::string::npos);
+  // One column cannot hold a rigid floor from turning: refused.
+  EXPECT_EQ(error_of(head + "frame: {columns: 1}\n").substr(0, 40), "f.yaml: frame.columns must be an integer");
+  // The storeys' heights may sum below the top as written: the top floor is still on the frame.
+  EXPECT_EQ(error_of("structure: frame\nframe: {heights: [0.7, 0.1]}\n"
+                     "sensors: [{name: a, at: frame, kind: displacement, location: 0.8}]\n"),
+            "(no InputError)");
+  // Without a frame section, the documented defaults: four storeys, each with its EI.
+  const io::Scenario d = io::parse_scenario("structure: frame\nsensors: [{name: a, at: frame, kind: displacement, location: 1.2}]\n", "d.yaml");
+  ASSERT_EQ(d.frame.storeys(), 4);
+  ASSERT_EQ(d.frame.EI.size(), 4u);
+  ASSERT_EQ(d.frame.floor_mass.size(), 4u);
+  const auto ds = make_structure(d, 8);
+  EXPECT_EQ((ds->model().sensors[0].row.array() != 0.0).count(), 1);
 }
 
 // Kelvin–Voigt damping with one time constant is stiffness-proportional: mode j's ratio τω_j/2.

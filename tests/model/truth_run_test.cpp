@@ -254,3 +254,37 @@ truth: {segments: 40}
     EXPECT_LT(diff / peak, 1e-3) << a.table.names[c];
   }
 }
+
+// A load that starts after a quiet stretch, at a sample time: Simbody's variable-step methods keep
+// the long steps of the structure at rest unless restarted at the load's breakpoint, and stepped
+// over it (a frame's record read F/m at the hit and nothing after). The record of a hit at
+// t0 = 5 samples is that of the hit at 0, shifted by 5 samples.
+TEST(TruthRun, ALoadStartingOnASampleAfterRestIsFollowed) {
+  const auto frame = [](const std::string& t0) {
+    return io::parse_scenario(R"(name: late-hit
+structure: frame
+frame: {heights: [0.3, 0.3], EI: 3.3, floor_mass: 1, tau: 2.0e-4}
+inputs:
+  - {name: hammer, at: frame, kind: force, location: 0.6, unit: N, signal: {type: haversine, amplitude: 20, t0: )" + t0 + R"(, width: 0.01}}
+sensors:
+  - {name: acc2, at: frame, kind: acceleration, location: 0.6, unit: m/s^2}
+  - {name: w1, at: frame, kind: displacement, location: 0.3, unit: m}
+simulation: {duration: 0.6, sample_interval: 0.002}
+truth: {segments: 16, integrator: cpodes}
+)", "test");
+  };
+  const TruthResult now = run_truth(frame("0"));
+  const TruthResult later = run_truth(frame("0.01"));
+  const std::size_t shift = 5, n = now.table.t.size();
+  for (std::size_t c = 1; c < 3; ++c) {
+    double peak = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i + shift < n; ++i) {
+      peak = std::max(peak, std::abs(now.table.columns[c][i]));
+      diff = std::max(diff, std::abs(later.table.columns[c][i + shift] - now.table.columns[c][i]));
+    }
+    std::printf("%s: peak %.4g, largest difference of the shifted records %.3g of it (%ld steps)\n", now.table.names[c].c_str(),
+                peak, diff / peak, static_cast<long>(later.summary.steps_taken));
+    ASSERT_GT(peak, 0.0);
+    EXPECT_LT(diff / peak, 1e-3) << now.table.names[c];
+  }
+}

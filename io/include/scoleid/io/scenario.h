@@ -112,10 +112,10 @@ struct BeamSpec {
 // c = τ·EI[k] (stiffness-proportional: mode j's damping ratio τω_j/2).
 struct FrameSpec {
   std::vector<double> heights = {0.3, 0.3, 0.3, 0.3};  // storey heights, bottom to top
-  int columns = 2;                                     // columns per storey
+  int columns = 2;                                     // columns per storey (at least 2: they hold the floor from turning)
   double bay = 0.2;                                    // distance between neighbouring columns (the truth's geometry)
   double rho_A = 0.3925;                               // a column's mass per length
-  std::vector<double> EI = {3.333};                    // a column's EI per storey (one value: every storey)
+  std::vector<double> EI = {3.333, 3.333, 3.333, 3.333};  // a column's EI per storey
   std::vector<double> floor_mass = {1.0, 1.0, 1.0, 1.0};  // each floor block's mass, bottom to top
   double zeta = 0.0;  // square-root (Chen–Russell) damping ratio of the columns
   double tau = 0.0;   // Kelvin–Voigt time constant: each column's c = tau·EI; mode j damped by tau·ω_j/2

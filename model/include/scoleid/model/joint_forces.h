@@ -40,6 +40,15 @@ struct PointSpring {
   SimTK::Vec3 other_station{0.0};
 };
 
+// A rotational spring-dashpot between two planar bodies: torque −k (θ_B − θ_O) − c (ω_B − ω_O)
+// about ground z on `body` and its opposite on `other` (θ each body's angle about ground z): a
+// clamped joint that closes a loop (a frame's column head in its floor block).
+struct RelativeSpring {
+  SimTK::MobilizedBodyIndex body, other;
+  double k = 0.0;
+  double c = 0.0;
+};
+
 struct RelativeDamper {
   SimTK::MobilizedBodyIndex body, reference;
   SimTK::Vec3 c{0.0};  // about the reference frame's x, y, z axes
@@ -49,7 +58,7 @@ class JointForces : public SimTK::Force::Custom::Implementation {
 public:
   JointForces(const SimTK::SimbodyMatterSubsystem& matter, std::vector<JointSpring> joints,
               std::vector<AnchorSpring> anchors, std::vector<RelativeDamper> relative = {},
-              std::vector<PointSpring> points = {});
+              std::vector<PointSpring> points = {}, std::vector<RelativeSpring> relative_springs = {});
   void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
                  SimTK::Vector_<SimTK::Vec3>& particle_forces,
                  SimTK::Vector& mobility_forces) const override;
@@ -68,6 +77,7 @@ private:
   std::vector<AnchorSpring> anchors_;
   std::vector<RelativeDamper> relative_;
   std::vector<PointSpring> points_;
+  std::vector<RelativeSpring> relative_springs_;
 };
 
 }  // namespace scoleid::model

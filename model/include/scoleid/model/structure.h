@@ -53,8 +53,13 @@ public:
   virtual double actuator_lag() const { return 0.0; }
   // The body in which displacements are measured (ground or shuttle).
   virtual SimTK::MobilizedBodyIndex reference_body() const = 0;
+  // The site a planar structure's loads and sensors name (beam; a frame's: frame).
+  virtual io::Site planar_site() const { return io::Site::Beam; }
   // The point at arc position s on the rigid segment that contains it.
-  Station station_at(double s) const;
+  virtual Station station_at(double s) const;
+  // Arc position s as a coordinate that is i at segment i's centre, linear between centres
+  // (s/h − 1/2 on a uniform chain; a rotation sensor interpolates the bars' angles by it).
+  virtual double centre_coordinate(double s) const { return s / (length_ / segments()) - 0.5; }
   // Named rigid bodies: the shuttle, the reflector; an invalid index if absent.
   virtual Station named_station(io::Site at) const;
   // Slider mobilizers of actuator K (1-based) along reference x and y, or invalid.
