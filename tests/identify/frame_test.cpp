@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <unistd.h>
 
@@ -157,6 +158,47 @@ TEST(Frame, StoreyStiffnessesFromFourNoisyFrequencies) {
               covered[3], draws, converged, 100 * worst);
   EXPECT_EQ(converged, draws);
   for (int k = 0; k < 4; ++k) EXPECT_GE(covered[k], 36) << "EI_" << k + 1 << " (90 % of 40 draws)";
+}
+
+// Frequencies alone cannot fix more unknowns than they are: the storeys' common EI and the four
+// floor masses from four frequencies (scaling every stiffness and mass alike keeps them) are
+// not all called identifiable, and the run does not claim an interval for what it flags.
+TEST(Frame, FourFrequenciesDoNotFixFiveUnknowns) {
+  const io::Scenario truth = io::truth_scenario(io::load_scenario(kFrame));
+  const std::vector<double> exact = exact_frequencies(truth.frame, 4);
+  const auto dir = std::filesystem::temp_directory_path() / ("scoleid-frame5-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ifstream in(kFrame);
+  std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "estimate: [EI_1, EI_2, EI_3, EI_4]";
+  yaml.replace(yaml.find(from), from.size(), "estimate: [EI, floor_mass_1, floor_mass_2, floor_mass_3, floor_mass_4]");
+  std::ofstream(dir / "frame.yaml") << yaml;
+  std::ofstream(dir / "e.yaml") << "experiments: frame5\nmodes: {file: m.csv, scenario: frame.yaml}\n";
+  io::ModalData md;
+  md.source = "exact";
+  for (int k = 0; k < 4; ++k) {
+    io::ModalData::Mode m;
+    m.label = k + 1;
+    m.frequency_hz = exact[k];
+    m.frequency_std_hz = 2e-3 * exact[k];
+    md.modes.push_back(m);
+  }
+  io::write_modal_data((dir / "m.csv").string(), md);
+  auto ep = make_experiments(load_experiments((dir / "e.yaml").string()));
+  ExperimentsOptions eo;
+  eo.verbose = false;
+  const ExperimentsResult r = run_experiments(*ep, eo);
+  std::filesystem::remove_all(dir);
+  int flagged = 0;
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    std::printf("  %s: %s %s\n", r.names[i].c_str(), r.ident.identifiable[i] ? "identifiable" : "NOT identifiable",
+                r.ident.reason[i].c_str());
+    if (!r.ident.identifiable[i]) {
+      ++flagged;
+      EXPECT_FALSE(std::isfinite(r.interval.half_width[static_cast<Eigen::Index>(i)])) << r.names[i];
+    }
+  }
+  EXPECT_GE(flagged, 1);
 }
 
 TEST(Frame, InputsAndSensorsAreHeightsOnTheFrame) {
