@@ -781,6 +781,22 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
     in.kind = r.choice_of("kind", InputKind::Force);
     in.location = r.num("location", 0.0);
     check_location(sc, r.field("location"), in.at, in.location);
+    if (r.has("attachment")) {
+      // A force on a lumped attachment's mass: at its station, on its own degree of freedom.
+      in.attachment = r.str("attachment", "");
+      const PointElement* e = nullptr;
+      for (const auto& a : sc.beam.attachments)
+        if (a.name == in.attachment) e = &a;
+      if (sc.structure != Structure::Beam || !e || !(e->lumped_mass > 0.0))
+        fail_field(sc.source, r.field("attachment"),
+                   "must name an attachment of the beam with a lumped_mass (beam.attachments[].name)", "'" + in.attachment + "'");
+      if (in.kind != InputKind::Force)
+        fail_field(sc.source, r.field("kind"), "must be 'force' on a lumped attachment (it moves along w only)", quoted(in.kind));
+      if (r.has("location") && in.location != e->location)
+        fail_field(sc.source, r.field("location"),
+                   "must be the attachment's own station (" + format_value(e->location) + ") or left out", format_value(in.location));
+      in.location = e->location;
+    }
     in.direction = parse_direction(r, "direction");
     in.unit = r.str("unit", "");
     in.signal_from = r.choice_of("signal_from", in.signal_from);
@@ -1401,6 +1417,7 @@ nlohmann::json to_json(const Scenario& s) {
                            {"signal_from", to_string(in.signal_from)},
                            {"interpolation", to_string(in.interpolation)},
                            {"signal", signal_json(in.signal)}});
+    if (!in.attachment.empty()) j["inputs"].back()["attachment"] = in.attachment;
     if (!in.column.empty()) j["inputs"].back()["column"] = in.column;
     if (!in.column_unit.empty()) j["inputs"].back()["column_unit"] = in.column_unit;
     if (in.conditioning.stated()) j["inputs"].back()["conditioning"] = conditioning_json(in.conditioning);

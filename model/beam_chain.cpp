@@ -172,6 +172,10 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
     const int i = bar_of(e.location, x);
     const MobilizedBody::Slider mass(matter_.updGround(), Transform(Rotation(Pi / 2, ZAxis), Vec3(e.location, 0, 0)),
                                      Body::Rigid(MassProperties(e.lumped_mass, Vec3(0), Inertia(0))), Transform());
+    Station at;
+    at.body = mass.getMobilizedBodyIndex();
+    at.p_RS0 = Vec3(e.location, 0, 0);
+    lumped_[e.name] = at;
     PointSpring coupling{segment_bodies_[static_cast<std::size_t>(i)], Vec3(x, 0, 0), e.lumped_k, e.lumped_c};
     coupling.other = mass.getMobilizedBodyIndex();
     points.push_back(coupling);
@@ -186,6 +190,11 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
   }
   joint_springs_ = joints;
   Force::Custom(forces_, new JointForces(matter_, std::move(joints), std::move(anchors), {}, std::move(points)));
+}
+
+Station BeamChain::attachment_station(const std::string& name) const {
+  const auto it = lumped_.find(name);
+  return it == lumped_.end() ? Station{} : it->second;
 }
 
 }  // namespace scoleid::model

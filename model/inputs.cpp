@@ -139,6 +139,11 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
       if (in.at != st.planar_site())
         io::fail_field(sc.source, field + ".at", "must be '" + std::string(io::to_string(st.planar_site())) + "' for a " + kind + " structure", io::quoted(in.at));
       a.station = st.station_at(in.location);
+      if (!in.attachment.empty()) {  // on the attachment's lumped mass (docs/theory.md §2.5)
+        a.station = st.attachment_station(in.attachment);
+        if (!a.station.body.isValid())
+          io::fail_field(sc.source, field + ".attachment", "names no lumped attachment of the " + kind, "'" + in.attachment + "'");
+      }
       a.d_R = a.kind == AppliedInput::Kind::Moment ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
     } else if (in.at == io::Site::Beam) {
       io::fail_field(sc.source, field + ".at", "must not be 'beam' for a " + kind + " structure", "'beam'");

@@ -18,6 +18,8 @@ Station Structure::station_at(double s) const {
 
 Station Structure::named_station(io::Site) const { return {}; }
 
+Station Structure::attachment_station(const std::string&) const { return {}; }
+
 SimTK::MobilizedBodyIndex Structure::actuator_slider(int, int) const { return {}; }
 
 }  // namespace scoleid::model

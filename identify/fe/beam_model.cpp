@@ -60,6 +60,14 @@ void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io:
                  format_value(in.location));
     ModelInput mi;
     mi.name = in.name;
+    if (!in.attachment.empty()) {  // a force on a lumped attachment's own DOF (docs/theory.md §2.5)
+      const auto it = fe.lumped_dof.find(in.attachment);
+      if (it == fe.lumped_dof.end())
+        fail_field(source, f + ".attachment", "must name an attachment with a lumped_mass", "'" + in.attachment + "'");
+      mi.vector = VectorXd::Unit(m.ndof, it->second);
+      m.inputs.push_back(std::move(mi));
+      continue;
+    }
     mi.vector = (in.kind == io::InputKind::Moment ? fe.rotation_row(in.location) : fe.displacement_row(in.location)).transpose();
     m.inputs.push_back(std::move(mi));
   }
@@ -137,7 +145,7 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
 
   // A lumped attachment's mass has a degree of freedom of its own, after the beam's (docs/theory.md
   // §2.5): its displacement along w.
-  std::map<std::string, int> lumped_dof;
+  std::map<std::string, int>& lumped_dof = fe.lumped_dof;
   for (const auto& e : beam.attachments)
     if (e.lumped_mass > 0.0) lumped_dof[e.name] = n + static_cast<int>(lumped_dof.size());
   n += static_cast<int>(lumped_dof.size());

@@ -362,3 +362,43 @@ TEST(PointElements, ALumpedAttachmentIsRefusedWithoutItsMassOrSpringOrOnAHeldEnd
     EXPECT_NE(std::string(e.what()).find("beam.supports.left.lumped_k"), std::string::npos) << e.what();
   }
 }
+
+// A force on a lumped attachment's own mass (inputs[].attachment: a shaker's drive on its
+// armature) reaches the beam through the stinger: statically the beam carries the whole force at
+// the station, w(L) = P L³/(3EI) for a tip station, and the mass sits P/k_l beyond it; a force on
+// anything but a lumped attachment, or a moment, is refused naming the field.
+TEST(PointElements, AForceOnTheArmatureReachesTheBeamThroughTheStinger) {
+  const double L = 0.5, EI = 11.25, P = 0.7, kl = 6000;
+  const std::string head = R"(structure: beam
+beam: {length: 0.5, left: clamped, right: free, rho_A: 0.58875, EI: 11.25,
+       attachments: [{name: shaker, location: 0.5, lumped_mass: 0.02, lumped_k: 6000}, {name: acc, location: 0.3, mass: 0.006}]}
+sensors: [{name: w, location: 0.5}]
+)";
+  const io::Scenario sc = io::parse_scenario(head + "inputs: [{name: F, attachment: shaker, kind: force, signal: {type: step, amplitude: 1, t0: 0}}]\n", "a.yaml");
+  EXPECT_DOUBLE_EQ(sc.inputs[0].location, 0.5);
+  const auto st = scoleid::identify::make_structure(sc, 8);
+  const auto& m = st->model();
+  const Eigen::VectorXd c = st->coefficients(sc);
+  const Eigen::SparseMatrix<double> K = m.assemble(m.stiffness, c);
+  const Eigen::VectorXd b = P * m.inputs[0].vector;
+  const Eigen::VectorXd u = Eigen::MatrixXd(K).ldlt().solve(b);
+  const double w_tip = m.sensors[0].row.dot(u), x_l = u[m.ndof - 1];
+  const double exact = P * L * L * L / (3 * EI);
+  std::printf("w(L) %.12g (exact %.12g), lumped mass %.12g (exact %.12g)\n", w_tip, exact, x_l, exact + P / kl);
+  EXPECT_NEAR(w_tip, exact, 1e-12 * exact);
+  EXPECT_NEAR(x_l, exact + P / kl, 1e-12 * x_l);
+  const auto error_of = [&](const std::string& input) {
+    try {
+      io::parse_scenario(head + input, "a.yaml");
+    } catch (const io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no InputError)");
+  };
+  EXPECT_EQ(error_of("inputs: [{name: F, attachment: acc, signal: {type: step, amplitude: 1, t0: 0}}]\n"),
+            "a.yaml: inputs[0].attachment must name an attachment of the beam with a lumped_mass (beam.attachments[].name), got 'acc'");
+  EXPECT_EQ(error_of("inputs: [{name: F, attachment: shaker, kind: moment, signal: {type: step, amplitude: 1, t0: 0}}]\n"),
+            "a.yaml: inputs[0].kind must be 'force' on a lumped attachment (it moves along w only), got 'moment'");
+  EXPECT_EQ(error_of("inputs: [{name: F, attachment: shaker, location: 0.4, signal: {type: step, amplitude: 1, t0: 0}}]\n"),
+            "a.yaml: inputs[0].location must be the attachment's own station (0.5) or left out, got 0.4");
+}

@@ -224,6 +224,9 @@ struct Conditioning {
 // force along its slider.
 struct InputSpec : PointSpec {
   InputKind kind = InputKind::Force;
+  // A beam's force on an attachment's lumped mass (its own degree of freedom, docs/theory.md §2.5:
+  // a shaker's drive on its armature) in place of a station: the attachment's name, "" for none.
+  std::string attachment;
   // With a data file (scole-identify --data): "auto" drives the input by the file's column of the
   // same name when there is one, else by `signal`; "data" requires the column (an error if it is
   // missing); "scenario" always uses `signal`. The truth always uses `signal`.

@@ -29,6 +29,9 @@
 // AnchorSpring on its bar, whose angle is the bar's mean slope (O(h), where the element's own
 // rotation is the slope at its station).
 // Valid for small rotations in the sense of the PDE; the chain itself is geometrically exact.
+#include <map>
+#include <string>
+
 #include "scoleid/io/scenario.h"
 #include "scoleid/model/structure.h"
 
@@ -46,9 +49,11 @@ public:
   bool planar() const override { return true; }
   SimTK::MobilizedBodyIndex reference_body() const override { return SimTK::GroundIndex; }
   const HenckyLumping& lumping() const { return lumping_; }
+  Station attachment_station(const std::string& name) const override;
 
 private:
   HenckyLumping lumping_;
+  std::map<std::string, Station> lumped_;  // each lumped attachment's mass (its Slider body)
 };
 
 }  // namespace scoleid::model

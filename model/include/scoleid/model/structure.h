@@ -60,6 +60,9 @@ public:
   // Arc position s as a coordinate that is i at segment i's centre, linear between centres
   // (s/h − 1/2 on a uniform chain; a rotation sensor interpolates the bars' angles by it).
   virtual double centre_coordinate(double s) const { return s / (length_ / segments()) - 0.5; }
+  // The lumped mass of a beam's attachment (its own body, moving along w), by the attachment's
+  // name; an invalid body if there is none.
+  virtual Station attachment_station(const std::string& name) const;
   // Named rigid bodies: the shuttle, the reflector; an invalid index if absent.
   virtual Station named_station(io::Site at) const;
   // Slider mobilizers of actuator K (1-based) along reference x and y, or invalid.

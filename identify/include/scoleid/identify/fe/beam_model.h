@@ -18,6 +18,7 @@
 // K = Σ_k EI_k K_k, D = Σ_k d_k G_k + c_kv Σ_k K_k, with K_k = ∫_{section k} N″N″ᵀ ds and
 // G_k = ∫_{section k} N′N′ᵀ ds (hermite_beam.h). Loads and sensors anywhere on the beam, through
 // the shape functions (a sensor between nodes reads the interpolated field).
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct BeamFE {
   int elements = 0;
   int sections = 0;
   std::vector<int> full_to_reduced;  // 2 per node: (w, θ); -1 where constrained
+  std::map<std::string, int> lumped_dof;  // a lumped attachment's own DOF, by the attachment's name
   // The point elements' quantities (supports and attachments, docs/theory.md §2.5), each > 0 and
   // one coefficient of its own after c_kv: its parameter name, station, field and value.
   struct PointQuantity {
