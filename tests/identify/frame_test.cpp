@@ -50,6 +50,26 @@ std::vector<double> fe_frequencies(const io::Scenario& sc, int elements) {
   return f;
 }
 
+// Measured natural frequencies (std rel × exact) written to dir/m.csv and identified by the
+// experiments file dir/e.yaml.
+ExperimentsResult fit_frequencies(const std::filesystem::path& dir, const std::vector<double>& measured,
+                                  const std::vector<double>& exact, double rel) {
+  io::ModalData md;
+  md.source = "frequencies";
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    io::ModalData::Mode m;
+    m.label = static_cast<int>(k) + 1;
+    m.frequency_hz = measured[k];
+    m.frequency_std_hz = rel * exact[k];
+    md.modes.push_back(m);
+  }
+  io::write_modal_data((dir / "m.csv").string(), md);
+  auto ep = make_experiments(load_experiments((dir / "e.yaml").string()));
+  ExperimentsOptions eo;
+  eo.verbose = false;
+  return run_experiments(*ep, eo);
+}
+
 }  // namespace
 
 TEST(Frame, ColumnDynamicStiffnessHasTheStaticLimit) {
@@ -127,20 +147,9 @@ TEST(Frame, StoreyStiffnessesFromFourNoisyFrequencies) {
   int converged = 0;
   double worst = 0.0;
   for (int d = 0; d < draws; ++d) {
-    io::ModalData md;
-    md.source = "draw";
-    for (int k = 0; k < 4; ++k) {
-      io::ModalData::Mode m;
-      m.label = k + 1;
-      m.frequency_hz = exact[k] * (1.0 + rel * noise(rng));
-      m.frequency_std_hz = rel * exact[k];
-      md.modes.push_back(m);
-    }
-    io::write_modal_data((dir / "m.csv").string(), md);
-    auto ep = make_experiments(load_experiments((dir / "e.yaml").string()));
-    ExperimentsOptions eo;
-    eo.verbose = false;
-    const ExperimentsResult r = run_experiments(*ep, eo);
+    std::vector<double> measured;
+    for (int k = 0; k < 4; ++k) measured.push_back(exact[k] * (1.0 + rel * noise(rng)));
+    const ExperimentsResult r = fit_frequencies(dir, measured, exact, rel);
     converged += r.converged();
     ASSERT_EQ(r.interval.half_width.size(), 4);
     std::printf("  draw %2d:", d);
@@ -174,20 +183,7 @@ TEST(Frame, FourFrequenciesDoNotFixFiveUnknowns) {
   yaml.replace(yaml.find(from), from.size(), "estimate: [EI, floor_mass_1, floor_mass_2, floor_mass_3, floor_mass_4]");
   std::ofstream(dir / "frame.yaml") << yaml;
   std::ofstream(dir / "e.yaml") << "experiments: frame5\nmodes: {file: m.csv, scenario: frame.yaml}\n";
-  io::ModalData md;
-  md.source = "exact";
-  for (int k = 0; k < 4; ++k) {
-    io::ModalData::Mode m;
-    m.label = k + 1;
-    m.frequency_hz = exact[k];
-    m.frequency_std_hz = 2e-3 * exact[k];
-    md.modes.push_back(m);
-  }
-  io::write_modal_data((dir / "m.csv").string(), md);
-  auto ep = make_experiments(load_experiments((dir / "e.yaml").string()));
-  ExperimentsOptions eo;
-  eo.verbose = false;
-  const ExperimentsResult r = run_experiments(*ep, eo);
+  const ExperimentsResult r = fit_frequencies(dir, exact, exact, 2e-3);
   std::filesystem::remove_all(dir);
   int flagged = 0;
   for (std::size_t i = 0; i < r.names.size(); ++i) {
