@@ -6,8 +6,6 @@
 #include <stdexcept>
 
 #include "scoleid/crosscheck/richardson.h"
-#include "scoleid/identify/fe/analytic_beam.h"
-#include "scoleid/identify/fe/analytic_frame.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
@@ -129,57 +127,6 @@ SideModes fe_modes(const io::Scenario& shape_sc, const std::vector<double>& scal
   return out;
 }
 
-// Analytic Euler–Bernoulli frequencies [Hz] of a uniform beam, or empty; `what` describes them.
-std::vector<double> analytic_hz(const io::Scenario& sc, int count, std::string& what) {
-  what.clear();
-  if (sc.structure == io::Structure::Frame) {
-    what = "the columns' exact dynamic stiffness on the floors' sways (undamped, below the first column mode)";
-    std::vector<double> hz;
-    for (double w : identify::analytic::frame_omegas(sc.frame, count)) hz.push_back(w / kTwoPi);
-    return hz;
-  }
-  if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1) return {};
-  using io::EndCondition;
-  namespace an = identify::analytic;
-  const auto& b = sc.beam;
-  const double L = b.length, EI = b.EI[0], rA = b.rho_A;
-  std::vector<double> bl;
-  auto is = [&](EndCondition l, EndCondition r) {
-    return (b.left == l && b.right == r) || (b.left == r && b.right == l);
-  };
-  const bool tip = b.tip_mass > 0 || b.tip_inertia > 0;
-  if (!b.supports.empty() || !b.attachments.empty()) {
-    // Supports and attachments: the exact transfer-matrix solution (analytic_beam.h).
-    what = "Euler-Bernoulli with supports and attachments (transfer matrix, undamped)";
-    std::vector<double> hz;
-    for (double w : an::point_element_omegas(b, count)) hz.push_back(w / kTwoPi);
-    return hz;
-  }
-  if (is(EndCondition::Clamped, EndCondition::Free) && b.left == EndCondition::Clamped) {
-    bl = tip ? an::beta_L_tip_mass(b.tip_mass / (rA * L), b.tip_inertia / (rA * L * L * L), count)
-             : an::beta_L(an::Support::ClampedFree, count);
-    what = tip ? "Euler-Bernoulli cantilever with tip mass and rotary inertia" : "Euler-Bernoulli clamped-free";
-  } else if (tip) {
-    return {};
-  } else if (is(EndCondition::Pinned, EndCondition::Pinned)) {
-    bl = an::beta_L(an::Support::PinnedPinned, count);
-    what = "Euler-Bernoulli pinned-pinned";
-  } else if (is(EndCondition::Clamped, EndCondition::Clamped)) {
-    bl = an::beta_L(an::Support::ClampedClamped, count);
-    what = "Euler-Bernoulli clamped-clamped";
-  } else if (is(EndCondition::Free, EndCondition::Free)) {
-    bl = an::beta_L(an::Support::FreeFree, count);
-    what = "Euler-Bernoulli free-free";
-  } else if (is(EndCondition::Clamped, EndCondition::Free)) {
-    bl = an::beta_L(an::Support::ClampedFree, count);
-    what = "Euler-Bernoulli clamped-free";
-  } else {
-    return {};
-  }
-  std::vector<double> hz;
-  for (double x : bl) hz.push_back(an::omega(x, L, EI, rA) / kTwoPi);
-  return hz;
-}
 }  // namespace
 
 bool ModesOptions::IsValid(std::string* why) const {
@@ -237,7 +184,7 @@ ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& opt)
   std::size_t count = static_cast<std::size_t>(opt.count);
   for (const auto& c : chain) count = std::min(count, c.hz.size());
   for (const auto& f : fe) count = std::min(count, f.hz.size());
-  const std::vector<double> exact = analytic_hz(truth_sc, static_cast<int>(count), rep.analytic);
+  const std::vector<double> exact = identify::make_structure(truth_sc, N0)->exact_hz(truth_sc, static_cast<int>(count), rep.analytic);
   rep.mac = mac_matrix(chain.front().shapes.leftCols(static_cast<Eigen::Index>(count)),
                        fe.front().shapes.leftCols(static_cast<Eigen::Index>(count)));
   for (std::size_t i = 0; i < count; ++i) {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "scoleid/identify/fe/modal.h"
+#include "scoleid/io/validation.h"
 #include "scoleid/identify/fe/scole_nonlinear.h"
 #include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/identify/run/problem.h"
@@ -66,11 +67,9 @@ AtTruth at_truth(const io::Scenario& scenario, const std::string& csv, int eleme
   AtTruth a;
   a.sc = io::truth_scenario(scenario);
   io::Scenario& sc = a.sc;
-  if (sc.structure == io::Structure::Scole && sc.scole.actuator_lag > 0)
-    io::fail_field(scenario.source, "truth.overrides.scole.actuator_lag",
-                   "is a servo lag of the Simbody truth only: the finite-element model cannot follow it, so the "
-                   "trajectories cannot be compared at the truth's physics",
-                   io::format_value(sc.scole.actuator_lag));
+  io::check_fe_reproduces_truth(scenario.source, sc,
+                                 "the finite-element model cannot follow it, so the trajectories cannot be compared "
+                                 "at the truth's physics");
   sc.truth.overrides.clear();
   sc.identification.elements = elements;
   sc.identification.time_step = 0.0;
@@ -115,13 +114,10 @@ FeResponse fe_response(const io::Scenario& scenario, const std::string& csv, int
 
 FeResponse nonlinear_fe_response(const io::Scenario& scenario, const std::string& csv, int elements, double step) {
   const AtTruth a = at_truth(scenario, csv, elements);
-  if (a.sc.structure != io::Structure::Scole)
-    io::fail_field(scenario.source, "structure", "has no nonlinear model (scole only)", "'" + std::string(io::to_string(a.sc.structure)) + "'");
   identify::VectorXd c;
   identify::MatrixXd dcdq;
   a.p->params->coefficients(a.q, c, dcdq);
-  const identify::ScoleFE fe = identify::build_scole(a.sc.scole, elements, a.sc.inputs, a.sc.sensors, a.sc.source);
-  const identify::ScoleNonlinear nl(fe, a.sc.inputs, a.sc.sensors);
+  const identify::ScoleNonlinear nl = identify::scole_nonlinear(a.sc, elements);
   identify::NonlinearForwardOptions opt;
   opt.max_step = step > 0 ? step : fe_reference_step(*a.p);
   const auto r = identify::simulate_nonlinear(nl.at(c), a.p->signals, a.p->data.t, opt);

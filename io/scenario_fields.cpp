@@ -37,6 +37,13 @@ bool* bool_field(Scenario& sc, const std::string& path) {
   return nullptr;
 }
 
+std::string truth_field(const Scenario& scenario, const Scenario& truth, const std::string& path) {
+  Scenario a = scenario, b = truth;
+  const double* x = numeric_field(a, path);
+  const double* y = numeric_field(b, path);
+  return x && y && *x != *y ? "truth.overrides." + path : path;
+}
+
 std::vector<std::string> field_paths(const Scenario& sc) {
   Scenario copy = sc;
   std::vector<std::string> v;

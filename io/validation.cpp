@@ -209,6 +209,12 @@ std::string shorten(const std::string& value, std::size_t keep) {
   return value.substr(0, utf8_boundary(value, keep)) + "... (" + std::to_string(value.size()) + " characters)";
 }
 
+void check_fe_reproduces_truth(const std::string& source, const Scenario& truth_sc, const std::string& why) {
+  if (truth_sc.structure == Structure::Scole && truth_sc.scole.actuator_lag > 0)
+    fail_field(source, "truth.overrides.scole.actuator_lag", "is a servo lag of the Simbody truth only: " + why,
+               format_value(truth_sc.scole.actuator_lag));
+}
+
 std::string one_line(const std::string& message) {
   // A message that echoes a huge name or cell is cut in the middle: its head names the file and
   // the field, its tail the requirement and the value's end.

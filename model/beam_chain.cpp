@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "scoleid/model/joint_forces.h"
+#include "scoleid/model/sensors.h"
 
 namespace scoleid::model {
 
@@ -22,7 +23,7 @@ double end_series_stiffness(const io::BeamSpec& beam, int end, double k0) {
   return k > 0.0 ? k * k0 / (k + k0) : 0.0;
 }
 
-BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
+BeamChain::BeamChain(const io::BeamSpec& beam, int n) : beam_(beam) {
   length_ = beam.length;
   root_R_ = Vec3(0);
   axis_B_ = axis_R_ = Vec3(1, 0, 0);
@@ -195,6 +196,45 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) {
 Station BeamChain::attachment_station(const std::string& name) const {
   const auto it = lumped_.find(name);
   return it == lumped_.end() ? Station{} : it->second;
+}
+
+// The strain gauge at s (sensors.h): the joints at j h and (j + 1) h around s, with their Hencky
+// springs (hencky.h) of the beam the chain simulates.
+void BeamChain::resolve_strain(const io::SensorSpec& se, ResolvedSensor& r) const {
+  const io::BeamSpec& beam = beam_;
+  const Structure& st = *this;
+  const int n = st.segments();
+  const double h = st.length() / n;
+  const PiecewiseField EI{beam.length, beam.EI};
+  const HenckyLumping lumping = hencky_lumping(n, EI, PiecewiseField{beam.length, {beam.c_kv}});
+  const auto& seg = st.segment_bodies();
+  auto joint = [&](int j) {
+    ResolvedSensor::Joint jt;
+    // An end's rotational spring (supports, attachments) acts in series with the end cell's: the
+    // joint carries the series stiffness (beam_chain.h).
+    if (j == 0) {
+      if (beam.left == io::EndCondition::Clamped) jt = {MobilizedBodyIndex(), seg.front(), lumping.stiffness.front()};
+      else if (const double k = end_series_stiffness(beam, 0, lumping.stiffness.front()); k > 0.0)
+        jt = {MobilizedBodyIndex(), seg.front(), k};
+    } else if (j == n) {
+      if (st.tip_body().isValid()) jt = {seg.back(), st.tip_body(), lumping.stiffness.back()};
+      else if (beam.right == io::EndCondition::Clamped) jt = {seg.back(), MobilizedBodyIndex(), lumping.stiffness.back()};
+      else if (const double k = end_series_stiffness(beam, 1, lumping.stiffness.back()); k > 0.0)
+        jt = {seg.back(), MobilizedBodyIndex(), k};
+    } else {
+      jt = {seg[static_cast<std::size_t>(j - 1)], seg[static_cast<std::size_t>(j)], lumping.stiffness[static_cast<std::size_t>(j)]};
+    }
+    return jt;
+  };
+  const int j = std::clamp(static_cast<int>(std::floor(se.location / h)), 0, n - 1);
+  r.joints[0] = joint(j);
+  r.joints[1] = joint(j + 1);
+  r.weight = std::clamp(se.location / h - j, 0.0, 1.0);
+  r.scale = -se.field("offset") / EI.at(se.location);
+}
+
+std::unique_ptr<Structure> make_beam_chain(const io::Scenario& sc, int segments) {
+  return std::make_unique<BeamChain>(sc.beam, segments);
 }
 
 }  // namespace scoleid::model

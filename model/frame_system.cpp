@@ -123,4 +123,13 @@ double FrameSystem::centre_coordinate(double s) const {
   return prev_c + 1.0;  // beyond the last centre
 }
 
+// Its storeys' bars differ in length: no arc range.
+std::string FrameSystem::segment_name(int i) const {
+  return "frame's first column, segment " + std::to_string(i + 1) + " of " + std::to_string(segments());
+}
+
+std::unique_ptr<Structure> make_frame_system(const io::Scenario& sc, int segments) {
+  return std::make_unique<FrameSystem>(sc.frame, segments);
+}
+
 }  // namespace scoleid::model

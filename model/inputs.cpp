@@ -167,7 +167,7 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
       if (d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       a.d_R = d;
-      a.station = in.at == io::Site::Mast ? st.station_at(in.location) : st.named_station(in.at);
+      a.station = st.site_station(in.at, in.location);
       if (!a.station.body.isValid())
         io::fail_field(sc.source, field + ".at", "is not a body of this structure", io::quoted(in.at));
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scoleid/io/error.h"
 #include "scoleid/model/joint_forces.h"
 
 namespace scoleid::model {
@@ -115,6 +116,7 @@ struct ScoleSystem::Build {
 ScoleSystem::ScoleSystem(const io::ScoleSpec& sc, int n) {
   length_ = sc.length;
   actuator_lag_ = sc.actuator_lag;
+  actuator_stroke_ = sc.actuator_stroke;
   root_R_ = Vec3(sc.mast_root[0], sc.mast_root[1], sc.mast_root[2]);
   axis_B_ = axis_R_ = Vec3(0, 0, -1);
   if (!sc.bending_rotary_inertia)
@@ -136,6 +138,15 @@ Station ScoleSystem::named_station(io::Site at) const {
 MobilizedBodyIndex ScoleSystem::actuator_slider(int k, int axis) const {
   const std::size_t i = static_cast<std::size_t>(2 * (k - 1) + axis);
   return k >= 1 && i < sliders_.size() ? sliders_[i] : MobilizedBodyIndex();
+}
+
+std::unique_ptr<Structure> make_scole_system(const io::Scenario& sc, int segments) {
+  if (!sc.scole.bending_rotary_inertia)
+    io::fail_field(sc.source, "scole.bending_rotary_inertia",
+                   "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "
+                   "inertia (a body with polar inertia J has Ixx + Iyy >= J); drop it on the identifier's side only",
+                   "false");
+  return std::make_unique<ScoleSystem>(sc.scole, segments);
 }
 
 }  // namespace scoleid::model

@@ -1,7 +1,5 @@
 #include "scoleid/model/sensors.h"
 
-#include "scoleid/model/beam_chain.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -44,39 +42,6 @@ double rotation_about(const SimbodyMatterSubsystem& matter, const State& state, 
   return aa[0] * dot(Vec3(aa[1], aa[2], aa[3]), d);
 }
 
-// The strain gauge at s on a beam chain (header): the joints at j h and (j + 1) h around s, with
-// their Hencky springs (hencky.h) of the beam the truth simulates.
-void resolve_strain(const io::BeamSpec& beam, const Structure& st, const io::SensorSpec& se, ResolvedSensor& r) {
-  const int n = st.segments();
-  const double h = st.length() / n;
-  const PiecewiseField EI{beam.length, beam.EI};
-  const HenckyLumping lumping = hencky_lumping(n, EI, PiecewiseField{beam.length, {beam.c_kv}});
-  const auto& seg = st.segment_bodies();
-  auto joint = [&](int j) {
-    ResolvedSensor::Joint jt;
-    // An end's rotational spring (supports, attachments) acts in series with the end cell's: the
-    // joint carries the series stiffness (beam_chain.h).
-    if (j == 0) {
-      if (beam.left == io::EndCondition::Clamped) jt = {MobilizedBodyIndex(), seg.front(), lumping.stiffness.front()};
-      else if (const double k = end_series_stiffness(beam, 0, lumping.stiffness.front()); k > 0.0)
-        jt = {MobilizedBodyIndex(), seg.front(), k};
-    } else if (j == n) {
-      if (st.tip_body().isValid()) jt = {seg.back(), st.tip_body(), lumping.stiffness.back()};
-      else if (beam.right == io::EndCondition::Clamped) jt = {seg.back(), MobilizedBodyIndex(), lumping.stiffness.back()};
-      else if (const double k = end_series_stiffness(beam, 1, lumping.stiffness.back()); k > 0.0)
-        jt = {seg.back(), MobilizedBodyIndex(), k};
-    } else {
-      jt = {seg[static_cast<std::size_t>(j - 1)], seg[static_cast<std::size_t>(j)], lumping.stiffness[static_cast<std::size_t>(j)]};
-    }
-    return jt;
-  };
-  const int j = std::clamp(static_cast<int>(std::floor(se.location / h)), 0, n - 1);
-  r.joints[0] = joint(j);
-  r.joints[1] = joint(j + 1);
-  r.weight = std::clamp(se.location / h - j, 0.0, 1.0);
-  r.scale = -se.field("offset") / EI.at(se.location);
-}
-
 double joint_moment(const SimbodyMatterSubsystem& matter, const State& state, const ResolvedSensor::Joint& jt) {
   if (jt.k == 0.0) return 0.0;
   const MobilizedBody& G = matter.getGround();
@@ -108,7 +73,7 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
       r.station = st.station_at(se.location);
       r.d_R = r.kind == K::Rotation ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
       if (r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
-      if (r.kind == K::Strain) resolve_strain(sc.beam, st, se, r);
+      if (r.kind == K::Strain) st.resolve_strain(se, r);
       if (r.kind == K::RelativeDisplacement) r.apart = st.station_at(se.field("reference"));
     } else {
       if (!io::reads(st.kind(), r.kind))
@@ -118,9 +83,10 @@ std::vector<ResolvedSensor> resolve_sensors(const io::Scenario& sc, const Struct
       if (d.norm() == 0)
         io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
       r.d_R = d;
-      r.station = se.at == io::Site::Mast ? st.station_at(se.location) : st.named_station(se.at);
-      if (se.at == io::Site::Mast && r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
-      if (se.at == io::Site::Shuttle) r.reference = GroundIndex;
+      r.station = st.site_station(se.at, se.location);
+      if (st.chain_site(se.at) && r.kind == K::Rotation) interpolate_rotation(st, se.location, r);
+      // The reference body's own motion is measured in the inertial frame.
+      if (r.station.body.isValid() && r.station.body == st.reference_body()) r.reference = GroundIndex;
     }
     out.push_back(r);
   }

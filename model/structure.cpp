@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 namespace scoleid::model {
 
@@ -21,5 +23,17 @@ Station Structure::named_station(io::Site) const { return {}; }
 Station Structure::attachment_station(const std::string&) const { return {}; }
 
 SimTK::MobilizedBodyIndex Structure::actuator_slider(int, int) const { return {}; }
+
+void Structure::resolve_strain(const io::SensorSpec&, ResolvedSensor&) const {
+  throw std::logic_error("Structure::resolve_strain: this structure has no strain gauges (io::reads)");
+}
+
+std::string Structure::segment_name(int i) const {
+  const int n = segments();
+  const double h = length_ / n;
+  char buf[96];
+  std::snprintf(buf, sizeof buf, " (s = %.6g to %.6g)", i * h, (i + 1) * h);
+  return chain_name() + " segment " + std::to_string(i + 1) + " of " + std::to_string(n) + buf;
+}
 
 }  // namespace scoleid::model

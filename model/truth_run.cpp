@@ -17,6 +17,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/scenario_fields.h"
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/model/beam_chain.h"
 #include "scoleid/model/frame_system.h"
@@ -99,14 +100,14 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Syste
 }
 
 std::unique_ptr<Structure> build_structure(const io::Scenario& sc, int segments) {
-  if (sc.structure == io::Structure::Frame) return std::make_unique<FrameSystem>(sc.frame, segments);
-  if (sc.structure == io::Structure::Scole && !sc.scole.bending_rotary_inertia)
-    io::fail_field(sc.source, "scole.bending_rotary_inertia",
-                   "must be true for the Simbody truth: its rigid segments carry the section's bending rotary "
-                   "inertia (a body with polar inertia J has Ixx + Iyy >= J); drop it on the identifier's side only",
-                   "false");
-  if (sc.structure == io::Structure::Scole) return std::make_unique<ScoleSystem>(sc.scole, segments);
-  return std::make_unique<BeamChain>(sc.beam, segments);
+  // The registry: scenario.structure -> its Simbody system (each factory in its kind's file).
+  using Factory = std::unique_ptr<Structure> (*)(const io::Scenario&, int);
+  static const std::map<io::Structure, Factory> registry = {
+      {io::Structure::Beam, &make_beam_chain}, {io::Structure::Scole, &make_scole_system}, {io::Structure::Frame, &make_frame_system}};
+  const auto it = registry.find(sc.structure);
+  if (it == registry.end())
+    io::fail_field(sc.source, "structure", "has no Simbody truth", "'" + std::string(io::to_string(sc.structure)) + "'");
+  return it->second(sc, segments);
 }
 
 std::unique_ptr<Structure> prepare_structure(const io::Scenario& sc, int segments) {
@@ -323,30 +324,24 @@ class PlausibilityGuard {
 public:
   PlausibilityGuard(const io::Scenario& scenario, const io::Scenario& truth, const Structure& st)
       : matter_(st.matter()), source_(truth.source) {
-    if (st.kind() == io::Structure::Scole) {
-      stroke_ = truth.scole.actuator_stroke;
-      stroke_field_ = truth.scole.actuator_stroke != scenario.scole.actuator_stroke
-                          ? "truth.overrides.scole.actuator_stroke" : "scole.actuator_stroke";
-      for (std::size_t k = 1; k <= truth.scole.actuator_locations.size(); ++k)
+    if (st.actuator_count() > 0) {
+      stroke_ = st.actuator_stroke();
+      stroke_field_ = io::truth_field(scenario, truth, std::string(io::to_string(st.kind())) + ".actuator_stroke");
+      for (int k = 1; k <= st.actuator_count(); ++k)
         for (int axis = 0; axis < 2; ++axis) {
-          const MobilizedBodyIndex b = st.actuator_slider(static_cast<int>(k), axis);
+          const MobilizedBodyIndex b = st.actuator_slider(k, axis);
           if (b.isValid()) sliders_.push_back({b, "actuator" + std::to_string(k), axis == 0 ? "x" : "y"});
         }
     }
     if (truth.truth.large_motion) return;
-    const bool scole = st.kind() == io::Structure::Scole;
     const MobilizedBodyIndex ref = st.reference_body();
-    const std::string rel = scole ? "relative to the shuttle" : "relative to ground";
-    if (ref != GroundIndex) rotations_.push_back({ref, GroundIndex, "shuttle attitude (relative to the inertial frame)"});
+    const std::string rel = ref == GroundIndex ? "relative to ground" : "relative to the " + st.reference_name();
+    if (ref != GroundIndex) rotations_.push_back({ref, GroundIndex, st.reference_name() + " attitude (relative to the inertial frame)"});
     const int n = st.segments();
-    const double h = st.length() / n;
-    const bool frame = st.kind() == io::Structure::Frame;  // its storeys' segments differ in length
     for (int i = 0; i < n; ++i)
-      rotations_.push_back({st.segment_bodies()[static_cast<std::size_t>(i)], ref,
-                            std::string(scole ? "mast" : frame ? "frame's first column," : "beam") + " segment " + std::to_string(i + 1) +
-                                " of " + std::to_string(n) + (frame ? " " : " (s = " + g6(i * h) + " to " + g6((i + 1) * h) + ") ") + rel});
+      rotations_.push_back({st.segment_bodies()[static_cast<std::size_t>(i)], ref, st.segment_name(i) + " " + rel});
     if (st.tip_body().isValid())
-      rotations_.push_back({st.tip_body(), ref, std::string(scole ? "reflector " : "tip body ") + rel});
+      rotations_.push_back({st.tip_body(), ref, st.tip_name() + " " + rel});
   }
 
   // Throws PlausibilityError at the first slider beyond the stroke or rotation beyond the bound.

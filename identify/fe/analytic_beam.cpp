@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+#include <string>
 
 namespace scoleid::identify::analytic {
 
@@ -186,6 +187,63 @@ std::vector<double> ss_step_samples(double x, double dt, int n, double a, double
   std::vector<double> w;
   for (int k = 0; k <= n; ++k) w.push_back(ss_step_response(x, k * dt, a, P, L, EI, rhoA, terms));
   return w;
+}
+
+// The exact frequencies [Hz] of a beam with one EI (its end conditions, tip body and point
+// elements), or empty (a tip body on ends other than clamped-free; EI by sections); `what` names
+// the solution (crosscheck modes' analytic column).
+std::vector<double> beam_hz(const io::BeamSpec& b, int count, std::string& what) {
+  what.clear();
+  if (b.EI.size() != 1) return {};
+  using io::EndCondition;
+  const double L = b.length, EI = b.EI[0], rA = b.rho_A;
+  std::vector<double> bl;
+  auto is = [&](EndCondition l, EndCondition r) {
+    return (b.left == l && b.right == r) || (b.left == r && b.right == l);
+  };
+  const bool tip = b.tip_mass > 0 || b.tip_inertia > 0;
+  if (!b.supports.empty() || !b.attachments.empty()) {
+    // Supports and attachments: the exact transfer-matrix solution (analytic_beam.h).
+    what = "Euler-Bernoulli with supports and attachments (transfer matrix, undamped)";
+    std::vector<double> hz;
+    for (double w : point_element_omegas(b, count)) hz.push_back(w / (2.0 * M_PI));
+    return hz;
+  }
+  if (is(EndCondition::Clamped, EndCondition::Free) && b.left == EndCondition::Clamped) {
+    bl = tip ? beta_L_tip_mass(b.tip_mass / (rA * L), b.tip_inertia / (rA * L * L * L), count)
+             : beta_L(Support::ClampedFree, count);
+    what = tip ? "Euler-Bernoulli cantilever with tip mass and rotary inertia" : "Euler-Bernoulli clamped-free";
+  } else if (tip) {
+    return {};
+  } else if (is(EndCondition::Pinned, EndCondition::Pinned)) {
+    bl = beta_L(Support::PinnedPinned, count);
+    what = "Euler-Bernoulli pinned-pinned";
+  } else if (is(EndCondition::Clamped, EndCondition::Clamped)) {
+    bl = beta_L(Support::ClampedClamped, count);
+    what = "Euler-Bernoulli clamped-clamped";
+  } else if (is(EndCondition::Free, EndCondition::Free)) {
+    bl = beta_L(Support::FreeFree, count);
+    what = "Euler-Bernoulli free-free";
+  } else if (is(EndCondition::Clamped, EndCondition::Free)) {
+    bl = beta_L(Support::ClampedFree, count);
+    what = "Euler-Bernoulli clamped-free";
+  } else {
+    return {};
+  }
+  std::vector<double> hz;
+  for (double x : bl) hz.push_back(omega(x, L, EI, rA) / (2.0 * M_PI));
+  return hz;
+}
+
+std::vector<double> ss_scenario_samples(const io::Scenario& sc, int terms) {
+  using io::EndCondition;
+  if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1 || sc.beam.left != EndCondition::Pinned ||
+      sc.beam.right != EndCondition::Pinned || sc.inputs.empty() || sc.sensors.empty())
+    throw std::invalid_argument("ss_scenario_samples: a uniform simply supported beam with an input and a sensor");
+  const double dt = sc.simulation.sample_interval;
+  const int n = static_cast<int>(std::lround(sc.simulation.duration / dt));
+  return ss_step_samples(sc.sensors[0].location, dt, n, sc.inputs[0].location, sc.inputs[0].signal(1.0), sc.beam.length,
+                         sc.beam.EI[0], sc.beam.rho_A, terms);
 }
 
 }  // namespace scoleid::identify::analytic

@@ -4,6 +4,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/fe/hermite_beam.h"
 #include "scoleid/io/error.h"
 
@@ -357,6 +358,38 @@ ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam) 
     return c;
   };
   return sp;
+}
+
+namespace {
+
+class BeamStructure final : public FEStructure {
+public:
+  BeamStructure(const io::Scenario& sc, int elements)
+      : fe_(build_beam(sc.beam, elements, sc.identification.sections, sc.inputs, sc.sensors, sc.source)) {}
+  const StructuralModel& model() const override { return fe_.model; }
+  int elements() const override { return fe_.elements; }
+  double length() const override { return fe_.length; }
+  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
+    return std::make_unique<PhysicalParameterization>(beam_parameter_space(fe_, sc.beam), sc.identification, sc.source);
+  }
+  VectorXd coefficients(const io::Scenario& sc) const override {
+    VectorXd c = beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta, sc.beam.c_kv);
+    for (std::size_t k = 0; k < fe_.points.size(); ++k)  // the point elements' values in sc (its truth's may differ)
+      if (const double v = point_value(fe_.points[k], sc.beam); !std::isnan(v)) c[fe_.coef_point(static_cast<int>(k))] = v;
+    return c;
+  }
+  std::vector<double> exact_hz(const io::Scenario& sc, int count, std::string& what) const override {
+    return analytic::beam_hz(sc.beam, count, what);
+  }
+
+private:
+  BeamFE fe_;
+};
+
+}  // namespace
+
+std::unique_ptr<FEStructure> make_beam_structure(const io::Scenario& sc, int elements) {
+  return std::make_unique<BeamStructure>(sc, elements);
 }
 
 }  // namespace scoleid::identify

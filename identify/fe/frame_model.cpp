@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scoleid/identify/fe/analytic_frame.h"
 #include "scoleid/identify/fe/hermite_beam.h"
 #include "scoleid/io/error.h"
 
@@ -196,6 +197,42 @@ ParameterSpace frame_parameter_space(const FrameFE& fe, const io::FrameSpec& fra
     return c;
   };
   return sp;
+}
+
+namespace {
+
+class FrameStructure final : public FEStructure {
+public:
+  FrameStructure(const io::Scenario& sc, int elements)
+      : fe_((check(sc), build_frame(sc.frame, elements, sc.inputs, sc.sensors, sc.source))) {}
+  const StructuralModel& model() const override { return fe_.model; }
+  int elements() const override { return fe_.elements; }
+  double length() const override { return fe_.height; }
+  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
+    return std::make_unique<PhysicalParameterization>(frame_parameter_space(fe_, sc.frame), sc.identification, sc.source);
+  }
+  VectorXd coefficients(const io::Scenario& sc) const override { return frame_coefficients(fe_, sc.frame); }
+  std::vector<double> exact_hz(const io::Scenario& sc, int count, std::string& what) const override {
+    what = "the columns' exact dynamic stiffness on the floors' sways (undamped, below the first column mode)";
+    std::vector<double> hz;
+    for (double w : analytic::frame_omegas(sc.frame, count)) hz.push_back(w / (2.0 * M_PI));
+    return hz;
+  }
+
+private:
+  static int check(const io::Scenario& sc) {
+    if (sc.identification.sections > 1)
+      io::fail_field(sc.source, "identification.sections", "must be 0 or 1 for a frame (its storeys are its sections)",
+                     std::to_string(sc.identification.sections));
+    return 0;
+  }
+  FrameFE fe_;
+};
+
+}  // namespace
+
+std::unique_ptr<FEStructure> make_frame_structure(const io::Scenario& sc, int elements) {
+  return std::make_unique<FrameStructure>(sc, elements);
 }
 
 }  // namespace scoleid::identify

@@ -506,4 +506,34 @@ ParameterSpace scole_parameter_space(const io::ScoleSpec& sc) {
   return sp;
 }
 
+namespace {
+
+class ScoleStructure final : public FEStructure {
+public:
+  ScoleStructure(const io::Scenario& sc, int elements)
+      : fe_((check(sc), build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source))) {}
+  const StructuralModel& model() const override { return fe_.model; }
+  int elements() const override { return fe_.elements; }
+  double length() const override { return fe_.spec.length; }
+  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
+    return std::make_unique<PhysicalParameterization>(scole_parameter_space(sc.scole), sc.identification, sc.source);
+  }
+  VectorXd coefficients(const io::Scenario& sc) const override { return scole_coefficients(sc.scole); }
+
+private:
+  static int check(const io::Scenario& sc) {
+    if (sc.identification.sections > 1)
+      io::fail_field(sc.source, "identification.sections", "must be 0 or 1 for a scole structure (uniform mast)",
+                     std::to_string(sc.identification.sections));
+    return 0;
+  }
+  ScoleFE fe_;
+};
+
+}  // namespace
+
+std::unique_ptr<FEStructure> make_scole_structure(const io::Scenario& sc, int elements) {
+  return std::make_unique<ScoleStructure>(sc, elements);
+}
+
 }  // namespace scoleid::identify

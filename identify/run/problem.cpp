@@ -357,18 +357,11 @@ io::DataTable measurement_table(const io::Scenario& sc, const Measurements& m) {
 }
 
 Measurements synthesize_series(const io::Scenario& sc, int terms) {
-  using io::EndCondition;
-  if (sc.structure != io::Structure::Beam || sc.beam.EI.size() != 1 || sc.beam.left != EndCondition::Pinned ||
-      sc.beam.right != EndCondition::Pinned || sc.inputs.empty() || sc.sensors.empty())
-    throw std::invalid_argument("synthesize_series: a uniform simply supported beam with an input and a sensor");
   Measurements m;
-  m.names = {sc.sensors[0].name};
-  const double dt = sc.simulation.sample_interval;
-  const int n = static_cast<int>(std::lround(sc.simulation.duration / dt));
-  const auto w = analytic::ss_step_samples(sc.sensors[0].location, dt, n, sc.inputs[0].location, sc.inputs[0].signal(1.0),
-                                           sc.beam.length, sc.beam.EI[0], sc.beam.rho_A, terms);
+  m.names = {sc.sensors.empty() ? std::string() : sc.sensors[0].name};
+  const std::vector<double> w = analytic::ss_scenario_samples(sc, terms);
   m.z = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
-  for (int k = 0; k <= n; ++k) m.t.push_back(k * dt);
+  for (std::size_t k = 0; k < w.size(); ++k) m.t.push_back(static_cast<double>(k) * sc.simulation.sample_interval);
   return m;
 }
 
@@ -425,16 +418,6 @@ Measurements synthesize_nonlinear(const io::Scenario& sc, int elements, double s
   m.z = simulate_nonlinear(nl.at(coefficients), scenario_signals(sc), m.t, o).outputs;
   add_sensor_errors(sc, add_noise, m);
   return m;
-}
-
-ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
-  if (sc.structure != io::Structure::Scole)
-    fail_field(sc.source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'" + std::string(io::to_string(sc.structure)) + "'");
-  if (sc.identification.sections > 0)
-    fail_field(sc.source, "identification.sections", "is not available with the nonlinear model (model: nonlinear)",
-               std::to_string(sc.identification.sections));
-  const ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
-  return ScoleNonlinear(fe, sc.inputs, sc.sensors);
 }
 
 namespace {
@@ -890,11 +873,9 @@ IdentifierStep synthesize_data(Problem& p) {
   p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
                            id.step_rule == io::StepRule::Data);
   const io::Scenario truth_sc = io::truth_scenario(sc);
-  if (truth_sc.structure == io::Structure::Scole && truth_sc.scole.actuator_lag > 0)
-    fail_field(sc.source, "truth.overrides.scole.actuator_lag",
-               "is a servo lag of the Simbody truth only: the finite-element synthesis cannot produce it (generate the "
-               "data with scole-truth and pass them with --data)",
-               io::format_value(truth_sc.scole.actuator_lag));
+  io::check_fe_reproduces_truth(sc.source, truth_sc,
+                                 "the finite-element synthesis cannot produce it (generate the data with scole-truth "
+                                 "and pass them with --data)");
   p.data = id.model == io::Model::Nonlinear ? synthesize_nonlinear(truth_sc, data_elements, step / 4.0, true)
                                             : synthesize(truth_sc, data_elements, id.rtol, step / 4.0, true, is.dirk_table);
   p.data_source = "synthetic (" + std::to_string(data_elements) + " elements)";

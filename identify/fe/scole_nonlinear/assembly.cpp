@@ -2,6 +2,8 @@
 // and the proof masses' mass points and rotors, the inputs and the sensors (scole_nonlinear.h).
 #include "parts.h"
 
+#include "scoleid/io/error.h"
+
 namespace scoleid::identify {
 
 using Eigen::Matrix3d;
@@ -314,6 +316,17 @@ void ScoleNonlinear::add_sensors(const ScoleFE& fe, const std::vector<io::Sensor
     sensors_.push_back(std::move(s));
     sensor_names_.push_back(ms.name);
   }
+}
+
+ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
+  if (sc.structure != io::Structure::Scole)
+    io::fail_field(sc.source, "structure", "has no nonlinear model (identification.model: nonlinear is SCOLE's)",
+                   "'" + std::string(io::to_string(sc.structure)) + "'");
+  if (sc.identification.sections > 0)
+    io::fail_field(sc.source, "identification.sections", "is not available with the nonlinear model (model: nonlinear)",
+                   std::to_string(sc.identification.sections));
+  const ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
+  return ScoleNonlinear(fe, sc.inputs, sc.sensors);
 }
 
 }  // namespace scoleid::identify

@@ -35,6 +35,13 @@ double sample_count(double duration, double interval);
 // calls it; a program that overrides fields from its command line calls it again.
 void validate_scenario(const Scenario& scenario);
 
+// The finite-element models follow what the Simbody truth follows except a SCOLE actuator's
+// servo lag (truth.overrides.scole.actuator_lag). A run that needs the FE model to reproduce
+// truth_sc (its synthesis, trajectories at the truth's physics) refuses such a lag: InputError
+// naming source, the field and the value, `why` after the field's "is a servo lag of the Simbody
+// truth only: ".
+void check_fe_reproduces_truth(const std::string& source, const Scenario& truth_sc, const std::string& why);
+
 // A message as one line: line breaks and other control characters shown as \n, \t, \xNN (C1
 // controls, U+0085 among them, as \uNNNN), and
 // a message over about 640 characters cut in the middle (its first 400 and last 160 kept, at UTF-8

@@ -30,6 +30,7 @@
 // rotation is the slope at its station).
 // Valid for small rotations in the sense of the PDE; the chain itself is geometrically exact.
 #include <map>
+#include <memory>
 #include <string>
 
 #include "scoleid/io/scenario.h"
@@ -50,10 +51,15 @@ public:
   SimTK::MobilizedBodyIndex reference_body() const override { return SimTK::GroundIndex; }
   const HenckyLumping& lumping() const { return lumping_; }
   Station attachment_station(const std::string& name) const override;
+  void resolve_strain(const io::SensorSpec& se, ResolvedSensor& r) const override;
 
 private:
+  io::BeamSpec beam_;
   HenckyLumping lumping_;
   std::map<std::string, Station> lumped_;  // each lumped attachment's mass (its Slider body)
 };
+
+// The truth's beam (truth_run.cpp's registry row).
+std::unique_ptr<Structure> make_beam_chain(const io::Scenario& sc, int segments);
 
 }  // namespace scoleid::model

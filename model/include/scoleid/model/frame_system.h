@@ -33,6 +33,7 @@ public:
   // The point at height s of the first column.
   Station station_at(double s) const override;
   double centre_coordinate(double s) const override;
+  std::string segment_name(int i) const override;
   const std::vector<SimTK::MobilizedBodyIndex>& floors() const { return floors_; }
 
 private:
@@ -40,5 +41,8 @@ private:
   std::vector<int> storey_segments_;  // bars per column in storey k
   std::vector<SimTK::MobilizedBodyIndex> floors_;
 };
+
+// The truth's frame (truth_run.cpp's registry row).
+std::unique_ptr<Structure> make_frame_system(const io::Scenario& sc, int segments);
 
 }  // namespace scoleid::model

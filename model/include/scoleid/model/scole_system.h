@@ -32,7 +32,16 @@ public:
   double actuator_lag() const override { return actuator_lag_; }
   SimTK::MobilizedBodyIndex reference_body() const override { return shuttle_; }
   Station named_station(io::Site at) const override;
+  Station site_station(io::Site at, double location) const override {
+    return at == io::Site::Mast ? station_at(location) : named_station(at);
+  }
+  bool chain_site(io::Site at) const override { return at == io::Site::Mast; }
   SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const override;
+  int actuator_count() const override { return static_cast<int>(sliders_.size() / 2); }
+  double actuator_stroke() const override { return actuator_stroke_; }
+  std::string chain_name() const override { return "mast"; }
+  std::string tip_name() const override { return "reflector"; }
+  std::string reference_name() const override { return "shuttle"; }
 
   SimTK::MobilizedBodyIndex shuttle() const { return shuttle_; }
   SimTK::MobilizedBodyIndex reflector() const { return reflector_; }
@@ -43,6 +52,10 @@ private:
  Station reflector_station_;
  std::vector<SimTK::MobilizedBodyIndex> sliders_;  // [2 (k-1) + axis]
  double actuator_lag_ = 0.0;
+ double actuator_stroke_ = 0.0;
 };
+
+// The truth's SCOLE (truth_run.cpp's registry row); InputError for what the chain cannot build.
+std::unique_ptr<Structure> make_scole_system(const io::Scenario& sc, int segments);
 
 }  // namespace scoleid::model

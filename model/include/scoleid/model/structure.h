@@ -11,10 +11,13 @@
 
 #include <Simbody.h>
 
+#include "scoleid/io/scenario.h"
 #include "scoleid/io/types.h"
 #include "scoleid/model/hencky.h"
 
 namespace scoleid::model {
+
+struct ResolvedSensor;  // sensors.h
 
 struct Station {
   SimTK::MobilizedBodyIndex body;
@@ -43,7 +46,7 @@ public:
   const SimTK::SimbodyMatterSubsystem& matter() const { return matter_; }
   SimTK::GeneralForceSubsystem& forces() { return forces_; }
 
-  // "beam" or "scole".
+  // The scenario's structure kind this system builds.
   virtual io::Structure kind() const = 0;
   // A planar chain (a beam): every load and sensor is at site 'beam', at an arc position, and acts
   // in the chain's plane (its direction implied). Otherwise an assembly in space, where each load
@@ -65,8 +68,26 @@ public:
   virtual Station attachment_station(const std::string& name) const;
   // Named rigid bodies: the shuttle, the reflector; an invalid index if absent.
   virtual Station named_station(io::Site at) const;
+  // A spatial structure's station at a site and its `location` (used where the site is a chain:
+  // SCOLE's mast), and whether the site is such a chain (a rotation there is interpolated between
+  // its bars). By default every site is a named body.
+  virtual Station site_station(io::Site at, double location) const { (void)location; return named_station(at); }
+  virtual bool chain_site(io::Site at) const { (void)at; return false; }
   // Slider mobilizers of actuator K (1-based) along reference x and y, or invalid.
   virtual SimTK::MobilizedBodyIndex actuator_slider(int k, int axis) const;
+  // The proof-mass actuators: their number and their stroke (the plausibility guard's bound on
+  // each slider); 0 and 0 when there are none.
+  virtual int actuator_count() const { return 0; }
+  virtual double actuator_stroke() const { return 0.0; }
+  // A strain gauge at se.location (only kinds that read strain, io::reads): the joints around it
+  // and their springs, into r (sensors.h). std::logic_error on a kind without strain.
+  virtual void resolve_strain(const io::SensorSpec& se, ResolvedSensor& r) const;
+  // Names in the truth's messages: segment i (0-based) of the chain, "beam segment 3 of 80 (s =
+  // 0.25 to 0.375)"; the body hinged at the tip; the reference body R ("ground", "shuttle").
+  virtual std::string segment_name(int i) const;
+  virtual std::string chain_name() const { return "beam"; }
+  virtual std::string tip_name() const { return "tip body"; }
+  virtual std::string reference_name() const { return "ground"; }
 
   int segments() const { return static_cast<int>(segment_bodies_.size()); }
   double length() const { return length_; }

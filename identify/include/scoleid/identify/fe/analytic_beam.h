@@ -17,6 +17,7 @@
 //
 // Step response of the pinned–pinned beam to a point step load P at a (zero initial state),
 // modal series: w(x,t) = Σ_k (2P / (ρA L ω_k²)) sin(kπa/L) sin(kπx/L) (1 − cos ω_k t).
+#include <string>
 #include <vector>
 
 #include "scoleid/io/scenario.h"
@@ -46,6 +47,11 @@ double omega(double betaL, double L, double EI, double rhoA);
 // the 2 × 2 determinant and bisection.
 std::vector<double> point_element_omegas(const io::BeamSpec& beam, int count);
 
+// The first `count` frequencies [Hz] of a beam with one EI from the closed forms above (its end
+// conditions, a cantilever's tip body) or point_element_omegas (supports, attachments); empty for
+// EI by sections or a tip body on other ends. `what` names the solution.
+std::vector<double> beam_hz(const io::BeamSpec& beam, int count, std::string& what);
+
 double ss_static_point_load(double x, double a, double P, double L, double EI);
 double cantilever_static_tip_load(double x, double P, double L, double EI);
 // Modal series with `terms` modes (the neglected tail is bounded by Σ k⁻⁴, below 1e-11 relative at 4000).
@@ -54,5 +60,8 @@ double ss_step_response(double x, double t, double a, double P, double L, double
 // The same at t_k = k·dt, k = 0..n.
 std::vector<double> ss_step_samples(double x, double dt, int n, double a, double P, double L, double EI, double rhoA,
                                     int terms = 4000);
+// The same for a scenario: a uniform simply supported beam under its first input's step load
+// (its value at t = 1), at its first sensor and sample times (std::invalid_argument otherwise).
+std::vector<double> ss_scenario_samples(const io::Scenario& sc, int terms = 4000);
 
 }  // namespace scoleid::identify::analytic

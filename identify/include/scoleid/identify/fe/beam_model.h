@@ -19,11 +19,13 @@
 // G_k = ∫_{section k} N′N′ᵀ ds (hermite_beam.h). Loads and sensors anywhere on the beam, through
 // the shape functions (a sensor between nodes reads the interpolated field).
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "scoleid/identify/inverse/physical_parameterization.h"
 #include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/scenario.h"
 
 namespace scoleid::identify {
@@ -75,5 +77,8 @@ VectorXd beam_coefficients(const BeamFE& fe, double rho_A, const std::vector<dou
 // q3 = c_kv/ρA (uniform beams only; ζ is held). φ's values: the scenario's beam (sections expanded
 // to the model's; a model section's true EI is known when it lies inside one scenario section).
 ParameterSpace beam_parameter_space(const BeamFE& fe, const io::BeamSpec& beam);
+
+// The identifier's view of a beam scenario (fe/structure.h); make_structure's registry row.
+std::unique_ptr<FEStructure> make_beam_structure(const io::Scenario& sc, int elements);
 
 }  // namespace scoleid::identify

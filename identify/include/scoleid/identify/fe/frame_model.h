@@ -18,10 +18,12 @@
 // unit-coefficient stiffness and slope products of storey k's columns). Loads and sensors at a height s on the first column, through
 // its shape functions (at a floor's height: the floor's sway).
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/physical_parameterization.h"
 #include "scoleid/io/scenario.h"
 
@@ -59,5 +61,8 @@ VectorXd frame_coefficients(const FrameFE& fe, const io::FrameSpec& frame);
 
 // φ = [ρA, EI_1..EI_n, ζ, τ, floor_mass_1..floor_mass_n], the group EI (every storey).
 ParameterSpace frame_parameter_space(const FrameFE& fe, const io::FrameSpec& frame);
+
+// The identifier's view of a frame scenario (fe/structure.h); make_structure's registry row.
+std::unique_ptr<FEStructure> make_frame_structure(const io::Scenario& sc, int elements);
 
 }  // namespace scoleid::identify

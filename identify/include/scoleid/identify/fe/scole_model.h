@@ -66,11 +66,13 @@
 //   velocity      d/dt of the displacement quantity (relative; the shuttle's CM in ground): its row on u̇
 //   acceleration  inertial acceleration of the point along d (an accelerometer): the absolute
 //                 displacement's row (u_x, u_y, w)(s), u_R or the shuttle CM, on ü
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "scoleid/identify/inverse/physical_parameterization.h"
 #include "scoleid/identify/fe/structural_model.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/scenario.h"
 
 namespace scoleid::identify {
@@ -122,5 +124,8 @@ VectorXd scole_coefficients(const io::ScoleSpec& s);
 // m_reflector, k_actuator, c_actuator], the group EI (both bending planes), the paper form q1 = EI/ρA, q2 = 1/ρA (the
 // bending equations divided by ρA).
 ParameterSpace scole_parameter_space(const io::ScoleSpec& scole);
+
+// The identifier's view of a scole scenario (fe/structure.h); make_structure's registry row.
+std::unique_ptr<FEStructure> make_scole_structure(const io::Scenario& sc, int elements);
 
 }  // namespace scoleid::identify

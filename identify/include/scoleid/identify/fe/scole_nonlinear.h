@@ -396,4 +396,8 @@ private:
   MatrixXd G_;
 };
 
+// The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for another
+// structure or sectional parameters, which it does not have).
+ScoleNonlinear scole_nonlinear(const io::Scenario& scenario, int elements);
+
 }  // namespace scoleid::identify

@@ -1,8 +1,9 @@
 #pragma once
 // The identifier's view of one structure kind (docs/theory.md §2–§4): its finite-element model on
 // the identifier's mesh, its named parameters and its model coefficients at a scenario's values.
-// make_structure() is the one place that looks at scenario.structure: adding a structure kind
-// means one FE model file and one line in its registry (structure.cpp).
+// make_structure() is the one place that looks at scenario.structure: a structure kind is its FE
+// model file (which defines its FEStructure and its make_<kind>_structure factory) and one line
+// in the registry (structure.cpp).
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +25,14 @@ public:
   virtual std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const = 0;
   // Model coefficients at sc's structure values.
   virtual VectorXd coefficients(const io::Scenario& sc) const = 0;
+  // The kind's exact undamped natural frequencies [Hz], the `count` lowest, at sc's structure
+  // values (a closed form or a dynamic-stiffness solution, independent of the mesh), and `what`
+  // names the solution; empty where the kind has none for sc's configuration.
+  virtual std::vector<double> exact_hz(const io::Scenario& sc, int count, std::string& what) const {
+    (void)sc, (void)count;
+    what.clear();
+    return {};
+  }
 };
 
 // The FE model of the scenario's structure on `elements` elements (its inputs and sensors

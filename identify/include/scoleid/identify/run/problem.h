@@ -164,9 +164,6 @@ Measurements synthesize(const io::Scenario& scenario, int elements, double rtol,
 Measurements synthesize_series(const io::Scenario& scenario, int terms = 4000);
 // The same from the nonlinear SCOLE model (identification.model: nonlinear) at a step of at most `step`.
 Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, double step, bool add_noise);
-// The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for a beam or
-// sectional parameters, which it does not have).
-ScoleNonlinear scole_nonlinear(const io::Scenario& scenario, int elements);
 // from_data (identification.step_rule: data): K = K_data instead of min(P + 2, K_nyq).
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
                          const std::vector<io::Signal>& signals, double t_end, double sample_interval,
