@@ -109,6 +109,33 @@ void finish_frf(Problem& p, io::FrfData d, double dof) {
   p.frf = std::move(d);
 }
 
+// The impact window's automatic decay a (docs/theory.md §6.10). The window cuts the record at T
+// while it may still ring: a response of RMS A over the record's last 5 % leaves e^{−aT} A there,
+// and that free ringing, cut off, reaches a line near its mode as about e^{−aT} A fs/(2a) (a sum of
+// e^{−a t} over the samples), against the line's noise σ (Σ w²)^½ ≈ σ (fs/2a)^½. The smallest
+// a >= ln 100 / T that puts the first at a tenth of the second for every sensor:
+//   a T >= ln(10 A/σ) + ½ ln(fs/2a),
+// at most ln 1e12 / T (by bisection; the left side grows with a, the right falls).
+double impact_decay(const std::vector<const double*>& y, std::size_t n, double fs, const std::vector<double>& sigma) {
+  const double T = static_cast<double>(n) / fs;
+  const std::size_t tail = std::min(n, std::max<std::size_t>(16, n / 20));
+  double ratio = 0.0;  // the largest A/σ
+  for (std::size_t s = 0; s < y.size(); ++s) {
+    double ss = 0.0;
+    for (std::size_t i = n - tail; i < n; ++i) ss += y[s][i] * y[s][i];
+    ratio = std::max(ratio, std::sqrt(ss / static_cast<double>(tail)) / sigma[s]);
+  }
+  const auto enough = [&](double a) { return a * T >= std::log(10.0 * ratio) + 0.5 * std::log(fs / (2.0 * a)); };
+  double lo = std::log(100.0) / T, hi = std::log(1e12) / T;
+  if (!(ratio > 0) || enough(lo)) return lo;
+  if (!enough(hi)) return hi;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (enough(mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
 }  // namespace
 
 void frf_from_record(Problem& p) {
@@ -164,7 +191,6 @@ void frf_from_record(Problem& p) {
     io::ImpactOptions o;
     o.sample_rate = fs;
     const double T = static_cast<double>(n) / fs;
-    o.decay = spec.decay >= 0 ? spec.decay : std::log(100.0) / T;
     o.f_max = 0.8 * 0.5 * fs;
     for (int s = 0; s < p.data.sensors(); ++s) {
       const double sd = p.noise_std[static_cast<std::size_t>(s)];
@@ -176,6 +202,7 @@ void frf_from_record(Problem& p) {
       o.response_std.push_back(sd);
     }
     take(0, n);
+    o.decay = spec.decay >= 0 ? spec.decay : impact_decay(yp, n, fs, o.response_std);
     io::FrfData d;
     try {
       d = io::impact_frf(x.data(), yp, n, o, p.data_source, name, p.data.names);
@@ -509,6 +536,7 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
     r.summary = minimize(m, q0, o, on_iteration);
     r.estimate = r.summary.q;
     r.fit = frf_fit_test(p, m, r.estimate);
+    if (ro.verbose) io::progress("fit test: %s\n", r.fit.message.c_str());
     RunResult::Attempt a;
     a.strategy = "plain";
     a.method = r.method;
