@@ -1,4 +1,5 @@
 #include "scoleid/identify/inverse/objective.h"
+#include "scoleid/identify/point_failure.h"
 
 #include <algorithm>
 #include <Eigen/Eigenvalues>
@@ -1187,9 +1188,8 @@ void Objective::step_matrix(const VectorXd& q, MatrixXd& H) {
   step_matrix_->reset_counters();
   try {
     step_matrix_->gauss_newton(q, g, H);  // (its last evaluation kept: the same q again costs nothing)
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     // The longer step fails where the model's may not (an extreme trial point): the model's own.
     counters_.Accumulate(step_matrix_->counters());
     gauss_newton(q, g, H);

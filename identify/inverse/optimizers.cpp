@@ -1,4 +1,5 @@
 #include "scoleid/identify/inverse/optimizers.h"
+#include "scoleid/identify/point_failure.h"
 
 #include "scoleid/identify/inverse/gauss_newton_step.h"
 #include "scoleid/io/interrupt.h"
@@ -155,12 +156,9 @@ struct Run {
         gx += prior.apply(x);
       }
       return std::isfinite(J);
-    } catch (const std::domain_error&) {
-      return false;
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::runtime_error&) {
-      return false;  // integrator failure at an extreme trial point: treat as infeasible
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
+      return false;  // no model at an extreme trial point (integrator failure, a parameter out of range): infeasible
     }
   }
 };
@@ -215,9 +213,8 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
   if (continuation) {
     try {
       obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       return fail_start();
     }
   }
@@ -317,9 +314,8 @@ void trust_region(Run& r, VectorXd x, StepStrategy& s) {
         break;
       }
     }
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     r.failed(e.what());
   }
   r.conclude(k, x, cur.J);
@@ -362,9 +358,8 @@ public:
       p.J = r_.obj.cost(q) + prior_.value(xx);
       p.g.resize(0);  // completed on acceptance
       return std::isfinite(p.J);
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       return false;
     }
   }
@@ -377,9 +372,8 @@ public:
       r_.obj.step_matrix(q, H);
       p.H = q.asDiagonal() * H * q.asDiagonal() + prior_matrix_;
       return p.H.allFinite();
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       return false;
     }
   }
@@ -406,9 +400,8 @@ public:
       p.g = q.cwiseProduct(g) + prior_.apply(xx);
       p.H = q.asDiagonal() * H * q.asDiagonal() + prior_matrix_;
       return std::isfinite(p.J) && p.g.allFinite() && p.H.allFinite();
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       return false;
     }
   }
@@ -425,9 +418,8 @@ public:
       double Ja = 0.0;
       try {
         Ja = r_.obj.cost((x + a * st.delta).array().exp()) + prior_.value(x + a * st.delta);
-      } catch (const io::Interrupted&) {
-        throw;
-      } catch (const std::exception&) {
+      } catch (const std::exception& e) {
+        if (!point_failure(e)) throw;
         break;
       }
       if (!(Ja < Jb)) break;
@@ -533,9 +525,8 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
   if (continuation) {
     try {
       obj.set_horizon(choose_horizon(x, t0));
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       start_ok = false;
     }
   }
@@ -606,9 +597,8 @@ void lbfgs(Run& r, VectorXd x, bool steepest) {
         break;
       }
     }
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     r.failed(e.what());
   }
   r.conclude(k, x, J);
@@ -722,9 +712,8 @@ void evaluate_start(Misfit& objective, const VectorXd& q0, const OptimizerOption
       objective.gradient_and_step_matrix(q, g, H);
     else
       objective.gauss_newton(q, g, H);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     // (the run meets it)
   }
 }

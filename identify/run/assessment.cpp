@@ -1,4 +1,5 @@
 #include "scoleid/identify/run/assessment.h"
+#include "scoleid/identify/point_failure.h"
 
 #include <algorithm>
 #include <chrono>
@@ -149,9 +150,8 @@ void flag_other_minima(const Problem& p, Objective& obj, RunResult& r, const Mat
     MatrixXd Ya;
     try {
       Ya = obj.predict(at.estimate);
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       continue;
     }
     if (c0 < 0) c0 = chi_square(p, r, Y);
@@ -199,9 +199,8 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
   MatrixXd Ym;
   try {
     Ym = obj.predict(qm);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     return;  // the mirrored profile cannot be solved: no second candidate
   }
   const double c0 = chi_square(p, r, Y), c1 = chi_square(p, r, Ym);
@@ -241,9 +240,8 @@ RecordModes own_modes(const Problem& p, Objective& obj, const RunResult& r, cons
   for (double sd : r.ident.std) kept.push_back(std::isfinite(sd));
   try {
     return record_modes(obj, p.model(), *p.params, r.estimate, Y, r.ident.noise_std, kept, o);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     return {};  // the model at the estimate cannot be stepped with the modes freed
   }
 }

@@ -1,4 +1,5 @@
 #include "scoleid/identify/run/attempts.h"
+#include "scoleid/identify/point_failure.h"
 
 #include <array>
 #include <cmath>
@@ -41,9 +42,8 @@ double AttemptsContext::attempt_cost(const VectorXd& q) {
   double J = INFINITY;
   try {
     if (q.allFinite()) J = objective.cost(q);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
   }
   cost_q = q;
   cost = std::isfinite(J) ? J : INFINITY;
@@ -306,9 +306,8 @@ Ladder coarse_to_fine(AttemptsContext& c, const std::vector<std::vector<int>>& f
       if_not = [&] {
         try {
           next = solve_level(c, families, 2 * B, out.q, 1);
-        } catch (const io::Interrupted&) {
-          throw;
-        } catch (const std::exception&) {
+        } catch (const std::exception& e) {
+          if (!point_failure(e)) throw;
           next.reset();
         }
       };
@@ -383,9 +382,8 @@ SpectralStart spectral_start_of(AttemptsContext& c, const VectorXd& q0) {
   try {
     c.objective.set_horizon(c.objective.data_end());
     ss = spectral_start(p.model(), *p.params, q0, p.data, c.objective.predict(q0));
-  } catch (const io::Interrupted&) {
-    throw;
   } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     ss.q.resize(0);
     ss.note = e.what();
   }

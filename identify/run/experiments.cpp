@@ -1,4 +1,5 @@
 #include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/point_failure.h"
 #include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/strategy.h"
 
@@ -425,9 +426,8 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   double J = 0.0;
   try {
     J = joint.cost(r.estimate);
-  } catch (const io::Interrupted&) {
-    throw;
   } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     throw std::runtime_error("the model cannot be evaluated at the estimate (" + io::one_line(e.what()) + ")");
   }
   r.summary.cost = J;

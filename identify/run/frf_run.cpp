@@ -579,7 +579,7 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
     r.interrupted_by = e.signal();
     r.interrupted_note = note;
   }
-  estimate_modes(p, r);
+  estimate_modes(p, r, ro.verbose);
   if (r.estimate.allFinite()) {
     m.set_horizon(m.data_end());
     r.frf_model = m.predict(r.estimate);

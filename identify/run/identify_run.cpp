@@ -1,6 +1,8 @@
 // One identification run (identify_run.h): the stages in order — strategy (run/strategy.h),
 // attempts (run/attempts.h), assessment (run/assessment.h); the outputs: run/run_report.cpp.
 #include "scoleid/identify/run/identify_run.h"
+#include "scoleid/identify/point_failure.h"
+#include "scoleid/io/progress.h"
 
 #include <csignal>
 #include <cstdio>
@@ -47,9 +49,8 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const Matr
   auto own = [&] {
     try {
       Y = obj.predict(q);
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       Y = MatrixXd::Constant(in.data.rows(), in.data.cols(), std::nan(""));  // not explained
     }
   };
@@ -73,8 +74,11 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const Matr
         }
       } catch (const io::Interrupted&) {
         fine_error = std::current_exception();
-      } catch (const std::exception&) {
-        // A model that cannot be refined: no discretisation estimate.
+      } catch (const io::InputError&) {
+        // A model that cannot be refined (its finer mesh): no discretisation estimate.
+      } catch (const std::exception& e) {
+        if (point_failure(e)) return;  // nor where the finer model cannot be evaluated
+        fine_error = std::current_exception();
       }
     });
     try {
@@ -112,8 +116,12 @@ bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, lo
   return a.cost < b.cost - margin;
 }
 
-void estimate_modes(const Problem& p, RunResult& r) {
+void estimate_modes(const Problem& p, RunResult& r, bool verbose) {
   if (!r.estimate.allFinite()) return;
+  if (verbose && p.model().ndof >= 1000)
+    io::progress("modes of the identified model: %ld dense eigen-solutions of the %d-degree-of-freedom model (each O(n^3); "
+                 "fewer elements are faster)\n",
+                 1L + (r.ident.std.size() == r.estimate.size() ? 2L * static_cast<long>(r.estimate.size()) : 0L), p.model().ndof);
   ModalUncertaintyOptions o;
   // Modes above the data's Nyquist frequency are not seen by the record (its median sample interval),
   // nor modes above the top line of FRFs.
@@ -128,9 +136,8 @@ void estimate_modes(const Problem& p, RunResult& r) {
   if (!r.record_modes.modes.empty()) o.record = &r.record_modes;
   try {
     r.modes = modal_estimates(p.model(), *p.params, r.estimate, r.ident, r.interval, o);
-  } catch (const io::Interrupted&) {
-    throw;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (!point_failure(e)) throw;
     r.modes.clear();  // a model without a modal decomposition at the estimate: no modes reported
   }
 }
@@ -218,9 +225,8 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     c.alongside_fit = [&](const VectorXd& q) {
       try {
         early = assessment_refits(p, obj, c.options, q, 1);  // one core: the other solves the doubled mesh
-      } catch (const io::Interrupted&) {
-        throw;
-      } catch (const std::exception&) {
+      } catch (const std::exception& e) {
+        if (!point_failure(e)) throw;
         early = {};  // made again, if needed, in the assessment
       }
     };
@@ -238,7 +244,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
     keep_interrupted(p, c, r, attempts_done, e.signal());
     r.summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  estimate_modes(p, r);
+  estimate_modes(p, r, ro.verbose);
   if (obj.estimates_initial_state() && r.estimate.size() == p.params->size()) {
     for (Eigen::Index j = 0; j < obj.initial_state_omega().size(); ++j)
       r.initial_state_hz.push_back(obj.initial_state_omega()[j] / (2.0 * M_PI));

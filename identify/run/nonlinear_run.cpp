@@ -6,6 +6,7 @@
 // interval.h from those and the half-record refit. Declared uncertainties (consider terms) are not
 // propagated through this model: with any declared, it gives no interval and says so.
 #include <chrono>
+#include "scoleid/identify/point_failure.h"
 #include <cmath>
 #include <cstdio>
 #include <tuple>
@@ -36,9 +37,8 @@ FitTest nonlinear_fit(const Problem& p, NonlinearObjective& obj, const VectorXd&
   if (q.allFinite()) {
     try {
       predicted = obj.predict(q);
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       // not explained
     }
   }
@@ -52,9 +52,8 @@ FitTest nonlinear_fit(const Problem& p, NonlinearObjective& obj, const VectorXd&
       NonlinearObjective fobj(fine, *p.params, p.signals, p.data, ff);
       const MatrixXd d = fobj.predict(q) - predicted;
       if (d.allFinite()) in.discretisation = d;
-    } catch (const io::Interrupted&) {
-      throw;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+      if (!point_failure(e)) throw;
       // no discretisation estimate
     }
   }
@@ -102,9 +101,8 @@ struct NonlinearRun {
     if (pred.allFinite()) {
       try {
         a.cost = obj.cost(s.q);
-      } catch (const io::Interrupted&) {
-        throw;
-      } catch (const std::exception&) {
+      } catch (const std::exception& e) {
+        if (!point_failure(e)) throw;
       }
     }
     if (!std::isfinite(a.cost)) a.cost = INFINITY;

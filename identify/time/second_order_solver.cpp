@@ -1,4 +1,5 @@
 #include "scoleid/identify/time/second_order_solver.h"
+#include "scoleid/identify/point_failure.h"
 
 #include "scoleid/identify/time/add_members.h"
 
@@ -106,6 +107,7 @@ struct SecondOrderSolver::Impl {
   mutable void* integrator_mem = nullptr;
   mutable int (*get_gamma)(void*, double*) = nullptr;
   mutable std::string callback_error;
+  mutable std::exception_ptr callback_exception;  // rethrown unless a point failure (point_failure.h)
 
   void rhs(double t, const double* y, double* ydot) const {
     const double* x = y;
@@ -183,6 +185,7 @@ int cv_rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
     return 0;
   } catch (const std::exception& e) {
     s->callback_error = e.what();
+    s->callback_exception = std::current_exception();
     return -1;
   }
 }
@@ -207,6 +210,7 @@ int ls_solve(SUNLinearSolver LS, SUNMatrix, N_Vector x, N_Vector b, realtype) {
     return 0;
   } catch (const std::exception& e) {
     s->callback_error = e.what();
+    s->callback_exception = std::current_exception();
     return -1;
   }
 }
@@ -398,6 +402,7 @@ public:
     if (flag < 0) {
       std::string msg = std::string(bdf_ ? "CVODES" : "ARKODE") + " failed at t = " + std::to_string(t) + " with flag " +
                         std::to_string(flag);
+      if (s_.callback_exception && !point_failure(s_.callback_exception)) std::rethrow_exception(s_.callback_exception);
       if (!s_.callback_error.empty()) msg += ": " + s_.callback_error;
       throw std::runtime_error(msg);
     }
@@ -476,6 +481,7 @@ Trajectory SecondOrderSolver::solve(double t0, double t1, const Forcing& forcing
   s.group_max.assign(static_cast<std::size_t>(2 * s.ngroups), 0.0);
   s.reference_scales(t0, t1, forcing, breakpoints);
   s.callback_error.clear();
+  s.callback_exception = nullptr;
 
   const std::vector<double> stops = segment_ends(breakpoints, t0, t1);
 

@@ -156,7 +156,9 @@ struct RunResult {
 };
 // The modes of the model at r.estimate with the uncertainty of r.ident and r.interval (those below
 // the data's Nyquist frequency, at most ten).
-void estimate_modes(const Problem& problem, RunResult& r);
+// `verbose`: on a large mesh (1000 degrees of freedom or more, where each dense eigen-solution
+// takes seconds) one progress line says how many it takes.
+void estimate_modes(const Problem& problem, RunResult& r, bool verbose = false);
 // A result with the problem's scenario, names, starting values and truth filled in.
 RunResult start_result(const Problem& problem, io::Model model);
 
