@@ -184,7 +184,7 @@ ModesReport compare_modes(const io::Scenario& scenario, const ModesOptions& opt)
   std::size_t count = static_cast<std::size_t>(opt.count);
   for (const auto& c : chain) count = std::min(count, c.hz.size());
   for (const auto& f : fe) count = std::min(count, f.hz.size());
-  const std::vector<double> exact = identify::make_structure(truth_sc, N0)->exact_hz(truth_sc, static_cast<int>(count), rep.analytic);
+  const std::vector<double> exact = identify::make_structure(shape_sc, N0)->exact_hz(truth_sc, static_cast<int>(count), rep.analytic);
   rep.mac = mac_matrix(chain.front().shapes.leftCols(static_cast<Eigen::Index>(count)),
                        fe.front().shapes.leftCols(static_cast<Eigen::Index>(count)));
   for (std::size_t i = 0; i < count; ++i) {

@@ -39,8 +39,15 @@ bool* bool_field(Scenario& sc, const std::string& path) {
 
 std::string truth_field(const Scenario& scenario, const Scenario& truth, const std::string& path) {
   Scenario a = scenario, b = truth;
-  const double* x = numeric_field(a, path);
-  const double* y = numeric_field(b, path);
+  const auto find = [&path](Scenario& sc) -> const double* {
+    if (const double* v = numeric_field(sc, path)) return v;
+    if (const auto extra = kind_table(sc.structure).truth_numbers)
+      for (auto& [name, ptr] : extra(sc))
+        if (name == path) return ptr;
+    return nullptr;
+  };
+  const double* x = find(a);
+  const double* y = find(b);
   return x && y && *x != *y ? "truth.overrides." + path : path;
 }
 

@@ -14,8 +14,7 @@ std::vector<std::pair<std::string, double*>> numbers(Scenario& sc) {
       {"scole.GJ", &s.GJ},                   {"scole.rho_I_psi", &s.rho_I_psi},
       {"scole.zeta", &s.zeta},               {"scole.reflector_rx", &s.reflector_rx},
       {"scole.reflector_ry", &s.reflector_ry}, {"scole.actuator_mass", &s.actuator_mass},
-      {"scole.actuator_stiffness", &s.actuator_stiffness}, {"scole.actuator_damping", &s.actuator_damping},
-      {"scole.actuator_stroke", &s.actuator_stroke}};
+      {"scole.actuator_stiffness", &s.actuator_stiffness}, {"scole.actuator_damping", &s.actuator_damping}};
   for (auto [name, body] : {std::pair<const char*, RigidBodySpec*>{"shuttle", &s.shuttle}, {"reflector", &s.reflector}}) {
     const std::string p = std::string("scole.") + name + ".";
     v.insert(v.end(), {{p + "mass", &body->mass}, {p + "Ixx", &body->Ixx}, {p + "Iyy", &body->Iyy}, {p + "Izz", &body->Izz},
@@ -77,7 +76,11 @@ const KindTable& scole_kind() {
       },
       parameters,
       set_stiffness,
-      shape_stations};
+      shape_stations,
+      [](Scenario& sc) {
+        return std::vector<std::pair<std::string, double*>>{{"scole.actuator_stroke", &sc.scole.actuator_stroke},
+                                                            {"scole.actuator_lag", &sc.scole.actuator_lag}};
+      }};
   return t;
 }
 

@@ -36,6 +36,10 @@ struct KindTable {
   // bending planes) and, for sections, EI_1..EI_N as a whole profile.
   void (*set_stiffness)(Scenario&, const std::map<std::string, double>&);
   std::vector<ShapeSensor> (*shape_sensors)(const Scenario&, int count);
+  // Numbers only the Simbody truth reads (a SCOLE actuator's stroke and servo lag), by path: not
+  // field paths of numeric_field (not estimable, not declarable uncertain), but named in the truth's
+  // messages (truth_field). nullptr: none.
+  std::vector<std::pair<std::string, double*>> (*truth_numbers)(Scenario&) = nullptr;
 };
 
 const KindTable& kind_table(Structure kind);  // structure_kinds.cpp

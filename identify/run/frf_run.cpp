@@ -110,22 +110,37 @@ void finish_frf(Problem& p, io::FrfData d, double dof) {
 }
 
 // The impact window's automatic decay a (docs/theory.md §6.10). The window cuts the record at T
-// while it may still ring: a response of RMS A over the record's last 5 % leaves e^{−aT} A there,
-// and that free ringing, cut off, reaches a line near its mode as about e^{−aT} A fs/(2a) (a sum of
-// e^{−a t} over the samples), against the line's noise σ (Σ w²)^½ ≈ σ (fs/2a)^½. The smallest
-// a >= ln 100 / T that puts the first at a tenth of the second for every sensor:
-//   a T >= ln(10 A/σ) + ½ ln(fs/2a),
-// at most ln 1e12 / T (by bisection; the left side grows with a, the right falls).
+// while it may still ring: a response ringing at RMS A over the record's last 5 % (what the tail
+// holds beyond its noise σ, its mean and trend removed: A² = max(0, ms − σ²)) leaves e^{−aT} A
+// there, and that free ringing, cut off, reaches a line near its mode as about e^{−aT} A fs/(√2 a)
+// (a cosine of amplitude √2 A summed under e^{−a t}), against the line's noise σ (Σ w²)^½ ≈
+// σ (fs/2a)^½. The smallest a >= ln 100 / T that puts the first at a tenth of the second for
+// every sensor:
+//   a T >= ln(10 A/σ) + ½ ln(fs/a),
+// at most ln 1e12 / T (by bisection; the left side grows with a, the right falls). A channel whose
+// tail is not finite counts as ringing at the cap.
 double impact_decay(const std::vector<const double*>& y, std::size_t n, double fs, const std::vector<double>& sigma) {
   const double T = static_cast<double>(n) / fs;
   const std::size_t tail = std::min(n, std::max<std::size_t>(16, n / 20));
   double ratio = 0.0;  // the largest A/σ
   for (std::size_t s = 0; s < y.size(); ++s) {
+    // Least-squares line through the tail (k = 0 .. m−1 centred), then the mean square about it.
+    const double m = static_cast<double>(tail), kc = 0.5 * (m - 1.0);
+    double sy = 0.0, sky = 0.0, skk = 0.0;
+    for (std::size_t i = 0; i < tail; ++i) {
+      const double k = static_cast<double>(i) - kc, v = y[s][n - tail + i];
+      sy += v, sky += k * v, skk += k * k;
+    }
+    const double mean = sy / m, slope = skk > 0 ? sky / skk : 0.0;
     double ss = 0.0;
-    for (std::size_t i = n - tail; i < n; ++i) ss += y[s][i] * y[s][i];
-    ratio = std::max(ratio, std::sqrt(ss / static_cast<double>(tail)) / sigma[s]);
+    for (std::size_t i = 0; i < tail; ++i) {
+      const double r = y[s][n - tail + i] - mean - slope * (static_cast<double>(i) - kc);
+      ss += r * r;
+    }
+    const double ringing = std::sqrt(std::max(0.0, ss / m - sigma[s] * sigma[s])) / sigma[s];
+    ratio = std::isfinite(ringing) ? std::max(ratio, ringing) : INFINITY;
   }
-  const auto enough = [&](double a) { return a * T >= std::log(10.0 * ratio) + 0.5 * std::log(fs / (2.0 * a)); };
+  const auto enough = [&](double a) { return a * T >= std::log(10.0 * ratio) + 0.5 * std::log(fs / a); };
   double lo = std::log(100.0) / T, hi = std::log(1e12) / T;
   if (!(ratio > 0) || enough(lo)) return lo;
   if (!enough(hi)) return hi;

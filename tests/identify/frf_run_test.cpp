@@ -285,6 +285,11 @@ TEST(FrfRun, AnImpactUnderAnExponentialWindowLeavesZetaUnbiased) {
   std::printf("decay %.4g 1/s (the 1 %% window: %.4g)\n", a, std::log(100.0) / 4.0);
   EXPECT_GE(a, std::log(100.0) / 4.0);
   EXPECT_LT(a, std::log(1e12) / 4.0);
+  {  // The same tap ten times as damped has died out by the record's end: the 1 % window.
+    auto damped = sc;
+    damped.beam.zeta = 0.1;
+    EXPECT_NEAR(make_problem(damped, std::nullopt)->frf->decay, std::log(100.0) / 4.0, 1e-3);  // T: 8193 samples
+  }
   const RunResult r = identify(*p);
   expect_fit_and_covering_intervals(r);
   for (std::size_t i = 0; i < r.names.size(); ++i) EXPECT_TRUE(r.ident.identifiable[i]) << r.names[i];

@@ -91,7 +91,7 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
       C->compute(d.Cbase_);
     }
     if (C->info() != Eigen::Success)
-      throw std::invalid_argument("ScoleNonlinear::at: the elastic mass block is not positive definite");
+      throw std::domain_error("ScoleNonlinear::at: the elastic mass block is not positive definite");
     d.C_ = C;
   }
   d.K_ = MatrixXd::Zero(ne_, ne_);

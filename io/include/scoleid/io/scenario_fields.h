@@ -18,7 +18,8 @@ bool signed_field(const std::string& path);
 // The switch at `path`, or nullptr.
 bool* bool_field(Scenario& sc, const std::string& path);
 // Where the truth's number at `path` is set: "truth.overrides.<path>" when truth (the scenario's
-// truth_scenario) holds another value there than scenario, else `path` (for messages).
+// truth_scenario) holds another value there than scenario, else `path` (for messages). Also for
+// the numbers only the truth reads (an actuator's stroke), which numeric_field does not offer.
 std::string truth_field(const Scenario& scenario, const Scenario& truth, const std::string& path);
 // Every path numeric_field and bool_field accept for this scenario (for messages).
 std::vector<std::string> field_paths(const Scenario& sc);
