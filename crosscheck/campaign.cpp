@@ -14,6 +14,7 @@
 #include "scoleid/crosscheck/scenario_overlay.h"
 #include "study_yaml.h"
 #include "scoleid/crosscheck/table.h"
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/input_file.h"
@@ -152,10 +153,8 @@ void make_points(Campaign& c, const std::string& path) {
       pt.key = fingerprint(pt.yaml);
       const std::string where = path + " (point " + pt.id + ": " + label + ")";
       pt.scenario = checked_scenario(pt.yaml, where);
-      // The identifier's own checks, before anything runs (make_problem's).
-      if (pt.scenario.sensors.empty()) io::fail_field(where, "sensors", "must list at least one sensor", "none");
-      if (pt.scenario.inputs.empty()) io::fail_field(where, "inputs", "must list at least one input", "none");
-      identify::make_structure(pt.scenario, pt.scenario.identification.elements)->parameterize(pt.scenario);
+      // The identifier's door, before anything runs (make_problem's).
+      identify::check_identification(pt.scenario);
       if (const auto it = keys.find(pt.key); it != keys.end())
         bad(path, "grid", "gives the same scenario twice", "points " + c.points[it->second].label + " and " + label);
       keys[pt.key] = c.points.size();

@@ -30,6 +30,7 @@
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/crosscheck/report.h"
 #include "scoleid/crosscheck/trajectories.h"
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/run/fit_plot.h"
 #include "scoleid/io/data_files.h"
@@ -168,9 +169,7 @@ int run_suite(const std::vector<std::string>& only, const std::string& suite_dir
           if (&f != &files.back() && f.family == files.back().family)
             throw io::InputError("suite file '" + p + "': family '" + f.family + "' is also the family of '" + f.path + "'");
         for (std::size_t k = 0; k < files.back().cases.size(); ++k) {
-          const io::Scenario sc = crosscheck::case_scenario(files.back(), k);
-          const auto st = identify::make_structure(sc, sc.identification.elements);
-          st->parameterize(sc);
+          identify::check_identification(crosscheck::case_scenario(files.back(), k));
         }
       }
     }

@@ -139,6 +139,9 @@ TrajectoryReport compare_trajectories(const io::Scenario& scenario, const Trajec
     throw io::InputError("trajectories: --fe-step " + io::format_value(opt.fe_step) + " exceeds the record's sample interval " +
                          io::format_value(scenario.simulation.sample_interval) +
                          " s: the response would not be resolved between samples (leave it 0 for the automatic step)");
+  if (opt.nonlinear && scenario.structure != io::Structure::Scole)
+    throw io::InputError("trajectories: --nonlinear is SCOLE's nonlinear model; " + scenario.source + " has structure '" +
+                         io::to_string(scenario.structure) + "'");
   const auto t0 = std::chrono::steady_clock::now();
   TrajectoryReport rep;
   rep.scenario = scenario.name;

@@ -1,6 +1,9 @@
 // The beam's table (structure_kinds.h): a planar Euler–Bernoulli beam (docs/theory.md §2).
 #include "structure_kinds.h"
 
+#include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
+
 namespace scoleid::io {
 
 namespace {
@@ -90,6 +93,35 @@ std::vector<ShapeSensor> shape_stations(const Scenario& sc, int count) {
   return out;
 }
 
+// Inputs, sensors and attachments on the beam; a force on an attachment's own degree of freedom
+// names one with a lumped mass; a beam clamped at both ends needs two elements to move at all.
+void check(const Scenario& sc) {
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    const InputSpec& in = sc.inputs[i];
+    const std::string f = "inputs[" + std::to_string(i) + "]";
+    if (in.at != Site::Beam) fail_field(sc.source, f + ".at", "must be 'beam' for a beam structure", quoted(in.at));
+    if (in.attachment.empty()) continue;
+    const PointElement* e = nullptr;
+    for (const auto& a : sc.beam.attachments)
+      if (a.name == in.attachment) e = &a;
+    if (!e || !(e->lumped_mass > 0.0))
+      fail_field(sc.source, f + ".attachment", "must name an attachment of the beam with a lumped_mass (beam.attachments[].name)",
+                 "'" + in.attachment + "'");
+  }
+  // An attachment's station (declared uncertain, or overridden) stays on the beam.
+  for (const auto& a : sc.beam.attachments)
+    if (!(a.location >= 0.0 && a.location <= sc.beam.length))
+      fail_field(sc.source, "beam.attachments." + a.name + ".location", "must lie on the beam [0, " + format_value(sc.beam.length) + "]",
+                 format_value(a.location));
+  for (std::size_t k = 0; k < sc.sensors.size(); ++k)
+    if (sc.sensors[k].at != Site::Beam)
+      fail_field(sc.source, "sensors[" + std::to_string(k) + "].at", "must be 'beam' for a beam structure", quoted(sc.sensors[k].at));
+  if (sc.beam.left == EndCondition::Clamped && sc.beam.right == EndCondition::Clamped && sc.identification.elements < 2)
+    fail_field(sc.source, "identification.elements",
+               "must be >= 2 for a beam clamped at both ends (one element leaves no free degree of freedom)",
+               std::to_string(sc.identification.elements));
+}
+
 }  // namespace
 
 const KindTable& beam_kind() {
@@ -99,7 +131,8 @@ const KindTable& beam_kind() {
                            [](Scenario&) { return std::vector<std::pair<std::string, bool*>>{}; },
                            parameters,
                            set_stiffness,
-                           shape_stations};
+                           shape_stations,
+                           check};
   return t;
 }
 

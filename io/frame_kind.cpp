@@ -3,6 +3,9 @@
 // first column.
 #include "structure_kinds.h"
 
+#include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
+
 namespace scoleid::io {
 
 namespace {
@@ -54,6 +57,19 @@ std::vector<ShapeSensor> shape_stations(const Scenario& sc, int count) {
   return out;
 }
 
+// Inputs and sensors on the frame (a height); its storeys are its stiffness sections.
+void check(const Scenario& sc) {
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i)
+    if (sc.inputs[i].at != Site::Frame)
+      fail_field(sc.source, "inputs[" + std::to_string(i) + "].at", "must be 'frame' for a frame structure", quoted(sc.inputs[i].at));
+  for (std::size_t k = 0; k < sc.sensors.size(); ++k)
+    if (sc.sensors[k].at != Site::Frame)
+      fail_field(sc.source, "sensors[" + std::to_string(k) + "].at", "must be 'frame' for a frame structure", quoted(sc.sensors[k].at));
+  if (sc.identification.sections > 1)
+    fail_field(sc.source, "identification.sections", "must be 0 or 1 for a frame (its storeys are its sections)",
+               std::to_string(sc.identification.sections));
+}
+
 }  // namespace
 
 const KindTable& frame_kind() {
@@ -63,7 +79,8 @@ const KindTable& frame_kind() {
                            [](Scenario&) { return std::vector<std::pair<std::string, bool*>>{}; },
                            parameters,
                            set_stiffness,
-                           shape_stations};
+                           shape_stations,
+                           check};
   return t;
 }
 

@@ -223,6 +223,8 @@ void validate_modal_data(const ModalData& d) {
       check_value(kShapeStd, m.shape_std, fail);
       for (std::size_t k = 0; k < m.shape.size(); ++k)
         if (!std::isfinite(m.shape[k])) fail(d.stations[k], "must be finite", format_value(m.shape[k]));
+      if (std::all_of(m.shape.begin(), m.shape.end(), [](double v) { return v == 0.0; }))
+        fail("shape", "must not vanish at every station", "0");
     }
   }
 }

@@ -666,29 +666,6 @@ void parse_frame(const YAML::Node& n, const std::string& source, FrameSpec& f, c
 
 double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
 
-// A sensor kind the structure's models read (types.h, reads).
-void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind) {
-  if (reads(sc.structure, kind)) return;
-  const std::string list = sensor_kinds_read_by(sc.structure);
-  std::string readers;
-  for (const auto& [st, name] : Names<Structure>::rows)
-    if (reads(st, kind)) readers += (readers.empty() ? "" : ", ") + std::string(name);
-  fail_field(sc.source, field,
-             "is not read on a " + std::string(to_string(sc.structure)) + " structure (it reads " + list + ")" +
-                 (readers.empty() ? "" : "; it is read with structure: " + readers),
-             quoted(kind));
-}
-
-void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "") {
-  if (!has_station(at)) return;
-  // A frame's height is a sum of storey heights, which may round below the top floor's height as
-  // written (0.7 + 0.1 < 0.8): its top is met within 1e-12 of the height.
-  const double L = structure_length(sc) * (at == Site::Frame ? 1.0 + 1e-12 : 1.0);
-  if (!(loc >= 0.0 && loc <= L))
-    fail_field(source.empty() ? sc.source : source, field,
-               "must lie on the " + std::string(to_string(at)) + " [0, " + format_value(L) + "]", format_value(loc));
-}
-
 // A sensor's or input's unit and its column's must be units of its quantity, and the unit the
 // scenario's unit system gives it (no label may disagree with the numbers).
 // conditioning: {offset: none | mean | {mean_before: T} | value, scale, sign, detrend} (scenario.h).
@@ -780,7 +757,6 @@ void parse_inputs(const YAML::Node& n, Scenario& sc) {
                               : sc.structure == Structure::Frame ? Site::Frame : Site::Beam);
     in.kind = r.choice_of("kind", InputKind::Force);
     in.location = r.num("location", 0.0);
-    check_location(sc, r.field("location"), in.at, in.location);
     if (r.has("attachment")) {
       // A force on a lumped attachment's mass: at its station, on its own degree of freedom.
       in.attachment = r.str("attachment", "");
@@ -859,9 +835,7 @@ void parse_sensors(const YAML::Node& n, Scenario& sc) {
                                 : sc.structure == Structure::Frame ? Site::Frame : Site::Beam,
                           {Site::Beam, Site::Mast, Site::Reflector, Site::Shuttle, Site::Frame});
     s.kind = r.choice_of("kind", SensorKind::Displacement);
-    check_sensor_kind(sc, r.field("kind"), s.kind);
     s.location = r.num("location", 0.0);
-    check_location(sc, r.field("location"), s.at, s.location);
     s.direction = parse_direction(r, "direction");
     s.unit = r.str("unit", "");
     s.noise_std = r.nonneg("noise_std", 0.0);
@@ -1201,8 +1175,6 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     }
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
-    if (sc.identification.model == Model::Nonlinear && sc.structure != Structure::Scole)
-      fail_field(source, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'nonlinear'");
     for (const auto& u : sc.identification.uncertain) {
       const std::string field = "identification.uncertain." + u.field;
       if (u.is_switch) {

@@ -2,6 +2,11 @@
 // (docs/theory.md §3).
 #include "structure_kinds.h"
 
+#include <cmath>
+
+#include "scoleid/io/error.h"
+#include "scoleid/io/number.h"
+
 namespace scoleid::io {
 
 namespace {
@@ -63,6 +68,50 @@ std::vector<ShapeSensor> shape_stations(const Scenario& sc, int count) {
   return out;
 }
 
+std::string vec_text(const std::vector<double>& v) {
+  return "[" + format_value(v[0]) + ", " + format_value(v[1]) + ", " + format_value(v[2]) + "]";
+}
+bool given(const std::vector<double>& d) { return d.size() == 3 && d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0.0; }
+
+// Inputs on the shuttle, the mast, the reflector or a proof-mass actuator (a force in the
+// actuator plane); sensors on the shuttle, the mast or the reflector, each along a given
+// direction; a line of sight starts at the mast's root, so it needs a point away from it; the
+// mast is uniform (no stiffness sections).
+void check(const Scenario& sc) {
+  const std::size_t nact = sc.scole.actuator_locations.size();
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
+    const InputSpec& in = sc.inputs[i];
+    const std::string f = "inputs[" + std::to_string(i) + "]";
+    if (const int k = actuator_index(in.at); k >= 0) {
+      if (static_cast<std::size_t>(k) >= nact)
+        fail_field(sc.source, f + ".at", "names an actuator the configuration does not have", quoted(in.at));
+      if (in.kind != InputKind::Force) fail_field(sc.source, f + ".kind", "must be 'force' for a proof-mass actuator", quoted(in.kind));
+      if (!given(in.direction) || std::abs(in.direction[2]) > 1e-12)
+        fail_field(sc.source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
+      continue;
+    }
+    if (in.at != Site::Shuttle && in.at != Site::Mast && in.at != Site::Reflector)
+      fail_field(sc.source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
+                 quoted(in.at));
+    if (!given(in.direction)) fail_field(sc.source, f + ".direction", "must be given (x, y, z or a 3-vector)", "none");
+  }
+  for (std::size_t k = 0; k < sc.sensors.size(); ++k) {
+    const SensorSpec& se = sc.sensors[k];
+    const std::string f = "sensors[" + std::to_string(k) + "]";
+    if (se.at != Site::Shuttle && se.at != Site::Mast && se.at != Site::Reflector)
+      fail_field(sc.source, f + ".at", "must be mast, reflector or shuttle for a scole structure", quoted(se.at));
+    if (!given(se.direction)) fail_field(sc.source, f + ".direction", "must be given (x, y, z or a 3-vector)", "none");
+    if (se.kind == SensorKind::LineOfSight && se.at == Site::Shuttle)
+      fail_field(sc.source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
+    if (se.kind == SensorKind::LineOfSight && se.at == Site::Mast && !(se.location > 0.0))
+      fail_field(sc.source, f + ".location", "must be > 0 for a line of sight (the line starts at the root)",
+                 format_value(se.location));
+  }
+  if (sc.identification.sections > 1)
+    fail_field(sc.source, "identification.sections", "must be 0 or 1 for a scole structure (uniform mast)",
+               std::to_string(sc.identification.sections));
+}
+
 }  // namespace
 
 const KindTable& scole_kind() {
@@ -77,6 +126,7 @@ const KindTable& scole_kind() {
       parameters,
       set_stiffness,
       shape_stations,
+      check,
       [](Scenario& sc) {
         return std::vector<std::pair<std::string, double*>>{{"scole.actuator_stroke", &sc.scole.actuator_stroke},
                                                             {"scole.actuator_lag", &sc.scole.actuator_lag}};

@@ -36,6 +36,10 @@ struct KindTable {
   // bending planes) and, for sections, EI_1..EI_N as a whole profile.
   void (*set_stiffness)(Scenario&, const std::map<std::string, double>&);
   std::vector<ShapeSensor> (*shape_sensors)(const Scenario&, int count);
+  // The kind's own checks of a whole scenario (validate_scenario, after the stations and sensor
+  // kinds): every input's and sensor's site and direction one its models read, and the
+  // identification settings its models have (sections, elements). InputError naming the field.
+  void (*check)(const Scenario&);
   // Numbers only the Simbody truth reads (a SCOLE actuator's stroke and servo lag), by path: not
   // field paths of numeric_field (not estimable, not declarable uncertain), but named in the truth's
   // messages (truth_field). nullptr: none.

@@ -6,6 +6,7 @@
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
+#include "structure_kinds.h"
 
 namespace scoleid::io {
 
@@ -106,6 +107,44 @@ double sample_count(double duration, double interval) {
   return std::floor(duration / interval + 1e-9) + 1.0;
 }
 
+// A sensor kind the structure's models read (types.h, reads).
+void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind) {
+  if (reads(sc.structure, kind)) return;
+  const std::string list = sensor_kinds_read_by(sc.structure);
+  std::string readers;
+  for (const auto& [st, name] : Names<Structure>::rows)
+    if (reads(st, kind)) readers += (readers.empty() ? "" : ", ") + std::string(name);
+  fail_field(sc.source, field,
+             "is not read on a " + std::string(to_string(sc.structure)) + " structure (it reads " + list + ")" +
+                 (readers.empty() ? "" : "; it is read with structure: " + readers),
+             quoted(kind));
+}
+
+void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source) {
+  if (!has_station(at)) return;
+  // A frame's height is a sum of storey heights, which may round below the top floor's height as
+  // written (0.7 + 0.1 < 0.8): its top is met within 1e-12 of the height.
+  const double L = kind_table(sc.structure).length(sc) * (at == Site::Frame ? 1.0 + 1e-12 : 1.0);
+  if (!(loc >= 0.0 && loc <= L))
+    fail_field(source.empty() ? sc.source : source, field,
+               "must lie on the " + std::string(to_string(at)) + " [0, " + format_value(L) + "]", format_value(loc));
+}
+
+namespace {
+// Every input's and sensor's station lies on the structure and every sensor's kind is read on it;
+// then the kind's own checks of sites, directions and sections.
+void check_sites(const Scenario& sc) {
+  for (std::size_t i = 0; i < sc.inputs.size(); ++i)
+    check_location(sc, "inputs[" + std::to_string(i) + "].location", sc.inputs[i].at, sc.inputs[i].location);
+  for (std::size_t k = 0; k < sc.sensors.size(); ++k) {
+    const std::string f = "sensors[" + std::to_string(k) + "]";
+    check_sensor_kind(sc, f + ".kind", sc.sensors[k].kind);
+    check_location(sc, f + ".location", sc.sensors[k].at, sc.sensors[k].location);
+  }
+  kind_table(sc.structure).check(sc);
+}
+}  // namespace
+
 void validate_scenario(const Scenario& sc) {
   const std::string& src = sc.source;
   check_name(src, "name", sc.name);
@@ -121,6 +160,7 @@ void validate_scenario(const Scenario& sc) {
     if (!names.insert(sc.sensors[i].name).second)
       fail_field(src, f, "must be unique among inputs and sensors", "'" + sc.sensors[i].name + "'");
   }
+  check_sites(sc);
   const double columns = 1.0 + static_cast<double>(sc.inputs.size() + sc.sensors.size());
   auto check_record = [&](const std::string& field, double interval) {
     const double n = sample_count(sc.simulation.duration, interval);
@@ -177,6 +217,13 @@ void validate_scenario(const Scenario& sc) {
                  format_value(lag));
   }
   const auto& id = sc.identification;
+  if (id.model == Model::Nonlinear && sc.structure != Structure::Scole)
+    fail_field(src, "identification.model", "'nonlinear' is a SCOLE model (structure: scole)", "'nonlinear'");
+  // One weight per estimated parameter (each name of identification.estimate is one).
+  if (!id.steepest_weights.empty() && id.steepest_weights.size() != id.estimate.size())
+    fail_field(src, "identification.steepest_weights",
+               "must hold one weight per estimated parameter (" + std::to_string(id.estimate.size()) + ")",
+               std::to_string(id.steepest_weights.size()) + " values");
   if (id.elements < 1 || id.elements > limits::kMaxElements)
     fail_field(src, "identification.elements", "must be an integer in [1, " + std::to_string(limits::kMaxElements) + "]",
                std::to_string(id.elements));

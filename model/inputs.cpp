@@ -124,10 +124,17 @@ double LaggedSignal::operator()(double t) const {
   return advance(f_[s.first + k], t0, t1, k + 1 == s.n, t - t0);
 }
 
+namespace {
+// A scenario that passed io::validate_scenario holds only sites, kinds and directions the
+// structure reads (io/<kind>_kind.cpp, KindTable::check); anything else is a caller's defect.
+[[noreturn]] void unchecked(const std::string& field) {
+  throw std::logic_error("resolve_inputs: " + field + " is not one this structure reads (io::validate_scenario refuses it)");
+}
+}  // namespace
+
 std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure& st) {
   std::vector<AppliedInput> out;
   const bool planar = st.planar();
-  const std::string kind = io::to_string(st.kind());
   for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
     const io::InputSpec& in = sc.inputs[i];
     const std::string field = "inputs[" + std::to_string(i) + "]";
@@ -137,39 +144,38 @@ std::vector<AppliedInput> resolve_inputs(const io::Scenario& sc, const Structure
     const Vec3 d(in.direction[0], in.direction[1], in.direction[2]);
     if (planar) {
       if (in.at != st.planar_site())
-        io::fail_field(sc.source, field + ".at", "must be '" + std::string(io::to_string(st.planar_site())) + "' for a " + kind + " structure", io::quoted(in.at));
+        unchecked(field + ".at");
       a.station = st.station_at(in.location);
       if (!in.attachment.empty()) {  // on the attachment's lumped mass (docs/theory.md §2.5)
         a.station = st.attachment_station(in.attachment);
         if (!a.station.body.isValid())
-          io::fail_field(sc.source, field + ".attachment", "names no lumped attachment of the " + kind, "'" + in.attachment + "'");
+          unchecked(field + ".attachment");
       }
       a.d_R = a.kind == AppliedInput::Kind::Moment ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
     } else if (in.at == io::Site::Beam) {
-      io::fail_field(sc.source, field + ".at", "must not be 'beam' for a " + kind + " structure", "'beam'");
+      unchecked(field + ".at");
     } else if (io::actuator_index(in.at) >= 0) {
       const int k = io::actuator_index(in.at) + 1;
       a.kind = AppliedInput::Kind::Slider;
       a.slider_x = st.actuator_slider(k, 0);
       a.slider_y = st.actuator_slider(k, 1);
       if (!a.slider_x.isValid())
-        io::fail_field(sc.source, field + ".at", "names an actuator the configuration does not have", io::quoted(in.at));
+        unchecked(field + ".at");
       if (in.kind != io::InputKind::Force)
-        io::fail_field(sc.source, field + ".kind", "must be 'force' for a proof-mass actuator", io::quoted(in.kind));
+        unchecked(field + ".kind");
       if (std::abs(d[2]) > 1e-12 || d.norm() == 0)
-        io::fail_field(sc.source, field + ".direction", "must lie in the actuator plane (x, y)",
-                       "[" + io::format_value(d[0]) + ", " + io::format_value(d[1]) + ", " + io::format_value(d[2]) + "]");
+        unchecked(field + ".direction");
       a.d_R = d;
       if (st.actuator_lag() > 0)
         a.lagged = std::make_shared<const LaggedSignal>(in.signal, st.actuator_lag(), sc.simulation.duration,
                                                         sc.source, field + ".signal");
     } else {
       if (d.norm() == 0)
-        io::fail_field(sc.source, field + ".direction", "must be given (x, y, z or a 3-vector)", "none");
+        unchecked(field + ".direction");
       a.d_R = d;
       a.station = st.site_station(in.at, in.location);
       if (!a.station.body.isValid())
-        io::fail_field(sc.source, field + ".at", "is not a body of this structure", io::quoted(in.at));
+        unchecked(field + ".at");
     }
     out.push_back(a);
   }

@@ -11,7 +11,6 @@
 namespace scoleid::identify {
 
 using io::EndCondition;
-using io::fail_field;
 using io::format_value;
 
 namespace {
@@ -50,21 +49,19 @@ Eigen::RowVectorXd BeamFE::curvature_row(double s) const { return field_row(*thi
 namespace {
 
 // The inputs' load vectors: a force on the displacement row, a moment on the rotation row.
-void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::InputSpec>& inputs, const std::string& source) {
+void add_beam_inputs(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::InputSpec>& inputs) {
   StructuralModel& m = fe.model;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& in = inputs[i];
     const std::string f = "inputs[" + std::to_string(i) + "]";
-    if (in.at != io::Site::Beam) fail_field(source, f + ".at", "must be 'beam' for a beam structure", io::quoted(in.at));
-    if (!(in.location >= 0.0 && in.location <= beam.length))
-      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
-                 format_value(in.location));
+    if (in.at != io::Site::Beam || !(in.location >= 0.0 && in.location <= beam.length))
+      throw std::logic_error("build_beam: " + f + " is not on the beam (io::validate_scenario refuses it)");
     ModelInput mi;
     mi.name = in.name;
     if (!in.attachment.empty()) {  // a force on a lumped attachment's own DOF (docs/theory.md §2.5)
       const auto it = fe.lumped_dof.find(in.attachment);
       if (it == fe.lumped_dof.end())
-        fail_field(source, f + ".attachment", "must name an attachment with a lumped_mass", "'" + in.attachment + "'");
+        throw std::logic_error("build_beam: " + f + ".attachment names no lumped attachment (io::validate_scenario refuses it)");
       mi.vector = VectorXd::Unit(m.ndof, it->second);
       m.inputs.push_back(std::move(mi));
       continue;
@@ -96,19 +93,13 @@ Eigen::RowVectorXd beam_sensor_row(const BeamFE& fe, const io::SensorSpec& se) {
   throw std::logic_error("beam_sensor_row: a sensor kind the beam does not read");
 }
 
-void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::SensorSpec>& sensors, const std::string& source) {
+void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io::SensorSpec>& sensors) {
   StructuralModel& m = fe.model;
   for (std::size_t k = 0; k < sensors.size(); ++k) {
     const auto& se = sensors[k];
     const std::string f = "sensors[" + std::to_string(k) + "]";
-    if (se.at != io::Site::Beam) fail_field(source, f + ".at", "must be 'beam' for a beam structure", io::quoted(se.at));
-    if (!io::reads(io::Structure::Beam, se.kind))
-      fail_field(source, f + ".kind",
-                 "is not supported by the beam identifier (" + io::sensor_kinds_read_by(io::Structure::Beam) + ")",
-                 io::quoted(se.kind));
-    if (!(se.location >= 0.0 && se.location <= beam.length))
-      fail_field(source, f + ".location", "must lie on the beam [0, " + format_value(beam.length) + "]",
-                 format_value(se.location));
+    if (se.at != io::Site::Beam || !io::reads(io::Structure::Beam, se.kind) || !(se.location >= 0.0 && se.location <= beam.length))
+      throw std::logic_error("build_beam: " + f + " is not a sensor the beam reads (io::validate_scenario refuses it)");
     ModelSensor ms;
     ms.name = se.name;
     ms.kind = se.kind;
@@ -121,8 +112,8 @@ void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io
 }  // namespace
 
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
-                  const std::vector<io::SensorSpec>& sensors, const std::string& source) {
-  if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
+                  const std::vector<io::SensorSpec>& sensors) {
+  if (elements < 1) throw std::logic_error("build_beam: " + std::to_string(elements) + " elements");
   if (sections < 1) sections = static_cast<int>(beam.EI.size());
   BeamFE fe;
   fe.length = beam.length;
@@ -142,7 +133,7 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   int n = 0;
   for (int i = 0; i < nfull; ++i)
     if (!fixed[static_cast<std::size_t>(i)]) fe.full_to_reduced[static_cast<std::size_t>(i)] = n++;
-  if (n == 0) fail_field(source, "beam", "leaves no free degree of freedom", std::to_string(elements) + " elements");
+  if (n == 0) throw std::logic_error("build_beam: " + std::to_string(elements) + " elements leave no free degree of freedom");
 
   // A lumped attachment's mass has a degree of freedom of its own, after the beam's (docs/theory.md
   // §2.5): its displacement along w.
@@ -239,9 +230,8 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   for (std::size_t k = 0; k < fe.points.size(); ++k) {
     const auto& p = fe.points[k];
     const std::string element = p.name.substr(p.name.find('.') + 1, p.name.rfind('.') - p.name.find('.') - 1);
-    if (!(p.location >= 0.0 && p.location <= beam.length))  // a station moved by identification.uncertain
-      fail_field(source, "beam." + p.name.substr(0, p.name.rfind('.')) + ".location",
-                 "must lie on the beam [0, " + format_value(beam.length) + "]", format_value(p.location));
+    if (!(p.location >= 0.0 && p.location <= beam.length))
+      throw std::logic_error("build_beam: " + p.name + " is not on the beam (io::validate_scenario refuses it)");
     const bool slope = p.field == "inertia" || p.field == "k_theta" || p.field == "c_theta";
     const bool lumped = p.field.rfind("lumped_", 0) == 0;
     Eigen::RowVectorXd row = slope ? fe.rotation_row(p.location) : fe.displacement_row(p.location);
@@ -261,8 +251,8 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     else m.damping.push_back(std::move(term));
   }
 
-  add_beam_inputs(fe, beam, inputs, source);
-  add_beam_sensors(fe, beam, sensors, source);
+  add_beam_inputs(fe, beam, inputs);
+  add_beam_sensors(fe, beam, sensors);
   return fe;
 }
 
@@ -365,13 +355,11 @@ namespace {
 class BeamStructure final : public FEStructure {
 public:
   BeamStructure(const io::Scenario& sc, int elements)
-      : fe_(build_beam(sc.beam, elements, sc.identification.sections, sc.inputs, sc.sensors, sc.source)) {}
+      : fe_(build_beam(sc.beam, elements, sc.identification.sections, sc.inputs, sc.sensors)) {}
   const StructuralModel& model() const override { return fe_.model; }
   int elements() const override { return fe_.elements; }
   double length() const override { return fe_.length; }
-  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
-    return std::make_unique<PhysicalParameterization>(beam_parameter_space(fe_, sc.beam), sc.identification, sc.source);
-  }
+  ParameterSpace parameter_space(const io::Scenario& sc) const override { return beam_parameter_space(fe_, sc.beam); }
   VectorXd coefficients(const io::Scenario& sc) const override {
     VectorXd c = beam_coefficients(fe_, sc.beam.rho_A, sc.beam.EI, sc.beam.zeta, sc.beam.c_kv);
     for (std::size_t k = 0; k < fe_.points.size(); ++k)  // the point elements' values in sc (its truth's may differ)

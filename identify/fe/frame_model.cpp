@@ -10,7 +10,14 @@
 
 namespace scoleid::identify {
 
-using io::fail_field;
+namespace {
+// A scenario that passed io::validate_scenario holds only what the model reads (io/frame_kind.cpp,
+// check); anything else here is a caller's defect.
+[[noreturn]] void unchecked(const std::string& what) {
+  throw std::logic_error("build_frame: " + what + " is not one the frame model reads (io::validate_scenario refuses it)");
+}
+}  // namespace
+
 using io::format_value;
 
 Eigen::RowVectorXd FrameFE::row(double s, int derivative) const {
@@ -32,8 +39,8 @@ Eigen::RowVectorXd FrameFE::row(double s, int derivative) const {
 }
 
 FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<io::InputSpec>& inputs,
-                    const std::vector<io::SensorSpec>& sensors, const std::string& source) {
-  if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
+                    const std::vector<io::SensorSpec>& sensors) {
+  if (elements < 1) unchecked(std::to_string(elements) + " elements");
   FrameFE fe;
   fe.storeys = frame.storeys();
   fe.columns = frame.columns;
@@ -112,9 +119,7 @@ FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& in = inputs[i];
     const std::string f = "inputs[" + std::to_string(i) + "]";
-    if (in.at != io::Site::Frame) fail_field(source, f + ".at", "must be 'frame' for a frame structure", io::quoted(in.at));
-    if (!(in.location >= 0.0 && in.location <= fe.height * (1.0 + 1e-12)))
-      fail_field(source, f + ".location", "must be a height on the frame [0, " + format_value(fe.height) + "]", format_value(in.location));
+    if (in.at != io::Site::Frame || !(in.location >= 0.0 && in.location <= fe.height * (1.0 + 1e-12))) unchecked(f);
     ModelInput mi;
     mi.name = in.name;
     mi.vector = fe.row(in.location, in.kind == io::InputKind::Moment ? 1 : 0).transpose();
@@ -123,12 +128,9 @@ FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<
   for (std::size_t i = 0; i < sensors.size(); ++i) {
     const auto& se = sensors[i];
     const std::string f = "sensors[" + std::to_string(i) + "]";
-    if (se.at != io::Site::Frame) fail_field(source, f + ".at", "must be 'frame' for a frame structure", io::quoted(se.at));
-    if (!io::reads(io::Structure::Frame, se.kind))
-      fail_field(source, f + ".kind", "is not supported by the frame identifier (" + io::sensor_kinds_read_by(io::Structure::Frame) + ")",
-                 io::quoted(se.kind));
-    if (!(se.location >= 0.0 && se.location <= fe.height * (1.0 + 1e-12)))
-      fail_field(source, f + ".location", "must be a height on the frame [0, " + format_value(fe.height) + "]", format_value(se.location));
+    if (se.at != io::Site::Frame || !io::reads(io::Structure::Frame, se.kind) ||
+        !(se.location >= 0.0 && se.location <= fe.height * (1.0 + 1e-12)))
+      unchecked(f);
     ModelSensor ms;
     ms.name = se.name;
     ms.kind = se.kind;
@@ -204,13 +206,11 @@ namespace {
 class FrameStructure final : public FEStructure {
 public:
   FrameStructure(const io::Scenario& sc, int elements)
-      : fe_((check(sc), build_frame(sc.frame, elements, sc.inputs, sc.sensors, sc.source))) {}
+      : fe_(build_frame(sc.frame, elements, sc.inputs, sc.sensors)) {}
   const StructuralModel& model() const override { return fe_.model; }
   int elements() const override { return fe_.elements; }
   double length() const override { return fe_.height; }
-  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
-    return std::make_unique<PhysicalParameterization>(frame_parameter_space(fe_, sc.frame), sc.identification, sc.source);
-  }
+  ParameterSpace parameter_space(const io::Scenario& sc) const override { return frame_parameter_space(fe_, sc.frame); }
   VectorXd coefficients(const io::Scenario& sc) const override { return frame_coefficients(fe_, sc.frame); }
   std::vector<double> exact_hz(const io::Scenario& sc, int count, std::string& what) const override {
     what = "the columns' exact dynamic stiffness on the floors' sways (undamped, below the first column mode)";
@@ -220,12 +220,6 @@ public:
   }
 
 private:
-  static int check(const io::Scenario& sc) {
-    if (sc.identification.sections > 1)
-      io::fail_field(sc.source, "identification.sections", "must be 0 or 1 for a frame (its storeys are its sections)",
-                     std::to_string(sc.identification.sections));
-    return 0;
-  }
   FrameFE fe_;
 };
 

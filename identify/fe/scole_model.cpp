@@ -1,5 +1,6 @@
 #include "scoleid/identify/fe/scole_model.h"
 
+#include <stdexcept>
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -10,7 +11,6 @@
 namespace scoleid::identify {
 
 using Eigen::Vector3d;
-using io::fail_field;
 using io::format_value;
 
 namespace {
@@ -182,16 +182,17 @@ struct FullOperators {
   std::vector<Trip> damp_roll, damp_pitch, act_spring;
 };
 
-void check_spec(const io::ScoleSpec& sc, int elements, const std::string& source) {
-  if (elements < 1) fail_field(source, "identification.elements", "must be >= 1", std::to_string(elements));
-  if (sc.mast_root.size() != 3)
-    fail_field(source, "scole.mast_root", "must be a 3-vector", std::to_string(sc.mast_root.size()) + " values");
-  // The actuator force enters the FE equations as commanded: there is no servo state to lag it.
-  if (sc.actuator_lag > 0)
-    fail_field(source, "scole.actuator_lag",
-               "must be 0: the finite-element model has no servo lag: set it under truth.overrides.scole to study the "
-               "mismatch",
-               format_value(sc.actuator_lag));
+// A scenario that passed io::validate_scenario holds only what the model reads (io/scole_kind.cpp,
+// check); anything else here is a caller's defect. The actuator force enters the equations as
+// commanded (no servo state): a servo lag is the truth's alone, refused by the identifier's door
+// (identify/door) and by io::check_fe_reproduces_truth where the model stands for the truth.
+[[noreturn]] void unchecked(const std::string& what) {
+  throw std::logic_error("build_scole: " + what + " is not one the SCOLE model reads (io::validate_scenario refuses it)");
+}
+
+void check_spec(const io::ScoleSpec& sc, int elements) {
+  if (elements < 1) unchecked(std::to_string(elements) + " elements");
+  if (sc.mast_root.size() != 3) unchecked("scole.mast_root");
 }
 
 // Reduced order: nodes 1..n (proof masses after their nearest node) | X, Y, Z, θx, θy, θz; and T:
@@ -336,18 +337,17 @@ void assemble_operators(ScoleFE& fe, const FullOperators& o) {
   }
 }
 
-Vector3d given_direction(const std::vector<double>& d, const std::string& source, const std::string& field) {
+Vector3d given_direction(const std::vector<double>& d, const std::string& field) {
   const Vector3d v = vec3(d);
-  if (!(v.norm() > 0.0)) fail_field(source, field, "must be given (x, y, z or a 3-vector)", "none");
+  if (!(v.norm() > 0.0)) unchecked(field);
   return v;
 }
-void check_station(double s, double L, const std::string& source, const std::string& field) {
-  if (!(s >= 0.0 && s <= L)) fail_field(source, field, "must lie on the mast [0, " + format_value(L) + "]", format_value(s));
+void check_station(double s, double L, const std::string& field) {
+  if (!(s >= 0.0 && s <= L)) unchecked(field);
 }
 
 // The rows (3 × nfull) a point input acts through: its work is fᵀ (rows u) along its direction.
-MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& in, const Vector3d& d, const std::string& f,
-                    const std::string& source) {
+MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& in, const Vector3d& d, const std::string& f) {
   const io::ScoleSpec& sc = fe.spec;
   const int nact = static_cast<int>(sc.actuator_locations.size());
   const double L = sc.length;
@@ -355,14 +355,14 @@ MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& 
   if (in.at == io::Site::Shuttle) return moment ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero());
   if (in.at == io::Site::Reflector) return moment ? fr.rotation(L) : fr.reflector();
   if (in.at == io::Site::Mast) {
-    check_station(in.location, L, source, f + ".location");
+    check_station(in.location, L, f + ".location");
     return moment ? fr.rotation(in.location) : fr.displacement(in.location);
   }
   if (const int k = io::actuator_index(in.at); k >= 0) {
-    if (k >= nact) fail_field(source, f + ".at", "names an actuator the configuration does not have", io::quoted(in.at));
-    if (moment) fail_field(source, f + ".kind", "must be 'force' for a proof-mass actuator", io::quoted(in.kind));
+    if (k >= nact) unchecked(f + ".at");
+    if (moment) unchecked(f + ".kind");
     if (std::abs(d[2]) > 1e-12)
-      fail_field(source, f + ".direction", "must lie in the actuator plane (x, y)", vec_text(in.direction));
+      unchecked(f + ".direction");
     // Slider force: +f on the proof mass, −f on the mast at s_k.
     MatrixXd rows = -fr.displacement(sc.actuator_locations[static_cast<std::size_t>(k)]);
     rows.row(2).setZero();
@@ -370,19 +370,18 @@ MatrixXd input_rows(const ScoleFE& fe, const FullRows& fr, const io::InputSpec& 
     rows(1, full_proof(fe.elements, k, 1)) += 1.0;
     return rows;
   }
-  fail_field(source, f + ".at", "must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure",
-             io::quoted(in.at));
+  unchecked(f + ".at");
 }
 
 // A rate sensor's row: velocity, d/dt of the displacement sensor's quantity (relative to the
 // shuttle frame; the shuttle's own CM in ground), a row on u̇; acceleration, the inertial
 // acceleration of the point along d (an accelerometer), the absolute displacement's row on ü.
 Eigen::RowVectorXd rate_sensor_row(const FullRows& fr, const io::SensorSpec& se, const Vector3d& d, int order, double L,
-                                   const std::string& f, const std::string& source) {
+                                   const std::string& f) {
   if (se.at != io::Site::Shuttle && se.at != io::Site::Mast && se.at != io::Site::Reflector)
-    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", io::quoted(se.at));
+    unchecked(f + ".at");
   const bool mast = se.at == io::Site::Mast;
-  if (mast) check_station(se.location, L, source, f + ".location");
+  if (mast) check_station(se.location, L, f + ".location");
   const MatrixXd absolute = se.at == io::Site::Shuttle ? fr.shuttle_rigid(Vector3d::Zero())
                             : mast           ? fr.displacement(se.location)
                                              : fr.reflector();
@@ -393,17 +392,17 @@ Eigen::RowVectorXd rate_sensor_row(const FullRows& fr, const io::SensorSpec& se,
 // A displacement, rotation or line-of-sight sensor's row on u: the shuttle's against ground, the
 // mast's and the reflector's relative to the shuttle frame.
 Eigen::RowVectorXd position_sensor_row(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const Vector3d& d,
-                                       const std::string& f, const std::string& source) {
+                                       const std::string& f) {
   const double L = fe.spec.length;
   if (se.at == io::Site::Shuttle) {
     if (se.kind == io::SensorKind::LineOfSight)
-      fail_field(source, f + ".kind", "is defined for the mast and the reflector, not the shuttle", "'line_of_sight'");
+      unchecked(f + ".kind");
     return d.transpose() * (se.kind == io::SensorKind::Rotation ? fr.shuttle_rotation() : fr.shuttle_rigid(Vector3d::Zero()));
   }
   if (se.at != io::Site::Mast && se.at != io::Site::Reflector)
-    fail_field(source, f + ".at", "must be mast, reflector or shuttle for a scole structure", io::quoted(se.at));
+    unchecked(f + ".at");
   const bool mast = se.at == io::Site::Mast;
-  if (mast) check_station(se.location, L, source, f + ".location");
+  if (mast) check_station(se.location, L, f + ".location");
   const Vector3d p0 = mast ? fr.mast_point(se.location) : fr.reflector_point();
   if (se.kind == io::SensorKind::Rotation) return d.transpose() * ((mast ? fr.rotation(se.location) : fr.rotation(L)) - fr.shuttle_rotation());
   const MatrixXd rel = (mast ? fr.displacement(se.location) : fr.reflector()) - fr.shuttle_rigid(p0);
@@ -411,28 +410,24 @@ Eigen::RowVectorXd position_sensor_row(const ScoleFE& fe, const FullRows& fr, co
   const Vector3d chord = p0 - vec3(fe.spec.mast_root);
   const double ell = chord.norm();
   if (!(ell > 0.0))
-    fail_field(source, f + ".location", "must be > 0 for a line of sight (the line starts at the root)",
-               format_value(se.location));
+    unchecked(f + ".location");
   const Vector3d u0 = chord / ell;
   return d.cross(u0).transpose() * rel / ell;
 }
 
-ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const std::string& f,
-                      const std::string& source) {
-  const Vector3d d = given_direction(se.direction, source, f + ".direction");
+ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpec& se, const std::string& f) {
+  const Vector3d d = given_direction(se.direction, f + ".direction");
   ModelSensor ms;
   ms.name = se.name;
   ms.kind = se.kind;
   Eigen::RowVectorXd row;
   if (io::derivative_order(se.kind) > 0) {
     ms.order = io::derivative_order(se.kind);
-    row = rate_sensor_row(fr, se, d, ms.order, fe.spec.length, f, source);
+    row = rate_sensor_row(fr, se, d, ms.order, fe.spec.length, f);
   } else if (!io::reads(io::Structure::Scole, se.kind)) {
-    fail_field(source, f + ".kind",
-               "is not supported by the SCOLE identifier (" + io::sensor_kinds_read_by(io::Structure::Scole) + ")",
-               io::quoted(se.kind));
+    unchecked(f + ".kind");
   } else {
-    row = position_sensor_row(fe, fr, se, d, f, source);
+    row = position_sensor_row(fe, fr, se, d, f);
   }
   ms.row = row * fe.T;
   return ms;
@@ -441,8 +436,8 @@ ModelSensor sensor_of(const ScoleFE& fe, const FullRows& fr, const io::SensorSpe
 }  // namespace
 
 ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io::InputSpec>& inputs,
-                    const std::vector<io::SensorSpec>& sensors, const std::string& source) {
-  check_spec(sc, elements, source);
+                    const std::vector<io::SensorSpec>& sensors) {
+  check_spec(sc, elements);
   ScoleFE fe;
   fe.spec = sc;
   fe.elements = elements;
@@ -455,14 +450,14 @@ ScoleFE build_scole(const io::ScoleSpec& sc, int elements, const std::vector<io:
   assemble_operators(fe, ops);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const std::string f = "inputs[" + std::to_string(i) + "]";
-    const Vector3d d = given_direction(inputs[i].direction, source, f + ".direction");
+    const Vector3d d = given_direction(inputs[i].direction, f + ".direction");
     ModelInput mi;
     mi.name = inputs[i].name;
-    mi.vector = SparseMatrix(fe.T.transpose()) * (input_rows(fe, fr, inputs[i], d, f, source).transpose() * d);
+    mi.vector = SparseMatrix(fe.T.transpose()) * (input_rows(fe, fr, inputs[i], d, f).transpose() * d);
     fe.model.inputs.push_back(std::move(mi));
   }
   for (std::size_t k = 0; k < sensors.size(); ++k)
-    fe.model.sensors.push_back(sensor_of(fe, fr, sensors[k], "sensors[" + std::to_string(k) + "]", source));
+    fe.model.sensors.push_back(sensor_of(fe, fr, sensors[k], "sensors[" + std::to_string(k) + "]"));
   return fe;
 }
 
@@ -511,22 +506,14 @@ namespace {
 class ScoleStructure final : public FEStructure {
 public:
   ScoleStructure(const io::Scenario& sc, int elements)
-      : fe_((check(sc), build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source))) {}
+      : fe_(build_scole(sc.scole, elements, sc.inputs, sc.sensors)) {}
   const StructuralModel& model() const override { return fe_.model; }
   int elements() const override { return fe_.elements; }
   double length() const override { return fe_.spec.length; }
-  std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const override {
-    return std::make_unique<PhysicalParameterization>(scole_parameter_space(sc.scole), sc.identification, sc.source);
-  }
+  ParameterSpace parameter_space(const io::Scenario& sc) const override { return scole_parameter_space(sc.scole); }
   VectorXd coefficients(const io::Scenario& sc) const override { return scole_coefficients(sc.scole); }
 
 private:
-  static int check(const io::Scenario& sc) {
-    if (sc.identification.sections > 1)
-      io::fail_field(sc.source, "identification.sections", "must be 0 or 1 for a scole structure (uniform mast)",
-                     std::to_string(sc.identification.sections));
-    return 0;
-  }
   ScoleFE fe_;
 };
 

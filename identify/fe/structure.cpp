@@ -1,5 +1,6 @@
 #include "scoleid/identify/fe/structure.h"
 
+#include <stdexcept>
 #include <map>
 
 #include "scoleid/identify/fe/beam_model.h"
@@ -24,12 +25,16 @@ const std::map<std::string, Factory>& registry() {
 
 std::unique_ptr<FEStructure> make_structure(const io::Scenario& sc, int elements) {
   const auto it = registry().find(io::to_string(sc.structure));
-  if (it == registry().end()) {
-    std::string list;
-    for (const auto& k : structure_kinds()) list += (list.empty() ? "" : "|") + k;
-    io::fail_field(sc.source, "structure", "is not supported by this identifier (" + list + ")", "'" + std::string(io::to_string(sc.structure)) + "'");
-  }
+  if (it == registry().end())  // every kind of io::Structure has its row
+    throw std::logic_error("make_structure: no finite-element model of structure '" + std::string(io::to_string(sc.structure)) + "'");
   return it->second(sc, elements);
+}
+
+std::unique_ptr<PhysicalParameterization> FEStructure::parameterize(const io::Scenario& sc) const {
+  auto p = std::make_unique<PhysicalParameterization>(parameter_space(sc), sc.identification);
+  if (const auto& r = p->refusal())
+    throw std::logic_error("FEStructure::parameterize: " + r->field + " " + r->what + " (identify::check_parameters refuses it)");
+  return p;
 }
 
 std::vector<std::string> structure_kinds() {

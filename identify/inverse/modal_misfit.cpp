@@ -91,13 +91,13 @@ ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& p
                          ModalMisfitOptions options)
     : model_(model), params_(params), data_(std::move(data)), options_(options) {
   if (data_.source.empty()) data_.source = "modal data";
-  io::validate_modal_data(data_);
-  const std::string& src = data_.source;
-  if (!(options_.extra_candidates >= 0))
-    io::fail_field(src, "extra_candidates", "must be >= 0", std::to_string(options_.extra_candidates));
-  if (!(options_.cluster_tolerance >= 0) || !std::isfinite(options_.cluster_tolerance))
-    io::fail_field(src, "cluster_tolerance", "must be a finite number >= 0",
-                   io::format_value(options_.cluster_tolerance));
+  // Data and options as the door leaves them (io::validate_modal_data; identify::check_modal_data:
+  // every station a sensor on u): anything else is a caller's defect.
+  auto unchecked = [](const std::string& what) {
+    throw std::logic_error("ModalMisfit: " + what + " (the door, identify::check_modal_data, refuses it)");
+  };
+  if (!(options_.extra_candidates >= 0)) unchecked("extra_candidates < 0");
+  if (!(options_.cluster_tolerance >= 0) || !std::isfinite(options_.cluster_tolerance)) unchecked("cluster_tolerance not >= 0");
   // Stations: sensors acting on u.
   Cs_ = MatrixXd::Zero(static_cast<Eigen::Index>(data_.stations.size()), model_.ndof);
   for (std::size_t k = 0; k < data_.stations.size(); ++k) {
@@ -105,22 +105,15 @@ ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& p
     const ModelSensor* found = nullptr;
     for (const auto& s : model_.sensors)
       if (s.name == name) found = &s;
-    if (!found || found->order != 0)
-      io::fail_field(
-          src, "column '" + name + "'", "is not a displacement, rotation or line-of-sight sensor of the scenario",
-          "'" + name + "'" + (found ? " (its kind is " + std::string(io::to_string(found->kind)) + ")" : std::string(" (no such sensor)")));
+    if (!found || found->order != 0) unchecked("station '" + name + "' is no sensor on u");
     Cs_.row(static_cast<Eigen::Index>(k)) = found->row;
   }
-  if (data_.has_damping() && model_.damping.empty())
-    io::fail_field(src, "column 'damping_ratio'",
-                   "needs a model with damping terms (the scenario's structure model has none)",
-                   "damping data for " + std::to_string(data_.modes.size()) + " modes");
+  if (data_.has_damping() && model_.damping.empty()) unchecked("damping data for a model without damping terms");
   for (const auto& m : data_.modes) {
     if (!data_.has_shapes()) break;
     Eigen::Map<const VectorXd> s(m.shape.data(), static_cast<Eigen::Index>(m.shape.size()));
-    const double norm = s.norm();
-    if (!(norm > 0) || !std::isfinite(norm))
-      io::fail_field(src, "mode " + std::to_string(m.label) + " shape", "must not vanish at every station", "0");
+    const double norm = s.stableNorm();
+    if (!(norm > 0) || !std::isfinite(norm)) unchecked("mode " + std::to_string(m.label) + "'s shape vanishes");
     measured_shape_.push_back(s / norm);
   }
   rows_per_mode_ = 1 + (data_.has_damping() ? 1 : 0) + static_cast<int>(data_.stations.size());

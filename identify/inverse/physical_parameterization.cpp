@@ -7,7 +7,6 @@
 
 namespace scoleid::identify {
 
-using io::fail_field;
 using io::format_value;
 
 namespace {
@@ -29,13 +28,20 @@ int PhysicalParameterization::quantity(const std::string& name) const {
   return it == space_.quantities.end() ? -1 : static_cast<int>(it - space_.quantities.begin());
 }
 
-PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const io::IdentificationSpec& id,
-                                                   const std::string& source)
+PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const io::IdentificationSpec& id)
     : space_(std::move(space)), paper_(id.parameterization == "paper") {
+  resolve(id);
+}
+
+void PhysicalParameterization::refuse(std::string field, std::string what, std::string value) {
+  refusal_ = ParameterRefusal{std::move(field), std::move(what), std::move(value)};
+}
+
+void PhysicalParameterization::resolve(const io::IdentificationSpec& id) {
   names_ = id.estimate;
-  if (names_.empty()) fail_field(source, "identification.estimate", "must name at least one parameter", "none");
+  if (names_.empty()) return refuse("identification.estimate", "must name at least one parameter", "none");
   if (paper_ && !space_.paper_requirement.empty())
-    fail_field(source, "identification.parameterization", space_.paper_requirement, "paper");
+    return refuse("identification.parameterization", space_.paper_requirement, "paper");
   std::vector<std::string> allowed, paper_names{"q1", "q2"};
   if (space_.has_q3) paper_names.push_back("q3");
   if (paper_) {
@@ -60,16 +66,16 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
   for (std::size_t i = 0; i < names_.size(); ++i) {
     const std::string f = "identification.estimate[" + std::to_string(i) + "]";
     if (std::find(allowed.begin(), allowed.end(), names_[i]) == allowed.end())
-      fail_field(source, f, "must be one of " + join(allowed) + " (" + id.parameterization + " parameterization of " +
+      return refuse(f, "must be one of " + join(allowed) + " (" + id.parameterization + " parameterization of " +
                                 space_.structure + ")",
                  "'" + names_[i] + "'");
     for (std::size_t j = 0; j < i; ++j)
-      if (names_[j] == names_[i]) fail_field(source, f, "is listed twice", "'" + names_[i] + "'");
+      if (names_[j] == names_[i]) return refuse(f, "is listed twice", "'" + names_[i] + "'");
     if (const auto* g = group(names_[i]))
       for (const auto& o : names_)
         for (int m : g->members)
           if (o == space_.quantities[static_cast<std::size_t>(m)])
-            fail_field(source, "identification.estimate", "cannot hold both " + g->name + " and " + o, "'" + o + "'");
+            return refuse("identification.estimate", "cannot hold both " + g->name + " and " + o, "'" + o + "'");
   }
   std::vector<std::string> keys = allowed;
   if (!paper_) keys.insert(keys.end(), paper_names.begin(), paper_names.end());
@@ -79,7 +85,7 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
   }
   for (const auto& [key, v] : id.initial)
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
-      fail_field(source, "identification.initial." + key, "is not a parameter of this " + space_.structure, format_value(v));
+      return refuse("identification.initial." + key, "is not a parameter of this " + space_.structure, format_value(v));
 
   // Starting φ: the scenario's values, overridden by identification.initial — groups first, then
   // single quantities, then the paper's q2 (ρA), q1 (EI = q1 ρA) and q3 (X = q3 ρA).
@@ -103,7 +109,7 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
     if (!g) continue;
     for (int m : g->members)
       if (start_[static_cast<std::size_t>(m)] != start_[static_cast<std::size_t>(g->members[0])])
-        fail_field(source, "identification.estimate",
+        return refuse("identification.estimate",
                    "estimates one " + g->name + " for " + std::to_string(g->members.size()) +
                        " quantities whose starting values differ (give identification.initial." + g->name +
                        ", or estimate them one by one)",
@@ -111,15 +117,15 @@ PhysicalParameterization::PhysicalParameterization(ParameterSpace space, const i
                        format_value(start_[static_cast<std::size_t>(m)]));
   }
   initial_ = parameters_of(start_, nullptr);
+  truth_ = parameters_of(space_.value, &space_.true_value);
   for (std::size_t i = 0; i < names_.size(); ++i) {
     // A starting value given for an estimated parameter is taken exactly.
     const auto it = ini.find(names_[i]);
     if (it != ini.end()) initial_[static_cast<Eigen::Index>(i)] = it->second;
     if (!(initial_[static_cast<Eigen::Index>(i)] > 0.0))
-      fail_field(source, "identification.initial." + names_[i], "must be > 0 (parameters are positive)",
+      return refuse("identification.initial." + names_[i], "must be > 0 (parameters are positive)",
                  format_value(initial_[static_cast<Eigen::Index>(i)]));
   }
-  truth_ = parameters_of(space_.value, &space_.true_value);
 }
 
 VectorXd PhysicalParameterization::parameters_of(const std::vector<double>& phi, const std::vector<bool>* defined) const {

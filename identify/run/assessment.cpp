@@ -1,4 +1,5 @@
 #include "scoleid/identify/run/assessment.h"
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/point_failure.h"
 
 #include <algorithm>
@@ -6,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
 
 #include "scoleid/identify/inverse/tied_parameterization.h"
 
@@ -89,18 +91,13 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability
       *vh += u.tolerance;
       *vl -= u.tolerance;
       // Central where both sides are valid scenarios; one-sided at the edge of the valid range (a
-      // sensor at the tip of the mast cannot move beyond it).
-      std::optional<VectorXd> yh, yl;
-      try { yh = outputs(hi); } catch (const io::InputError&) {}
-      // A quantity that cannot be negative (a stiffness, a mass) is not moved through zero.
-      const bool lo_valid = io::signed_field(u.field) || (t.value > 0 ? *vl > 0 : *vl >= 0);
-      if (lo_valid) try { yl = outputs(lo); } catch (const io::InputError&) {}
-      if (yh && yl) d = 0.5 * (*yh - *yl);
-      else if (yh) d = *yh - flat(Y0);
-      else if (yl) d = flat(Y0) - *yl;
-      else
-        io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
-                       "moves the scenario out of its valid range on both sides", io::format_value(u.tolerance));
+      // sensor at the tip of the mast cannot move beyond it); the door refused a tolerance with
+      // neither (check_scenario).
+      const UncertainSides sides = uncertain_sides(p.scenario, u);
+      if (sides.high && sides.low) d = 0.5 * (outputs(hi) - outputs(lo));
+      else if (sides.high) d = outputs(hi) - flat(Y0);
+      else if (sides.low) d = flat(Y0) - outputs(lo);
+      else throw std::logic_error("consider_terms: '" + u.field + "' has no valid side (identify::check_scenario refuses it)");
     }
     if (!(d.squaredNorm() > 0) || !d.allFinite())
       io::fail_field(p.scenario.source, "identification.uncertain." + u.field,

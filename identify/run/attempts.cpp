@@ -1,6 +1,7 @@
 #include "scoleid/identify/run/attempts.h"
 #include "scoleid/identify/point_failure.h"
 
+#include <stdexcept>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -131,9 +132,7 @@ double noise_misfit(const Problem& p, const Objective& obj) {
   const double V = p.data.white_noise_integral_variance(obj.data_start(), obj.data_end()) / (band ? p.band_gain : 1.0);
   for (std::size_t k = 0; k < R.size(); ++k) {
     const double sd = k < p.noise_std.size() ? p.noise_std[k] : 0.0;
-    if (!(sd > 0.0))
-      io::fail_field(p.scenario.source, "identification.smoothness",
-                     "discrepancy needs every sensor's noise level stated (sensor '" + p.data.names[k] + "' has none)", "discrepancy");
+    if (!(sd > 0.0)) throw std::logic_error("discrepancy: sensor '" + p.data.names[k] + "' has no noise level (identify::check_run refuses it)");
     const double c = 0.5 * R[k] * sd * sd;
     expected += c * W;
     variance += c * c * V;
@@ -542,7 +541,7 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   const Problem& p = c.problem;
   const Runner run{c, Table(*p.params, p.params->names().size() <= 3 && p.params->paper_form())};
   const auto families = section_families(r.names);
-  const bool from_ladder = ladder_first(p.scenario.identification, longest(families), p.scenario.source);
+  const bool from_ladder = ladder_first(p.scenario.identification, longest(families));
   const bool spectral_first = first_attempt(run, r, families, from_ladder);
   // The restarts, each tried when its condition holds, up to identification.restarts of them:
   //  - the other start of a sectional family (coarse to fine after a plain run, the plain run after

@@ -1,3 +1,4 @@
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/point_failure.h"
 #include "scoleid/identify/run/assessment.h"
@@ -243,6 +244,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
           "sets identification.uncertain, which measured modes do not take (their interval has no consider terms)",
           spec.modes_scenario);
     ep->modes_structure = make_structure(*ep->modes_scenario, ep->modes_scenario->identification.elements);
+    check_parameters(*ep->modes_structure, *ep->modes_scenario);
     ep->modes_params = ep->modes_structure->parameterize(*ep->modes_scenario);
     same_parameters(*ep->modes_params, "modes.scenario");
   }
@@ -267,6 +269,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
   // Modal data the model cannot be compared with at the start (fewer flexible modes than measured,
   // a measured mode no model mode can be matched to) are bad input, not a failed run.
   if (ep->modes) {
+    check_modal_data(*ep->modes, *ep->modes_scenario);
     try {
       ModalMisfit probe(ep->modes_structure->model(), *ep->modes_params, *ep->modes);
       probe.cost(ep->modes_params->initial());
@@ -406,7 +409,7 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
                             joint.has_matrix_free_products());
   if (r.method == io::Method::GaussNewtonKrylov && !joint.has_matrix_free_products())
     bad(ep.spec.source, "method", "needs displacement sensors only in every run", io::to_string(r.method));
-  const OptimizerOptions oo = optimizer_options(lead.identification, r.method, params.size(), eo.max_iterations, lead.source);
+  const OptimizerOptions oo = optimizer_options(lead.identification, r.method, params.size(), eo.max_iterations);
   if (eo.verbose) {
     io::progress("%5s", "iter");
     for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) io::progress(" %13s", r.names[i].c_str());

@@ -1,6 +1,7 @@
 // An identification in the frequency domain (frf_run.h; docs/theory.md §6.10).
 #include "scoleid/identify/run/frf_run.h"
 
+#include <stdexcept>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -30,10 +31,7 @@ double effective_averages(int segments, io::FrfWindowKind window, double overlap
 // The one input the FRFs are per unit of: the scenario's only input.
 int frf_input_index(const Problem& p) {
   const auto& sc = p.scenario;
-  if (sc.inputs.size() != 1)
-    fail_field(sc.source, "inputs",
-               "must hold exactly one input with identification.domain: frequency (FRFs are per unit of one input)",
-               std::to_string(sc.inputs.size()) + " inputs");
+  if (sc.inputs.size() != 1) throw std::logic_error("frf_input_index: " + std::to_string(sc.inputs.size()) + " inputs (identify::check_scenario refuses it)");
   return 0;
 }
 
@@ -76,10 +74,7 @@ void keep_band(const Problem& p, io::FrfData& d) {
 // Checks shared by both sources, and the variance's F-law scaling (frf_run.h).
 void finish_frf(Problem& p, io::FrfData d, double dof) {
   const auto& sc = p.scenario;
-  if (!sc.identification.uncertain.empty())
-    fail_field(sc.source, "identification.uncertain",
-               "is not propagated by a frequency-domain run (declared uncertainties need the time-domain path, domain: time)",
-               sc.identification.uncertain.front().field);
+  if (!sc.identification.uncertain.empty()) throw std::logic_error("finish_frf: declared uncertainties (identify::check_scenario refuses them)");
   keep_band(p, d);
   if (dof > 0.0 && !(dof > 4.0))
     fail_field(sc.source, "identification.frf.segment",
@@ -534,10 +529,9 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
   FrfMisfit m(p.model(), *p.params, *p.frf, p.frf_sensors, p.frf_input);
   r.method = ro.method.value_or(id.method);
   if (r.method == io::Method::GaussNewtonKrylov)
-    throw io::InputError("method gauss-newton-krylov (--method or identification.method) needs matrix-free Gauss-Newton products, which a "
-                         "frequency-domain run does not offer (its Jacobian is explicit: one adjoint per sensor and line); use gauss-newton or lbfgs");
+    throw std::logic_error("run_frf_identification: gauss-newton-krylov (identify::check_run refuses it)");
   if (r.method == io::Method::Auto) r.method = io::Method::GaussNewton;
-  OptimizerOptions o = optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source);
+  OptimizerOptions o = optimizer_options(id, r.method, p.params->size(), ro.max_iterations);
   std::vector<IterationRecord> iterates;
   auto on_iteration = [&](const IterationRecord& it) {
     iterates.push_back(it);

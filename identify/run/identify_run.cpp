@@ -1,9 +1,12 @@
 // One identification run (identify_run.h): the stages in order — strategy (run/strategy.h),
 // attempts (run/attempts.h), assessment (run/assessment.h); the outputs: run/run_report.cpp.
 #include "scoleid/identify/run/identify_run.h"
+
+#include "scoleid/identify/door/run_door.h"
 #include "scoleid/identify/point_failure.h"
 #include "scoleid/io/progress.h"
 
+#include <stdexcept>
 #include <csignal>
 #include <cstdio>
 #include <chrono>
@@ -158,9 +161,7 @@ namespace {
 std::vector<std::vector<int>> smoothness_chains(const Problem& p, const std::vector<std::string>& names) {
   if (p.scenario.identification.smoothness == 0.0) return {};
   auto chains = section_families(names);
-  if (chains.empty())
-    io::fail_field(p.scenario.source, "identification.smoothness",
-                   "needs sectional parameters (X_1 ... X_N) among those estimated", "none");
+  if (chains.empty()) throw std::logic_error("smoothness_chains: no sectional family (identify::check_run refuses it)");
   return chains;
 }
 }  // namespace
@@ -199,6 +200,7 @@ void keep_interrupted(const Problem& p, const AttemptsContext& c, RunResult& r, 
 }  // namespace
 
 RunResult run_identification(Problem& p, const RunOptions& ro) {
+  check_run(p, ro);
   if (p.scenario.identification.model == io::Model::Nonlinear) return run_nonlinear_identification(p, ro);
   if (p.frf) return run_frf_identification(p, ro);
   const auto t0 = std::chrono::steady_clock::now();
@@ -207,15 +209,10 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
   r.method = resolve_method(ro.method.value_or(id.method), p.params->size(), id.smoothness != 0.0,
                             obj.has_matrix_free_products());
-  // A method given on the command line meets the checks the scenario's field meets at the door.
   if (r.method == io::Method::GaussNewtonKrylov && !obj.has_matrix_free_products())
-    throw io::InputError(std::string("method gauss-newton-krylov (--method or identification.method) needs matrix-free "
-                                     "Gauss-Newton products, which ") +
-                         (obj.estimates_initial_state() ? "an estimated initial state (identification.initial_state: estimate) does"
-                                                        : "velocity and acceleration sensors do") +
-                         " not offer; use gauss-newton or lbfgs");
+    throw std::logic_error("run_identification: gauss-newton-krylov without matrix-free products (identify::check_run refuses it)");
   const auto chains = smoothness_chains(p, r.names);
-  AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source),
+  AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations),
                     ro.verbose};
   c.options.smoothness_chains = chains;
   // The assessment's refits (ro.compute_std) at the first attempt's estimate, made while its fit

@@ -5,6 +5,7 @@
 // resolution, flags) from differenced output sensitivities, and the uncertainty interval of
 // interval.h from those and the half-record refit. Declared uncertainties (consider terms) are not
 // propagated through this model: with any declared, it gives no interval and says so.
+#include <stdexcept>
 #include <chrono>
 #include "scoleid/identify/point_failure.h"
 #include <cmath>
@@ -174,17 +175,12 @@ RunResult run_nonlinear_identification(Problem& p, const RunOptions& ro) {
   RunResult r = start_result(p, io::Model::Nonlinear);
   // The nonlinear model has no matrix-free products and takes no smoothness prior.
   r.method = resolve_method(ro.method.value_or(id.method), p.params->size(), false, false);
-  if (r.method == io::Method::GaussNewtonKrylov)
-    io::fail_field(p.scenario.source, "identification.method",
-                   "'gauss-newton-krylov' needs matrix-free products, which the nonlinear model does not offer",
-                   io::to_string(r.method));
-  if (id.smoothness != 0.0)
-    io::fail_field(p.scenario.source, "identification.smoothness", "is not available with the nonlinear model",
-                   id.smoothness < 0 ? "discrepancy" : io::format_value(id.smoothness));
+  if (r.method == io::Method::GaussNewtonKrylov || id.smoothness != 0.0)
+    throw std::logic_error("run_nonlinear_identification: a choice the nonlinear model has not (identify::check_run refuses it)");
   NonlinearForwardOptions fo;
   fo.max_step = p.objective_options.solver.step > 0 ? p.objective_options.solver.step : (p.data.t[1] - p.data.t[0]) / 4.0;
   NonlinearRun run(p, fo, ro.verbose, r);
-  const OptimizerOptions oo = optimizer_options(id, r.method, p.params->size(), ro.max_iterations, p.scenario.source);
+  const OptimizerOptions oo = optimizer_options(id, r.method, p.params->size(), ro.max_iterations);
   if (ro.verbose)
     io::progress("nonlinear model: %d elastic DOFs, step %.4g s, %s\n", run.model.elastic(), fo.max_step, io::to_string(r.method));
   run.attempts(oo);

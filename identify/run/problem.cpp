@@ -4,9 +4,11 @@
 #include "scoleid/io/uff.h"
 #include "scoleid/io/uff_frf.h"
 
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/time/checkpoints.h"
 
+#include <stdexcept>
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -410,9 +412,8 @@ Measurements synthesize_nonlinear(const io::Scenario& sc, int elements, double s
   const ScoleNonlinear nl = scole_nonlinear(sc, elements);
   NonlinearForwardOptions o;
   o.max_step = step;
-  if (sc.simulation.record_start > 0)
-    fail_field(sc.source, "simulation.record_start", "is not available to the nonlinear model's synthesis (model: nonlinear)",
-               io::format_value(sc.simulation.record_start));
+  if (sc.simulation.record_start > 0)  // refused by the door (check_synthesis)
+    throw std::logic_error("synthesize_nonlinear: simulation.record_start " + io::format_value(sc.simulation.record_start));
   Measurements m;
   m.t = sample_times(sc);
   m.z = simulate_nonlinear(nl.at(coefficients), scenario_signals(sc), m.t, o).outputs;
@@ -425,21 +426,20 @@ namespace {
 // The true values of the estimated parameters for a structure (the truth's), translated to the
 // problem's parameterization.
 void set_true_values(Problem& p, const io::Scenario& truth_sc) {
-  const VectorXd tv = p.structure->parameterize(truth_sc)->truth();
+  // The truth's values need not be valid starting values (an absent damper of the truth is 0):
+  // only truth() is read.
+  const VectorXd tv = PhysicalParameterization(p.structure->parameter_space(truth_sc), truth_sc.identification).truth();
   for (int i = 0; i < tv.size(); ++i)
     if (std::isfinite(tv[i])) p.true_values[p.params->names()[static_cast<std::size_t>(i)]] = tv[i];
 }
 
 // The structure, its parameters, the scenario's signals and the stated noise levels.
 std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc) {
-  if (sc.sensors.empty()) fail_field(sc.source, "sensors", "must list at least one sensor", "none");
-  if (sc.inputs.empty() && sc.identification.initial_state != io::InitialState::Estimate)
-    fail_field(sc.source, "inputs",
-               "must list at least one input (a record with none, a free decay, needs identification.initial_state: estimate)",
-               "none");
+  check_scenario(sc);
   auto p = std::make_unique<Problem>();
   p->scenario = sc;
   p->structure = make_structure(sc, sc.identification.elements);
+  check_parameters(*p->structure, sc);
   p->params = p->structure->parameterize(sc);
   p->signals = scenario_signals(sc);
   p->noise_std.assign(sc.sensors.size(), 0.0);
@@ -848,25 +848,7 @@ void measurements_from_table(Problem& p, const io::DataTable& tab, const std::st
 IdentifierStep synthesize_data(Problem& p) {
   const auto& sc = p.scenario;
   const auto& id = sc.identification;
-  if (sc.inputs.empty())
-    fail_field(sc.source, "inputs",
-               "is empty and this run synthesises its data: from rest with no input nothing moves (a free decay's record "
-               "comes from a data file, --data)",
-               "[]");
-  // Conditioning is for a data column; synthetic data have none to condition.
-  for (std::size_t i = 0; i < sc.inputs.size(); ++i)
-    if (sc.inputs[i].conditioning.stated())
-      fail_field(sc.source, "inputs[" + std::to_string(i) + "].conditioning",
-                 "conditions a data column, and this run synthesises its data (give a data file)", "'" + sc.inputs[i].name + "'");
-  for (std::size_t j = 0; j < sc.sensors.size(); ++j)
-    if (sc.sensors[j].conditioning.stated())
-      fail_field(sc.source, "sensors[" + std::to_string(j) + "].conditioning",
-                 "conditions a data column, and this run synthesises its data (give a data file)", "'" + sc.sensors[j].name + "'");
   const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
-  if (data_elements < 2 * id.elements)
-    fail_field(sc.source, "identification.data_elements",
-               "must be at least 2x identification.elements (" + std::to_string(2 * id.elements) + ")",
-               std::to_string(data_elements));
   const IdentifierStep is = identifier_integration(sc, p.model(), *p.params, p.signals);
   const double step = is.step;
   check_step(sc, p.model(), *p.params, p.signals, step, true);
@@ -1165,16 +1147,7 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
   p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
                                           : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
                                                                              : SolverOptions::Integrator::Esdirk;
-  if (id.initial_state == io::InitialState::Estimate) {
-    if (id.integrator != "esdirk")
-      fail_field(p.scenario.source, "identification.integrator",
-                 "must be esdirk with initial_state: estimate (its tangents carry the initial state's directions)",
-                 "'" + id.integrator + "'");
-    if (id.method == io::Method::GaussNewtonKrylov)
-      fail_field(p.scenario.source, "identification.method",
-                 "cannot be gauss-newton-krylov with initial_state: estimate (the initial state is profiled out of the "
-                 "explicit Gauss-Newton matrix)",
-                 "'gauss-newton-krylov'");
+  if (id.initial_state == io::InitialState::Estimate) {  // esdirk, not Krylov (the door: check_scenario)
     // The flexible modes the step resolves (the data's content, docs/theory.md §5.2), or as stated.
     p.objective_options.initial_state_modes =
         id.initial_state_modes > 0 ? id.initial_state_modes
@@ -1290,6 +1263,7 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const io::DataTabl
 std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
   auto p = problem_skeleton(sc);
   if (!data_csv) {
+    check_synthesis(sc);
     finish_problem(*p, synthesize_data(*p), nullptr);
     return p;
   }

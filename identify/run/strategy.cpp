@@ -15,7 +15,7 @@ io::Method resolve_method(io::Method requested, int parameters, bool smoothness_
 }
 
 OptimizerOptions optimizer_options(const io::IdentificationSpec& id, io::Method method, int parameters,
-                                   std::optional<int> max_iterations, const std::string& source) {
+                                   std::optional<int> max_iterations) {
   OptimizerOptions oo;
   oo.method = method;
   oo.max_iterations = max_iterations.value_or(id.max_iterations);
@@ -25,9 +25,8 @@ OptimizerOptions optimizer_options(const io::IdentificationSpec& id, io::Method 
   oo.continuation = id.continuation_misfit > 0;
   if (oo.continuation) oo.continuation_misfit = id.continuation_misfit;
   if (!oo.steepest_weights.empty() && static_cast<int>(oo.steepest_weights.size()) != parameters)
-    io::fail_field(source, "identification.steepest_weights",
-                   "must hold one weight per estimated parameter (" + std::to_string(parameters) + ")",
-                   std::to_string(oo.steepest_weights.size()) + " values");
+    throw std::logic_error("optimizer_options: " + std::to_string(oo.steepest_weights.size()) + " steepest weights for " +
+                           std::to_string(parameters) + " parameters (io::validate_scenario refuses it)");
   return oo;
 }
 
@@ -43,10 +42,9 @@ std::string cautious_continuation_label(const OptimizerOptions& options) {
          io::format_value(options.continuation_misfit);
 }
 
-bool ladder_first(const io::IdentificationSpec& id, std::size_t sections, const std::string& source) {
+bool ladder_first(const io::IdentificationSpec& id, std::size_t sections) {
   if (id.start == io::Start::CoarseToFine && sections == 0)
-    io::fail_field(source, "identification.start", "needs sectional parameters (X_1 ... X_N) among those estimated",
-                   io::to_string(id.start));
+    throw std::logic_error("ladder_first: coarse_to_fine without a sectional family (identify::check_run refuses it)");
   return id.start == io::Start::CoarseToFine ||
          (id.start == io::Start::Auto && sections > static_cast<std::size_t>(kExplicitGaussNewtonParameters));
 }

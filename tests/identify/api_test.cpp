@@ -9,6 +9,7 @@
 
 #include "scoleid/identify.h"
 #include "scoleid/identify/run/strategy.h"
+#include "scoleid/io/validation.h"
 #include "scoleid/io/error.h"
 
 namespace fs = std::filesystem;
@@ -133,29 +134,35 @@ TEST(Strategy, TheOptimiserOptionsAreTheScenariosAndTheCautiousRestartIsFourTime
   id.gradient_tolerance = 3e-7;
   id.step_tolerance = 2e-4;
   id.continuation_misfit = 0.08;
-  const auto oo = identify::optimizer_options(id, io::Method::Lbfgs, 2, std::nullopt, "x");
+  const auto oo = identify::optimizer_options(id, io::Method::Lbfgs, 2, std::nullopt);
   EXPECT_EQ(oo.method, io::Method::Lbfgs);
   EXPECT_EQ(oo.max_iterations, 17);
   EXPECT_EQ(oo.gradient_tolerance, 3e-7);
   EXPECT_EQ(oo.step_tolerance, 2e-4);
   EXPECT_TRUE(oo.continuation);
   EXPECT_EQ(oo.continuation_misfit, 0.08);
-  EXPECT_EQ(identify::optimizer_options(id, io::Method::Lbfgs, 2, 3, "x").max_iterations, 3);
+  EXPECT_EQ(identify::optimizer_options(id, io::Method::Lbfgs, 2, 3).max_iterations, 3);
   EXPECT_DOUBLE_EQ(identify::cautious_continuation(oo, id).continuation_misfit, 0.02);
   id.continuation_misfit = 0.0;  // no continuation in the scenario: the cautious one from the default
-  const auto off = identify::optimizer_options(id, io::Method::GaussNewton, 2, std::nullopt, "x");
+  const auto off = identify::optimizer_options(id, io::Method::GaussNewton, 2, std::nullopt);
   EXPECT_FALSE(off.continuation);
   EXPECT_DOUBLE_EQ(identify::cautious_continuation(off, id).continuation_misfit,
                    identify::OptimizerOptions{}.continuation_misfit / 4.0);
+  // One weight per estimated parameter: the scenario's door refuses three for two; below it a
+  // mismatch is a caller's defect.
   id.steepest_weights = {1.0, 2.0, 3.0};
+  io::Scenario sc = io::load_scenario("paper-beam-1");
+  sc.identification.estimate = {"EI", "rho_A"};
+  sc.identification.steepest_weights = id.steepest_weights;
   try {
-    identify::optimizer_options(id, io::Method::SteepestDescent, 2, std::nullopt, "scenario 'w.yaml'");
+    io::validate_scenario(sc);
     FAIL() << "three weights for two parameters were accepted";
   } catch (const io::InputError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("identification.steepest_weights"), std::string::npos) << m;
     EXPECT_NE(m.find("3 values"), std::string::npos) << m;
   }
+  EXPECT_THROW(identify::optimizer_options(id, io::Method::SteepestDescent, 2, std::nullopt), std::logic_error);
 }
 
 // A load cell's static offset and inverted polarity, a sensor read at twice its scale: stated as

@@ -38,7 +38,7 @@ io::BeamSpec pinned_beam() {
 }
 
 std::vector<DampedMode> fe_damped_modes(int elements, double zeta, double c_kv) {
-  const BeamFE fe = build_beam(pinned_beam(), elements, 1, {}, {}, "test");
+  const BeamFE fe = build_beam(pinned_beam(), elements, 1, {}, {});
   const AssembledModel a = assemble(fe.model, beam_coefficients(fe, kRhoA, {kEI}, zeta, c_kv));
   return damped_modes(MatrixXd(a.M), MatrixXd(a.D), MatrixXd(a.K));
 }
@@ -102,7 +102,7 @@ TEST(BeamDamping, DampedModesHandleOverdampingAndRigidBodies) {
   // A free–free beam: the two rigid-body motions are left out, the flexible modes kept.
   io::BeamSpec b = pinned_beam();
   b.left = b.right = io::EndCondition::Free;
-  const BeamFE fe = build_beam(b, 20, 1, {}, {}, "test");
+  const BeamFE fe = build_beam(b, 20, 1, {}, {});
   const AssembledModel a = assemble(fe.model, beam_coefficients(fe, kRhoA, {kEI}, 0.0, 1.0));
   const auto f = damped_modes(MatrixXd(a.M), MatrixXd(a.D), MatrixXd(a.K));
   ASSERT_FALSE(f.empty());
@@ -155,7 +155,7 @@ TEST(BeamDamping, AssembledSlopeMatrixIntegratesTheSlopeSquared) {
   const double beta = k * kPi / kL, exact = beta * beta * kL / 2.0;
   std::vector<double> err;
   for (int ne : {10, 20, 40}) {
-    const BeamFE fe = build_beam(pinned_beam(), ne, 1, {}, {}, "test");
+    const BeamFE fe = build_beam(pinned_beam(), ne, 1, {}, {});
     const SparseMatrix* G = nullptr;
     for (const auto& t : fe.model.damping)
       if (t.coefficient == fe.coef_chen_russell(0)) G = &t.matrix;

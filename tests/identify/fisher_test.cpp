@@ -256,7 +256,7 @@ TEST(Interval, TheRefitMadeAlongsideTheFitTestIsTheAssessmentsOwn) {
   ASSERT_EQ(r.half_record_estimate.size(), r.estimate.size());
   Objective obj(p->model(), *p->params, p->signals, p->data, p->objective_options);
   const auto& id = p->scenario.identification;
-  const OptimizerOptions oo = optimizer_options(id, r.method, p->params->size(), std::nullopt, p->scenario.source);
+  const OptimizerOptions oo = optimizer_options(id, r.method, p->params->size(), std::nullopt);
   const IntervalInputs again = assessment_refits(*p, obj, oo, r.estimate);
   for (int i = 0; i < r.estimate.size(); ++i) EXPECT_EQ(r.half_record_estimate[i], again.half_record_estimate[i]) << r.names[i];
   EXPECT_EQ(r.half_record_converged, again.half_record_converged);

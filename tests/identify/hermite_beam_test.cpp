@@ -25,7 +25,7 @@ BeamFE make(EndCondition left, EndCondition right, int ne, std::vector<scoleid::
   b.EI = {EI};
   b.tip_mass = tip_mass;
   b.tip_inertia = tip_inertia;
-  return build_beam(b, ne, 1, in, {}, "test");
+  return build_beam(b, ne, 1, in, {});
 }
 
 std::vector<double> fe_omegas(const BeamFE& fe) {
@@ -147,7 +147,7 @@ TEST(HermiteBeam, SectionsNotAlignedWithMeshAreIntegratedExactly) {
   BeamSpec b;
   b.length = L;
   b.EI = {20000.0, 50000.0, 30000.0};
-  const BeamFE coarse = build_beam(b, 4, 3, {}, {}, "t");
+  const BeamFE coarse = build_beam(b, 4, 3, {}, {});
   const auto kc = assemble(coarse.model, beam_coefficients(coarse, RHOA, b.EI, 0.0)).K;
   auto quad_field = [&](const BeamFE& fe) {
     VectorXd u = VectorXd::Zero(fe.model.ndof);

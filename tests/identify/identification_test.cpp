@@ -40,7 +40,7 @@ TEST(Forward, CaseOneResponseConvergesToTheModalSeries) {
   const double peak = exact.z.cwiseAbs().maxCoeff();
   std::vector<double> err;
   for (int ne : {10, 40}) {
-    const BeamFE fe = build_beam(sc.beam, ne, 1, sc.inputs, sc.sensors, "t");
+    const BeamFE fe = build_beam(sc.beam, ne, 1, sc.inputs, sc.sensors);
     const AssembledModel ops = assemble(fe.model, beam_coefficients(fe, sc.beam.rho_A, sc.beam.EI, 0.0));
     SolverOptions so;
     so.step = 1e-3;

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
@@ -206,7 +207,7 @@ TEST(PointElements, BadInputNamesTheField) {
         "beam: {length: 1, left: pinned, right: free, rho_A: 1, EI: 10, supports: {left: {k_theta: 5}}}\n"
         "identification: {estimate: [EI, supports.left.k_w]}\n",
         "s.yaml");
-    identify::make_structure(sc, 4)->parameterize(sc);
+    identify::check_parameters(*identify::make_structure(sc, 4), sc);
     ADD_FAILURE() << "supports.left.k_w (not held) accepted";
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("supports.left.k_theta"), std::string::npos) << e.what();

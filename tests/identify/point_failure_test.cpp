@@ -9,12 +9,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scoleid/identify/door/scenario_door.h"
+#include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/misfit.h"
 #include "scoleid/identify/inverse/optimizers.h"
 #include "scoleid/identify/point_failure.h"
 #include "scoleid/identify/time/second_order_solver.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
+#include "scoleid/io/scenario.h"
 
 using namespace scoleid::identify;
 
@@ -153,4 +156,28 @@ TEST(PointFailure, TheIntegratorsCallbacksKeepTheKind) {
   // And the solver works again afterwards.
   const Trajectory tr = solver.solve(0.0, 1.0, [](double, double* F) { F[0] = 1.0; }, {});
   EXPECT_GT(tr.times().size(), 2u);
+}
+
+// Below the door a scenario is taken as valid: a model built on one that went around it (a sensor
+// off the beam, a sensor on the mast of a frame) is a defect, a std::logic_error that is no point
+// failure; the door (check_scenario) refuses the same scenario as an input error naming the field.
+TEST(PointFailure, AModelBuiltAroundTheDoorIsADefectTheDoorRefusesAsInput) {
+  scoleid::io::Scenario sc = scoleid::io::load_scenario("paper-beam-1");
+  sc.sensors[0].location = 2 * sc.beam.length;
+  try {
+    make_structure(sc, 4);
+    ADD_FAILURE() << "a sensor off the beam was modelled";
+  } catch (const std::logic_error& e) {
+    EXPECT_FALSE(point_failure(e)) << e.what();
+  }
+  try {
+    check_scenario(sc);
+    ADD_FAILURE() << "the door let a sensor off the beam through";
+  } catch (const scoleid::io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sensors[0].location must lie on the beam"), std::string::npos) << e.what();
+  }
+  scoleid::io::Scenario f = scoleid::io::load_scenario("frame-4storey");
+  f.inputs[0].at = scoleid::io::Site::Mast;
+  EXPECT_THROW(make_structure(f, 2), std::logic_error);
+  EXPECT_THROW(check_scenario(f), scoleid::io::InputError);
 }

@@ -47,7 +47,7 @@ TEST(ScoleDamping, RigidMotionsAreNotDamped) {
   s.zeta = 0.02;
   s.actuator_damping = 0.5;
   s.actuator_stiffness = 3.0;
-  const ScoleFE fe = build_scole(s, 12, {}, {}, "test");
+  const ScoleFE fe = build_scole(s, 12, {}, {});
   const AssembledModel a = assemble(fe.model, scole_coefficients(s));
   const MatrixXd D(a.D), K(a.K);
   EXPECT_LT((D - D.transpose()).cwiseAbs().maxCoeff(), 1e-13 * D.cwiseAbs().maxCoeff());
@@ -74,7 +74,7 @@ TEST(ScoleDamping, BareClampedMastTorsionRatioIsZeta) {
   s.actuator_mass = 1e-9;
   s.actuator_stiffness = 1.0;  // keeps the proof masses' modes away from zero
   s.EI_roll = 3.0e7;           // separates the planes
-  const ScoleFE fe = build_scole(s, 80, {}, {}, "test");
+  const ScoleFE fe = build_scole(s, 80, {}, {});
   const AssembledModel a = assemble(fe.model, scole_coefficients(s));
   const auto modes = damped_modes(MatrixXd(a.M), MatrixXd(a.D), MatrixXd(a.K));
   const double L = s.length, w_t = M_PI / (2 * L) * std::sqrt(s.GJ / s.rho_I_psi);
@@ -105,7 +105,7 @@ TEST(ScoleDamping, ActuatorOnAFixedBaseIsASingleDofOscillator) {
   in.at = scoleid::io::Site::Actuator1;
   in.kind = scoleid::io::InputKind::Force;
   in.direction = {1.0, 0.0, 0.0};
-  const ScoleFE fe = build_scole(s, 10, {in}, {}, "test");
+  const ScoleFE fe = build_scole(s, 10, {in}, {});
   const AssembledModel a = assemble(fe.model, scole_coefficients(s));
   const Eigen::RowVectorXd stroke = [&] {
     Eigen::RowVectorXd r = -fe.mast_displacement(s.actuator_locations[0]).row(0);

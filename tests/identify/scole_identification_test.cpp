@@ -77,7 +77,7 @@ TEST(ScoleIdentification, CaseTwoZetaIsResolvedAndTheStepDampsLessThanOnePercent
     EXPECT_TRUE(id.identifiable[static_cast<std::size_t>(j)]) << n;
   }
 
-  const ScoleFE fe = build_scole(sc.scole, sc.identification.elements, {}, {}, "test");
+  const ScoleFE fe = build_scole(sc.scole, sc.identification.elements, {}, {});
   const AssembledModel a = assemble(fe.model, scole_coefficients(sc.scole));
   Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> es{MatrixXd(a.K), MatrixXd(a.M)};
   const double wmax = std::sqrt(es.eigenvalues().maxCoeff());

@@ -132,7 +132,7 @@ const char* field_name(const Eigen::Vector3d& share) {
 
 TEST(ScoleModel, RigidBodyMotionsSpanTheNullSpaceAndCarryTheWholeInertia) {
   const ScoleSpec s = general_spec();
-  const ScoleFE fe = build_scole(s, 10, {}, {}, "test");
+  const ScoleFE fe = build_scole(s, 10, {}, {});
   const AssembledModel a = operators(fe);
   const MatrixXd K(a.K), M(a.M);
   EXPECT_LT((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-14 * K.cwiseAbs().maxCoeff());
@@ -192,7 +192,7 @@ TEST(ScoleModel, FlexibleFrequenciesConvergeAtTheRateOfTheirField) {
   const std::vector<int> meshes = {5, 10, 20, 40, 80};
   const int shown = 14;
   std::vector<Modes> m;
-  for (int ne : meshes) m.push_back(modes(build_scole(s, ne, {}, {}, "test"), 1e-7));
+  for (int ne : meshes) m.push_back(modes(build_scole(s, ne, {}, {}), 1e-7));
   std::printf("  mode  dominant (roll/pitch/tors)");
   for (int ne : meshes) std::printf("   ne=%-10d", ne);
   std::printf("  rates 5-10-20, 10-20-40, 20-40-80   d_b(20)   d_t(20)  (w20-w40)/w\n");
@@ -276,7 +276,7 @@ TEST(ScoleModel, ClampedLimitMatchesTipBodyBeamAndShaft) {
                                analytic::omega(pitch.back(), L, s.EI_pitch, s.rho_A),
                                beta_t.back() / L * std::sqrt(s.GJ / s.rho_I_psi)});
   for (int ne : {20, 40}) {
-    const Modes m = modes(build_scole(s, ne, {}, {}, "test"), 1e-7);
+    const Modes m = modes(build_scole(s, ne, {}, {}), 1e-7);
     const double h = L / ne;
     std::printf("  %d elements (%d zero modes)\n  %-8s %2s %16s %16s %12s %12s\n", ne, m.zero, "field", "k", "analytic",
                 "FE", "rel.error", "bound");
@@ -411,7 +411,7 @@ TEST(ScoleModel, NewtonMatrixBandwidthDoesNotGrowWithTheMesh) {
   for (int ne : {10, 40, 160}) {
     ScoleSpec spec;
     spec.mast_root = {1.5, -2.0, 3.0};  // every coupling of the root
-    const ScoleFE fe = build_scole(spec, ne, {}, {}, "test");
+    const ScoleFE fe = build_scole(spec, ne, {}, {});
     const AssembledModel a = operators(fe);
     const SparseMatrix S = a.M + 0.01 * a.D + 1e-4 * a.K;
     b.push_back(BandedCholesky::shape(S));

@@ -45,7 +45,7 @@ void expect_static_cantilever_readings(const std::vector<scoleid::io::SensorSpec
   scoleid::io::InputSpec tip;
   tip.name = "P";
   tip.location = beam.length;
-  const BeamFE fe = build_beam(beam, 3, 1, {tip}, gauges, "test");
+  const BeamFE fe = build_beam(beam, 3, 1, {tip}, gauges);
   const AssembledModel a = assemble(fe.model, beam_coefficients(fe, beam.rho_A, beam.EI, 0.0));
   Eigen::SimplicialLDLT<SparseMatrix> K(a.K);
   const VectorXd u = K.solve(kP * fe.model.inputs[0].vector);

@@ -9,6 +9,7 @@
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/scenario_fields.h"
+#include "scoleid/io/validation.h"
 
 using namespace scoleid::io;
 
@@ -531,4 +532,55 @@ TEST(Scenario, DataSectionWithoutSampleRateLeavesItUnstated) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("data.sample_rate"), std::string::npos) << e.what();
   }
+}
+
+// What each structure's models read is checked once, by the kind's own check in validate_scenario
+// (parse_scenario's last step, and every program after its command-line overrides): a site,
+// direction or setting the models cannot read is one line naming the field, before any model.
+TEST(Scenario, EachKindRefusesSitesAndSettingsItsModelsDoNotRead) {
+  const std::string beam = "name: b\nbeam: {length: 2, EI: [1], rho_A: 1}\ninputs: [{at: beam, location: 1}]\n";
+  expect_errors(beam, {
+      {"sensors: [{at: mast, location: 1}]\n", "scenario 'x.yaml': sensors[0].at must be 'beam' for a beam structure, got 'mast'"},
+      {"sensors: [{location: 2.5}]\n", "scenario 'x.yaml': sensors[0].location must lie on the beam [0, 2], got 2.5"},
+  });
+  EXPECT_NE(error_of(beam + "sensors: [{location: 1, kind: line_of_sight}]\n")
+                .find("sensors[0].kind is not read on a beam structure"),
+            std::string::npos);
+  expect_errors("name: b\nbeam: {length: 2, EI: [1], rho_A: 1, left: clamped, right: clamped}\ninputs: [{location: 1}]\n"
+                "sensors: [{location: 1}]\n",
+                {{"identification: {elements: 1}\n",
+                  "scenario 'x.yaml': identification.elements must be >= 2 for a beam clamped at both ends (one element "
+                  "leaves no free degree of freedom), got 1"}});
+  const std::string scole = "name: s\nstructure: scole\n";
+  expect_errors(scole, {
+      {"inputs: [{at: beam, direction: x}]\nsensors: [{at: reflector, direction: x}]\n",
+       "scenario 'x.yaml': inputs[0].at must be shuttle, reflector, mast, actuator1 or actuator2 for a scole structure, got 'beam'"},
+      {"inputs: [{at: reflector}]\nsensors: [{at: reflector, direction: x}]\n",
+       "scenario 'x.yaml': inputs[0].direction must be given (x, y, z or a 3-vector), got none"},
+      {"inputs: [{at: actuator1, direction: z}]\nsensors: [{at: reflector, direction: x}]\n",
+       "scenario 'x.yaml': inputs[0].direction must lie in the actuator plane (x, y), got [0, 0, 1]"},
+      {"inputs: [{at: actuator1, kind: moment, direction: x}]\nsensors: [{at: reflector, direction: x}]\n",
+       "scenario 'x.yaml': inputs[0].kind must be 'force' for a proof-mass actuator, got 'moment'"},
+      {"inputs: [{at: reflector, direction: x}]\nsensors: [{at: mast, location: 0, kind: line_of_sight, direction: x}]\n",
+       "scenario 'x.yaml': sensors[0].location must be > 0 for a line of sight (the line starts at the root), got 0"},
+      {"inputs: [{at: reflector, direction: x}]\nsensors: [{at: shuttle, kind: line_of_sight, direction: x}]\n",
+       "scenario 'x.yaml': sensors[0].kind is defined for the mast and the reflector, not the shuttle, got 'line_of_sight'"},
+      {"inputs: [{at: reflector, direction: x}]\nsensors: [{at: reflector, direction: x}]\nidentification: {sections: 2}\n",
+       "scenario 'x.yaml': identification.sections must be 0 or 1 for a scole structure (uniform mast), got 2"},
+  });
+  // After a program's override, the same checks (validate_scenario), e.g. --model nonlinear.
+  Scenario b = parse_scenario(beam + "sensors: [{location: 1}]\n", "b.yaml");
+  b.identification.model = Model::Nonlinear;
+  try {
+    validate_scenario(b);
+    ADD_FAILURE() << "a nonlinear beam was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "b.yaml: identification.model 'nonlinear' is a SCOLE model (structure: scole), got 'nonlinear'");
+  }
+  Scenario f = load_scenario("frame-4storey");
+  f.sensors[0].at = Site::Beam;
+  EXPECT_THROW(validate_scenario(f), InputError);
+  f = load_scenario("frame-4storey");
+  f.identification.sections = 2;
+  EXPECT_THROW(validate_scenario(f), InputError);
 }

@@ -43,7 +43,7 @@ std::vector<model::Mode> chain_modes(const io::BeamSpec& b, int n) {
 }
 
 std::vector<identify::DampedMode> fe_modes(const io::BeamSpec& b, int elements) {
-  const identify::BeamFE fe = identify::build_beam(b, elements, 1, {}, {}, "test");
+  const identify::BeamFE fe = identify::build_beam(b, elements, 1, {}, {});
   const identify::AssembledModel a =
       identify::assemble(fe.model, identify::beam_coefficients(fe, b.rho_A, b.EI, b.zeta, b.c_kv));
   return identify::damped_modes(Eigen::MatrixXd(a.M), Eigen::MatrixXd(a.D), Eigen::MatrixXd(a.K));

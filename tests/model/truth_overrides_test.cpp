@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 
+#include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/error.h"
@@ -332,9 +333,10 @@ TEST(ActuatorLag, TruthResponseIsDelayedToFirstOrderAndChangedByALargeLag) {
 // naming the field and the place a mismatch study sets it; a lag under truth.overrides does not
 // reach it.
 TEST(ActuatorLag, FiniteElementModelRefusesALag) {
+  // The identifier's door refuses a lag outside truth.overrides: its model has no servo state.
   namespace io = scoleid::io;
   try {
-    scoleid::identify::make_structure(lag_scenario(", actuator_lag: 0.05", ""), 4);
+    scoleid::identify::check_scenario(lag_scenario(", actuator_lag: 0.05", ""));
     FAIL() << "no error";
   } catch (const io::InputError& e) {
     EXPECT_EQ(std::string(e.what()),
@@ -342,6 +344,7 @@ TEST(ActuatorLag, FiniteElementModelRefusesALag) {
               "truth.overrides.scole to study the mismatch, got 0.05");
   }
   const io::Scenario ov = lag_scenario("", "  overrides:\n    scole: {actuator_lag: 0.05}\n");
+  EXPECT_NO_THROW(scoleid::identify::check_scenario(ov));
   EXPECT_NO_THROW(scoleid::identify::make_structure(ov, 4));
   EXPECT_DOUBLE_EQ(io::truth_scenario(ov).scole.actuator_lag, 0.05);
 }

@@ -319,13 +319,11 @@ void ScoleNonlinear::add_sensors(const ScoleFE& fe, const std::vector<io::Sensor
 }
 
 ScoleNonlinear scole_nonlinear(const io::Scenario& sc, int elements) {
+  // A SCOLE scenario's mast is uniform (identification.sections 0 or 1, io/scole_kind.cpp); the
+  // callers refuse the model for other structures (io::validate_scenario, scole-crosscheck).
   if (sc.structure != io::Structure::Scole)
-    io::fail_field(sc.source, "structure", "has no nonlinear model (identification.model: nonlinear is SCOLE's)",
-                   "'" + std::string(io::to_string(sc.structure)) + "'");
-  if (sc.identification.sections > 0)
-    io::fail_field(sc.source, "identification.sections", "is not available with the nonlinear model (model: nonlinear)",
-                   std::to_string(sc.identification.sections));
-  const ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors, sc.source);
+    throw std::logic_error("scole_nonlinear: structure '" + std::string(io::to_string(sc.structure)) + "' has no nonlinear model");
+  const ScoleFE fe = build_scole(sc.scole, elements, sc.inputs, sc.sensors);
   return ScoleNonlinear(fe, sc.inputs, sc.sensors);
 }
 

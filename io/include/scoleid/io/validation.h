@@ -33,7 +33,17 @@ double sample_count(double duration, double interval);
 // The cross-field checks and count limits (names unique across inputs and sensors; samples,
 // values per record, segments, elements, steps of a fixed identifier step). parse_scenario
 // calls it; a program that overrides fields from its command line calls it again.
+// Then every input's and sensor's site, kind, station and direction are ones the structure's
+// models read (the kind's own checks: KindTable::check in its io file), so the finite-element
+// models and the Simbody truth below take them as given.
 void validate_scenario(const Scenario& scenario);
+
+// A station `loc` at a site with one (has_station): on the structure, [0, length]. InputError
+// naming `source` (default the scenario's), `field` and the value.
+void check_location(const Scenario& sc, const std::string& field, Site at, double loc, const std::string& source = "");
+// A sensor kind the structure's models read (types.h, reads); InputError naming the structures
+// that read it.
+void check_sensor_kind(const Scenario& sc, const std::string& field, SensorKind kind);
 
 // The finite-element models follow what the Simbody truth follows except a SCOLE actuator's
 // servo lag (truth.overrides.scole.actuator_lag). A run that needs the FE model to reproduce

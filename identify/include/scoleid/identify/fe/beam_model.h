@@ -59,11 +59,12 @@ struct BeamFE {
   Eigen::RowVectorXd curvature_row(double s) const;  // w_ss(s) (a strain gauge reads −offset times it)
 };
 
-// `source` names the scenario in error messages. Inputs of kind force/moment at `location`;
-// sensors of kind displacement/rotation (rows on u), velocity (u̇), acceleration (ü); others are
-// rejected with InputError.
+// Inputs of kind force/moment at `location`; sensors of kind displacement/rotation (rows on u),
+// velocity (u̇), acceleration (ü), strain and relative displacement. The inputs and sensors are a
+// validated scenario's (io::validate_scenario: on the beam, of kinds it reads); anything else is a
+// std::logic_error.
 BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
-                  const std::vector<io::SensorSpec>& sensors, const std::string& source);
+                  const std::vector<io::SensorSpec>& sensors);
 
 // A point quantity's value in `beam` (found by its parameter name), or NaN if `beam` lacks it.
 double point_value(const BeamFE::PointQuantity& p, const io::BeamSpec& beam);

@@ -51,10 +51,11 @@ struct FrameFE {
   Eigen::RowVectorXd row(double s, int derivative) const;
 };
 
-// `source` names the scenario in messages. Forces (horizontal) and moments at heights on the
-// first column; sensors of kind displacement, rotation, velocity, acceleration; others refused.
+// Forces (horizontal) and moments at heights on the first column; sensors of kind displacement,
+// rotation, velocity, acceleration. A validated scenario's (io::validate_scenario); anything else
+// is a std::logic_error.
 FrameFE build_frame(const io::FrameSpec& frame, int elements, const std::vector<io::InputSpec>& inputs,
-                    const std::vector<io::SensorSpec>& sensors, const std::string& source);
+                    const std::vector<io::SensorSpec>& sensors);
 
 // Coefficients at a frame's values.
 VectorXd frame_coefficients(const FrameFE& fe, const io::FrameSpec& frame);

@@ -112,10 +112,10 @@ struct ScoleFE {
   std::vector<int> node_reduced;  // 5 per node: reduced index, −1 at node 0
 };
 
-// `source` names the scenario in error messages; inputs and sensors as described above
-// (anything that cannot be represented is rejected with io::InputError naming the field).
+// Inputs and sensors as described above, a validated scenario's (io::validate_scenario, SCOLE's
+// KindTable::check); anything else is a std::logic_error.
 ScoleFE build_scole(const io::ScoleSpec& scole, int elements, const std::vector<io::InputSpec>& inputs,
-                    const std::vector<io::SensorSpec>& sensors, const std::string& source);
+                    const std::vector<io::SensorSpec>& sensors);
 
 // Coefficients c for the physical values of a ScoleSpec.
 VectorXd scole_coefficients(const io::ScoleSpec& s);

@@ -396,8 +396,9 @@ private:
   MatrixXd G_;
 };
 
-// The nonlinear SCOLE model of a scenario on `elements` elements (io::InputError for another
-// structure or sectional parameters, which it does not have).
+// The nonlinear SCOLE model of a scenario on `elements` elements (a SCOLE scenario: its mast is
+// uniform, identification.sections 0 or 1; std::logic_error for another structure, which
+// io::validate_scenario refuses with identification.model: nonlinear).
 ScoleNonlinear scole_nonlinear(const io::Scenario& scenario, int elements);
 
 }  // namespace scoleid::identify

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "scoleid/identify/inverse/parameterization.h"
+#include "scoleid/identify/inverse/physical_parameterization.h"
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/io/scenario.h"
 
@@ -20,9 +20,13 @@ public:
   virtual const StructuralModel& model() const = 0;
   virtual int elements() const = 0;
   virtual double length() const = 0;
+  // The structure's physical quantities at sc's values, their groups and coefficients
+  // (inverse/physical_parameterization.h).
+  virtual ParameterSpace parameter_space(const io::Scenario& sc) const = 0;
   // The named parameters of sc.identification, starting from sc's structure values: the
-  // scenario's own, or (for the true values) the truth's.
-  virtual std::unique_ptr<Parameterization> parameterize(const io::Scenario& sc) const = 0;
+  // scenario's own, or (for the true values) the truth's. Names the door took
+  // (identify::check_parameters); a refused one is a std::logic_error here.
+  std::unique_ptr<PhysicalParameterization> parameterize(const io::Scenario& sc) const;
   // Model coefficients at sc's structure values.
   virtual VectorXd coefficients(const io::Scenario& sc) const = 0;
   // The kind's exact undamped natural frequencies [Hz], the `count` lowest, at sc's structure
@@ -36,7 +40,8 @@ public:
 };
 
 // The FE model of the scenario's structure on `elements` elements (its inputs and sensors
-// attached). io::InputError for anything the structure cannot represent, naming the field.
+// attached). The scenario is a validated one (io::validate_scenario, identify::check_scenario):
+// anything else is a std::logic_error.
 std::unique_ptr<FEStructure> make_structure(const io::Scenario& sc, int elements);
 // The kinds make_structure knows.
 std::vector<std::string> structure_kinds();

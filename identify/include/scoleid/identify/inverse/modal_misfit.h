@@ -97,9 +97,9 @@ public:
     double damping_ratio = 0.0;  // ζ (light damping, see above)
   };
 
-  // Station names must be sensors of `model` acting on u (displacement, rotation, line of sight);
-  // damping data need a model with damping terms. io::InputError naming data.source, the column
-  // and the value otherwise (and for anything validate_modal_data refuses, or a zero measured shape).
+  // Data the door took (identify::check_modal_data: io::validate_modal_data, every station a
+  // sensor acting on u); damping data need a model with damping terms (every scenario's has).
+  // std::logic_error otherwise: a caller that went around the door.
   ModalMisfit(const StructuralModel& model, const Parameterization& params, io::ModalData data,
               ModalMisfitOptions options = {});
 

@@ -15,6 +15,7 @@
 // rounding, no step-size choice.
 #include <complex>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,11 +46,20 @@ struct ParameterSpace {
   std::function<std::vector<Cd>(const std::vector<Cd>& phi)> coefficients;
 };
 
+// What a parameterization cannot take from identification.estimate / .initial / .parameterization:
+// the field, the requirement and the value, as io::fail_field writes them (the door raises it:
+// identify::check_parameters).
+struct ParameterRefusal {
+  std::string field, what, value;
+};
+
 class PhysicalParameterization final : public Parameterization {
 public:
   using Cd = std::complex<double>;
-  // `source` names the scenario in messages (identification.estimate / .initial errors).
-  PhysicalParameterization(ParameterSpace space, const io::IdentificationSpec& id, const std::string& source);
+  // The names resolved against the space; the first thing it cannot take is kept as refusal()
+  // (then only refusal() and truth() — when the names resolved — are meaningful).
+  PhysicalParameterization(ParameterSpace space, const io::IdentificationSpec& id);
+  const std::optional<ParameterRefusal>& refusal() const { return refusal_; }
   const std::vector<std::string>& names() const override { return names_; }
   void coefficients(const VectorXd& q, VectorXd& c, MatrixXd& dcdq) const override;
   std::map<std::string, double> physical(const VectorXd& q) const override;
@@ -58,6 +68,8 @@ public:
   bool paper_form() const override { return paper_; }
 
 private:
+  void resolve(const io::IdentificationSpec& id);
+  void refuse(std::string field, std::string what, std::string value);
   const ParameterSpace::Group* group(const std::string& name) const;
   int quantity(const std::string& name) const;
   // φ for parameter values q (complex for the complex step), from the starting φ.
@@ -70,6 +82,7 @@ private:
   std::vector<std::string> names_;
   std::vector<double> start_;
   VectorXd initial_, truth_;
+  std::optional<ParameterRefusal> refusal_;
 };
 
 }  // namespace scoleid::identify

@@ -38,10 +38,10 @@ io::Method resolve_method(io::Method requested, int parameters, bool smoothness_
 
 // The optimiser's options from the identification section: method, iteration limit (the override
 // if given), tolerances, the paper's steepest-descent weights and the horizon continuation.
-// Throws io::InputError (naming `source`) when steepest_weights does not hold one weight per
-// parameter.
+// steepest_weights holds one weight per parameter (io::validate_scenario refuses other counts;
+// std::logic_error here).
 OptimizerOptions optimizer_options(const io::IdentificationSpec& id, io::Method method, int parameters,
-                                   std::optional<int> max_iterations, const std::string& source);
+                                   std::optional<int> max_iterations);
 
 // The options of the cautious restart: the same run with a horizon continuation four times as
 // cautious as the scenario's (or the default's) misfit bound.
@@ -51,7 +51,8 @@ std::string cautious_continuation_label(const OptimizerOptions& options);
 
 // Whether the first attempt starts from the coarse-to-fine ladder: identification.start says so, or
 // it is auto and a sectional family has more sections than the explicit Gauss–Newton limit.
-// `sections` is the longest family's length (0: none; then coarse-to-fine is refused).
-bool ladder_first(const io::IdentificationSpec& id, std::size_t sections, const std::string& source);
+// `sections` is the longest family's length (0: none; coarse-to-fine then is refused by the door,
+// identify::check_run).
+bool ladder_first(const io::IdentificationSpec& id, std::size_t sections);
 
 }  // namespace scoleid::identify
