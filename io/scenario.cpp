@@ -1000,25 +1000,6 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
   }
 }
 
-// The estimated parameter that sets the number at `path` ("" when none does): each estimated
-// parameter is moved in a copy of the scenario, and the one that moves the number names it.
-std::string estimated_by(const Scenario& sc, const std::string& path) {
-  Scenario probe = sc;
-  const double* here = numeric_field(probe, path);
-  if (!here) return "";
-  const double before = *here;
-  // Two values, so that one differs from the parameter's own (a name such as SCOLE's EI, which
-  // sets both bending planes, has no single value of its own).
-  for (const auto& name : sc.identification.estimate)
-    for (const double to : {1.0, 2.0}) {
-      Scenario moved = sc;
-      set_structure_parameters(moved, {{name, to}});
-      const double* there = numeric_field(moved, path);
-      if (there && *there != before) return name;
-    }
-  return "";
-}
-
 void parse_truth(const YAML::Node& n, const std::string& source, Scenario& sc) {
   TruthModelSpec& t = sc.truth;
   Reader r(n, source, "truth");
@@ -1175,33 +1156,6 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source)
     }
     if (r.has("identification")) parse_identification(r.child("identification"), source, sc.identification);
     if (r.has("truth")) parse_truth(r.child("truth"), source, sc);
-    for (const auto& u : sc.identification.uncertain) {
-      const std::string field = "identification.uncertain." + u.field;
-      if (u.is_switch) {
-        const bool* b = bool_field(sc, u.field);
-        if (!b) fail_field(source, field, "names no switch of this scenario (switches: scole.bending_rotary_inertia)", "'" + u.field + "'");
-        if (*b == u.alternative)
-          fail_field(source, field, "must name the alternative to the model's setting", u.alternative ? "true" : "false");
-      } else if (const double* v = numeric_field(sc, u.field); !v) {
-        std::string known;
-        for (const auto& p : field_paths(sc))
-          if (p != "scole.bending_rotary_inertia") known += (known.empty() ? "" : ", ") + p;
-        fail_field(source, field, "names no number of this scenario (known: " + known + ")", "'" + u.field + "'");
-      } else if (const std::string by = estimated_by(sc, u.field); !by.empty()) {
-        // The interval's consider term moves a quantity the fit holds fixed; an estimated one the
-        // fit sets itself.
-        fail_field(source, field,
-                   "is estimated (identification.estimate names " + by + "): a quantity is estimated or declared uncertain, not both",
-                   format_value(u.tolerance));
-      } else if (!signed_field(u.field) && *v > 0 && !(u.tolerance < *v)) {
-        // The interval's consider term is a first-order shift: a tolerance as large as the value
-        // of a quantity that cannot be negative says the quantity is unknown, not uncertain.
-        fail_field(source, field,
-                   "must be smaller than the value it is a tolerance of (" + format_value(*v) +
-                       "): a quantity known no better than that is unknown (estimate it instead)",
-                   format_value(u.tolerance));
-      }
-    }
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }

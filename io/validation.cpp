@@ -6,6 +6,8 @@
 
 #include "scoleid/io/error.h"
 #include "scoleid/io/limits.h"
+#include "scoleid/io/scenario_fields.h"
+#include "scoleid/io/structure_parameters.h"
 #include "structure_kinds.h"
 
 namespace scoleid::io {
@@ -131,6 +133,72 @@ void check_location(const Scenario& sc, const std::string& field, Site at, doubl
 }
 
 namespace {
+// The physical quantities an estimated name sets: itself, or in the paper's form (the equation
+// divided by ρA, docs/theory.md §2.3) q1 = EI/ρA the EI group, q2 = 1/ρA ρA and, with q1 and q3
+// held, EI and c_kv too, q3 = c_kv/ρA c_kv.
+std::vector<std::string> quantities_set_by(const std::string& name, bool paper) {
+  if (!paper) return {name};
+  if (name == "q1") return {"EI"};
+  if (name == "q2") return {"rho_A", "EI", "c_kv"};
+  if (name == "q3") return {"c_kv"};
+  return {name};
+}
+
+// The estimated parameter that sets the number at `path` ("" when none does): each quantity an
+// estimated parameter sets is moved in a copy of the scenario, and the one that moves the number
+// names it.
+std::string estimated_by(const Scenario& sc, const std::string& path) {
+  Scenario probe = sc;
+  const double* here = numeric_field(probe, path);
+  if (!here) return "";
+  const double before = *here;
+  const bool paper = sc.identification.parameterization == "paper";
+  // Two values, so that one differs from the parameter's own (a name such as SCOLE's EI, which
+  // sets both bending planes, has no single value of its own).
+  for (const auto& name : sc.identification.estimate)
+    for (const auto& quantity : quantities_set_by(name, paper))
+      for (const double to : {1.0, 2.0}) {
+        Scenario moved = sc;
+        set_structure_parameters(moved, {{quantity, to}});
+        const double* there = numeric_field(moved, path);
+        if (there && *there != before) return name;
+      }
+  return "";
+}
+
+// identification.uncertain: a field of this scenario, not estimated, its tolerance below the value
+// of a quantity that cannot be negative; a switch with the other setting.
+void check_uncertain(const Scenario& sc) {
+  Scenario probe = sc;
+  for (const auto& u : sc.identification.uncertain) {
+    const std::string field = "identification.uncertain." + u.field;
+    if (u.is_switch) {
+      const bool* b = bool_field(probe, u.field);
+      if (!b) fail_field(sc.source, field, "names no switch of this scenario (switches: scole.bending_rotary_inertia)", "'" + u.field + "'");
+      if (*b == u.alternative)
+        fail_field(sc.source, field, "must name the alternative to the model's setting", u.alternative ? "true" : "false");
+    } else if (const double* v = numeric_field(probe, u.field); !v) {
+      std::string known;
+      for (const auto& p : field_paths(probe))
+        if (p != "scole.bending_rotary_inertia") known += (known.empty() ? "" : ", ") + p;
+      fail_field(sc.source, field, "names no number of this scenario (known: " + known + ")", "'" + u.field + "'");
+    } else if (const std::string by = estimated_by(sc, u.field); !by.empty()) {
+      // The interval's consider term moves a quantity the fit holds fixed; an estimated one the
+      // fit sets itself.
+      fail_field(sc.source, field,
+                 "is estimated (identification.estimate names " + by + "): a quantity is estimated or declared uncertain, not both",
+                 format_value(u.tolerance));
+    } else if (!signed_field(u.field) && *v > 0 && !(u.tolerance < *v)) {
+      // The interval's consider term is a first-order shift: a tolerance as large as the value
+      // of a quantity that cannot be negative says the quantity is unknown, not uncertain.
+      fail_field(sc.source, field,
+                 "must be smaller than the value it is a tolerance of (" + format_value(*v) +
+                     "): a quantity known no better than that is unknown (estimate it instead)",
+                 format_value(u.tolerance));
+    }
+  }
+}
+
 // Every input's and sensor's station lies on the structure and every sensor's kind is read on it;
 // then the kind's own checks of sites, directions and sections.
 void check_sites(const Scenario& sc) {
@@ -161,6 +229,7 @@ void validate_scenario(const Scenario& sc) {
       fail_field(src, f, "must be unique among inputs and sensors", "'" + sc.sensors[i].name + "'");
   }
   check_sites(sc);
+  check_uncertain(sc);
   const double columns = 1.0 + static_cast<double>(sc.inputs.size() + sc.sensors.size());
   auto check_record = [&](const std::string& field, double interval) {
     const double n = sample_count(sc.simulation.duration, interval);

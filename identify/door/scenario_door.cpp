@@ -21,10 +21,13 @@ bool valid(const io::Scenario& sc) {
 
 UncertainSides uncertain_sides(const io::Scenario& sc, const io::UncertainSpec& u) {
   if (u.is_switch) return {true, false};
-  io::Scenario hi = sc, lo = sc;
+  // The moved structure's validity (its declarations are the original's, checked by the caller).
+  io::Scenario hi = sc;
+  hi.identification.uncertain.clear();
+  io::Scenario lo = hi;
   double* vh = io::numeric_field(hi, u.field);
   double* vl = io::numeric_field(lo, u.field);
-  if (!vh || !vl) throw std::logic_error("uncertain_sides: '" + u.field + "' is no numeric field (the reader refuses it)");
+  if (!vh || !vl) throw std::logic_error("uncertain_sides: '" + u.field + "' is no numeric field (io::validate_scenario refuses it)");
   const double value = *vh;
   *vh += u.tolerance;
   *vl -= u.tolerance;

@@ -23,6 +23,8 @@ UncertaintyInterval uncertainty_interval(const Identifiability& id, const Interv
   else if (!in.half_record_converged) u.note = "the half-record refit did not converge: its shift is where it stopped";
   if (smoothing && !in.smoothing_converged)
     u.note += std::string(u.note.empty() ? "" : "; ") + "the refit at a tenth of the smoothness weight did not converge: its shift is where it stopped";
+  for (const auto& t : in.consider)
+    if (!t.note.empty()) u.note += std::string(u.note.empty() ? "" : "; ") + t.note;
   for (Eigen::Index i = 0; i < P; ++i) {
     double c = 0.0;
     for (const auto& t : in.consider) c += std::abs(t.shift[i]);

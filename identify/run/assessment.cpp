@@ -99,11 +99,23 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability
       else if (sides.low) d = flat(Y0) - outputs(lo);
       else throw std::logic_error("consider_terms: '" + u.field + "' has no valid side (identify::check_scenario refuses it)");
     }
-    if (!(d.squaredNorm() > 0) || !d.allFinite())
-      io::fail_field(p.scenario.source, "identification.uncertain." + u.field,
-                     d.allFinite() ? "does not change the model's outputs (an estimated quantity, or one the sensors do not depend on)"
-                                   : "makes the model's response non-finite",
-                     u.is_switch ? (u.alternative ? "true" : "false") : io::format_value(u.tolerance));
+    // Found only at q̂, after the fit: a quantity the outputs do not depend on has no consider term
+    // (0, said), one whose move leaves no finite response no interval (NaN, said). The door refused
+    // an estimated one (io::validate_scenario).
+    const std::string moved = "identification.uncertain." + u.field + " (" +
+                              (u.is_switch ? std::string(u.alternative ? "true" : "false") : io::format_value(u.tolerance)) + ")";
+    if (!d.allFinite()) {
+      t.shift = VectorXd::Constant(P, std::nan(""));
+      t.note = moved + " makes the model's response non-finite: no consider term, no interval";
+      terms.push_back(t);
+      continue;
+    }
+    if (!(d.squaredNorm() > 0)) {
+      t.shift = VectorXd::Zero(P);
+      t.note = moved + " does not change the model's outputs at the estimate: its consider term is 0";
+      terms.push_back(t);
+      continue;
+    }
     const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
     t.shift = VectorXd::Zero(P);
     for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];

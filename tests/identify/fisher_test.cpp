@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scoleid/identify/inverse/interval.h"
 #include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/identify/run/strategy.h"
@@ -210,8 +211,16 @@ truth: {overrides: {beam: {tip_mass: 21}}}
 TEST(Interval, ToleranceOnAnEstimatedQuantityIsRefused) {
   auto sc = scoleid::io::load_scenario("paper-beam-1");
   sc.identification.uncertain.push_back({"beam.rho_A", 2.0, false, false});
-  const std::string e = test_support::run_error(sc);
-  EXPECT_NE(e.find("identification.uncertain.beam.rho_A"), std::string::npos) << e;
+  // Refused at the door, before any solve, also for a scenario built in memory: in the paper's
+  // form q2 = 1/rho_A sets it.
+  try {
+    scoleid::identify::make_problem(sc, std::nullopt);
+    FAIL() << "an estimated quantity declared uncertain was accepted";
+  } catch (const scoleid::io::InputError& err) {
+    const std::string e = err.what();
+    EXPECT_NE(e.find("identification.uncertain.beam.rho_A"), std::string::npos) << e;
+    EXPECT_NE(e.find("is estimated (identification.estimate names q2)"), std::string::npos) << e;
+  }
 }
 
 // A parameter with a small share in a direction the data cannot see has no std to give: the
@@ -266,4 +275,38 @@ TEST(Interval, TheRefitMadeAlongsideTheFitTestIsTheAssessmentsOwn) {
   EXPECT_TRUE(ran);
   EXPECT_EQ(f.within_noise_and_discretisation, r.fit.within_noise_and_discretisation);
   EXPECT_EQ(f.message, r.fit.message);
+}
+
+// A declared uncertainty found after the fit to leave the outputs unchanged adds 0 and says so; one
+// whose move leaves no finite response leaves no interval and says so (never a refusal after the
+// solve, never a silent number). Half-widths are 2 std + Σ|shift| without a record to halve.
+TEST(Interval, ConsiderTermsThatCannotBeMadeAreZeroOrNoIntervalAndSaid) {
+  using scoleid::identify::ConsiderTerm;
+  scoleid::identify::Identifiability id;
+  id.std = Eigen::Vector2d(0.1, 0.2);
+  id.resolution = Eigen::Vector2d(0.0, 0.0);
+  scoleid::identify::IntervalInputs in;
+  in.estimate = Eigen::Vector2d(1.0, 2.0);
+  in.refit_applies = false;
+  ConsiderTerm a;
+  a.field = "beam.tip_mass";
+  a.shift = Eigen::Vector2d(0.05, -0.01);
+  ConsiderTerm none;
+  none.field = "beam.tip_inertia";
+  none.shift = Eigen::Vector2d::Zero();
+  none.note = "identification.uncertain.beam.tip_inertia (0.001) does not change the model's outputs at the estimate: its consider term is 0";
+  in.consider = {a, none};
+  auto u = scoleid::identify::uncertainty_interval(id, in);
+  EXPECT_NEAR(u.half_width[0], 0.2 + 0.05, 1e-15);
+  EXPECT_NEAR(u.half_width[1], 0.4 + 0.01, 1e-15);
+  EXPECT_NE(u.note.find("does not change the model's outputs"), std::string::npos) << u.note;
+  ConsiderTerm nan;
+  nan.field = "beam.attachments.clamp.location";
+  nan.shift = Eigen::Vector2d::Constant(std::nan(""));
+  nan.note = "identification.uncertain.beam.attachments.clamp.location (0.002) makes the model's response non-finite: no consider term, no interval";
+  in.consider.push_back(nan);
+  u = scoleid::identify::uncertainty_interval(id, in);
+  EXPECT_TRUE(std::isnan(u.half_width[0]) && std::isnan(u.half_width[1]));
+  EXPECT_NE(u.note.find("no interval"), std::string::npos) << u.note;
+  EXPECT_NE(u.note.find("does not change"), std::string::npos) << u.note;
 }

@@ -42,6 +42,7 @@ struct ConsiderTerm {
   double value = 0;      // the model's value
   double delta = 0;      // its declared uncertainty (absolute)
   VectorXd shift;        // F⁻¹ Gᵀ W G_θ Δθ per estimated parameter: the bias if the structure's θ is θ + Δθ
+  std::string note;      // why the shift is 0 (the outputs do not depend on θ) or NaN (no finite response); "" otherwise
 };
 
 struct IntervalInputs {
