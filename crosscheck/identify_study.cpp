@@ -52,12 +52,12 @@ IdentifyStudy identify_study(const io::Scenario& scenario, const IdentifyStudyOp
                              const std::vector<TruthLevel>& reuse) {
   std::string why;
   if (!opt.IsValid(&why)) throw io::InputError("identify: " + why);
-  if (scenario.identification.integrator != "esdirk")
+  if (scenario.identification.integrator != io::Integrator::Esdirk)
     io::fail_field(scenario.source, "identification.integrator",
                    "must be 'esdirk' inside scole-crosscheck: Simbody's bundled CPODES exports the same N_Vector "
                    "functions as SUNDIALS, so SUNDIALS-based integrators cannot share its process (run scole-truth and "
                    "scole-identify separately for them)",
-                   "'" + scenario.identification.integrator + "'");
+                   io::quoted(scenario.identification.integrator));
   const auto t0 = std::chrono::steady_clock::now();
   IdentifyStudy st;
   st.scenario = scenario.name;

@@ -163,13 +163,13 @@ void Identification::write(const std::string& dir) const {
   run_dir.commit();
 }
 
-std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data) {
+std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data, bool verbose) {
   io::validate_scenario(scenario);
   if (data.table) {
     io::check_table(*data.table);  // a table built in memory passes the checks a file's does
-    return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.meta_name.empty() ? data.name + " (metadata)" : data.meta_name);
+    return identify::make_problem(scenario, *data.table, data.name, data.meta ? &*data.meta : nullptr, data.meta_name.empty() ? data.name + " (metadata)" : data.meta_name, verbose);
   }
-  return identify::make_problem(scenario, data.csv);
+  return identify::make_problem(scenario, data.csv, verbose);
 }
 
 Identification identify_parameters(std::shared_ptr<identify::Problem> problem, const IdentifyOptions& options) {

@@ -16,7 +16,7 @@
 
 #include "scoleid/io/program.h"
 #include "scoleid/identify.h"
-#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/door/experiments_door.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/mat_file.h"
@@ -322,7 +322,7 @@ int main(int argc, char** argv) {
     // outputs: a run that fails or is interrupted leaves neither.
     std::optional<io::StagedFile> staged_model;
     if (!export_model.empty()) staged_model.emplace(export_model, "command line: --export-model");
-    const auto problem = prepare(sc, data.empty() ? DataSource::synthetic() : DataSource::file(data));
+    const auto problem = prepare(sc, data.empty() ? DataSource::synthetic() : DataSource::file(data), options.verbose);
     // (Checked again by the run; here so that the refusal is the only line on stderr.)
     if (const auto& w = sc.identification.steepest_weights; !w.empty() && static_cast<int>(w.size()) != problem->params->size())
       io::fail_field(sc.source, "identification.steepest_weights",

@@ -181,7 +181,7 @@ class Feed {
     if (samples_ < 16) throw InputError(source_ + ": " + std::to_string(samples_) + " samples are too few for frequency responses");
     r.sample_rate = clock_.rate();
     const double fs = r.sample_rate;
-    char note[240];
+    char note[400];
     try {
       if (o_.estimator == RecordFrfEstimator::Lines) {
         LinesOptions lo;

@@ -664,8 +664,6 @@ void parse_frame(const YAML::Node& n, const std::string& source, FrameSpec& f, c
   }
 }
 
-double structure_length(const Scenario& sc) { return kind_table(sc.structure).length(sc); }
-
 // A sensor's or input's unit and its column's must be units of its quantity, and the unit the
 // scenario's unit system gives it (no label may disagree with the numbers).
 // conditioning: {offset: none | mean | {mean_before: T} | value, scale, sign, detrend} (scenario.h).
@@ -937,7 +935,7 @@ void parse_identification(const YAML::Node& n, const std::string& source, Identi
     if (!(id.steepest_weights[i] > 0))
       fail_field(source, "identification.steepest_weights[" + std::to_string(i) + "]", "must be > 0",
                  format_value(id.steepest_weights[i]));
-  id.integrator = r.choice("integrator", id.integrator, {"esdirk", "esdirk-arkode", "bdf"});
+  id.integrator = r.choice_of("integrator", id.integrator);
   id.time_step = r.nonneg("time_step", id.time_step);
   id.step_rule = r.choice_of("step_rule", id.step_rule);
   id.rtol = r.positive("rtol", id.rtol);
@@ -1367,7 +1365,7 @@ nlohmann::json to_json(const Scenario& s) {
                          {"gradient_tolerance", id.gradient_tolerance}, {"step_tolerance", id.step_tolerance},
                          {"continuation_misfit", id.continuation_misfit},
                          {"band", !id.band.empty() ? json(id.band) : json(id.band_mode == IdentificationSpec::BandMode::None ? "none" : "auto")},
-                         {"steepest_weights", id.steepest_weights}, {"integrator", id.integrator},
+                         {"steepest_weights", id.steepest_weights}, {"integrator", to_string(id.integrator)},
                          {"time_step", id.time_step}, {"step_rule", to_string(id.step_rule)}, {"rtol", id.rtol},
                          {"model_error", id.model_error < 0 ? json("auto") : json(id.model_error)},
                          {"restarts", id.restarts}, {"start", to_string(id.start)}, {"model", to_string(id.model)},

@@ -72,7 +72,7 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) : beam_(beam) {
   for (const auto& e : elements) {
     double x = 0.0;
     const int i = bar_of(e.location, x);
-    if (e.k_w > 0.0 || e.c_w > 0.0) points.push_back({MobilizedBodyIndex(), Vec3(x, 0, 0), e.k_w, e.c_w});
+    if (e.k_w > 0.0 || e.c_w > 0.0) points.push_back({MobilizedBodyIndex(), Vec3(x, 0, 0), e.k_w, e.c_w, MobilizedBodyIndex(), Vec3(0.0)});
     if (e.k_theta > 0.0 || e.c_theta > 0.0) {
       const int end = e.location == 0.0 ? 0 : e.location == length_ ? 1 : -1;
       if (end >= 0 && e.k_theta > 0.0) {
@@ -177,8 +177,8 @@ BeamChain::BeamChain(const io::BeamSpec& beam, int n) : beam_(beam) {
     at.body = mass.getMobilizedBodyIndex();
     at.p_RS0 = Vec3(e.location, 0, 0);
     lumped_[e.name] = at;
-    PointSpring coupling{segment_bodies_[static_cast<std::size_t>(i)], Vec3(x, 0, 0), e.lumped_k, e.lumped_c};
-    coupling.other = mass.getMobilizedBodyIndex();
+    PointSpring coupling{segment_bodies_[static_cast<std::size_t>(i)], Vec3(x, 0, 0), e.lumped_k, e.lumped_c,
+                         mass.getMobilizedBodyIndex(), Vec3(0.0)};
     points.push_back(coupling);
     if (e.lumped_k_ground > 0.0) joints.push_back({mass.getMobilizedBodyIndex(), 0, e.lumped_k_ground, 0.0});
   }

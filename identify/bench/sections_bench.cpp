@@ -527,6 +527,7 @@ json part2() {
       auto p = make_problem(part2_scenario(st.initial), std::nullopt);
       p->data = data;
       p->data_source = "modal series";
+      p->origin = Problem::DataOrigin::Caller;
       RunOptions ro;
       ro.method = scoleid::io::Method::GaussNewton;
       ro.compute_std = true;

@@ -1,7 +1,5 @@
 #include "scoleid/identify/door/run_door.h"
 
-#include <algorithm>
-
 #include "scoleid/identify/inverse/tied_parameterization.h"
 #include "scoleid/io/error.h"
 
@@ -42,6 +40,17 @@ void check_run(const Problem& p, const RunOptions& ro) {
   if (id.start == io::Start::CoarseToFine && !sections)
     io::fail_field(src, "identification.start", "needs sectional parameters (X_1 ... X_N) among those estimated",
                    io::to_string(id.start));
+}
+
+void check_experiments_run(const ExperimentsProblem& ep, const ExperimentsOptions& eo) {
+  const io::Scenario& lead = ep.runs.empty() ? *ep.modes_scenario : ep.runs.front()->scenario;
+  if (eo.method.value_or(lead.identification.method) != io::Method::GaussNewtonKrylov) return;
+  for (std::size_t i = 0; i < ep.runs.size(); ++i)
+    if (const std::string why = no_matrix_free_products(*ep.runs[i]); !why.empty())
+      io::fail_field(ep.spec.source, "runs[" + std::to_string(i) + "] (" + ep.spec.runs[i].name + ")",
+                     "cannot take method gauss-newton-krylov (--method or the lead scenario's identification.method): it needs "
+                     "matrix-free Gauss-Newton products, which " + why + " not offer; use gauss-newton or lbfgs",
+                     io::to_string(io::Method::GaussNewtonKrylov));
 }
 
 }  // namespace scoleid::identify

@@ -53,10 +53,10 @@ void check_scenario(const io::Scenario& sc) {
   }
   const auto& id = sc.identification;
   if (id.initial_state == io::InitialState::Estimate) {
-    if (id.integrator != "esdirk")
+    if (id.integrator != io::Integrator::Esdirk)
       io::fail_field(sc.source, "identification.integrator",
                      "must be esdirk with initial_state: estimate (its tangents carry the initial state's directions)",
-                     "'" + id.integrator + "'");
+                     io::quoted(id.integrator));
     if (id.method == io::Method::GaussNewtonKrylov)
       io::fail_field(sc.source, "identification.method",
                      "cannot be gauss-newton-krylov with initial_state: estimate (the initial state is profiled out of the "

@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -116,6 +118,33 @@ NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K) {
 
 std::vector<DampedMode> damped_modes(const MatrixXd& M, const MatrixXd& D, const MatrixXd& K) {
   return io::interruptible([M, D, K] { return damped_modes_now(M, D, K); });
+}
+
+double dense_eigen_seconds(int n, bool vectors) {
+  constexpr int kCalibration = 256;
+  static const std::array<double, 2> seconds = [] {
+    std::vector<Eigen::Triplet<double>> k, m;
+    for (int i = 0; i < kCalibration; ++i) {
+      k.emplace_back(i, i, 2.0);
+      if (i + 1 < kCalibration) k.emplace_back(i, i + 1, -1.0), k.emplace_back(i + 1, i, -1.0);
+      m.emplace_back(i, i, 1.0);
+    }
+    SparseMatrix K(kCalibration, kCalibration), M(kCalibration, kCalibration);
+    K.setFromTriplets(k.begin(), k.end());
+    M.setFromTriplets(m.begin(), m.end());
+    std::array<double, 2> best{INFINITY, INFINITY};
+    for (int rep = 0; rep < 2; ++rep)
+      for (int v = 0; v < 2; ++v) {
+        const auto t0 = std::chrono::steady_clock::now();
+        if (v) natural_modes_now(M, K);
+        else natural_frequencies_now(M, K);
+        best[static_cast<std::size_t>(v)] =
+            std::min(best[static_cast<std::size_t>(v)], std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      }
+    return best;
+  }();
+  const double r = static_cast<double>(n) / kCalibration;
+  return seconds[vectors ? 1 : 0] * r * r * r;
 }
 
 }  // namespace scoleid::identify

@@ -33,10 +33,6 @@ int element_of(double s, double L, int ne, double& xi) {
 
 Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
-std::string vec_text(const std::vector<double>& v) {
-  return "[" + format_value(v[0]) + ", " + format_value(v[1]) + ", " + format_value(v[2]) + "]";
-}
-
 Eigen::Matrix3d inertia_matrix(const io::RigidBodySpec& b) {
   // Products as the off-diagonal entries, as Simbody's Inertia(moments, products) takes them.
   Eigen::Matrix3d I;

@@ -237,7 +237,7 @@ void flag_mirror_ambiguity(const Problem& p, Objective& obj, RunResult& r, const
 RecordModes own_modes(const Problem& p, Objective& obj, const RunResult& r, const MatrixXd& Y, double information_scale,
                       bool stated_noise) {
   const Measurements& data = obj.data();
-  if (!stated_noise || data.t.size() < 3 || r.ident.std.size() != static_cast<std::size_t>(r.estimate.size())) return {};
+  if (!stated_noise || data.t.size() < 3 || static_cast<Eigen::Index>(r.ident.std.size()) != r.estimate.size()) return {};
   RecordModesOptions o;
   o.information_scale = information_scale;
   o.f_hi_hz = 0.5 * static_cast<double>(data.t.size() - 1) / (data.t.back() - data.t.front());

@@ -411,7 +411,7 @@ bool first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
   int iterations = 0;
   std::vector<RunResult::Attempt::Level> levels;
   bool spectral = false;
-  if (c.problem.measured && families.empty() && !from_ladder) {
+  if (c.problem.measured() && families.empty() && !from_ladder) {
     const SpectralStart ss = spectral_start_of(c, r.initial);
     if (ss.q.size() == r.initial.size()) {
       start = ss.q;
@@ -422,7 +422,7 @@ bool first_attempt(const Runner& run, RunResult& r, const std::vector<std::vecto
                      ss.pairs, ss.model_hz, ss.data_hz);
     }
   }
-  if (c.problem.measured && c.problem.scenario.identification.model == io::Model::Linear) {
+  if (c.problem.measured() && c.problem.scenario.identification.model == io::Model::Linear) {
     r.start_check = check_start(c.problem, c.objective, start);
     if (c.verbose)
       for (const auto& w : r.start_check.warnings) io::progress("warning: %s\n", w.c_str());
@@ -479,28 +479,40 @@ VectorXd smoothed(const VectorXd& q, const std::vector<std::vector<int>>& famili
   return out;
 }
 
-// One restart: from the starting point ("coarse-to-fine", "plain", "cautious-continuation") or from
-// the smoothed estimate of the runs so far ("smoothed"), or from the spectral start `spectral`
-// ("spectral").
-void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, const std::string& how,
+// The restarts a run may take (run_attempts): from the starting point (coarse to fine, plain, the
+// cautious continuation), from the smoothed estimate of the runs so far, or from the spectral start.
+enum class Restart { CoarseToFine, Plain, Smoothed, Spectral, CautiousContinuation };
+const char* to_string(Restart k) {
+  switch (k) {
+    case Restart::CoarseToFine: return "coarse-to-fine";
+    case Restart::Plain: return "plain";
+    case Restart::Smoothed: return "smoothed";
+    case Restart::Spectral: return "spectral";
+    case Restart::CautiousContinuation: return "cautious-continuation";
+  }
+  return "?";
+}
+
+// One restart of kind `how` (the spectral one from `spectral`).
+void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>>& families, Restart how,
              const SpectralStart& spectral) {
   AttemptsContext& c = run.c;
   OptimizerSummary s;
   int iterations = 0;
   std::string label;
   std::vector<RunResult::Attempt::Level> levels;
-  if (how == "coarse-to-fine") {
+  if (how == Restart::CoarseToFine) {
     Ladder lad = coarse_to_fine(c, families, r.initial, run_from_level(c));
     iterations += lad.iterations;
     label = lad.label;
     levels = std::move(lad.levels);
     run.header();
     s = run.minimize_from(lad.q, c.options);
-  } else if (how == "plain") {
+  } else if (how == Restart::Plain) {
     label = std::string("plain ") + io::to_string(c.options.method);
     run.header();
     s = run.minimize_from(r.initial, c.options);
-  } else if (how == "smoothed") {
+  } else if (how == Restart::Smoothed) {
     Ladder lad = coarse_to_fine(c, families, smoothed(r.summary.q, families),
                                 run_from_level(c));
     iterations += lad.iterations;
@@ -508,7 +520,7 @@ void restart(const Runner& run, RunResult& r, const std::vector<std::vector<int>
     levels = std::move(lad.levels);
     run.header();
     s = run.minimize_from(lad.q, c.options);
-  } else if (how == "spectral") {
+  } else if (how == Restart::Spectral) {
     const SpectralStart& ss = spectral;
     label = spectral_label(c, ss);
     if (c.verbose)
@@ -568,38 +580,38 @@ void run_attempts(AttemptsContext& c, RunResult& r) {
   // minimum; the run stays unconverged (RunResult::converged) and says why.
   // The best attempt is kept (better_attempt); where two converged attempts fit alike but differ,
   // the assessment flags the parameters they disagree on (assessment.cpp, the other-minimum test).
-  std::vector<std::string> strategies;
-  if (!families.empty()) strategies.insert(strategies.end(), {from_ladder ? "plain" : "coarse-to-fine", "smoothed"});
+  std::vector<Restart> strategies;
+  if (!families.empty()) strategies.insert(strategies.end(), {from_ladder ? Restart::Plain : Restart::CoarseToFine, Restart::Smoothed});
   // (after a spectral first attempt, the plain one from the stated start takes the spectral's place)
-  strategies.insert(strategies.end(), {spectral_first ? "plain" : "spectral", "cautious-continuation"});
+  strategies.insert(strategies.end(), {spectral_first ? Restart::Plain : Restart::Spectral, Restart::CautiousContinuation});
   int done = 0;
   SpectralStart spectral;
   auto failed = [&r]() { return !(r.summary.converged() && r.fit.explains_data); };
-  for (const std::string& how : strategies) {
+  for (const Restart how : strategies) {
     if (done >= p.scenario.identification.restarts) break;
     bool wanted = false;
     // (not after a level that explained the data: a blocked profile is no sawtooth to smooth)
-    if (how == "smoothed")
+    if (how == Restart::Smoothed)
       wanted = r.summary.q.allFinite() && r.summary.termination != OptimizerSummary::Termination::DataExplained &&
                !(r.smoothness_weight > 0.0);
-    else if (how == "spectral") {
+    else if (how == Restart::Spectral) {
       if (failed()) spectral = spectral_start_of(c, r.initial);
       wanted = failed() && spectral.q.size() == r.initial.size();
     }
-    else if (how == "cautious-continuation" || (how == "plain" && spectral_first)) wanted = failed();
+    else if (how == Restart::CautiousContinuation || (how == Restart::Plain && spectral_first)) wanted = failed();
     else
       wanted = !r.fit.within_noise_and_discretisation || r.summary.termination == OptimizerSummary::Termination::MaxIterations;
     if (!wanted) continue;
     if (c.verbose) {
       io::progress("fit test: %s\n", r.fit.message.c_str());
-      if (how == "smoothed")
+      if (how == Restart::Smoothed)
         io::progress("restart %d (smoothed): from the estimate smoothed along its sections — a sectional minimum may be local\n",
                     done + 1);
       else
-        io::progress("restart %d (%s) from the starting point\n", done + 1, how.c_str());
+        io::progress("restart %d (%s) from the starting point\n", done + 1, to_string(how));
     }
     restart(run, r, families, how, spectral);
-    if (how != "smoothed") ++done;  // a check of every sectional run, not an answer to a failure
+    if (how != Restart::Smoothed) ++done;  // a check of every sectional run, not an answer to a failure
   }
   r.summary.cost = r.attempts[static_cast<std::size_t>(r.chosen_attempt)].cost;  // over the whole record
   if (c.verbose) io::progress("fit test: %s\n", r.fit.message.c_str());

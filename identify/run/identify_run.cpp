@@ -29,7 +29,7 @@ namespace scoleid::identify {
 double model_error(const Problem& p) {
   const double m = p.scenario.identification.model_error;
   if (m >= 0) return m;
-  const bool own_model = p.data_source.rfind("synthetic", 0) == 0 && !io::has_truth_overrides(p.scenario);
+  const bool own_model = p.origin == Problem::DataOrigin::Synthesis && !io::has_truth_overrides(p.scenario);
   return own_model ? 0.0 : 0.01;
 }
 
@@ -122,9 +122,10 @@ bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, lo
 void estimate_modes(const Problem& p, RunResult& r, bool verbose) {
   if (!r.estimate.allFinite()) return;
   if (verbose && p.model().ndof >= 1000)
-    io::progress("modes of the identified model: %ld dense eigen-solutions of the %d-degree-of-freedom model (each O(n^3); "
-                 "fewer elements are faster)\n",
-                 1L + (r.ident.std.size() == r.estimate.size() ? 2L * static_cast<long>(r.estimate.size()) : 0L), p.model().ndof);
+    io::progress("modes of the identified model: %ld dense eigen-solutions of the %d-degree-of-freedom model (each about %.2g s, "
+                 "O(n^3); fewer elements are faster)\n",
+                 1L + (r.ident.std.size() == r.estimate.size() ? 2L * static_cast<long>(r.estimate.size()) : 0L), p.model().ndof,
+                 dense_eigen_seconds(p.model().ndof, true));
   ModalUncertaintyOptions o;
   // Modes above the data's Nyquist frequency are not seen by the record (its median sample interval),
   // nor modes above the top line of FRFs.
@@ -212,8 +213,7 @@ RunResult run_identification(Problem& p, const RunOptions& ro) {
   if (r.method == io::Method::GaussNewtonKrylov && !obj.has_matrix_free_products())
     throw std::logic_error("run_identification: gauss-newton-krylov without matrix-free products (identify::check_run refuses it)");
   const auto chains = smoothness_chains(p, r.names);
-  AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations),
-                    ro.verbose};
+  AttemptsContext c{p, obj, optimizer_options(id, r.method, p.params->size(), ro.max_iterations), ro.verbose, {}, {}};
   c.options.smoothness_chains = chains;
   // The assessment's refits (ro.compute_std) at the first attempt's estimate, made while its fit
   // test's doubled-mesh solve runs (AttemptsContext::alongside_fit), kept if that estimate stands.

@@ -1,9 +1,10 @@
 #include "scoleid/identify/run/problem.h"
 
-#include "scoleid/identify/run/frf_run.h"
+#include "scoleid/identify/door/frf_door.h"
 #include "scoleid/io/uff.h"
 #include "scoleid/io/uff_frf.h"
 
+#include "scoleid/identify/door/record_door.h"
 #include "scoleid/identify/door/scenario_door.h"
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/identify/time/checkpoints.h"
@@ -22,17 +23,13 @@
 #include "scoleid/identify/fe/scole_model.h"
 #include "scoleid/identify/time/nonlinear_forward.h"
 #include "scoleid/io/error.h"
-#include "scoleid/io/quiet_start.h"
-#include "scoleid/io/limits.h"
+#include "scoleid/io/progress.h"
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/io/data_source.h"
-#include "scoleid/io/units.h"
 #include "scoleid/io/validation.h"
 
 namespace scoleid::identify {
 
-using io::fail_field;
-using io::InputError;
 
 namespace {
 
@@ -66,18 +63,53 @@ std::pair<StructuralModel, VectorXd> true_model(const io::Scenario& sc, int elem
 
 }  // namespace
 
-DataContent data_content(const StructuralModel& model, const Parameterization& params,
-                         const std::vector<io::Signal>& signals, double t_end, double sample_interval,
-                         bool from_data) {
+StartModes::StartModes(const StructuralModel& model, const Parameterization& params, bool verbose)
+    : model_(model), params_(params), verbose_(verbose) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(params.initial(), c, dcdq);
-  const AssembledModel ops = assemble(model, c);
+  ops_ = assemble(model, c);
+}
+
+const std::vector<double>& StartModes::frequencies() {
+  if (!frequencies_) {
+    if (verbose_ && model_.ndof >= 1000)
+      io::progress("the starting model's frequencies: a dense eigen-solution of %d degrees of freedom, about %.2g s (O(n^3); fewer "
+                   "elements are faster)\n",
+                   model_.ndof, dense_eigen_seconds(model_.ndof, false));
+    frequencies_ = natural_frequencies(ops_.M, ops_.K);
+  }
+  return *frequencies_;
+}
+
+const NaturalModes& StartModes::modes() {
+  if (!modes_) {
+    if (verbose_ && model_.ndof >= 1000)
+      io::progress("the starting model's modes: a dense eigen-solution of %d degrees of freedom, about %.2g s (O(n^3); fewer "
+                   "elements are faster)\n",
+                   model_.ndof, dense_eigen_seconds(model_.ndof, true));
+    modes_ = natural_modes(ops_.M, ops_.K);
+  }
+  return *modes_;
+}
+
+DataContent data_content(const StructuralModel& model, const Parameterization& params,
+                         const std::vector<io::Signal>& signals, double t_end, double sample_interval,
+                         bool from_data) {
+  StartModes start(model, params);
+  return data_content(start, signals, t_end, sample_interval, from_data);
+}
+
+DataContent data_content(StartModes& start, const std::vector<io::Signal>& signals, double t_end, double sample_interval,
+                         bool from_data) {
+  const StructuralModel& model = start.model();
+  const Parameterization& params = start.params();
+  const AssembledModel& ops = start.ops();
   DataContent d;
   d.nyquist = M_PI / sample_interval;
   // K and ω_K from the frequencies alone (modes with ω <= 1e-6 ω_max count as rigid).
   {
-    const std::vector<double> w = natural_frequencies(ops.M, ops.K);
+    const std::vector<double>& w = start.frequencies();
     const double wmax = w.empty() ? 0.0 : w.back();
     std::vector<double> below;
     for (double x : w)
@@ -89,7 +121,7 @@ DataContent data_content(const StructuralModel& model, const Parameterization& p
     d.omega = below[static_cast<std::size_t>(d.mode - 1)];
   }
   // The visible content K_data (reported): from the mode shapes.
-  const NaturalModes m = natural_modes(ops.M, ops.K);
+  const NaturalModes& m = start.modes();
   std::vector<Eigen::Index> flexible;
   for (Eigen::Index k = 0; k < m.omega.size(); ++k)
     if (m.omega[k] > m.floor && m.omega[k] <= d.nyquist) flexible.push_back(k);
@@ -175,13 +207,9 @@ bool estimates_damping(const StructuralModel& model, const Parameterization& par
 
 // The smallest positive modal damping ratio φᵀDφ / (2ω) (M-orthonormal φ) over the flexible
 // modes 1 … count at the starting parameters; 0 if none is damped.
-double smallest_modal_damping(const StructuralModel& model, const Parameterization& params, int count) {
-  VectorXd c;
-  MatrixXd dcdq;
-  params.coefficients(params.initial(), c, dcdq);
-  const AssembledModel ops = assemble(model, c);
-  const NaturalModes m = natural_modes(ops.M, ops.K);
-  const MatrixXd D(ops.D);
+double smallest_modal_damping(StartModes& start, int count) {
+  const NaturalModes& m = start.modes();
+  const MatrixXd D(start.ops().D);
   double smallest = 0.0;
   int counted = 0;
   for (Eigen::Index k = 0; k < m.omega.size() && counted < count; ++k) {
@@ -217,10 +245,15 @@ int implicit_stages(const ButcherTable& t) {
 
 IdentifierStep identifier_integration(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
                                       const std::vector<io::Signal>& signals) {
+  StartModes start(model, params);
+  return identifier_integration(sc, start, signals);
+}
+
+IdentifierStep identifier_integration(const io::Scenario& sc, StartModes& start, const std::vector<io::Signal>& signals) {
   if (sc.identification.time_step > 0) return {sc.identification.time_step, -1, sc.identification.time_step};
   // Resolve (ω h <= 0.3) modes 1 … K, K = min(P + 2, modes below Nyquist) (data_content): an
   // L-stable step damps what it does not resolve, keeping its quasi-static part.
-  const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
+  const DataContent content = data_content(start, signals, sc.simulation.duration, sc.simulation.sample_interval,
                                            sc.identification.step_rule == io::StepRule::Data);
   const double w = content.omega;
   double h = sc.simulation.sample_interval;
@@ -229,8 +262,8 @@ IdentifierStep identifier_integration(const io::Scenario& sc, const StructuralMo
   // small against the physical one, ζ_num(ω_K h) <= 1 % of the smallest modal damping ratio
   // there (docs/theory.md §5.2), or the fit absorbs the integrator's damping into the estimate.
   IdentifierStep out{h, -1, h};
-  if (w > 0 && estimates_damping(model, params)) {
-    const double target = 0.01 * smallest_modal_damping(model, params, content.mode);
+  if (w > 0 && estimates_damping(start.model(), start.params())) {
+    const double target = 0.01 * smallest_modal_damping(start, content.mode);
     if (target > 0.0) {
       const ButcherTable third = ButcherTable::arkode_dirk(-1), fourth = ButcherTable::arkode_dirk(ButcherTable::esdirk436_id());
       const double h3 = damping_bounded_step(third, w, h, target), h4 = damping_bounded_step(fourth, w, h, target);
@@ -249,77 +282,6 @@ double identifier_step(const io::Scenario& sc, const StructuralModel& model, con
   return identifier_integration(sc, model, params, signals).step;
 }
 
-namespace {
-// Refuses a step the run cannot afford or cannot trust, before any solve: a step given in the
-// scenario that does not resolve the modes the data contain (ω_K h > 1: the L-stable step would
-// damp them away and the fit would absorb that into the parameters), and trajectory storage
-// beyond io::limits (state, costate and, for Gauss–Newton or the standard deviations, a block of
-// sensitivity trajectories; synthetic data on its finer mesh and step).
-void check_step(const io::Scenario& sc, const StructuralModel& model, const Parameterization& params,
-                const std::vector<io::Signal>& signals, double h, bool synthetic) {
-  const auto& id = sc.identification;
-  const double T = sc.simulation.duration;
-  const std::string field = id.time_step > 0 ? "identification.time_step" : "identification.elements";
-  const std::string got = id.time_step > 0 ? io::format_value(id.time_step)
-                                           : std::to_string(id.elements) + " (automatic time step " + io::format_value(h) + ")";
-  if (id.time_step > 0 && id.integrator != "bdf") {
-    const DataContent content = data_content(model, params, signals, sc.simulation.duration, sc.simulation.sample_interval,
-                                             id.step_rule == io::StepRule::Data);
-    const double w = content.omega;
-    if (w * h > 1.0)
-      fail_field(sc.source, "identification.time_step",
-                 "must resolve flexible mode " + std::to_string(content.mode) +
-                     (id.step_rule == io::StepRule::Data ? std::string(" = the highest the data visibly contain (")
-                                             : std::string(" = min(P + 2, modes below Nyquist) (")) +
-                     io::format_value(w / (2 * M_PI)) + " Hz at the starting values): omega h = " +
-                     io::format_value(w * h) + " > 1; leave it 0 for the automatic step " +
-                     io::format_value(std::min(sc.simulation.sample_interval, 0.3 / w)),
-                 io::format_value(h));
-  }
-  // A scenario signal the step cannot resolve would be sampled, not integrated: a pulse shorter than
-  // a step is seen whole or not at all (a 1e-9 s pulse of 2e-8 impulse drives a step's worth of
-  // response), a sine at or above 1/(2h) aliases into a slow one. (A data column is read on its own
-  // grid and is exempt.)
-  for (std::size_t i = 0; i < signals.size() && i < sc.inputs.size(); ++i) {
-    const io::Signal& s = signals[i];
-    const std::string f = "inputs[" + std::to_string(i) + "].signal";
-    if (s.shortest_width() < h)
-      fail_field(sc.source, f + ".width",
-                 "is shorter than the identifier's time step " + io::format_value(h) +
-                     " s: a pulse is not resolved by the steps that integrate it (widen it to at least one step, or "
-                     "record it faster)",
-                 io::format_value(s.shortest_width()));
-    if (s.highest_frequency() >= 0.5 / h)
-      fail_field(sc.source, f + ".frequency",
-                 "is at or above " + io::format_value(0.5 / h) + " Hz, the Nyquist frequency of the identifier's time step " +
-                     io::format_value(h) + " s: it would alias into a slower input",
-                 io::format_value(s.highest_frequency()));
-  }
-  const double steps = T / h;
-  // State and costate, and the sensitivities in blocks of at most kSensitivityBlockBytes (objective.h).
-  const double one = (steps + 1.0) * model.ndof * 3.0 * 8.0;
-  const double bytes = 2.0 * one + std::min(params.size() * one, std::max(one, kSensitivityBlockBytes));
-  if (!(steps <= io::limits::kMaxSteps) || !(bytes <= io::limits::kMaxTrajectoryBytes))
-    fail_field(sc.source, field,
-               "gives " + io::format_value(std::ceil(steps)) + " steps of " + std::to_string(model.ndof) + " DOF (about " +
-                   io::format_value(std::ceil(bytes / 1048576.0)) + " MiB of trajectories); the limits are " +
-                   io::format_value(io::limits::kMaxSteps) + " steps and " +
-                   io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
-               got);
-  if (synthetic) {
-    const int de = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
-    const double dsteps = 4.0 * steps;
-    const double dbytes = (dsteps + 1.0) * model.ndof * (static_cast<double>(de) / id.elements) * 3.0 * 8.0;
-    if (!(dsteps <= io::limits::kMaxSteps) || !(dbytes <= io::limits::kMaxTrajectoryBytes))
-      fail_field(sc.source, field,
-                 "makes the synthetic data (" + std::to_string(de) + " elements, step h/4) take " +
-                     io::format_value(std::ceil(dsteps)) + " steps (about " + io::format_value(std::ceil(dbytes / 1048576.0)) +
-                     " MiB); the limits are " + io::format_value(io::limits::kMaxSteps) + " steps and " +
-                     io::format_value(io::limits::kMaxTrajectoryBytes / 1048576.0) + " MiB",
-                 got);
-  }
-}
-}  // namespace
 
 namespace {
 // Names, the truth's sensor errors (truth.overrides.sensors: bias and drift, as the Simbody truth
@@ -434,9 +396,10 @@ void set_true_values(Problem& p, const io::Scenario& truth_sc) {
 }
 
 // The structure, its parameters, the scenario's signals and the stated noise levels.
-std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc) {
+std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc, bool verbose) {
   check_scenario(sc);
   auto p = std::make_unique<Problem>();
+  p->build_progress = verbose;
   p->scenario = sc;
   p->structure = make_structure(sc, sc.identification.elements);
   check_parameters(*p->structure, sc);
@@ -452,396 +415,7 @@ std::unique_ptr<Problem> problem_skeleton(const io::Scenario& sc) {
   return p;
 }
 
-// Truth metadata beside the data (truth.json): the two must describe the same columns; its noise
-// levels stand for sensors without a stated one. Returns its true parameters.
-std::map<std::string, double> apply_truth_meta(Problem& p, const io::DataTable& tab, const std::string& csv,
-                                               const io::TruthMeta& meta, const std::string& meta_path) {
-  const auto& sc = p.scenario;
-  std::vector<std::string> described;
-  for (const auto& c : meta.columns) described.push_back(c.name);
-  for (const auto& n : tab.names)
-    if (std::find(described.begin(), described.end(), n) == described.end())
-      throw InputError(meta_path + ": does not describe column '" + n + "' of data file '" + csv +
-                       "'; the two files are not from the same run");
-  for (const auto& n : described)
-    if (tab.find(n) < 0)
-      throw InputError(meta_path + ": describes column '" + n + "', which data file '" + csv +
-                       "' lacks; the two files are not from the same run");
-  // The structure, and each column's quantity, site and unit, as the scenario has them: a truth of
-  // another structure, a force read as a moment, a sensor on another body, or values in another
-  // unit would be identified without a word.
-  const std::string structure = io::to_string(sc.structure);
-  if (!meta.structure.empty() && meta.structure != structure)
-    throw InputError(meta_path + ": structure '" + meta.structure + "' but the scenario's is '" + structure +
-                     "'; the data are not of this scenario's structure");
-  for (const auto& c : meta.columns) {
-    std::optional<std::string> kind;
-    std::string at;
-    for (const auto& in : sc.inputs)
-      if (in.name == c.name) kind = io::to_string(in.kind), at = io::to_string(in.at);
-    for (const auto& se : sc.sensors)
-      if (se.name == c.name) kind = io::to_string(se.kind), at = io::to_string(se.at);
-    if (!kind) continue;
-    const std::string what = "column '" + io::one_line(c.name) + "'";
-    if (!c.quantity.empty() && c.quantity != *kind)
-      throw InputError(meta_path + ": " + what + " is a " + c.quantity + " but the scenario's is a " + *kind);
-    if (!c.at.empty() && c.at != at)
-      throw InputError(meta_path + ": " + what + " is at the " + c.at + " but the scenario's is at the " + at);
-    const int col = tab.find(c.name);
-    const std::string file_unit = tab.unit(col);
-    if (!c.unit.empty() && !file_unit.empty() && file_unit != c.unit)
-      throw InputError(meta_path + ": " + what + " is in '" + c.unit + "' but data file '" + csv + "' states '" +
-                       file_unit + "'; the two files are not from the same run");
-    if (!c.unit.empty()) p.meta_units[c.name] = c.unit;
-  }
-  for (const auto& c : meta.columns)
-    for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-      const auto& s = sc.sensors[j];
-      if (s.name != c.name) continue;
-      if (p.noise_std[j] <= 0 && c.noise_std > 0) {
-        p.noise_std[j] = c.noise_std;
-        p.noise_origin[j] = "truth.json";
-      }
-    }
-  return meta.true_parameters;
-}
 
-// A sensor's record with one sample over kLoneSpike times the RMS of all its others: no
-// structure's response does that (a response spreads over the samples its modes last; even a
-// step near the record's end keeps the peak within ten times the RMS), so it is a spike, a
-// corrupted cell or a unit slip in one row (a 1e23 m sample), and a least-squares fit would
-// chase it. Refused, naming the sample.
-constexpr double kLoneSpike = 1e3;
-void check_lone_spike(const std::vector<double>& v, const io::DataTable& tab, int col, const std::string& field,
-                      const std::string& name) {
-  if (v.size() < 30) return;
-  std::size_t peak = 0;
-  for (std::size_t k = 1; k < v.size(); ++k)
-    if (std::abs(v[k]) > std::abs(v[peak])) peak = k;
-  double ms = 0.0;
-  for (std::size_t k = 0; k < v.size(); ++k)
-    if (k != peak) ms += v[k] * v[k];
-  const double rest = std::sqrt(ms / static_cast<double>(v.size() - 1));
-  if (!(std::abs(v[peak]) > kLoneSpike * rest)) return;
-  throw InputError("data file '" + tab.source + "': column '" + io::one_line(tab.names[static_cast<std::size_t>(col)]) +
-                   "' (" + field + ", sensor '" + name + "'): the sample at t = " + io::format_value(tab.t[peak]) + " s is " +
-                   io::format_value(v[peak]) + ", over " + io::format_value(kLoneSpike) +
-                   " times the RMS of the column's other samples (" + io::format_value(rest) +
-                   "): a spike, a corrupted cell or a unit slip that a least-squares fit would chase; correct or remove it");
-}
-
-// A header without its unit suffix ("acc [m/s^2]" → "acc"); the header itself when it states none.
-std::string name_without_unit(const std::string& header) {
-  if (io::units::bracketed_unit(header).empty()) return header;
-  const auto e = header.find_last_not_of(" \t");
-  const auto open = header.rfind(header[e] == ']' ? '[' : '(', e);
-  const auto end = header.find_last_not_of(" \t", open == 0 ? std::string::npos : open - 1);
-  return open == 0 || end == std::string::npos ? std::string() : header.substr(0, end + 1);
-}
-
-// The table column of a sensor or input: its `column` (exactly), else its name — a column of that
-// name, or the one column that is that name with a unit ("acc [m/s^2]" for a sensor acc: labs write
-// units into headers); -1 when absent. Two columns that are the name with units are refused.
-int column_of(const io::DataTable& tab, const std::string& name, const std::string& column, const std::string& csv,
-              const std::string& field) {
-  if (!column.empty()) return tab.find(column);
-  if (const int exact = tab.find(name); exact >= 0) return exact;
-  int found = -1;
-  for (std::size_t c = 0; c < tab.names.size(); ++c) {
-    if (name_without_unit(tab.names[c]) != name) continue;
-    if (found >= 0)
-      throw InputError("data file '" + csv + "': columns '" + io::one_line(tab.names[static_cast<std::size_t>(found)]) + "' and '" +
-                       io::one_line(tab.names[c]) + "' are both '" + name + "' with a unit; name one in " + field + ".column");
-    found = static_cast<int>(c);
-  }
-  return found;
-}
-
-// The table's columns, for a message (the first 12).
-std::string columns_listed(const io::DataTable& tab) {
-  std::string s;
-  for (std::size_t c = 0; c < tab.names.size() && c < 12; ++c) s += (c ? ", '" : "'") + io::one_line(tab.names[c]) + "'";
-  if (tab.names.size() > 12) s += ", ... (" + std::to_string(tab.names.size()) + " in all)";
-  return s;
-}
-
-// The values of column `col` in the unit of a sensor or input of kind `kind` and unit `unit`
-// (or its unit system's): the column's unit from column_unit, else from its file. A column without
-// a stated unit is taken as it is; one with a unit needs a unit to convert into.
-// The column conditioned as the scenario says (io::Conditioning): x' = sign·scale·(x − offset), then
-// less its least-squares line with detrend; what was removed is recorded in `src`.
-void condition(std::vector<double>& v, const std::vector<double>& t, const io::Conditioning& c, const std::string& where,
-               const std::string& field, ColumnUse::Source& src) {
-  if (!c.transforms()) return;
-  double offset = 0.0;
-  switch (c.offset) {
-    case io::Conditioning::Offset::None: break;
-    case io::Conditioning::Offset::Value: offset = c.offset_value; break;
-    case io::Conditioning::Offset::Mean:
-      for (double x : v) offset += x / static_cast<double>(v.size());
-      break;
-    case io::Conditioning::Offset::MeanBefore: {
-      std::size_t n = 0;
-      while (n < t.size() && t[n] < c.offset_value) ++n;
-      if (n == 0)
-        throw InputError(where + ": " + field + ".conditioning.offset.mean_before " + io::format_value(c.offset_value) +
-                         " s leaves no sample before it (the record starts at " + io::format_value(t.front()) + " s)");
-      if (n == t.size())
-        throw InputError(where + ": " + field + ".conditioning.offset.mean_before " + io::format_value(c.offset_value) +
-                         " s takes the whole record (it ends at " + io::format_value(t.back()) + " s): use offset: mean");
-      for (std::size_t k = 0; k < n; ++k) offset += v[k] / static_cast<double>(n);
-      break;
-    }
-  }
-  const double factor = c.sign * c.scale;
-  for (double& x : v) x = factor * (x - offset);
-  double slope = 0.0, mean = 0.0;
-  if (c.detrend) {
-    // Least-squares line a + b (t − t̄).
-    double tm = 0.0;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      tm += t[k] / static_cast<double>(v.size());
-      mean += v[k] / static_cast<double>(v.size());
-    }
-    double stt = 0.0, sty = 0.0;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      stt += (t[k] - tm) * (t[k] - tm);
-      sty += (t[k] - tm) * (v[k] - mean);
-    }
-    slope = stt > 0 ? sty / stt : 0.0;
-    for (std::size_t k = 0; k < v.size(); ++k) v[k] -= mean + slope * (t[k] - tm);
-  }
-  src.conditioned = true;
-  src.offset_removed = offset;
-  src.factor = factor;
-  src.trend_removed = {mean, slope};
-}
-
-std::vector<double> column_values(Problem& p, const io::DataTable& tab, int col, const std::string& field,
-                                  const std::string& name, const std::string& kind, const std::string& unit,
-                                  const std::string& column_unit, const io::Conditioning& conditioning) {
-  const auto& sc = p.scenario;
-  const std::string& column = tab.names[static_cast<std::size_t>(col)];
-  ColumnUse::Source src{name, column, column_unit.empty() ? tab.unit(col) : column_unit,
-                        column_unit.empty() ? "file" : field + ".column_unit", unit, 1.0};
-  const auto q = io::units::quantity_of_kind(kind);
-  if (src.to_unit.empty() && q) src.to_unit = io::units::system_unit(sc.units, *q);
-  // A column its file gives no unit takes the one truth.json beside it states, when the scenario
-  // states a unit to read it in (without one, values are taken as they are, as from any file).
-  if (const auto it = p.meta_units.find(column);
-      src.from_unit.empty() && it != p.meta_units.end() && !src.to_unit.empty() && it->second != src.to_unit) {
-    src.from_unit = it->second;
-    src.unit_stated_by = "truth.json";
-  }
-  std::vector<double> v = tab.columns[static_cast<std::size_t>(col)];
-  const std::string where = "data file '" + tab.source + "': column '" + io::one_line(column) + "' (" + field + ", '" + name + "')";
-  if (src.from_unit.empty() || !q) {
-    src.unit_stated_by = src.from_unit.empty() ? "none" : src.unit_stated_by;
-    condition(v, tab.t, conditioning, where, field, src);
-    p.columns.sources.push_back(src);
-    return v;
-  }
-  if (src.to_unit.empty())
-    throw InputError(where + ": is in '" + src.from_unit + "' but " + field +
-                     " states no unit to convert it into: give " + field + ".unit or the scenario's units");
-  io::units::Conversion c;
-  try {
-    c = io::units::conversion(src.from_unit, src.to_unit, *q);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(where + ": cannot convert '" + src.from_unit + "' into '" + src.to_unit + "': " + e.what());
-  }
-  src.scale = c.scale;
-  if (!c.identity())
-    for (double& x : v) x = c.apply(x);
-  condition(v, tab.t, conditioning, where, field, src);
-  p.columns.sources.push_back(src);
-  return v;
-}
-
-// A pulse over at most this many samples (above a tenth of its peak) is an impact.
-constexpr int kImpactSamples = 8;
-bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable& tab, const std::vector<double>& f);
-
-// An input driven by its column, read between samples as inputs[i].interpolation says (auto:
-// cubic unless the column jumps, then piecewise linear), with its largest jump within one sample.
-// An input column's force window (io::Conditioning::Window; docs/data.md §2). A force transducer
-// reads noise before and after a hit, and a model driven by it answers that noise (at an
-// accelerometer, whose response to force has a direct term, as much as to the hit). Auto, on an
-// impact (add_stepped_input: a pulse over at most kImpactSamples samples): the channel's noise σ_f
-// is read where it holds no force — at least 20 samples before the pulse, else the record's last
-// quarter when that lies after it; the window runs from before the pulse's first sample above a
-// twentieth of its peak, back to where the column falls to 4σ_f, to the start of the first run of
-// 20 samples under 4σ_f after its last (a DAQ filter's ringing is force the accelerometers felt, and
-// stays in); outside it the column is zero. A clean column (σ_f = 0) is thus left as it is, and so
-// is one whose level outside the window is not small (RMS over a twentieth of the peak: an offset
-// not removed, a continuous force). The hits are the runs above a fifth of the peak, apart by at
-// least two samples under a twentieth. Span keeps [from, to] s. What was done is recorded in `st`.
-void force_window(const io::InputSpec& in, const std::string& field, const io::DataTable& tab, std::vector<double>& f,
-                  ColumnUse::SteppedInput* st, const std::string& csv) {
-  const auto& c = in.conditioning;
-  const auto& t = tab.t;
-  if (c.window == io::Conditioning::Window::Span) {
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < f.size(); ++k)
-      if (t[k] < c.window_from || t[k] > c.window_to) f[k] = 0.0;
-      else ++kept;
-    if (kept == 0)
-      throw InputError("data file '" + csv + "': " + field + ".conditioning.window [" + io::format_value(c.window_from) + ", " +
-                       io::format_value(c.window_to) + "] s holds no sample of the record (" + io::format_value(t.front()) + " .. " +
-                       io::format_value(t.back()) + " s)");
-    return;
-  }
-  if (c.window != io::Conditioning::Window::Auto || !st || st->pulse_samples == 0) return;
-  const std::size_t n = f.size();
-  double peak = 0.0;
-  for (double x : f) peak = std::max(peak, std::abs(x));
-  if (!(peak > 0)) return;
-  std::size_t a = n, b = 0;
-  for (std::size_t k = 0; k < n; ++k)
-    if (std::abs(f[k]) > 0.05 * peak) a = std::min(a, k), b = k;
-  // The channel's noise where it holds no force.
-  constexpr std::size_t kNoiseSamples = 20, kQuietRun = 20;
-  auto rms = [&](std::size_t from, std::size_t to) {  // about the mean, samples [from, to)
-    double m = 0.0, s = 0.0;
-    for (std::size_t k = from; k < to; ++k) m += f[k] / static_cast<double>(to - from);
-    for (std::size_t k = from; k < to; ++k) s += (f[k] - m) * (f[k] - m) / static_cast<double>(to - from);
-    return std::sqrt(s);
-  };
-  double sigma = -1.0;
-  if (a >= kNoiseSamples + 4) sigma = rms(0, a - 4);
-  else if (3 * n / 4 > b + kQuietRun) sigma = rms(3 * n / 4, n);
-  if (!(sigma >= 0.0)) return;
-  const double level = 4.0 * sigma;
-  std::size_t from = a;
-  while (from > 0 && std::abs(f[from - 1]) > level) --from;
-  from = from >= 2 ? from - 2 : 0;
-  std::size_t to = n - 1, run = 0;
-  for (std::size_t k = b + 1; k < n; ++k) {
-    run = std::abs(f[k]) <= level ? run + 1 : 0;
-    if (run == kQuietRun) {
-      to = k - kQuietRun + 1;
-      break;
-    }
-  }
-  double outside = 0.0;
-  std::size_t n_out = 0;
-  for (std::size_t k = 0; k < n; ++k)
-    if (k < from || k > to) outside += f[k] * f[k], ++n_out;
-  if (n_out == 0 || std::sqrt(outside / static_cast<double>(n_out)) > 0.05 * peak) return;
-  // The hits: runs above a fifth of the peak, apart by at least two samples under a twentieth.
-  std::size_t quiet = 2;
-  for (std::size_t k = a; k <= b; ++k) {
-    const double x = std::abs(f[k]);
-    if (x > 0.2 * peak) {
-      if (quiet >= 2) st->hits.push_back({t[k], x / peak});
-      else if (x / peak > st->hits.back().second) st->hits.back() = {t[k], x / peak};
-      quiet = 0;
-    } else if (x < 0.05 * peak) {
-      ++quiet;
-    }
-  }
-  for (std::size_t k = 0; k < n; ++k)
-    if (k < from || k > to) f[k] = 0.0;
-  st->window_from = t[from];
-  st->window_to = t[to];
-  st->windowed = true;
-}
-
-void input_from_column(Problem& p, std::size_t i, const io::DataTable& tab, int col, const std::string& csv) {
-  const auto& in = p.scenario.inputs[i];
-  const std::string field = "inputs[" + std::to_string(i) + "]";
-  auto f = column_values(p, tab, col, field, in.name, io::to_string(in.kind), in.unit, in.column_unit, in.conditioning);
-  p.columns.inputs_from_data.push_back(in.name);
-  const bool stepped = add_stepped_input(p, in, tab, f);
-  force_window(in, field, tab, f, stepped ? &p.columns.stepped_inputs.back() : nullptr, csv);
-  const bool cubic = in.interpolation == io::Interpolation::Cubic || (in.interpolation == io::Interpolation::Auto && !stepped);
-  p.signals[i] = cubic ? io::Signal::cubic_table(tab.t, f) : io::Signal::table(tab.t, f);
-  if (stepped) p.columns.stepped_inputs.back().cubic = cubic;
-  p.columns.input_interpolation.push_back(cubic ? io::Interpolation::Cubic : io::Interpolation::Linear);
-}
-
-// Whether the column jumps by more than a quarter of its range within one sample, in a step (a
-// change more than three times either neighbour's) or an impact (a pulse over a few samples); if it
-// does, it is listed among the stepped inputs (ColumnUse), its largest jump and where.
-bool add_stepped_input(Problem& p, const io::InputSpec& in, const io::DataTable& tab, const std::vector<double>& f) {
-  const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
-  ColumnUse::SteppedInput st{in.name, 0.0, 0.0, 0.0, !in.signal.terms().empty()};
-  std::size_t at = 0;
-  for (std::size_t k = 1; k < f.size(); ++k)
-    if (std::abs(f[k] - f[k - 1]) > st.jump) {
-      st.jump = std::abs(f[k] - f[k - 1]);
-      st.at = tab.t[k];
-      st.sample = tab.t[k] - tab.t[k - 1];
-      at = k;
-    }
-  if (!(*hi > *lo && st.jump > 0.25 * (*hi - *lo))) return false;
-  if (std::abs(f.back() - f.front()) < 0.25 * (*hi - *lo)) {
-    const double peak = std::max(std::abs(*hi - f.front()), std::abs(*lo - f.front()));
-    st.pulse_samples = static_cast<int>(
-        std::count_if(f.begin(), f.end(), [&](double x) { return std::abs(x - f.front()) > 0.1 * peak; }));
-  }
-  // A jump (a change with a neighbour under a third of it: a step, one caught mid-way, a switch),
-  // or an impact over a few samples; not a smooth signal sampled a few times a period (a sampled
-  // harmonic's largest change has both neighbours at cos(ω Δt) of it, over a third above 5.1
-  // samples a period).
-  const double before = at >= 2 ? std::abs(f[at - 1] - f[at - 2]) : 0.0;
-  const double after = at + 1 < f.size() ? std::abs(f[at + 1] - f[at]) : 0.0;
-  const bool isolated = st.jump > 3.0 * std::min(before, after);
-  const bool impact = st.pulse_samples > 0 && st.pulse_samples <= kImpactSamples;
-  if (!isolated && !impact) return false;
-  p.columns.stepped_inputs.push_back(st);
-  return true;
-}
-
-// The measurements from the table's sensor columns, the inputs from theirs (signal_from), and
-// which columns were used (ColumnUse).
-void measurements_from_table(Problem& p, const io::DataTable& tab, const std::string& csv) {
-  const auto& sc = p.scenario;
-  p.data.t = tab.t;
-  p.data.z.resize(static_cast<Eigen::Index>(tab.t.size()), static_cast<Eigen::Index>(sc.sensors.size()));
-  std::vector<bool> used(tab.names.size(), false);
-  for (std::size_t j = 0; j < sc.sensors.size(); ++j) {
-    const auto& s = sc.sensors[j];
-    const std::string field = "sensors[" + std::to_string(j) + "]";
-    const int col = column_of(tab, s.name, s.column, csv, field);
-    if (col < 0)
-      throw InputError("data file '" + csv + "': no column " +
-                       (s.column.empty() ? "for sensor '" + s.name + "'" : "'" + io::one_line(s.column) + "' (" + field + ".column)") +
-                       " (" + field + " of " + sc.source + "); its columns: " + columns_listed(tab));
-    const auto v = column_values(p, tab, col, field, s.name, io::to_string(s.kind), s.unit, s.column_unit, s.conditioning);
-    check_lone_spike(v, tab, col, field, s.name);
-    for (std::size_t k = 0; k < tab.t.size(); ++k) p.data.z(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v[k];
-    p.data.names.push_back(s.name);
-    used[static_cast<std::size_t>(col)] = true;
-    p.columns.sensors.push_back(s.name);
-  }
-  for (std::size_t i = 0; i < sc.inputs.size(); ++i) {
-    const auto& in = sc.inputs[i];
-    const std::string field = "inputs[" + std::to_string(i) + "]";
-    const int col = column_of(tab, in.name, in.column, csv, field);
-    if ((in.signal_from == io::SignalFrom::Data || !in.column.empty()) && col < 0)
-      throw InputError("data file '" + csv + "': no column " +
-                       (in.column.empty() ? "for input '" + in.name + "'" : "'" + io::one_line(in.column) + "' (" + field + ".column)") +
-                       " (" + field + (in.column.empty() ? ".signal_from is data" : "") + ", in " + sc.source + "); its columns: " +
-                       columns_listed(tab));
-    if (in.signal_from != io::SignalFrom::Scenario && col >= 0) {
-      input_from_column(p, i, tab, col, csv);
-      used[static_cast<std::size_t>(col)] = true;
-    } else {
-      if (in.signal.terms().empty())
-        throw InputError("data file '" + csv + "': no column for input '" + in.name + "' and " + field + " of " + sc.source +
-                         " gives no signal");
-      p.columns.inputs_from_scenario.push_back(in.name);
-    }
-  }
-  for (std::size_t c = 0; c < tab.names.size(); ++c)
-    if (!used[c]) p.columns.unused.push_back(tab.names[c]);
-  if (tab.t.size() < 3)
-    throw InputError("data file '" + csv + "': " + std::to_string(tab.t.size()) + " rows: at least 3 samples are needed");
-  if (tab.t.front() < 0.0)
-    throw InputError("data file '" + csv + "': first time must be >= 0, got " + io::format_value(tab.t.front()));
-  p.data_source = csv;
-}
 
 // Synthetic data: the truth's structure (truth.overrides applied) on a finer mesh, with a step 4x
 // finer than the identifier's. Returns the identifier's step.
@@ -849,11 +423,11 @@ IdentifierStep synthesize_data(Problem& p) {
   const auto& sc = p.scenario;
   const auto& id = sc.identification;
   const int data_elements = id.data_elements > 0 ? id.data_elements : 2 * id.elements;
-  const IdentifierStep is = identifier_integration(sc, p.model(), *p.params, p.signals);
+  StartModes start(p.model(), *p.params, p.build_progress);
+  const IdentifierStep is = identifier_integration(sc, start, p.signals);
   const double step = is.step;
-  check_step(sc, p.model(), *p.params, p.signals, step, true);
-  p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
-                           id.step_rule == io::StepRule::Data);
+  p.content = data_content(start, p.signals, sc.simulation.duration, sc.simulation.sample_interval, id.step_rule == io::StepRule::Data);
+  check_identifier_step(sc, p.model(), *p.params, p.signals, p.content, step, true);
   const io::Scenario truth_sc = io::truth_scenario(sc);
   io::check_fe_reproduces_truth(sc.source, truth_sc,
                                  "the finite-element synthesis cannot produce it (generate the data with scole-truth "
@@ -867,18 +441,14 @@ IdentifierStep synthesize_data(Problem& p) {
 
 // The identifier's step for measured data (the inputs as they will drive the model: a data column
 // replaces a scenario signal), within the limits for the record's own span.
-IdentifierStep measured_data_step(Problem& p, const std::string& csv) {
+IdentifierStep measured_data_step(Problem& p) {
   const auto& sc = p.scenario;
-  const IdentifierStep is = identifier_integration(sc, p.model(), *p.params, p.signals);
-  const double step = is.step;
-  check_step(sc, p.model(), *p.params, p.signals, step, false);
-  const double span = p.data.t.back() - p.data.t.front(), steps = step > 0 ? span / step : 0.0;
-  if (!(steps <= io::limits::kMaxSteps))
-    throw InputError("data file '" + csv + "': column t spans " + io::format_value(span) + " s, " +
-                     io::format_value(std::ceil(steps)) + " steps of the identifier's " + io::format_value(step) +
-                     " s; the limit is " + io::format_value(io::limits::kMaxSteps) + " steps");
-  p.content = data_content(p.model(), *p.params, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
+  StartModes start(p.model(), *p.params, p.build_progress);
+  const IdentifierStep is = identifier_integration(sc, start, p.signals);
+  p.content = data_content(start, p.signals, sc.simulation.duration, sc.simulation.sample_interval,
                            sc.identification.step_rule == io::StepRule::Data);
+  check_identifier_step(sc, p.model(), *p.params, p.signals, p.content, is.step, false);
+  check_record_span(p, is.step);
   return is;
 }
 
@@ -887,27 +457,9 @@ IdentifierStep measured_data_step(Problem& p, const std::string& csv) {
 void apply_band(Problem& p) {
   const auto& band = p.scenario.identification.band;
   if (band.empty()) return;
+  check_band(p);
   const auto& t = p.data.t;
-  const std::string& src = p.scenario.source;
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  if (const io::TimeGrid g = io::uniform_grid(t); !g.uniform) {  // (a coarsely written clock is on its grid by now)
-    char buf[320];
-    std::snprintf(buf, sizeof buf, "sample %zu at t = %.9g s lies %.3g steps off the uniform grid of %.9g s, more than their writing (%s) explains",
-                  g.worst + 1, t[g.worst], g.max_shift / g.step, g.step, g.precision.c_str());
-    fail_field(src, "identification.band",
-               "needs uniformly sampled data, and the times of '" + p.data_source + "' are not: " + buf +
-                   " (a dropped sample, a second segment?); when the DAQ's clock was uniform, state data.sample_rate",
-               io::format_value(band[0]) + " .. " + io::format_value(band[1]) + " Hz");
-  }
-  if (!(band[1] < 0.5 / dt))
-    fail_field(src, "identification.band[1]", "must lie below the data's Nyquist frequency " + io::format_value(0.5 / dt) + " Hz",
-               io::format_value(band[1]));
-  for (std::size_t k = 0; k < p.noise_std.size(); ++k)
-    if (!(p.noise_std[k] > 0))
-      fail_field(src, "identification.band",
-                 "needs every sensor's noise_std stated (the band's noise level and its chi-square band are drawn from it); sensor '" +
-                     p.scenario.sensors[k].name + "' has none",
-                 io::format_value(band[0]) + " .. " + io::format_value(band[1]) + " Hz");
   const BandFilter g(band[0], band[1], dt);
   for (auto& sig : p.signals) {
     std::vector<double> f(t.size());
@@ -953,7 +505,7 @@ double lagrange_limit(double error) {
 
 void choose_band(Problem& p) {
   auto& id = p.scenario.identification;
-  if (!p.measured || !id.band.empty() || id.band_mode != io::IdentificationSpec::BandMode::Auto || id.model != io::Model::Linear) return;
+  if (!p.measured() || !id.band.empty() || id.band_mode != io::IdentificationSpec::BandMode::Auto || id.model != io::Model::Linear) return;
   const auto& t = p.data.t;
   auto hz = [](double f) {
     char b[32];
@@ -1025,7 +577,7 @@ void choose_band(Problem& p) {
 // conditioning that removes it. Read before the band, whose high-pass would hide it.
 void input_offsets(Problem& p) {
   const auto& t = p.data.t;
-  if (!p.measured || t.size() < 4) return;
+  if (!p.measured() || t.size() < 4) return;
   const auto& from_data = p.columns.inputs_from_data;
   for (std::size_t i = 0; i < p.scenario.inputs.size() && i < p.signals.size(); ++i) {
     const auto& in = p.scenario.inputs[i];
@@ -1089,48 +641,7 @@ void moving_start(Problem& p) {
 // parameter fits it the same until the model moves, and then only worse).
 void finish_problem(Problem& p, const IdentifierStep& step, const std::string* csv) {
   const auto& id = p.scenario.identification;
-  if (p.data.z.size() > 0 && (p.data.z.array() == 0.0).all()) {
-    if (csv) throw InputError("data file '" + *csv + "': every sensor's column is zero: nothing to identify from");
-    fail_field(p.scenario.source, "sensors",
-               "record nothing: every sensor's synthetic record is zero (no input within the record, zero amplitudes, or "
-               "sensors where the structure cannot move)",
-               std::to_string(p.data.sensors()) + " sensor" + (p.data.sensors() == 1 ? "" : "s"));
-  }
-  // A stated noise level the record contradicts: white noise of std σ added to any signal gives a
-  // record whose mean square is at least about σ² (the signal's share adds to it), and over 30 or
-  // more samples its sample mean square falls below σ²/9 with probability 3e-10 (χ²₃₀ < 30/9). A level
-  // three times the record's RMS is a wrong unit or a typo (noise_std: 1e20), and a fit test drawn
-  // from it would pass any start.
-  const Eigen::Index N = p.data.z.rows();
-  for (Eigen::Index j = 0; j < p.data.z.cols() && N >= 30; ++j) {
-    const double sd = p.noise_std[static_cast<std::size_t>(j)];
-    const double rms = std::sqrt(p.data.z.col(j).squaredNorm() / static_cast<double>(N));
-    if (!(sd > 3.0 * rms)) continue;
-    const std::string why = "states more noise than the record holds: sensor '" + p.scenario.sensors[static_cast<std::size_t>(j)].name +
-                            "' reads " + io::format_value(rms) + " RMS over " + std::to_string(N) +
-                            " samples, and noise of the stated level alone would read about itself";
-    if (p.noise_origin[static_cast<std::size_t>(j)] == "truth.json" && csv)
-      throw InputError("truth.json beside data file '" + *csv + "': the noise_std of column '" +
-                       p.scenario.sensors[static_cast<std::size_t>(j)].name + "' " + why + ", got " + io::format_value(sd));
-    fail_field(p.scenario.source, "sensors[" + std::to_string(j) + "].noise_std", why, io::format_value(sd));
-  }
-  // A synthetic record whose stated noise buries the signal of every sensor: its mean square
-  // exceeds the noise's σ² by less than (σ/3)² (over N ≥ 30 samples the noise's own mean square
-  // scatters by σ²√(2/N) ≤ 0.26σ², so a signal of a third of σ is the least the record can show).
-  // Nothing is determined by such data; every start would "converge" where it is.
-  if (!csv && N >= 30) {
-    bool signal = false;
-    for (Eigen::Index j = 0; j < p.data.z.cols() && !signal; ++j) {
-      const double sd = p.noise_std[static_cast<std::size_t>(j)];
-      const double ms = p.data.z.col(j).squaredNorm() / static_cast<double>(N);
-      signal = !(sd > 0.0) || ms - sd * sd > sd * sd / 9.0;
-    }
-    if (!signal)
-      fail_field(p.scenario.source, "sensors[0].noise_std",
-                 "buries every sensor's signal: the synthetic records hold noise of the stated levels and less than a third of "
-                 "as much signal, from which no parameter can be determined",
-                 io::format_value(p.noise_std.front()));
-  }
+  check_record_levels(p, csv);
   input_offsets(p);
   if (id.domain == io::Domain::Frequency) {  // FRFs of the record, no time-domain model (frf_run.h)
     frf_from_record(p);
@@ -1144,9 +655,7 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
   p.objective_options.solver.dirk_table = step.dirk_table;
   p.objective_options.noise_std = p.noise_std;
   p.objective_options.noise_independent_fraction = p.band_gain;
-  p.objective_options.solver.integrator = id.integrator == "bdf"             ? SolverOptions::Integrator::Bdf
-                                          : id.integrator == "esdirk-arkode" ? SolverOptions::Integrator::EsdirkArkode
-                                                                             : SolverOptions::Integrator::Esdirk;
+  p.objective_options.solver.integrator = id.integrator;
   if (id.initial_state == io::InitialState::Estimate) {  // esdirk, not Krylov (the door: check_scenario)
     // The flexible modes the step resolves (the data's content, docs/theory.md §5.2), or as stated.
     p.objective_options.initial_state_modes =
@@ -1155,113 +664,31 @@ void finish_problem(Problem& p, const IdentifierStep& step, const std::string* c
   }
 }
 
-// The record's times on their grid (io/time_grid.h): a stated data.sample_rate's (the times within
-// half a step of it), else the uniform grid they round to when their jitter is their written
-// precision's. Times already uniform to their arithmetic, or not uniform at all, stay as they are.
-void regularise_time(const io::Scenario& sc, io::DataTable& tab, const std::string& source, ColumnUse& use) {
-  if (sc.data.sample_rate > 0) {
-    std::string why;
-    const auto g = io::stated_grid(tab.t, sc.data.sample_rate, &why, tab.stated_step, tab.stated_step_rounding);
-    if (!g)
-      fail_field(sc.source, "data.sample_rate", "disagrees with the time column '" + tab.time_name + "' of data file '" + source + "': " + why,
-                 io::format_value(sc.data.sample_rate));
-    use.time = *g;
-    use.time_regularised = true;
-    tab.t = g->times(tab.t.size());
-    return;
-  }
-  use.time = io::uniform_grid(tab.t);
-  if (use.time.uniform && use.time.precision != "full") {
-    use.time_regularised = true;
-    tab.t = use.time.times(tab.t.size());
-  }
-}
-
-// data.window: only the samples within [t_start, t_end] are fitted, the model starting at the first
-// of them (at rest, or from the state identification.initial_state: estimate finds). The columns
-// are read, converted and conditioned whole before (an offset's pre-trigger, a force window's
-// noise), and the inputs stay functions of the record's time; a window holding fewer than 3
-// samples is refused naming the record's span.
-void fit_window(Problem& p, const std::string& source) {
-  const auto& w = p.scenario.data.window;
-  if (w.size() != 2) return;
-  const auto& t = p.data.t;
-  std::size_t first = 0, last = t.size();
-  while (first < t.size() && t[first] < w[0]) ++first;
-  while (last > first && t[last - 1] > w[1]) --last;
-  if (last - first < 3)
-    fail_field(p.scenario.source, "data.window",
-               "holds " + std::to_string(last - first) + " samples of data file '" + source + "' (its times run from " +
-                   io::format_value(t.front()) + " to " + io::format_value(t.back()) + " s); at least 3 are needed",
-               "[" + io::format_value(w[0]) + ", " + io::format_value(w[1]) + "]");
-  if (first == 0 && last == t.size()) return;
-  const auto rows = static_cast<Eigen::Index>(last - first);
-  p.data.t = std::vector<double>(t.begin() + static_cast<std::ptrdiff_t>(first), t.begin() + static_cast<std::ptrdiff_t>(last));
-  p.data.z = MatrixXd(p.data.z.middleRows(static_cast<Eigen::Index>(first), rows));
-  p.columns.window = {p.data.t.front(), p.data.t.back()};
-}
-
-// Noise levels a lab does not state, from the record's quiet start (docs/data.md §2; the
-// estimator io/quiet_start.h). The trigger is the earliest sample at which an input (its column or
-// the scenario's signal) exceeds a twentieth of its peak; a sensor without a stated level gets the
-// quiet start's σ̂ where it is usable.
-void noise_from_quiet_start(Problem& p) {
-  const auto& t = p.data.t;
-  const std::size_t n = t.size();
-  if (n < static_cast<std::size_t>(io::kQuietSamples + io::kQuietMargin) || p.signals.empty()) return;
-  std::size_t trigger = n;
-  std::vector<double> x(n);
-  for (const auto& sig : p.signals) {
-    for (std::size_t i = 0; i < n; ++i) x[i] = sig(t[i]);
-    trigger = std::min(trigger, io::trigger_sample(x.data(), n));
-  }
-  const std::size_t quiet = io::quiet_samples(trigger);
-  if (trigger >= n || quiet == 0) return;
-  bool used = false;
-  for (std::size_t j = 0; j < p.noise_std.size(); ++j) {
-    if (p.noise_std[j] > 0) continue;
-    const double sd = io::quiet_start_noise(p.data.z.col(static_cast<Eigen::Index>(j)).data(), quiet);
-    if (!(sd > 0)) continue;
-    p.noise_std[j] = sd;
-    p.noise_origin[j] = "pre-trigger";
-    used = true;
-  }
-  if (used) {
-    p.columns.trigger_time = t[trigger];
-    p.columns.quiet_samples = static_cast<int>(quiet);
-  }
-}
 
 // The problem from measured data: the table's columns, the metadata beside it.
 std::unique_ptr<Problem> from_table(std::unique_ptr<Problem> p, const io::DataTable& table, const std::string& source,
                                     const io::TruthMeta* meta, const std::string& meta_source) {
-  p->measured = true;
-  io::DataTable tab = table;
-  regularise_time(p->scenario, tab, source, p->columns);
-  std::map<std::string, double> meta_truth;
-  if (meta) meta_truth = apply_truth_meta(*p, tab, source, *meta, meta_source);
-  measurements_from_table(*p, tab, source);
-  fit_window(*p, source);
-  noise_from_quiet_start(*p);
+  p->origin = Problem::DataOrigin::Record;
+  const std::map<std::string, double> meta_truth = read_record(*p, table, source, meta, meta_source);
   if (!meta_truth.empty()) {
     io::Scenario truth_sc = p->scenario;
     io::set_structure_parameters(truth_sc, meta_truth);
     set_true_values(*p, truth_sc);
   }
   const bool frequency = p->scenario.identification.domain == io::Domain::Frequency;
-  finish_problem(*p, frequency ? IdentifierStep{} : measured_data_step(*p, source), &source);
+  finish_problem(*p, frequency ? IdentifierStep{} : measured_data_step(*p), &source);
   return p;
 }
 
 }  // namespace
 
 std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const io::DataTable& table, const std::string& source,
-                                      const io::TruthMeta* meta, const std::string& meta_source) {
-  return from_table(problem_skeleton(sc), table, source, meta, meta_source);
+                                      const io::TruthMeta* meta, const std::string& meta_source, bool verbose) {
+  return from_table(problem_skeleton(sc, verbose), table, source, meta, meta_source);
 }
 
-std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv) {
-  auto p = problem_skeleton(sc);
+std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optional<std::string>& data_csv, bool verbose) {
+  auto p = problem_skeleton(sc, verbose);
   if (!data_csv) {
     check_synthesis(sc);
     finish_problem(*p, synthesize_data(*p), nullptr);
@@ -1278,7 +705,7 @@ std::unique_ptr<Problem> make_problem(const io::Scenario& sc, const std::optiona
       o.source = sc.source;
       std::vector<int> orders;
       io::FrfData d = io::frf_data_from_uff(file, *data_csv, o, &orders);
-      p->measured = true;
+      p->origin = Problem::DataOrigin::FrfFile;
       p->data_source = *data_csv;
       p->data.names.clear();
       for (const auto& s : sc.sensors) p->data.names.push_back(s.name);

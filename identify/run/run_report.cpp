@@ -406,7 +406,7 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
     out["initial_state"] = {{"estimated", false}, {"note", "the structure at rest at the first sample"}};
   }
   counts_json(*this, out);
-  if (p.data_source != "" && p.data_source.rfind("synthetic", 0) != 0) out["data_columns"] = data_columns_json(p.columns);
+  if (p.origin != Problem::DataOrigin::Synthesis) out["data_columns"] = data_columns_json(p.columns);
   if (!start_check.sensors.empty()) {
     json sensors = json::array();
     for (const auto& s : start_check.sensors)

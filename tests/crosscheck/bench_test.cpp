@@ -19,7 +19,7 @@
 
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/identify.h"
-#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/door/experiments_door.h"
 #include "scoleid/io/modal_data.h"
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/identify/fe/analytic_beam.h"

@@ -23,7 +23,7 @@
 #include "scoleid/crosscheck/campaign.h"
 #include "scoleid/crosscheck/mismatch_suite.h"
 #include "scoleid/crosscheck/report.h"
-#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/door/experiments_door.h"
 #include "scoleid/io/error.h"
 
 namespace fs = std::filesystem;

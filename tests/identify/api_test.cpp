@@ -1,16 +1,20 @@
 // The identifier's front door (scoleid/identify.h) and the strategy behind it (run/strategy.h).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
 
 #include "scoleid/identify.h"
+#include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/validation.h"
 #include "scoleid/io/error.h"
+#include "scoleid/io/progress.h"
 
 namespace fs = std::filesystem;
 using namespace scoleid;
@@ -240,4 +244,69 @@ TEST(Api, APretriggerOffsetIsTheMeanBeforeItsTime) {
     msg = e.what();
   }
   EXPECT_NE(msg.find("sensors[0].conditioning conditions a data column"), std::string::npos) << msg;
+}
+
+// A mesh of 1000 degrees of freedom or more: the build solves the starting model's two dense
+// eigenproblems (its frequencies, its modes) once each, however many of its steps ask for them (the
+// step's data content and damping bound, the problem's content: five solutions before) — and
+// with `verbose` says so before each; without it, it is silent. The numbers are those of the
+// stand-alone functions, which solve afresh.
+TEST(Api, ALargeMeshSolvesTheStartingModelsEigenproblemsOnceEachAndSaysSo) {
+  io::Scenario sc = noisy_beam();
+  sc.beam.zeta = 0.02;
+  sc.simulation.duration = 1.0;
+  sc.identification.parameterization = "physical";
+  sc.identification.estimate = {"EI", "rho_A", "zeta"};
+  sc.identification.initial = {{"EI", 19000.0}, {"rho_A", 63.0}, {"zeta", 0.015}};
+  sc.identification.elements = 500;
+  io::validate_scenario(sc);
+  io::DataTable table;
+  table.names = {"P", "w_mid"};
+  table.columns.resize(2);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    table.t.push_back(t);
+    table.columns[0].push_back(10.0);
+    table.columns[1].push_back(1e-3 * std::sin(2.0 * M_PI * 3.0 * t));
+  }
+  table.source = "record";
+  std::vector<std::string> lines;
+  std::unique_ptr<identify::Problem> p;
+  {
+    io::ProgressSink sink([&](const std::string& l) { lines.push_back(l); });
+    p = identify::make_problem(sc, table, "record", nullptr, "", true);
+    ASSERT_EQ(p->model().ndof, 1000);
+    int frequencies = 0, modes = 0;
+    for (const auto& l : lines) {
+      frequencies += l.find("frequencies: a dense eigen-solution of 1000 degrees of freedom") != std::string::npos;
+      modes += l.find("modes: a dense eigen-solution of 1000 degrees of freedom") != std::string::npos;
+    }
+    EXPECT_EQ(frequencies, 1);
+    EXPECT_EQ(modes, 1);
+    lines.clear();
+    identify::make_problem(sc, table, "record");
+    EXPECT_TRUE(lines.empty()) << lines.front();
+  }
+  const identify::IdentifierStep alone = identify::identifier_integration(p->scenario, p->model(), *p->params, p->signals);
+  EXPECT_EQ(alone.step, p->objective_options.solver.step);
+  EXPECT_EQ(alone.dirk_table, p->objective_options.solver.dirk_table);
+  const identify::DataContent content = identify::data_content(p->model(), *p->params, p->signals, sc.simulation.duration,
+                                                              sc.simulation.sample_interval);
+  EXPECT_EQ(content.mode, p->content.mode);
+  EXPECT_EQ(content.omega, p->content.omega);
+  EXPECT_EQ(content.content_mode, p->content.content_mode);
+  EXPECT_GT(p->content.mode, 0);
+  // The time the progress line promised, against the solve's own (within a factor of 10: the
+  // estimate scales a small solve by n³, and this machine's load varies).
+  const auto ops = identify::assemble(p->model(), p->structure->coefficients(sc));
+  for (const bool vectors : {false, true}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (vectors) identify::natural_modes(ops.M, ops.K);
+    else identify::natural_frequencies(ops.M, ops.K);
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double said = identify::dense_eigen_seconds(p->model().ndof, vectors);
+    std::printf("  %s of 1000 DOF: estimated %.3g s, took %.3g s\n", vectors ? "modes" : "frequencies", said, took);
+    EXPECT_GT(said, 0.1 * took);
+    EXPECT_LT(said, 10.0 * took);
+  }
 }

@@ -21,7 +21,7 @@ namespace {
 std::unique_ptr<Problem> scole_problem(const std::string& integrator) {
   auto sc = scoleid::io::load_scenario("paper-scole-2");
   sc.simulation.duration = 2.0;
-  sc.identification.integrator = integrator;
+  sc.identification.integrator = *scoleid::io::parse<scoleid::io::Integrator>(integrator);
   return make_problem(sc, std::nullopt);
 }
 

@@ -22,9 +22,10 @@
 #include "scoleid/identify/fe/frame_model.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
-#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/door/experiments_door.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/modal_data.h"
+#include "common/scratch.h"
 #include "scoleid/io/scenario.h"
 
 using namespace scoleid;
@@ -135,7 +136,7 @@ TEST(Frame, StoreyStiffnessesFromFourNoisyFrequencies) {
   const io::Scenario sc = io::load_scenario(kFrame);
   const io::Scenario truth = io::truth_scenario(sc);
   const std::vector<double> exact = exact_frequencies(truth.frame, 4);
-  const auto dir = std::filesystem::temp_directory_path() / ("scoleid-frame-" + std::to_string(::getpid()));
+  const auto dir = scoleid::test::scratch_root() / "frame";
   std::filesystem::create_directories(dir);
   std::filesystem::copy_file(kFrame, dir / "frame.yaml", std::filesystem::copy_options::overwrite_existing);
   std::ofstream(dir / "e.yaml") << "experiments: frame\nmodes: {file: m.csv, scenario: frame.yaml}\n";

@@ -68,6 +68,7 @@ TEST(Identification, CaseOneFromModalSeriesDataWithinTenthOfAPercent) {
   auto p = make_problem(sc, std::nullopt);
   p->data = series_data(sc);
   p->data_source = "modal series";
+  p->origin = Problem::DataOrigin::Caller;
   const RunResult r = identify_builtin(*p);
   const double e = max_rel_error(*p, r.estimate);
   std::printf("  series data: q1 %.6g q2 %.6g, max relative error %.3e after %d iterations\n", r.estimate[0],

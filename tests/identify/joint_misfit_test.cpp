@@ -11,7 +11,8 @@
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/joint_misfit.h"
-#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/door/experiments_door.h"
+#include "scoleid/identify/door/run_door.h"
 #include "scoleid/io/error.h"
 #include "test_support.h"
 
@@ -383,6 +384,31 @@ identification:
   EXPECT_NE(m6.find("identification.model"), std::string::npos) << m6;
   EXPECT_NE(m6.find("e6.yaml"), std::string::npos) << m6;
   for (const std::string& m : {m1, m2, m3, m4, m5, m6}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+// The joint run's method at its door: gauss-newton-krylov needs every run's matrix-free products,
+// which an accelerometer's run does not offer; refused naming the run before any joint solve,
+// while two displacement runs pass.
+TEST(Experiments, TheKrylovMethodIsRefusedAtTheDoorForARunWithAnAccelerometer) {
+  Scratch s;
+  const std::string load = "{name: P, at: beam, kind: force, location: 3, unit: N, signal: {type: step, amplitude: 10, t0: 0}}";
+  s.write("d.yaml", beam_run(load, "  - {name: w7, at: beam, kind: displacement, location: 7, unit: m}\n", 0.5));
+  s.write("a.yaml", beam_run(load, "  - {name: a7, at: beam, kind: acceleration, location: 7, unit: m/s^2}\n", 0.5));
+  ExperimentsOptions eo;
+  eo.method = io::Method::GaussNewtonKrylov;
+  const auto mixed = make_experiments(load_experiments(
+      s.write("mixed.yaml", "experiments: mixed\nruns:\n  - {name: disp, scenario: d.yaml}\n  - {name: acc, scenario: a.yaml}\n")));
+  const std::string m = input_error([&] { check_experiments_run(*mixed, eo); });
+  EXPECT_NE(m.find("mixed.yaml"), std::string::npos) << m;
+  EXPECT_NE(m.find("runs[1] (acc)"), std::string::npos) << m;
+  EXPECT_NE(m.find("velocity and acceleration sensors"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  EXPECT_NE(input_error([&] { run_experiments(*mixed, eo); }).find("runs[1] (acc)"), std::string::npos);
+  const auto disp = make_experiments(load_experiments(
+      s.write("disp.yaml", "experiments: disp\nruns:\n  - {name: one, scenario: d.yaml}\n  - {name: two, scenario: d.yaml}\n")));
+  EXPECT_NO_THROW(check_experiments_run(*disp, eo));
+  eo.method = io::Method::GaussNewton;
+  EXPECT_NO_THROW(check_experiments_run(*mixed, eo));
 }
 
 }  // namespace

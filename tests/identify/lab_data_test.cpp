@@ -15,6 +15,7 @@
 #include "scoleid/io/data_files.h"
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
+#include "common/scratch.h"
 #include "common/test_data.h"
 
 namespace fs = std::filesystem;
@@ -43,7 +44,7 @@ identification: {estimate: [EI, rho_A], initial: {EI: 27, rho_A: 0.44}, elements
 const char* kHeader = "Time [s],Hammer [N],Acc1 @0.30m [g],Acc2 @tip [g]";
 
 fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("scoleid-lab-" + std::to_string(::getpid())) / name;
+  const fs::path d = scoleid::test::scratch_root() / name;
   fs::create_directories(d);
   return d;
 }

@@ -191,6 +191,7 @@ std::unique_ptr<Problem> four_sections(double ei_start, double rho_start, int re
         sc.beam.EI[0], sc.beam.rho_A, 2000);
   (void)dt;
   p->data_source = "closed-form modal series";
+  p->origin = Problem::DataOrigin::Caller;
   p->true_values = {{"EI_1", 23000.0}, {"EI_2", 23000.0}, {"EI_3", 23000.0}, {"EI_4", 23000.0}, {"rho_A", 67.0}};
   return p;
 }
@@ -552,7 +553,7 @@ TEST(SensitivityBlocks, OneParameterPerBlockGivesTheSameGaussNewtonQuantitiesAnd
   // esdirk path streams all tangents in one pass and needs none.
   auto sc = scoleid::io::load_scenario("beam-ei8");
   sc.identification.elements = 16;
-  sc.identification.integrator = "esdirk-arkode";
+  sc.identification.integrator = scoleid::io::Integrator::EsdirkArkode;
   sc.simulation.duration = 2.0;
   const auto p = make_problem(sc, std::nullopt);
   ObjectiveOptions one = p->objective_options, many = p->objective_options;

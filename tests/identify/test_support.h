@@ -76,7 +76,7 @@ inline Case make_case(const std::string& yaml, bool bdf, double step = 0.0) {
   auto sc = scoleid::io::parse_scenario(yaml, "test");
   sc.identification.time_step = step;
   if (bdf) {
-    sc.identification.integrator = "bdf";
+    sc.identification.integrator = scoleid::io::Integrator::Bdf;
     sc.identification.rtol = 1e-10;
   }
   c.p = make_problem(sc, std::nullopt);

@@ -23,6 +23,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/frf_record.h"
 #include "scoleid/io/uff_frf.h"
+#include "common/scratch.h"
 #include "scoleid/io/uff.h"
 
 #ifndef SCOLE_DATA_EXE
@@ -41,7 +42,7 @@ using scoleid::test::slurp;
 
 fs::path scratch() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = fs::temp_directory_path() / ("scoleid-data-cli-" + std::to_string(::getpid()) + "-" + info->name());
+  const fs::path d = scoleid::test::scratch_root() / info->name();
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/cli_support.h"
+#include "common/scratch.h"
 #include "scoleid/io/error.h"
 
 using namespace scoleid::io;
@@ -14,8 +15,7 @@ namespace fs = std::filesystem;
 
 namespace {
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("scoleid_io_" + std::to_string(::getpid()) + "_" +
-                                                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path d = scoleid::test::scratch_root() / ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::create_directories(d);
   return d;
 }

@@ -21,6 +21,7 @@
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/lvm.h"
+#include "common/scratch.h"
 #include "scoleid/io/tdms.h"
 
 namespace fs = std::filesystem;
@@ -32,7 +33,7 @@ const auto& error_of = scoleid::test::input_error_of;
 
 fs::path scratch() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = fs::temp_directory_path() / ("scoleid-writers-" + std::to_string(::getpid()) + "-" + info->name());
+  const fs::path d = scoleid::test::scratch_root() / info->name();
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -24,6 +24,7 @@
 #include "scoleid/io/error.h"
 #include "scoleid/io/frf_estimate.h"
 #include "scoleid/io/quiet_start.h"
+#include "common/scratch.h"
 #include "scoleid/io/tdms.h"
 
 namespace fs = std::filesystem;
@@ -37,7 +38,7 @@ constexpr double kG = 9.80665, kLbf = 4.4482216152605, kMm = 1e-3;
 
 fs::path scratch() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = fs::temp_directory_path() / ("scoleid-frf-record-" + std::to_string(::getpid()) + "-" + info->name());
+  const fs::path d = scoleid::test::scratch_root() / info->name();
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

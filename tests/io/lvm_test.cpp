@@ -16,6 +16,7 @@
 #include "scoleid/io/time_grid.h"
 #include "common/test_data.h"
 #include "scoleid/io/error.h"
+#include "common/scratch.h"
 #include "scoleid/io/units.h"
 
 namespace fs = std::filesystem;
@@ -27,7 +28,7 @@ const fs::path kData = fs::path(SCOLEID_TEST_DATA_DIR) / "lvm";
 const auto& error_of = scoleid::test::input_error_of;
 
 fs::path write_lvm(const std::string& name, const std::string& text) {
-  const fs::path d = fs::temp_directory_path() / ("scoleid-lvm-" + std::to_string(::getpid()));
+  const fs::path d = scoleid::test::scratch_root() / "lvm";
   fs::create_directories(d);
   std::ofstream(d / name, std::ios::binary) << text;
   return d / name;

@@ -20,6 +20,7 @@
 #include "scoleid/io/data_source.h"
 #include "scoleid/io/error.h"
 #include "scoleid/io/lvm.h"
+#include "common/scratch.h"
 #include "scoleid/io/units.h"
 
 namespace fs = std::filesystem;
@@ -118,7 +119,7 @@ std::string values(const std::vector<T>& v, bool big = false) {
 }
 
 fs::path write_file(const std::string& name, const std::string& bytes) {
-  const fs::path d = fs::temp_directory_path() / ("scoleid-tdms-" + std::to_string(::getpid()));
+  const fs::path d = scoleid::test::scratch_root() / "tdms";
   fs::create_directories(d);
   std::ofstream(d / name, std::ios::binary) << bytes;
   return d / name;

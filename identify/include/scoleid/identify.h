@@ -110,7 +110,8 @@ private:
 };
 
 // The problem a scenario and its data pose (validated; io::InputError before any solve).
-std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data);
+// `verbose`: the build's long steps said as they start (identify::make_problem).
+std::shared_ptr<identify::Problem> prepare(const io::Scenario& scenario, const DataSource& data, bool verbose = false);
 // Identify a prepared problem.
 Identification identify_parameters(std::shared_ptr<identify::Problem> problem, const IdentifyOptions& options);
 // Both in one.

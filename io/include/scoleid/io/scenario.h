@@ -347,7 +347,7 @@ struct IdentificationSpec {
   // `band: none`: the whole record. A stated band always wins.
   enum class BandMode { Auto, None };
   BandMode band_mode = BandMode::Auto;
-  std::string integrator = "esdirk";   // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
+  Integrator integrator = Integrator::Esdirk;  // esdirk (fixed step, L-stable) | esdirk-arkode (the same through ARKODE) | bdf (adaptive CVODES)
   double time_step = 0.0;             // esdirk step; 0 = automatic (step_rule)
   // The automatic step's rule (docs/theory.md §5.2): "parameters" resolves flexible modes up to
   // min(P + 2, modes below Nyquist) (P the estimated parameters; the default), "data" the modes

@@ -8,6 +8,7 @@
 //   Start       identification.start                how the first attempt starts (docs/theory.md §7.6)
 //   Model       identification.model                the identifier's linear or nonlinear model (§3.8)
 //   StepRule    identification.step_rule            the automatic time step's rule (§5.2)
+//   Integrator  identification.integrator           the identifier's time stepper (§5)
 //   Domain      identification.domain               time records or frequency responses (§6.10)
 //   FrfEstimatorKind identification.frf.estimator   how FRFs are made from a time record (§6.10)
 //   FrfWindowKind    identification.frf.window      the Welch segments' window
@@ -36,6 +37,7 @@ enum class Method { Auto, GaussNewton, GaussNewtonKrylov, Lbfgs, SteepestDescent
 enum class Start { Auto, Plain, CoarseToFine };
 enum class Model { Linear, Nonlinear };
 enum class StepRule { Parameters, Data };
+enum class Integrator { Esdirk, EsdirkArkode, Bdf };
 enum class InitialState { Rest, Estimate };
 enum class Domain { Time, Frequency };
 enum class FrfEstimatorKind { Auto, H1, H2, Lines, Impact };
@@ -95,6 +97,12 @@ template <>
 struct Names<StepRule> {
   static constexpr std::array<std::pair<StepRule, const char*>, 2> rows{
       {{StepRule::Parameters, "parameters"}, {StepRule::Data, "data"}}};
+};
+
+template <>
+struct Names<Integrator> {
+  static constexpr std::array<std::pair<Integrator, const char*>, 3> rows{
+      {{Integrator::Esdirk, "esdirk"}, {Integrator::EsdirkArkode, "esdirk-arkode"}, {Integrator::Bdf, "bdf"}}};
 };
 
 template <>

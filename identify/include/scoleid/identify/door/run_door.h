@@ -9,6 +9,7 @@
 //     of the linear model only; `discrepancy` weighs it by every sensor's stated noise;
 //   - identification.start: coarse_to_fine climbs a sectional family's ladder: it needs one.
 // Below it the run's stages take the choices as valid (a std::logic_error otherwise).
+#include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/identify/run/problem.h"
 
@@ -16,5 +17,8 @@ namespace scoleid::identify {
 
 // io::InputError naming the scenario's source (or the command line's option), the field and the value.
 void check_run(const Problem& p, const RunOptions& ro);
+// A joint run's choices: gauss-newton-krylov (--method or the lead scenario's) needs every run's
+// matrix-free products (modal data offer them).
+void check_experiments_run(const ExperimentsProblem& ep, const ExperimentsOptions& eo);
 
 }  // namespace scoleid::identify

@@ -24,6 +24,13 @@ struct NaturalModes {
 };
 NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K);
 
+// Roughly how long natural_frequencies (vectors false) or natural_modes (true) takes on an
+// n-degree-of-freedom model on this machine [s]: the solve's cost grows as n³, so one of 256
+// degrees of freedom (a chain's stiffness, best of two) is timed once per process and scaled by
+// (n/256)³. What a progress line can promise before a long solve; larger problems run out of
+// cache, so the estimate tends to be low (tests/identify/api_test.cpp measures it).
+double dense_eigen_seconds(int n, bool vectors);
+
 // Damped modes of M ü + D u̇ + K u = 0 from the eigenvalues λ of the first-order system, computed
 // densely and exactly (no proportional-damping or small-damping assumption):
 //   omega   = |λ|, the undamped-equivalent frequency [rad/s]

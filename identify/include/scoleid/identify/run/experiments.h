@@ -64,8 +64,6 @@ struct ExperimentsSpec {
   bool modes_uff_given = false;
   int threads = 0;
 };
-// Throws io::InputError (one line: file, field, value).
-ExperimentsSpec load_experiments(const std::string& path);
 
 struct ExperimentsOptions {
   std::optional<io::Method> method;  // unset = the lead scenario's (auto resolved by run/strategy.h)
@@ -118,7 +116,6 @@ struct ExperimentsProblem {
   std::unique_ptr<FEStructure> modes_structure;
   std::unique_ptr<Parameterization> modes_params;
 };
-std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec);
 ExperimentsResult run_experiments(ExperimentsProblem& problem, const ExperimentsOptions& options);
 
 // identify.json, fit-<run>.csv (+ .gp, .png) per time run, modes-fit.csv with modal data.

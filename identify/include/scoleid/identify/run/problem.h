@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/fe/scole_nonlinear.h"
 #include "scoleid/identify/fe/structure.h"
 #include "scoleid/identify/inverse/measurements.h"
@@ -82,7 +83,7 @@ struct ColumnUse {
     // `pulse_samples` samples hold more than a tenth of its peak. 0 for a step.
     int pulse_samples = 0;
     bool cubic = false;  // read cubically all the same (interpolation: cubic): it overshoots at each jump
-    // An impact's force window (conditioning.window auto; problem.cpp force_window): the column is
+    // An impact's force window (conditioning.window auto; door/record_columns.cpp force_window): the column is
     // zero outside [window_from, window_to]; the hits found in it (time of each one's peak, and its
     // peak relative to the largest): two or more are a double hit.
     bool windowed = false;
@@ -110,9 +111,13 @@ struct Problem {
   std::vector<io::Signal> signals;
   Measurements data;
   std::string data_source;                    // "synthetic (N elements)" or the CSV path
-  // The data are a measured record (a file or a table), not synthesised from the scenario: the lab
-  // defaults apply (quiet-start noise, force window, automatic band, spectral first start).
-  bool measured = false;
+  // Where the data come from: synthesised by the scenario's own model family (its default
+  // model_error is 0), a measured record (a file or a table) or a file of FRFs — to which the lab
+  // defaults apply (quiet-start noise, force window, automatic band, spectral first start) —, or
+  // put in by the caller (a closed-form series: another model, model_error 1 %).
+  enum class DataOrigin { Synthesis, Record, FrfFile, Caller };
+  DataOrigin origin = DataOrigin::Synthesis;
+  bool measured() const { return origin == DataOrigin::Record || origin == DataOrigin::FrfFile; }
   std::map<std::string, double> true_values;  // by parameter name, where known
   std::vector<double> noise_std;              // per sensor: stated noise level, 0 = unknown
   std::vector<std::string> noise_origin;      // per sensor: "scenario" | "truth.json" | "pre-trigger" | "" (unknown)
@@ -130,6 +135,7 @@ struct Problem {
   // What the record says of its own channels before any fit (an input's static offset;
   // docs/data.md §2.5), one line each naming the channel.
   std::vector<std::string> warnings;
+  bool build_progress = false;  // make_problem's `verbose`
   // Inputs driven by their column that read with a static offset (the warning above): the input's
   // index and the column's mean, which the start check sets aside before it judges signs and scales.
   std::vector<std::pair<std::size_t, double>> static_offsets;
@@ -145,12 +151,16 @@ struct Problem {
   ObjectiveOptions objective_options;
 };
 
-// Throws io::InputError for anything wrong with the scenario or the data.
-std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::optional<std::string>& data_csv);
+// Throws io::InputError for anything wrong with the scenario or the data. `verbose`: the build's
+// long steps (a dense eigen-solution on a mesh of 1000 degrees of freedom or more) said on stdout
+// (io::progress) before they start.
+std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const std::optional<std::string>& data_csv,
+                                      bool verbose = false);
 // The same from a table in memory (columns matched as a file's are; `source` names it in messages),
 // with the truth metadata that came with it, if any (`meta_source` names that).
 std::unique_ptr<Problem> make_problem(const io::Scenario& scenario, const io::DataTable& table, const std::string& source,
-                                      const io::TruthMeta* meta = nullptr, const std::string& meta_source = "");
+                                      const io::TruthMeta* meta = nullptr, const std::string& meta_source = "",
+                                      bool verbose = false);
 
 // Measurements as a lab's file holds them: t, then each input's signal as the scenario states it,
 // then each sensor's column (io::write_csv writes it).
@@ -164,7 +174,32 @@ Measurements synthesize(const io::Scenario& scenario, int elements, double rtol,
 Measurements synthesize_series(const io::Scenario& scenario, int terms = 4000);
 // The same from the nonlinear SCOLE model (identification.model: nonlinear) at a step of at most `step`.
 Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, double step, bool add_noise);
+// The starting model (the parameters' initial values) assembled, its natural frequencies and its
+// modes, each computed once, when first asked: a problem's build asks for them several times (the
+// data's content, the step's damping bound, a stated step's check), and each is a dense
+// eigen-solution, O(n³) in the degrees of freedom. `verbose` says so on stdout (io::progress)
+// before each on a model of 1000 degrees of freedom or more.
+class StartModes {
+public:
+  StartModes(const StructuralModel& model, const Parameterization& params, bool verbose = false);
+  const StructuralModel& model() const { return model_; }
+  const Parameterization& params() const { return params_; }
+  const AssembledModel& ops() const { return ops_; }
+  const std::vector<double>& frequencies();  // natural_frequencies(M, K), ascending [rad/s]
+  const NaturalModes& modes();               // natural_modes(M, K)
+
+private:
+  const StructuralModel& model_;
+  const Parameterization& params_;
+  bool verbose_;
+  AssembledModel ops_;
+  std::optional<std::vector<double>> frequencies_;
+  std::optional<NaturalModes> modes_;
+};
+
 // from_data (identification.step_rule: data): K = K_data instead of min(P + 2, K_nyq).
+DataContent data_content(StartModes& start, const std::vector<io::Signal>& signals, double t_end, double sample_interval,
+                         bool from_data = false);
 DataContent data_content(const StructuralModel& model, const Parameterization& params,
                          const std::vector<io::Signal>& signals, double t_end, double sample_interval,
                          bool from_data = false);
@@ -185,6 +220,7 @@ struct IdentifierStep {
   int dirk_table = -1;            // SolverOptions::dirk_table
   double third_order_step = 0.0;  // the step the third-order table alone would take (= step when it is taken)
 };
+IdentifierStep identifier_integration(const io::Scenario& scenario, StartModes& start, const std::vector<io::Signal>& signals);
 IdentifierStep identifier_integration(const io::Scenario& scenario, const StructuralModel& model,
                                       const Parameterization& params, const std::vector<io::Signal>& signals);
 double identifier_step(const io::Scenario& scenario, const StructuralModel& model, const Parameterization& params,

@@ -46,11 +46,12 @@
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/identify/time/esdirk_stepper.h"
 #include "scoleid/identify/time/trajectory.h"
+#include "scoleid/io/types.h"
 
 namespace scoleid::identify {
 
 struct SolverOptions {
-  enum class Integrator { Esdirk, EsdirkArkode, Bdf };
+  using Integrator = io::Integrator;  // identification.integrator
   Integrator integrator = Integrator::Esdirk;
   double step = 0.0;           // esdirk: fixed step; 0 = (t1 − t0)/2000
   int dirk_table = -1;         // esdirk, esdirk-arkode: ARKODE DIRK table id; −1 = ESDIRK3(2)4L[2]SA
