@@ -27,6 +27,9 @@ void check_run(const Problem& p, const RunOptions& ro) {
   const bool sections = !section_families(p.params->names()).empty();
   if (id.smoothness != 0.0) {
     const std::string value = id.smoothness < 0 ? "discrepancy" : io::format_value(id.smoothness);
+    if (p.frf)
+      io::fail_field(src, "identification.smoothness",
+                     "is not available in the frequency domain (identification.domain: frequency fits the FRFs without a prior)", value);
     if (nonlinear) io::fail_field(src, "identification.smoothness", "is not available with the nonlinear model", value);
     if (!sections)
       io::fail_field(src, "identification.smoothness", "needs sectional parameters (X_1 ... X_N) among those estimated", value);
@@ -37,6 +40,10 @@ void check_run(const Problem& p, const RunOptions& ro) {
                          "discrepancy needs every sensor's noise level stated (sensor '" + p.data.names[k] + "' has none)",
                          "discrepancy");
   }
+  if (id.start == io::Start::CoarseToFine && p.frf)
+    io::fail_field(src, "identification.start",
+                   "is not available in the frequency domain (its fit starts from the FRFs' peaks, not a coarse-to-fine ladder)",
+                   io::to_string(id.start));
   if (id.start == io::Start::CoarseToFine && !sections)
     io::fail_field(src, "identification.start", "needs sectional parameters (X_1 ... X_N) among those estimated",
                    io::to_string(id.start));

@@ -109,18 +109,12 @@ void add_beam_sensors(BeamFE& fe, const io::BeamSpec& beam, const std::vector<io
   }
 }
 
-}  // namespace
-
-BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
-                  const std::vector<io::SensorSpec>& sensors) {
-  if (elements < 1) throw std::logic_error("build_beam: " + std::to_string(elements) + " elements");
-  if (sections < 1) sections = static_cast<int>(beam.EI.size());
-  BeamFE fe;
-  fe.length = beam.length;
-  fe.elements = elements;
-  fe.sections = sections;
+// The free degrees of freedom: the nodes' w and θ less those the ends' supports constrain
+// (fe.full_to_reduced), then one for each lumped attachment's mass (docs/theory.md §2.5: its
+// displacement along w, fe.lumped_dof). Returns their number.
+int beam_dofs(BeamFE& fe, const io::BeamSpec& beam) {
+  const int elements = fe.elements;
   const int nfull = 2 * (elements + 1);
-
   // Constrained DOFs.
   std::vector<bool> fixed(static_cast<std::size_t>(nfull), false);
   auto constrain = [&](int node, EndCondition ec) {
@@ -134,13 +128,19 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
   for (int i = 0; i < nfull; ++i)
     if (!fixed[static_cast<std::size_t>(i)]) fe.full_to_reduced[static_cast<std::size_t>(i)] = n++;
   if (n == 0) throw std::logic_error("build_beam: " + std::to_string(elements) + " elements leave no free degree of freedom");
-
-  // A lumped attachment's mass has a degree of freedom of its own, after the beam's (docs/theory.md
-  // §2.5): its displacement along w.
+  // A lumped attachment's mass: a degree of freedom of its own, after the beam's.
   std::map<std::string, int>& lumped_dof = fe.lumped_dof;
   for (const auto& e : beam.attachments)
     if (e.lumped_mass > 0.0) lumped_dof[e.name] = n + static_cast<int>(lumped_dof.size());
   n += static_cast<int>(lumped_dof.size());
+  return n;
+}
+
+// The coefficients: rho_A, EI and d per section, c_kv, then one per point element's quantity
+// (docs/theory.md §2.5, fe.points); the DOFs' unit groups.
+void beam_coefficients(BeamFE& fe, const io::BeamSpec& beam, int n) {
+  const int sections = fe.sections;
+  const int nfull = 2 * (fe.elements + 1);
   StructuralModel& m = fe.model;
   m.ndof = n;
   m.ncoef = 2 + 2 * sections;
@@ -163,8 +163,23 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     const int r = fe.full_to_reduced[static_cast<std::size_t>(i)];
     if (r >= 0) m.dof_group[static_cast<std::size_t>(r)] = i % 2;  // 0: w, 1: θ
   }
+}
 
-  using Trip = Eigen::Triplet<double>;
+using Trip = Eigen::Triplet<double>;
+
+SparseMatrix sparse_of(int n, const std::vector<Trip>& t) {
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+// The distributed operators: ρA's mass, each section's stiffness and Chen–Russell slope product
+// (an element split at section boundaries, so jumps of EI and d are integrated exactly), the
+// Kelvin–Voigt term, the tip's mass and inertia.
+void beam_operators(BeamFE& fe, const io::BeamSpec& beam, int n) {
+  const int elements = fe.elements, sections = fe.sections;
+  StructuralModel& m = fe.model;
   const double h = beam.length / elements;
   const double hs = beam.length / sections;
   std::vector<Trip> mass;
@@ -197,22 +212,16 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
       if (hi >= sb) break;
     }
   }
-  auto to_sparse = [n](const std::vector<Trip>& t) {
-    SparseMatrix A(n, n);
-    A.setFromTriplets(t.begin(), t.end());
-    A.makeCompressed();
-    return A;
-  };
-  m.mass.push_back({to_sparse(mass), fe.coef_rho_A()});
+  m.mass.push_back({sparse_of(n, mass), fe.coef_rho_A()});
   // K = Σ EI_k K_k; D = Σ d_k G_k (Chen–Russell) + c_kv Σ K_k (Kelvin–Voigt, one coefficient for
   // the whole beam: the unit-EI stiffness summed over the sections). docs/theory.md §2.2.
   SparseMatrix Kunit(n, n);
   for (int s = 0; s < sections; ++s) {
-    const SparseMatrix Ks = to_sparse(stiff[static_cast<std::size_t>(s)]);
+    const SparseMatrix Ks = sparse_of(n, stiff[static_cast<std::size_t>(s)]);
     m.stiffness.push_back({Ks, fe.coef_EI(s)});
     Kunit += Ks;
   }
-  for (int s = 0; s < sections; ++s) m.damping.push_back({to_sparse(slopes[static_cast<std::size_t>(s)]), fe.coef_chen_russell(s)});
+  for (int s = 0; s < sections; ++s) m.damping.push_back({sparse_of(n, slopes[static_cast<std::size_t>(s)]), fe.coef_chen_russell(s)});
   m.damping.push_back({Kunit, fe.coef_kelvin_voigt()});
   if (beam.tip_mass > 0.0 || beam.tip_inertia > 0.0) {
     std::vector<Trip> tip;
@@ -220,13 +229,18 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
     const int rt = fe.full_to_reduced[static_cast<std::size_t>(2 * elements + 1)];
     if (rw >= 0 && beam.tip_mass > 0.0) tip.emplace_back(rw, rw, beam.tip_mass);
     if (rt >= 0 && beam.tip_inertia > 0.0) tip.emplace_back(rt, rt, beam.tip_inertia);
-    if (!tip.empty()) m.mass.push_back({to_sparse(tip), -1});
+    if (!tip.empty()) m.mass.push_back({sparse_of(n, tip), -1});
   }
-  // A point element at s: m N Nᵀ and J N′N′ᵀ in M, k_w N Nᵀ and k_θ N′N′ᵀ in K, c_w N Nᵀ and
-  // c_θ N′N′ᵀ in D, N (N′) the displacement (slope) row at s (docs/theory.md §2.5). Each row lies
-  // on one element's DOFs, so the operators keep the mesh's pattern. A lumped attachment with DOF
-  // a (unit row e_a): m_l e_a e_aᵀ in M, k_l (N − e_a)(N − e_a)ᵀ in K and c_l the same in D, the
-  // ground spring k_g e_a e_aᵀ in K (its row joins the banded solver's border).
+}
+
+// A point element at s: m N Nᵀ and J N′N′ᵀ in M, k_w N Nᵀ and k_θ N′N′ᵀ in K, c_w N Nᵀ and
+// c_θ N′N′ᵀ in D, N (N′) the displacement (slope) row at s (docs/theory.md §2.5). Each row lies
+// on one element's DOFs, so the operators keep the mesh's pattern. A lumped attachment with DOF
+// a (unit row e_a): m_l e_a e_aᵀ in M, k_l (N − e_a)(N − e_a)ᵀ in K and c_l the same in D, the
+// ground spring k_g e_a e_aᵀ in K (its row joins the banded solver's border).
+void point_element_terms(BeamFE& fe, const io::BeamSpec& beam, int n) {
+  StructuralModel& m = fe.model;
+  const std::map<std::string, int>& lumped_dof = fe.lumped_dof;
   for (std::size_t k = 0; k < fe.points.size(); ++k) {
     const auto& p = fe.points[k];
     const std::string element = p.name.substr(p.name.find('.') + 1, p.name.rfind('.') - p.name.find('.') - 1);
@@ -245,12 +259,28 @@ BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const st
       if (row[a] != 0.0)
         for (int b = 0; b < n; ++b)
           if (row[b] != 0.0) t.emplace_back(a, b, row[a] * row[b]);
-    OperatorTerm term{to_sparse(t), fe.coef_point(static_cast<int>(k))};
+    OperatorTerm term{sparse_of(n, t), fe.coef_point(static_cast<int>(k))};
     if (p.field == "mass" || p.field == "inertia" || p.field == "lumped_mass") m.mass.push_back(std::move(term));
     else if (p.field == "k_w" || p.field == "k_theta" || p.field == "lumped_k" || p.field == "lumped_k_ground") m.stiffness.push_back(std::move(term));
     else m.damping.push_back(std::move(term));
   }
 
+}
+
+}  // namespace
+
+BeamFE build_beam(const io::BeamSpec& beam, int elements, int sections, const std::vector<io::InputSpec>& inputs,
+                  const std::vector<io::SensorSpec>& sensors) {
+  if (elements < 1) throw std::logic_error("build_beam: " + std::to_string(elements) + " elements");
+  if (sections < 1) sections = static_cast<int>(beam.EI.size());
+  BeamFE fe;
+  fe.length = beam.length;
+  fe.elements = elements;
+  fe.sections = sections;
+  const int n = beam_dofs(fe, beam);
+  beam_coefficients(fe, beam, n);
+  beam_operators(fe, beam, n);
+  point_element_terms(fe, beam, n);
   add_beam_inputs(fe, beam, inputs);
   add_beam_sensors(fe, beam, sensors);
   return fe;

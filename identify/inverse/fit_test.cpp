@@ -1,10 +1,95 @@
 #include "scoleid/identify/inverse/fit_test.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace scoleid::identify {
+
+namespace {
+
+// A sensor's noise variance from its residual r when none is stated: second differences of the
+// residual, bounded by fourth differences of the data z (noise is in the data, so a high-frequency
+// misfit of a model to smooth data is not counted as noise). At least 3 samples.
+double estimated_noise_variance(const Eigen::VectorXd& r, const Eigen::VectorXd& z) {
+  const Eigen::Index N = r.size();
+  double sum = 0.0;
+  for (Eigen::Index i = 1; i + 1 < N; ++i) {
+    const double d2 = r[i + 1] - 2.0 * r[i] + r[i - 1];
+    sum += d2 * d2;
+  }
+  double var = sum / (6.0 * static_cast<double>(N - 2));
+  if (N >= 5) {
+    double sz = 0.0;
+    for (Eigen::Index i = 2; i + 2 < N; ++i) {
+      const double d4 = z[i + 2] - 4.0 * z[i + 1] + 6.0 * z[i] - 4.0 * z[i - 1] + z[i - 2];
+      sz += d4 * d4;
+    }
+    var = std::min(var, sz / (70.0 * static_cast<double>(N - 4)));
+  }
+  return var;
+}
+
+// The sensor whose residual passes only on a discretisation estimate over kUnresolvedDiscretisation
+// of its signal, the residual being over that too (the largest such estimate), or null.
+const SensorFit* unresolved_sensor(const std::vector<SensorFit>& sensors) {
+  const SensorFit* unresolved = nullptr;
+  for (const auto& s : sensors)
+    if (s.rms_signal > 0 && s.discretisation > kUnresolvedDiscretisation * s.rms_signal &&
+        s.systematic > kUnresolvedDiscretisation * s.rms_signal &&
+        (!unresolved || s.discretisation / s.rms_signal > unresolved->discretisation / unresolved->rms_signal))
+      unresolved = &s;
+  return unresolved;
+}
+
+// The fit test's one-line verdict: why it cannot be tested, which sensor is unresolved, which
+// allowance it passes on, or the worst sensor beyond its own.
+std::string fit_message(const FitTest& f, double model_error, Eigen::Index N, bool finite, bool disc, const SensorFit* unresolved) {
+  std::string message;
+  char buf[512];
+  if (N < 3) {
+    message = "fewer than 3 samples: the fit cannot be tested";
+  } else if (!finite) {
+    message = "the model's outputs at the estimate are not finite";
+  } else if (unresolved) {
+    std::snprintf(buf, sizeof buf,
+                  "sensor %s's residual (%.3g %% of its RMS signal) passes only on the model's own discretisation error at this "
+                  "point, %.3g %% (both over %.0f %%): its mesh and step do not resolve it, and no fit can be tested against such "
+                  "an allowance (start nearer, or refine identification.elements or identification.time_step)",
+                  unresolved->name.c_str(), 100.0 * unresolved->systematic / unresolved->rms_signal,
+                  100.0 * unresolved->discretisation / unresolved->rms_signal, 100.0 * kUnresolvedDiscretisation);
+    message = buf;
+  } else {
+    // The sensor furthest beyond its own allowance, to say where the misfit is.
+    const SensorFit* worst = nullptr;
+    auto beyond = [](const SensorFit& s) { return s.allowed > 0 ? s.systematic / s.allowed : (s.systematic > 0 ? INFINITY : 0.0); };
+    for (const auto& s : f.sensors)
+      if (s.rms_signal > 0 && (!worst || beyond(s) > beyond(*worst))) worst = &s;
+    char dbuf[40] = "not estimated";
+    if (disc && worst) std::snprintf(dbuf, sizeof dbuf, "%.3g %%", 100.0 * worst->discretisation / worst->rms_signal);
+    if ((f.explains_data || !worst) && !f.within_noise_and_discretisation && model_error > 0)
+      std::snprintf(buf, sizeof buf,
+                    "passes only with the model-error allowance of %.3g %% (identification.model_error): the residual needs at "
+                    "least %.3g %%, beyond what noise and discretisation allow",
+                    100.0 * model_error, 100.0 * f.model_error_needed);
+    else if (f.explains_data || !worst)
+      std::snprintf(buf, sizeof buf, "the systematic residual is %.2f of what noise, discretisation and the declared model error allow",
+                    f.ratio);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "the systematic residual is %.3g times what noise, discretisation and the declared model error (%.3g %%) "
+                    "allow; worst sensor %s: %.3g %% of its RMS signal against %.3g %% (noise %.3g %%%s, discretisation %s)",
+                    f.ratio, 100.0 * model_error, worst->name.c_str(), 100.0 * worst->systematic / worst->rms_signal,
+                    100.0 * worst->allowed / worst->rms_signal, 100.0 * worst->noise / worst->rms_signal,
+                    (" " + worst->noise_origin).c_str(), dbuf);
+    message = buf;
+  }
+  return message;
+}
+
+}  // namespace
 
 FitTest fit_test(const FitTestInputs& in) {
   const Eigen::Index N = in.residual.rows(), ns = in.residual.cols();
@@ -31,23 +116,7 @@ FitTest fit_test(const FitTestInputs& in) {
     if (stated > 0) {
       var = stated * stated;
     } else if (N >= 3) {
-      // Second differences of the residual, bounded by fourth differences of the data: noise is in
-      // the data, so a high-frequency misfit of a model to smooth data is not counted as noise.
-      double sum = 0.0;
-      for (Eigen::Index i = 1; i + 1 < N; ++i) {
-        const double d2 = r[i + 1] - 2.0 * r[i] + r[i - 1];
-        sum += d2 * d2;
-      }
-      var = sum / (6.0 * static_cast<double>(N - 2));
-      if (N >= 5) {
-        const Eigen::VectorXd z = in.data.col(k);
-        double sz = 0.0;
-        for (Eigen::Index i = 2; i + 2 < N; ++i) {
-          const double d4 = z[i + 2] - 4.0 * z[i + 1] + 6.0 * z[i] - 4.0 * z[i - 1] + z[i - 2];
-          sz += d4 * d4;
-        }
-        var = std::min(var, sz / (70.0 * static_cast<double>(N - 4)));
-      }
+      var = estimated_noise_variance(r, in.data.col(k));
       s.noise_estimated = true;
     }
     const std::string origin = static_cast<std::size_t>(k) < in.noise_origin.size() ? in.noise_origin[static_cast<std::size_t>(k)] : "";
@@ -80,55 +149,13 @@ FitTest fit_test(const FitTestInputs& in) {
   // estimate far stiffer than the step was chosen for): an allowance of twice that would pass any
   // fit, so the fit is not explained. (A small residual beside a large, conservative estimate — a
   // hammer's pulse the step resolves coarsely — is a fit like any other.)
-  const SensorFit* unresolved = nullptr;
-  for (const auto& s : f.sensors)
-    if (disc && s.rms_signal > 0 && s.discretisation > kUnresolvedDiscretisation * s.rms_signal &&
-        s.systematic > kUnresolvedDiscretisation * s.rms_signal &&
-        (!unresolved || s.discretisation / s.rms_signal > unresolved->discretisation / unresolved->rms_signal))
-      unresolved = &s;
+  const SensorFit* unresolved = disc ? unresolved_sensor(f.sensors) : nullptr;
   f.explains_data = finite && !unresolved && S <= A;
   f.within_noise_and_discretisation = finite && !unresolved && S <= A_strict;
   f.ratio = A > 0 ? std::sqrt(S / A) : (S > 0 ? INFINITY : 0.0);
   // The least model error with which the sum passes: S <= A_strict + moving·m².
   f.model_error_needed = S <= A_strict ? 0.0 : moving > 0 ? std::sqrt((S - A_strict) / moving) : INFINITY;
-  char buf[512];
-  if (N < 3) {
-    f.message = "fewer than 3 samples: the fit cannot be tested";
-  } else if (!finite) {
-    f.message = "the model's outputs at the estimate are not finite";
-  } else if (unresolved) {
-    std::snprintf(buf, sizeof buf,
-                  "sensor %s's residual (%.3g %% of its RMS signal) passes only on the model's own discretisation error at this "
-                  "point, %.3g %% (both over %.0f %%): its mesh and step do not resolve it, and no fit can be tested against such "
-                  "an allowance (start nearer, or refine identification.elements or identification.time_step)",
-                  unresolved->name.c_str(), 100.0 * unresolved->systematic / unresolved->rms_signal,
-                  100.0 * unresolved->discretisation / unresolved->rms_signal, 100.0 * kUnresolvedDiscretisation);
-    f.message = buf;
-  } else {
-    // The sensor furthest beyond its own allowance, to say where the misfit is.
-    const SensorFit* worst = nullptr;
-    auto beyond = [](const SensorFit& s) { return s.allowed > 0 ? s.systematic / s.allowed : (s.systematic > 0 ? INFINITY : 0.0); };
-    for (const auto& s : f.sensors)
-      if (s.rms_signal > 0 && (!worst || beyond(s) > beyond(*worst))) worst = &s;
-    char dbuf[40] = "not estimated";
-    if (disc && worst) std::snprintf(dbuf, sizeof dbuf, "%.3g %%", 100.0 * worst->discretisation / worst->rms_signal);
-    if ((f.explains_data || !worst) && !f.within_noise_and_discretisation && in.model_error > 0)
-      std::snprintf(buf, sizeof buf,
-                    "passes only with the model-error allowance of %.3g %% (identification.model_error): the residual needs at "
-                    "least %.3g %%, beyond what noise and discretisation allow",
-                    100.0 * in.model_error, 100.0 * f.model_error_needed);
-    else if (f.explains_data || !worst)
-      std::snprintf(buf, sizeof buf, "the systematic residual is %.2f of what noise, discretisation and the declared model error allow",
-                    f.ratio);
-    else
-      std::snprintf(buf, sizeof buf,
-                    "the systematic residual is %.3g times what noise, discretisation and the declared model error (%.3g %%) "
-                    "allow; worst sensor %s: %.3g %% of its RMS signal against %.3g %% (noise %.3g %%%s, discretisation %s)",
-                    f.ratio, 100.0 * in.model_error, worst->name.c_str(), 100.0 * worst->systematic / worst->rms_signal,
-                    100.0 * worst->allowed / worst->rms_signal, 100.0 * worst->noise / worst->rms_signal,
-                    (" " + worst->noise_origin).c_str(), dbuf);
-    f.message = buf;
-  }
+  f.message = fit_message(f, in.model_error, N, finite, disc, unresolved);
   return f;
 }
 

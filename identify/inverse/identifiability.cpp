@@ -62,30 +62,16 @@ FisherInformation fisher_information(const Measurements& data, const MatrixXd& Y
   return id;
 }
 
-Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q, const std::vector<std::string>* names) {
-  Identifiability id;
+namespace {
+
+// Directions the data cannot see (eigenvalues of the relative Fisher matrix below 1e-12 of the
+// largest): every parameter with a sizeable share in them is flagged; the others get their bounds
+// from the Fisher matrix restricted to them (i.e. with the flagged parameters held fixed). A
+// parameter's share in them is the length of its unit vector projected on their span
+// (√Σ_e v_ie², independent of how a repeated small eigenvalue's vectors are chosen); returned.
+VectorXd unseen_directions(const Eigen::SelfAdjointEigenSolver<MatrixXd>& es, const VectorXd& q, Identifiability& id) {
   const int P = static_cast<int>(q.size());
-  const MatrixXd& F = fi.F;
-  const double systematic = fi.systematic;
-  id.chi2 = fi.chi2;
-  id.data_values = fi.data_values;
-  id.noise_std = fi.noise_std;
-  id.noise_source = fi.stated_noise ? "scenario" : "residual";
-  const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
-  const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
-  id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
-  id.std = VectorXd::Constant(P, std::nan(""));
-  id.resolution = VectorXd::Constant(P, std::nan(""));
-  id.covariance = MatrixXd::Constant(P, P, std::nan(""));
-  id.systematic = systematic;
-  id.identifiable.assign(static_cast<std::size_t>(P), true);
-  id.reason.assign(static_cast<std::size_t>(P), "");
-  // Directions the data cannot see (eigenvalues below 1e-12 of the largest): every parameter
-  // with a sizeable share in them is flagged; the others get their bounds from the Fisher matrix
-  // restricted to them (i.e. with the flagged parameters held fixed).
-  // A parameter's share in them is the length of its unit vector projected on their span
-  // (√Σ_e v_ie², independent of how a repeated small eigenvalue's vectors are chosen).
+  const double lmax = es.eigenvalues().maxCoeff();
   VectorXd unseen_share = VectorXd::Zero(P);
   for (int e = 0; e < P; ++e)
     if (!(es.eigenvalues()[e] > 1e-12 * lmax)) unseen_share += es.eigenvectors().col(e).cwiseAbs2();
@@ -111,41 +97,45 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
       id.covariance_pinv = q.asDiagonal() * Cr * q.asDiagonal();
     }
   }
-  // An unseen direction shared by exactly two parameters i, j (d log q = s (v_i, v_j)): the data fix
-  // the one combination it leaves unchanged, q_i / q_j^(v_i/v_j) (a free decay: EI/rho_A).
-  if (names && static_cast<int>(names->size()) == P)
-    for (int e = 0; e < P; ++e) {
-      if (es.eigenvalues()[e] > 1e-12 * lmax) continue;
-      const VectorXd v = es.eigenvectors().col(e);
-      std::vector<int> big;
-      for (int i = 0; i < P; ++i)
-        if (std::abs(v[i]) > 0.1) big.push_back(i);
-      if (big.size() != 2) continue;
-      const int i = big[0], j = big[1];
-      const double k = v[i] / v[j];
-      const std::string& ni = (*names)[static_cast<std::size_t>(i)];
-      const std::string& nj = (*names)[static_cast<std::size_t>(j)];
-      char comb[160];
-      if (std::abs(k - 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s/%s", ni.c_str(), nj.c_str());
-      else if (std::abs(k + 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s*%s", ni.c_str(), nj.c_str());
-      else std::snprintf(comb, sizeof comb, "%s/%s^%.3g", ni.c_str(), nj.c_str(), k);
-      for (int a : {i, j}) {
-        const std::string& other = a == i ? nj : ni;
-        id.reason[static_cast<std::size_t>(a)] = "moves with " + other +
-                                                 " along a direction the data cannot see (Fisher eigenvalue below 1e-12 of "
-                                                 "the largest): the data fix " + comb + " only";
-      }
+  return unseen_share;
+}
+
+// An unseen direction shared by exactly two parameters i, j (d log q = s (v_i, v_j)): the data fix
+// the one combination it leaves unchanged, q_i / q_j^(v_i/v_j) (a free decay: EI/rho_A), which
+// their reasons name.
+void name_unseen_pairs(const Eigen::SelfAdjointEigenSolver<MatrixXd>& es, const std::vector<std::string>& names, Identifiability& id) {
+  const int P = static_cast<int>(names.size());
+  const double lmax = es.eigenvalues().maxCoeff();
+  for (int e = 0; e < P; ++e) {
+    if (es.eigenvalues()[e] > 1e-12 * lmax) continue;
+    const VectorXd v = es.eigenvectors().col(e);
+    std::vector<int> big;
+    for (int i = 0; i < P; ++i)
+      if (std::abs(v[i]) > 0.1) big.push_back(i);
+    if (big.size() != 2) continue;
+    const int i = big[0], j = big[1];
+    const double k = v[i] / v[j];
+    const std::string& ni = names[static_cast<std::size_t>(i)];
+    const std::string& nj = names[static_cast<std::size_t>(j)];
+    char comb[160];
+    if (std::abs(k - 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s/%s", ni.c_str(), nj.c_str());
+    else if (std::abs(k + 1.0) < 0.05) std::snprintf(comb, sizeof comb, "%s*%s", ni.c_str(), nj.c_str());
+    else std::snprintf(comb, sizeof comb, "%s/%s^%.3g", ni.c_str(), nj.c_str(), k);
+    for (int a : {i, j}) {
+      const std::string& other = a == i ? nj : ni;
+      id.reason[static_cast<std::size_t>(a)] = "moves with " + other +
+                                               " along a direction the data cannot see (Fisher eigenvalue below 1e-12 of "
+                                               "the largest): the data fix " + comb + " only";
     }
-  // Without a stated noise level σ comes from the residual with ν = N − P degrees of freedom; below
-  // ν = 10 that estimate is not a scale (at ν = 10 the level is within a factor 1.75 at 95 %, at
-  // ν = 1 within a factor 16), and neither is any std drawn from it.
-  if (!fi.stated_noise && static_cast<double>(fi.data_values) - P < 10.0)
-    for (int i = 0; i < P; ++i) {
-      id.identifiable[static_cast<std::size_t>(i)] = false;
-      id.reason[static_cast<std::size_t>(i)] =
-          "no noise level stated and " + std::to_string(fi.data_values) + " data values for " + std::to_string(P) +
-          " parameters: fewer than 10 left to estimate the noise from the residual";
-    }
+  }
+}
+
+// The std and resolution of the parameters the data see (id.identifiable so far), from the
+// relative Fisher matrix Fr restricted to them; each flagged where either exceeds half its value,
+// where the restricted matrix is singular too, or where its share in an unseen direction exceeds
+// its relative std (docs/theory.md §8.1).
+void seen_bounds(const MatrixXd& Fr, const VectorXd& q, double systematic, const VectorXd& unseen_share, Identifiability& id) {
+  const int P = static_cast<int>(q.size());
   std::vector<int> keep;
   for (int i = 0; i < P; ++i)
     if (id.identifiable[static_cast<std::size_t>(i)]) keep.push_back(i);
@@ -198,6 +188,42 @@ Identifiability identifiability_from(const FisherInformation& fi, const VectorXd
       }
     }
   }
+}
+
+}  // namespace
+
+Identifiability identifiability_from(const FisherInformation& fi, const VectorXd& q, const std::vector<std::string>* names) {
+  Identifiability id;
+  const int P = static_cast<int>(q.size());
+  const MatrixXd& F = fi.F;
+  const double systematic = fi.systematic;
+  id.chi2 = fi.chi2;
+  id.data_values = fi.data_values;
+  id.noise_std = fi.noise_std;
+  id.noise_source = fi.stated_noise ? "scenario" : "residual";
+  const MatrixXd Fr = q.asDiagonal() * F * q.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<MatrixXd> es(Fr);
+  const double lmax = es.eigenvalues().maxCoeff(), lmin = es.eigenvalues().minCoeff();
+  id.condition_number = lmin > 0 ? lmax / lmin : std::numeric_limits<double>::infinity();
+  id.std = VectorXd::Constant(P, std::nan(""));
+  id.resolution = VectorXd::Constant(P, std::nan(""));
+  id.covariance = MatrixXd::Constant(P, P, std::nan(""));
+  id.systematic = systematic;
+  id.identifiable.assign(static_cast<std::size_t>(P), true);
+  id.reason.assign(static_cast<std::size_t>(P), "");
+  const VectorXd unseen_share = unseen_directions(es, q, id);
+  if (names && static_cast<int>(names->size()) == P) name_unseen_pairs(es, *names, id);
+  // Without a stated noise level σ comes from the residual with ν = N − P degrees of freedom; below
+  // ν = 10 that estimate is not a scale (at ν = 10 the level is within a factor 1.75 at 95 %, at
+  // ν = 1 within a factor 16), and neither is any std drawn from it.
+  if (!fi.stated_noise && static_cast<double>(fi.data_values) - P < 10.0)
+    for (int i = 0; i < P; ++i) {
+      id.identifiable[static_cast<std::size_t>(i)] = false;
+      id.reason[static_cast<std::size_t>(i)] =
+          "no noise level stated and " + std::to_string(fi.data_values) + " data values for " + std::to_string(P) +
+          " parameters: fewer than 10 left to estimate the noise from the residual";
+    }
+  seen_bounds(Fr, q, systematic, unseen_share, id);
   return id;
 }
 

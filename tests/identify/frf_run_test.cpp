@@ -221,6 +221,23 @@ TEST(FrfRun, TheDoorRefusesWhatAFrequencyRunCannotDo) {
     o.method = scoleid::io::Method::GaussNewtonKrylov;
     EXPECT_THROW(run_identification(*p, o), InputError);
   }
+  // Nor a smoothness prior or a coarse-to-fine ladder, which the frequency-domain fit does not use:
+  // refused before its first solve, not ignored.
+  for (const bool ladder : {false, true}) {
+    auto sc = multisine();
+    if (ladder) sc.identification.start = scoleid::io::Start::CoarseToFine;
+    else sc.identification.smoothness = 1e-3;
+    auto p = make_problem(sc, std::nullopt);
+    RunOptions o;
+    o.verbose = false;
+    try {
+      run_identification(*p, o);
+      ADD_FAILURE() << (ladder ? "start: coarse_to_fine" : "smoothness") << " not refused in the frequency domain";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(ladder ? "identification.start" : "identification.smoothness"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("frequency domain"), std::string::npos) << e.what();
+    }
+  }
   // The scenario reader: an estimated initial state and the nonlinear model have no FRF.
   const std::string text = R"(
 name: x

@@ -7,7 +7,8 @@
 //     initial state do not offer;
 //   - identification.smoothness: a prior along sectional families (X_1 … X_N among the estimated),
 //     of the linear model only; `discrepancy` weighs it by every sensor's stated noise;
-//   - identification.start: coarse_to_fine climbs a sectional family's ladder: it needs one.
+//   - identification.start: coarse_to_fine climbs a sectional family's ladder: it needs one;
+//   - a frequency-domain run takes neither a smoothness prior nor the ladder.
 // Below it the run's stages take the choices as valid (a std::logic_error otherwise).
 #include "scoleid/identify/run/experiments.h"
 #include "scoleid/identify/run/identify_run.h"
