@@ -175,6 +175,47 @@ ExperimentsSpec load_experiments(const std::string& path) {
   return s;
 }
 
+// What a joint run does not take, in run i's scenario.
+static void check_joint_run_scenario(const ExperimentsSpec& spec, std::size_t i, const io::Scenario& sc) {
+  if (sc.identification.smoothness != 0.0)
+    bad(spec.source, "runs[" + std::to_string(i) + "].scenario", "sets identification.smoothness, which a joint run does not take",
+        spec.runs[i].scenario);
+  if (sc.identification.start != io::Start::Auto)
+    bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+        "sets identification.start, which a joint run does not take (it starts plain, without restarts)", spec.runs[i].scenario);
+  if (!sc.identification.band.empty())
+    bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+        "sets identification.band, which a joint run does not take (its Fisher sum counts independent samples)", spec.runs[i].scenario);
+  if (!sc.identification.uncertain.empty())
+    bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+        "sets identification.uncertain, which a joint run does not take (its interval has no consider terms)", spec.runs[i].scenario);
+  if (sc.identification.model != io::Model::Linear)
+    bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
+        std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",
+        spec.runs[i].scenario);
+}
+
+// Likelihood weights (header): with modal data beside time runs every run needs stated noise.
+static void set_likelihood_weights(const ExperimentsSpec& spec, ExperimentsProblem& ep) {
+  bool all_stated = !ep.runs.empty();
+  for (std::size_t i = 0; i < ep.runs.size(); ++i)
+    for (std::size_t k = 0; k < ep.runs[i]->noise_std.size(); ++k)
+      if (!(ep.runs[i]->noise_std[k] > 0)) {
+        all_stated = false;
+        if (spec.modes_file)
+          bad(spec.source, "runs[" + std::to_string(i) + "] (" + spec.runs[i].name + ")",
+              "sensor has no stated noise level (noise_std), needed to weigh its data against the modal data",
+              ep.runs[i]->data.names[k]);
+      }
+  if (all_stated)
+    for (auto& p : ep.runs) {
+      const double W = p->data.white_noise_integral(p->data.t.front(), p->data.t.back());
+      const auto n = static_cast<double>(p->data.t.size());
+      p->objective_options.weights.clear();
+      for (double sd : p->noise_std) p->objective_options.weights.push_back(n / (sd * sd * W));
+    }
+}
+
 std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec) {
   auto ep = std::make_unique<ExperimentsProblem>();
   ep->spec = spec;
@@ -204,22 +245,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     const auto& r = spec.runs[i];
     io::Scenario sc = io::load_scenario(r.scenario);
     io::validate_scenario(sc);
-    if (sc.identification.smoothness != 0.0)
-      bad(spec.source, "runs[" + std::to_string(i) + "].scenario", "sets identification.smoothness, which a joint run does not take",
-          r.scenario);
-    if (sc.identification.start != io::Start::Auto)
-      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
-          "sets identification.start, which a joint run does not take (it starts plain, without restarts)", r.scenario);
-    if (!sc.identification.band.empty())
-      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
-          "sets identification.band, which a joint run does not take (its Fisher sum counts independent samples)", r.scenario);
-    if (!sc.identification.uncertain.empty())
-      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
-          "sets identification.uncertain, which a joint run does not take (its interval has no consider terms)", r.scenario);
-    if (sc.identification.model != io::Model::Linear)
-      bad(spec.source, "runs[" + std::to_string(i) + "].scenario",
-          std::string("sets identification.model: ") + io::to_string(sc.identification.model) + ", which a joint run does not take (linear model only)",
-          r.scenario);
+    check_joint_run_scenario(spec, i, sc);
     sc.identification.band_mode = io::IdentificationSpec::BandMode::None;  // (a joint run takes no band; above)
     ep->runs.push_back(make_problem(sc, r.data));
     same_parameters(*ep->runs.back()->params, "runs[" + std::to_string(i) + "] (" + r.name + ")");
@@ -238,24 +264,7 @@ std::unique_ptr<ExperimentsProblem> make_experiments(const ExperimentsSpec& spec
     ep->modes_params = ep->modes_structure->parameterize(*ep->modes_scenario);
     same_parameters(*ep->modes_params, "modes.scenario");
   }
-  // Likelihood weights (header): with modal data beside time runs every run needs stated noise.
-  bool all_stated = !ep->runs.empty();
-  for (std::size_t i = 0; i < ep->runs.size(); ++i)
-    for (std::size_t k = 0; k < ep->runs[i]->noise_std.size(); ++k)
-      if (!(ep->runs[i]->noise_std[k] > 0)) {
-        all_stated = false;
-        if (spec.modes_file)
-          bad(spec.source, "runs[" + std::to_string(i) + "] (" + spec.runs[i].name + ")",
-              "sensor has no stated noise level (noise_std), needed to weigh its data against the modal data",
-              ep->runs[i]->data.names[k]);
-      }
-  if (all_stated)
-    for (auto& p : ep->runs) {
-      const double W = p->data.white_noise_integral(p->data.t.front(), p->data.t.back());
-      const auto n = static_cast<double>(p->data.t.size());
-      p->objective_options.weights.clear();
-      for (double sd : p->noise_std) p->objective_options.weights.push_back(n / (sd * sd * W));
-    }
+  set_likelihood_weights(spec, *ep);
   // Modal data the model cannot be compared with at the start (fewer flexible modes than measured,
   // a measured mode no model mode can be matched to) are bad input, not a failed run.
   if (ep->modes) {

@@ -105,6 +105,15 @@ std::vector<DampedMode> damped_modes_now(const MatrixXd& M, const MatrixXd& D, c
 
 }  // namespace
 
+double rigid_floor(const SparseMatrix& M, const SparseMatrix& K) {
+  double ratio = 0.0;
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    const double m = M.coeff(i, i);
+    if (m > 0) ratio = std::max(ratio, K.coeff(i, i) / m);
+  }
+  return 1e-4 * std::sqrt(ratio > 0 ? 1e-6 * ratio : 1.0);
+}
+
 // Each dense eigen solve runs through io::interruptible (a fine mesh takes minutes in Eigen, which
 // cannot check for a signal): its body owns copies of its (sparse or small) arguments.
 

@@ -6,6 +6,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "scoleid/identify/fe/lowest_modes.h"
+#include "scoleid/identify/fe/modal.h"
+
 namespace scoleid::identify {
 namespace {
 
@@ -59,28 +62,60 @@ StateSpace state_space(const StructuralModel& model, const VectorXd& c) {
   return s;
 }
 
-ModalModel modal_model(const StructuralModel& model, const VectorXd& c) {
-  const Dense d = dense(model, c);
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> eig(d.K, d.M);  // φᵀ M φ = 1, ascending
-  const VectorXd lambda = eig.eigenvalues();
-  const MatrixXd& phi = eig.eigenvectors();
-  const Eigen::Index modes = lambda.size();
+namespace {
+
+// ζ from the modal damping, the shapes from the mass-normalised vectors; `rigid` says which are
+// rigid-body modes (ζ NaN).
+template <class Matrix, class Rigid>
+ModalModel modal_model_from(const StructuralModel& model, const VectorXd& omega, const MatrixXd& phi, const Matrix& M,
+                            const Matrix& D, const MatrixXd& B0, Rigid rigid) {
+  const Eigen::Index modes = omega.size();
   ModalModel mm;
-  mm.omega.resize(modes);
+  mm.omega = omega;
   mm.zeta.resize(modes);
-  const double top = std::sqrt(std::max(lambda.maxCoeff(), 0.0));
   for (Eigen::Index k = 0; k < modes; ++k) {
-    mm.omega[k] = std::sqrt(std::max(lambda[k], 0.0));
-    const double modal_damping = phi.col(k).dot(d.D * phi.col(k));
-    mm.zeta[k] = mm.omega[k] > 1e-6 * top ? modal_damping / (2.0 * mm.omega[k]) : std::numeric_limits<double>::quiet_NaN();
+    const double modal_damping = phi.col(k).dot(VectorXd(D * phi.col(k)));
+    mm.zeta[k] = !rigid(k) ? modal_damping / (2.0 * mm.omega[k]) : std::numeric_limits<double>::quiet_NaN();
   }
   mm.output_shapes.resize(static_cast<Eigen::Index>(model.sensors.size()), modes);
   for (std::size_t j = 0; j < model.sensors.size(); ++j) mm.output_shapes.row(static_cast<Eigen::Index>(j)) = model.sensors[j].row * phi;
-  mm.input_shapes = d.B0.transpose() * phi;
-  mm.mass_shapes = d.M * phi;
+  mm.input_shapes = B0.transpose() * phi;
+  mm.mass_shapes = MatrixXd(M * phi);
   mm.inputs = input_names(model);
   mm.outputs = output_names(model);
   return mm;
+}
+
+// The few lowest modes of a large model (fe/lowest_modes.h), all matrices sparse.
+ModalModel sparse_modal_model(const StructuralModel& model, const VectorXd& c, int elastic) {
+  const AssembledModel a = assemble(model, c);
+  LowestModesOptions o;
+  o.flexible = elastic;
+  const NaturalModes nm = lowest_modes(a.M, a.K, o);
+  MatrixXd B0 = MatrixXd::Zero(model.ndof, static_cast<Eigen::Index>(a.loads.size()));
+  for (std::size_t i = 0; i < a.loads.size(); ++i) B0.col(static_cast<Eigen::Index>(i)) = a.loads[i];
+  return modal_model_from(model, nm.omega, nm.vectors, a.M, a.D, B0, [&](Eigen::Index k) { return !(nm.omega[k] >= nm.floor); });
+}
+
+}  // namespace
+
+ModalModel modal_model(const StructuralModel& model, const VectorXd& c, int elastic) {
+  // Six rigid-body modes at most in space: the sparse solver pays when these and the elastic ones are few.
+  if (elastic > 0 && sparse_modes_pay(model.ndof, elastic + 6)) {
+    try {
+      return sparse_modal_model(model, c, elastic);
+    } catch (const LowestModesFailure&) {
+      // the dense solution below
+    }
+  }
+  const Dense d = dense(model, c);
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> eig(d.K, d.M);  // φᵀ M φ = 1, ascending
+  const VectorXd lambda = eig.eigenvalues();
+  VectorXd omega(lambda.size());
+  for (Eigen::Index k = 0; k < lambda.size(); ++k) omega[k] = std::sqrt(std::max(lambda[k], 0.0));
+  const AssembledModel a = assemble(model, c);
+  const double floor = rigid_floor(a.M, a.K);
+  return modal_model_from(model, omega, eig.eigenvectors(), d.M, d.D, d.B0, [&](Eigen::Index k) { return !(omega[k] >= floor); });
 }
 
 }  // namespace scoleid::identify

@@ -11,15 +11,16 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
-// Frequencies (Hz) and damping ratios of the elastic modes at q, lowest first.
+// Frequencies (Hz) and damping ratios of the elastic modes at q, lowest first: every one, or on a
+// large model the lowest `wanted` (state_space.h).
 struct Modes {
   VectorXd f, zeta;
 };
-Modes elastic_modes(const StructuralModel& model, const Parameterization& params, const VectorXd& q) {
+Modes elastic_modes(const StructuralModel& model, const Parameterization& params, const VectorXd& q, int wanted) {
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(q, c, dcdq);
-  const ModalModel mm = modal_model(model, c);
+  const ModalModel mm = modal_model(model, c, wanted);
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < mm.omega.size(); ++k)
     if (std::isfinite(mm.zeta[k])) keep.push_back(k);  // rigid-body modes have ζ = NaN
@@ -98,7 +99,7 @@ std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const P
                                            const Identifiability& ident, const UncertaintyInterval& interval,
                                            const ModalUncertaintyOptions& o) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const Modes m0 = elastic_modes(model, params, q);
+  const Modes m0 = elastic_modes(model, params, q, o.max_modes + 1);  // and the next one's gap
   Eigen::Index n = std::min<Eigen::Index>(m0.f.size(), o.max_modes);
   if (o.max_frequency_hz > 0)
     while (n > 0 && !(m0.f[n - 1] < o.max_frequency_hz)) --n;
@@ -125,7 +126,8 @@ std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const P
     VectorXd qp = q, qm = q;
     qp[i] += h;
     qm[i] -= h;
-    const Modes mp = elastic_modes(model, params, qp), mm = elastic_modes(model, params, qm);
+    const Modes mp = elastic_modes(model, params, qp, o.max_modes),
+                mm = elastic_modes(model, params, qm, o.max_modes);
     if (mp.f.size() < n || mm.f.size() < n) {
       reordered = true;
       break;

@@ -72,6 +72,47 @@ private:
   double h_ref_ = 0.0;
   bool have_ref_ = false;
 };
+
+// One step's stages backwards (docs/theory.md §6.7): Λ_i from the stage adjoint solves, their
+// share of the coefficient gradient added to gc; ybar, the adjoint at the step's end, becomes the
+// adjoint at its start.
+void step_adjoint(const ScoleNonlinear::Dynamics& dyn, const ButcherTable& tab, const NonlinearStep& st, StageAdjointSolver& stages,
+                  std::vector<VectorXd>& Lam, VectorXd& ybar, VectorXd& gc, NonlinearCostateSummary& sum) {
+  const int s = tab.stages;
+  const auto n = ybar.size();
+  const double gamma = tab.a(1, 1);
+  const double h = st.h;
+  stages.prepare(st.Y[static_cast<std::size_t>(s - 1)], st.inputs[static_cast<std::size_t>(s - 1)], h);
+  for (int i = s - 1; i >= 1; --i) {
+    const auto iu = static_cast<std::size_t>(i);
+    VectorXd S = VectorXd::Zero(n);
+    for (int k = i + 1; k < s; ++k) S += tab.a(k, i) * Lam[static_cast<std::size_t>(k)];
+    auto JT = [&](const VectorXd& x) {
+      ++sum.products;
+      return dyn.derivative_vjp(st.Y[iu].data(), st.inputs[iu], st.F[iu], x);
+    };
+    VectorXd rhs = i == s - 1 ? ybar : VectorXd::Zero(n);
+    if (S.cwiseAbs().maxCoeff() > 0) rhs += h * JT(S);
+    const VectorXd L = stages.solve(rhs, JT, st.Y[iu], st.inputs[iu], h, st.t);
+    Lam[iu] = L;
+    const VectorXd Phi = gamma * L + S;
+    if (Phi.cwiseAbs().maxCoeff() > 0) {
+      gc += h * dyn.coefficient_vjp(st.Y[iu].data(), st.inputs[iu], st.F[iu], Phi);
+      ++sum.products;
+    }
+  }
+  VectorXd Phi0 = VectorXd::Zero(n), next = VectorXd::Zero(n);
+  for (int i = 1; i < s; ++i) {
+    Phi0 += tab.a(i, 0) * Lam[static_cast<std::size_t>(i)];
+    next += Lam[static_cast<std::size_t>(i)];
+  }
+  if (Phi0.cwiseAbs().maxCoeff() > 0) {
+    next += h * dyn.derivative_vjp(st.Y[0].data(), st.inputs[0], st.F[0], Phi0);
+    gc += h * dyn.coefficient_vjp(st.Y[0].data(), st.inputs[0], st.F[0], Phi0);
+    sum.products += 2;
+  }
+  ybar = next;
+}
 }  // namespace
 
 NonlinearObjective::NonlinearObjective(const ScoleNonlinear& model, const Parameterization& params,
@@ -235,37 +276,7 @@ double NonlinearObjective::cost_and_coefficient_gradient(const VectorXd& c, Vect
       io::check_interrupt();
       sample_adjoint(st.sample, ybar);
     }
-    const double h = st.h;
-    stages.prepare(st.Y[static_cast<std::size_t>(s - 1)], st.inputs[static_cast<std::size_t>(s - 1)], h);
-    for (int i = s - 1; i >= 1; --i) {
-      const auto iu = static_cast<std::size_t>(i);
-      VectorXd S = VectorXd::Zero(n);
-      for (int k = i + 1; k < s; ++k) S += tab.a(k, i) * Lam[static_cast<std::size_t>(k)];
-      auto JT = [&](const VectorXd& x) {
-        ++sum.products;
-        return dyn.derivative_vjp(st.Y[iu].data(), st.inputs[iu], st.F[iu], x);
-      };
-      VectorXd rhs = i == s - 1 ? ybar : VectorXd::Zero(n);
-      if (S.cwiseAbs().maxCoeff() > 0) rhs += h * JT(S);
-      const VectorXd L = stages.solve(rhs, JT, st.Y[iu], st.inputs[iu], h, st.t);
-      Lam[iu] = L;
-      const VectorXd Phi = gamma * L + S;
-      if (Phi.cwiseAbs().maxCoeff() > 0) {
-        gc += h * dyn.coefficient_vjp(st.Y[iu].data(), st.inputs[iu], st.F[iu], Phi);
-        ++sum.products;
-      }
-    }
-    VectorXd Phi0 = VectorXd::Zero(n), next = VectorXd::Zero(n);
-    for (int i = 1; i < s; ++i) {
-      Phi0 += tab.a(i, 0) * Lam[static_cast<std::size_t>(i)];
-      next += Lam[static_cast<std::size_t>(i)];
-    }
-    if (Phi0.cwiseAbs().maxCoeff() > 0) {
-      next += h * dyn.derivative_vjp(st.Y[0].data(), st.inputs[0], st.F[0], Phi0);
-      gc += h * dyn.coefficient_vjp(st.Y[0].data(), st.inputs[0], st.F[0], Phi0);
-      sum.products += 2;
-    }
-    ybar = next;
+    step_adjoint(dyn, tab, st, stages, Lam, ybar, gc, sum);
   }
   // The first sample (the given initial state): only its u̇ depends on c.
   {

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "scoleid/identify/inverse/coefficient_quadrature.h"
+#include "scoleid/identify/fe/lowest_modes.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/io/interrupt.h"
 
@@ -1213,26 +1214,9 @@ double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, Matr
   Setup s = setup(q);
   SecondOrderSolver solver(s.ops.M, s.ops.D, s.ops.K, model_.dof_group, options_.solver);
   settle_initial_state(s, solver);
-  const int P = size(), n = model_.ndof, ns = data_.sensors();
+  const int P = size(), ns = data_.sensors();
   const double state_end = profile ? data_.t.back() : T_;
-  if (estimates_initial_state()) {
-    // The parameters' tangents and the initial state's, from the settled start; then the Schur
-    // complement: g and H of the parameters with the initial state's coefficients profiled out.
-    kept_ = {};
-    std::vector<Derivative> d;
-    for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
-    for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
-    VectorXd g_all;
-    MatrixXd H_all;
-    const double J = gauss_newton_streamed(s, solver, state_end, g_all, H_all, profile, nullptr, &d);
-    const int m = static_cast<int>(d.size()) - P;
-    const MatrixXd Hpa = H_all.topRightCorner(P, m);
-    const MatrixXd X = pseudo_solve(H_all.bottomRightCorner(m, m), Hpa.transpose());
-    H = H_all.topLeftCorner(P, P) - Hpa * X;
-    H = 0.5 * (H + H.transpose()).eval();
-    gradient = g_all.head(P) - X.transpose() * g_all.tail(m);
-    return J;
-  }
+  if (estimates_initial_state()) return gauss_newton_with_start(s, solver, state_end, gradient, H, profile);
   if (solver.has_tangent_solve()) {
     kept_ = {};
     MatrixXd G;
@@ -1242,6 +1226,33 @@ double Objective::gauss_newton_solve(const VectorXd& q, VectorXd& gradient, Matr
     if (keep) kept_ = {q, std::move(G)};
     return J;
   }
+  return gauss_newton_blocked(s, solver, state_end, gradient, H, profile);
+}
+
+double Objective::gauss_newton_with_start(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
+                                          MatrixXd& H, MisfitProfile* profile) {
+  // The parameters' tangents and the initial state's, from the settled start; then the Schur
+  // complement: g and H of the parameters with the initial state's coefficients profiled out.
+  const int P = size();
+  kept_ = {};
+  std::vector<Derivative> d;
+  for (int i = 0; i < P; ++i) d.push_back(derivative(s, i));
+  for (Derivative& di : initial_state_derivatives()) d.push_back(std::move(di));
+  VectorXd g_all;
+  MatrixXd H_all;
+  const double J = gauss_newton_streamed(s, solver, state_end, g_all, H_all, profile, nullptr, &d);
+  const int m = static_cast<int>(d.size()) - P;
+  const MatrixXd Hpa = H_all.topRightCorner(P, m);
+  const MatrixXd X = pseudo_solve(H_all.bottomRightCorner(m, m), Hpa.transpose());
+  H = H_all.topLeftCorner(P, P) - Hpa * X;
+  H = 0.5 * (H + H.transpose()).eval();
+  gradient = g_all.head(P) - X.transpose() * g_all.tail(m);
+  return J;
+}
+
+double Objective::gauss_newton_blocked(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
+                                       MatrixXd& H, MisfitProfile* profile) {
+  const int P = size(), n = model_.ndof, ns = data_.sensors();
   // Without a tangent stepper: the tangents in blocks of at most sensitivity_block() trajectories,
   // the state re-solved with each block; their outputs C S at the quadrature points are kept
   // (quadrature points × sensors × P numbers), not the trajectories.
@@ -1430,6 +1441,29 @@ bool Objective::keeps_sensitivities() const {
   return !accelerations_ && bytes <= options_.sensitivity_block_bytes;
 }
 
+// One streamed Gauss–Newton pass's running quadrature: the sums, the last recorded point's time,
+// the first data time not below it, and the time spent integrating.
+struct Objective::StreamPass {
+  StreamPass(int P, const Eigen::Map<const VectorXd>& R, double& J, VectorXd& gradient, MatrixXd& H, double t0, double T)
+      : gn(P, R, J, gradient, H), t0(t0), T(T), m(1 + P) {}
+  GaussNewtonSums gn;
+  const double t0, T;
+  const int m;  // columns: the state and the P tangents
+  double t_prev = 0.0, quadrature = 0.0;
+  bool have_prev = false;
+  std::size_t next_data = 0;
+  std::vector<double> cuts;
+  // The interval from the last point to one at t1 (with `cols` columns) clipped to [t0, T]: true,
+  // with its cuts at the data times, when there is one to integrate.
+  bool interval_to(const Objective& o, double t1, int cols) {
+    const double a_end = std::max(t_prev, t0), b_end = std::min(t1, T);
+    if (!(have_prev && t1 > t_prev && b_end > a_end)) return false;
+    if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
+    o.interval_cuts(a_end, b_end, next_data, cuts);
+    return true;
+  }
+};
+
 double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end,
                                         VectorXd& gradient, MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows,
                                         const std::vector<Derivative>* derivs) {
@@ -1441,14 +1475,13 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   std::vector<Derivative> d;
   if (derivs) d = *derivs;
   else for (int i = 0; i < size(); ++i) d.push_back(derivative(s, i));
-  const int P = static_cast<int>(d.size()), n = model_.ndof, ns = data_.sensors(), m = 1 + P;
-  const double t0 = data_.t.front();
+  const int P = static_cast<int>(d.size()), n = model_.ndof, ns = data_.sensors();
   const auto ts = Clock::now();
   const Eigen::Map<const VectorXd> Rv(R_.data(), ns);
   gradient = VectorXd::Zero(P);
   H = MatrixXd::Zero(P, P);
-  double J = 0.0, quadrature = 0.0;
-  GaussNewtonSums gn(P, Rv, J, gradient, H);
+  double J = 0.0;
+  StreamPass pass(P, Rv, J, gradient, H, data_.t.front(), T_);
   // The misfit profile (over the whole record) from the state's column in windows.
   std::unique_ptr<ProfileSums> sums;
   std::unique_ptr<WindowedSink> profile_sink;
@@ -1457,101 +1490,20 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
     profile_sink = std::make_unique<WindowedSink>(n, kStreamWindow, [&](const Trajectory& w) {
       const auto tp = Clock::now();
       profile_window(s, solver, w, *sums);
-      quadrature += since(tp);
+      pass.quadrature += since(tp);
     });
   }
-  MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
-  VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
-  double t_prev = 0.0;
-  bool have_prev = false;
-  std::size_t next_data = 0;  // first data time not below t_prev
-  std::vector<double> cuts;
   SolverSummary sum;
   if (!accelerations_) {
-    // Without acceleration sensors the outputs are C x + C₁ v of every column, linear in the
-    // recorded points: the Hermite interpolation is done on the outputs of the two points (sensors ×
-    // columns) instead of on the states (DOFs × columns). Yx = C X + C₁ V, Yv = C V + C₁ A per point
-    // (stream_outputs: on one thread or two).
-    MatrixXd Yx0(ns, m), Yv0(ns, m), Ys(ns, m), Ykeep(ns, m);
-    std::size_t next_sample = 0;  // the first sample not yet in sample_rows
-    const auto at = [&](double t1, int cols, const MatrixXd& Yx1, const MatrixXd& Yv1) {
-      if (sample_rows && cols == m)
-        sample_output_rows(data_.t, next_sample, have_prev, t_prev, t1, Yx0, Yv0, Yx1, Yv1, Ykeep, *sample_rows);
-      const double a_end = std::max(t_prev, t0), b_end = std::min(t1, T_);
-      if (have_prev && t1 > t_prev && b_end > a_end) {
-        if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
-        const auto tq = Clock::now();
-        const double h = t1 - t_prev;
-        interval_cuts(a_end, b_end, next_data, cuts);
-        for_each_gauss_point(cuts, [&](double t, double wt) {
-          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
-          Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
-          data_.eval(t, z.data());
-          const VectorXd r = Ys.col(0) - z;
-          gn.add(wt, r, Ys.rightCols(P));
-        });
-        quadrature += since(tq);
-      }
-      // This point's outputs are the next interval's left end (beyond the horizon, where the
-      // tangents have stopped, nothing more is integrated).
-      if (cols == m) {
-        Yx0 = Yx1;
-        Yv0 = Yv1;
-      }
-      t_prev = t1;
-      have_prev = true;
-    };
     SecondOrderSolver::Sink state_visit;
     if (profile_sink) state_visit = [&](const SecondOrderSolver::Point& pt) { (*profile_sink)(pt); };
-    stream_outputs(s, solver, state_end, T_, d, state_visit, at, sum);
+    stream_output_pass(s, solver, state_end, d, state_visit, sample_rows, pass, sum);
   } else {
-    const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
-    auto visit = [&](const SecondOrderSolver::Point& pt) {
-      if (profile_sink) (*profile_sink)(pt);
-      const int cols = pt.columns;
-      const Eigen::Map<const MatrixXd> X1(pt.x, n, cols), V1(pt.v, n, cols), A1(pt.a, n, cols);
-      const double a_end = std::max(t_prev, t0), b_end = std::min(pt.t, T_);
-      if (have_prev && pt.t > t_prev && b_end > a_end) {
-        if (cols < m) throw std::logic_error("gauss_newton: the tangents stopped before the horizon");
-        const auto tq = Clock::now();
-        const double h = pt.t - t_prev;
-        interval_cuts(a_end, b_end, next_data, cuts);
-        for_each_gauss_point(cuts, [&](double t, double wt) {
-          const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
-          Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
-          Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
-          x = Xs.col(0);
-          v = Vs.col(0);
-          data_.eval(t, z.data());
-          const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
-          for (int i = 0; i < P; ++i) {
-            si = Xs.col(1 + i);
-            svi = Vs.col(1 + i);
-            CS.col(i) = tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, svi);
-          }
-          gn.add(wt, r, CS);
-        });
-        quadrature += since(tq);
-      }
-      if (cols == m) {
-        X0 = X1;
-        V0 = V1;
-        A0 = A1;
-      } else {  // the tangents have stopped (beyond the horizon): only the state moves on
-        X0.col(0) = X1.col(0);
-        V0.col(0) = V1.col(0);
-        A0.col(0) = A1.col(0);
-      }
-      t_prev = pt.t;
-      have_prev = true;
-    };
-    const auto start = run_start(s, d);
-    solver.stream_tangent(t0, state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum, StepAnchor::Start,
-                          start.get());
+    stream_state_pass(s, solver, state_end, d, profile_sink.get(), pass, sum);
   }
   const auto tf = Clock::now();
-  gn.finish();
-  quadrature += since(tf);
+  pass.gn.finish();
+  pass.quadrature += since(tf);
   if (profile) {
     profile_sink->finish();  // (its windows' time is in `quadrature`)
     *profile = std::move(sums->prof);
@@ -1559,9 +1511,97 @@ double Objective::gauss_newton_streamed(const Setup& s, const SecondOrderSolver&
   counters_.solver.Accumulate(sum);
   ++counters_.forward_solves;
   counters_.sensitivity_solves += P;
-  counters_.sensitivity_seconds += since(ts) - quadrature;
-  counters_.quadrature_seconds += quadrature;
+  counters_.sensitivity_seconds += since(ts) - pass.quadrature;
+  counters_.quadrature_seconds += pass.quadrature;
   return J;
+}
+
+void Objective::stream_output_pass(const Setup& s, const SecondOrderSolver& solver, double state_end,
+                                   const std::vector<Derivative>& d, const SecondOrderSolver::Sink& state_visit,
+                                   MatrixXd* sample_rows, StreamPass& pass, SolverSummary& sum) const {
+  // Without acceleration sensors the outputs are C x + C₁ v of every column, linear in the
+  // recorded points: the Hermite interpolation is done on the outputs of the two points (sensors ×
+  // columns) instead of on the states (DOFs × columns). Yx = C X + C₁ V, Yv = C V + C₁ A per point
+  // (stream_outputs: on one thread or two).
+  const int ns = data_.sensors(), m = pass.m, P = m - 1;
+  MatrixXd Yx0(ns, m), Yv0(ns, m), Ys(ns, m), Ykeep(ns, m);
+  VectorXd z(ns);
+  std::size_t next_sample = 0;  // the first sample not yet in sample_rows
+  const auto at = [&](double t1, int cols, const MatrixXd& Yx1, const MatrixXd& Yv1) {
+    if (sample_rows && cols == m)
+      sample_output_rows(data_.t, next_sample, pass.have_prev, pass.t_prev, t1, Yx0, Yv0, Yx1, Yv1, Ykeep, *sample_rows);
+    if (pass.interval_to(*this, t1, cols)) {
+      const auto tq = Clock::now();
+      const double t_prev = pass.t_prev, h = t1 - t_prev;
+      for_each_gauss_point(pass.cuts, [&](double t, double wt) {
+        const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
+        Ys = h00 * Yx0 + h10 * Yv0 + h01 * Yx1 + h11 * Yv1;
+        data_.eval(t, z.data());
+        const VectorXd r = Ys.col(0) - z;
+        pass.gn.add(wt, r, Ys.rightCols(P));
+      });
+      pass.quadrature += since(tq);
+    }
+    // This point's outputs are the next interval's left end (beyond the horizon, where the
+    // tangents have stopped, nothing more is integrated).
+    if (cols == m) {
+      Yx0 = Yx1;
+      Yv0 = Yv1;
+    }
+    pass.t_prev = t1;
+    pass.have_prev = true;
+  };
+  stream_outputs(s, solver, state_end, T_, d, state_visit, at, sum);
+}
+
+void Objective::stream_state_pass(const Setup& s, const SecondOrderSolver& solver, double state_end,
+                                  const std::vector<Derivative>& d, WindowedSink* profile_sink, StreamPass& pass,
+                                  SolverSummary& sum) const {
+  // With acceleration sensors an output needs the state's acceleration: the states (DOFs × columns)
+  // are interpolated and each tangent's output taken from them.
+  const int n = model_.ndof, ns = data_.sensors(), m = pass.m, P = m - 1;
+  MatrixXd X0(n, m), V0(n, m), A0(n, m), Xs(n, m), Vs(n, m), CS(ns, P);
+  VectorXd x(n), v(n), a(n), si(n), svi(n), z(ns);
+  const SecondOrderSolver::TangentForcing Gf = tangent_forcing(d);
+  auto visit = [&](const SecondOrderSolver::Point& pt) {
+    if (profile_sink) (*profile_sink)(pt);
+    const int cols = pt.columns;
+    const Eigen::Map<const MatrixXd> X1(pt.x, n, cols), V1(pt.v, n, cols), A1(pt.a, n, cols);
+    if (pass.interval_to(*this, pt.t, cols)) {
+      const auto tq = Clock::now();
+      const double t_prev = pass.t_prev, h = pt.t - t_prev;
+      for_each_gauss_point(pass.cuts, [&](double t, double wt) {
+        const auto [h00, h10, h01, h11] = hermite_weights(t, t_prev, h);
+        Xs = h00 * X0 + h10 * V0 + h01 * X1 + h11 * V1;
+        Vs = h00 * V0 + h10 * A0 + h01 * V1 + h11 * A1;
+        x = Xs.col(0);
+        v = Vs.col(0);
+        data_.eval(t, z.data());
+        const VectorXd r = output_at(s, solver, t, x, v, &a) - z;
+        for (int i = 0; i < P; ++i) {
+          si = Xs.col(1 + i);
+          svi = Vs.col(1 + i);
+          CS.col(i) = tangent_output_at(solver, d[static_cast<std::size_t>(i)], t, x, v, a, si, svi);
+        }
+        pass.gn.add(wt, r, CS);
+      });
+      pass.quadrature += since(tq);
+    }
+    if (cols == m) {
+      X0 = X1;
+      V0 = V1;
+      A0 = A1;
+    } else {  // the tangents have stopped (beyond the horizon): only the state moves on
+      X0.col(0) = X1.col(0);
+      V0.col(0) = V1.col(0);
+      A0.col(0) = A1.col(0);
+    }
+    pass.t_prev = pt.t;
+    pass.have_prev = true;
+  };
+  const auto start = run_start(s, d);
+  solver.stream_tangent(data_.t.front(), state_end, state_forcing(s), P, Gf, T_, breakpoints_, visit, &sum, StepAnchor::Start,
+                        start.get());
 }
 
 Objective::MisfitProfile Objective::misfit_profile(const VectorXd& q) {
@@ -1829,7 +1869,9 @@ void Objective::make_initial_state_basis() {
   MatrixXd dcdq;
   params_.coefficients(params_.initial(), c, dcdq);
   const AssembledModel ops = assemble(model_, c);
-  const NaturalModes nm = natural_modes(ops.M, ops.K);
+  LowestModesOptions few;
+  few.flexible = options_.initial_state_modes;
+  const NaturalModes nm = few_or_all_modes(ops.M, ops.K, few);
   Eigen::Index rigid = 0;
   while (rigid < nm.omega.size() && nm.omega[rigid] < nm.floor) ++rigid;
   basis_ = nm.vectors.leftCols(std::min<Eigen::Index>(rigid + options_.initial_state_modes, nm.vectors.cols()));

@@ -198,131 +198,162 @@ public:
   virtual double prior_cost(const VectorXd& x, const Point& p) const = 0;
 };
 
-void trust_region(Run& r, VectorXd x, StepStrategy& s) {
-  Misfit& obj = r.obj;
-  const double t0 = obj.response_start(), t_end = obj.data_end();  // horizons measured from t0
-  const bool continuation = r.opt.continuation;
-  auto full = [&]() { return obj.horizon() >= t_end; };
-  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
-  auto fail_start = [&]() {
-    r.failed("cost cannot be evaluated at the starting point");
-    r.sum.cost = NAN;  // (no cost: not a zero one)
-    r.sum.q = x.array().exp();
-  };
-  obj.set_horizon(t_end);
-  if (continuation) {
+// The loop's state between iterations: the iterate, the point it stands on, the radius.
+class TrustRegionLoop {
+public:
+  TrustRegionLoop(Run& r, VectorXd x, StepStrategy& s)
+      : r_(r), obj_(r.obj), s_(s), x_(std::move(x)), t0_(obj_.response_start()), t_end_(obj_.data_end()) {}
+
+  void run() {
+    if (!begin()) {
+      r_.failed("cost cannot be evaluated at the starting point");
+      r_.sum.cost = NAN;  // (no cost: not a zero one)
+      r_.sum.q = x_.array().exp();
+      return;
+    }
     try {
-      obj.set_horizon(r.horizon_from(obj.misfit_profile(x.array().exp()), t0));
+      while (iterate() == Next::Go) {
+      }
     } catch (const std::exception& e) {
       if (!point_failure(e)) throw;
-      return fail_start();
+      r_.failed(e.what());
     }
+    r_.conclude(k_, x_, cur_.J);
+    r_.sum.prior_cost = s_.prior_cost(x_, cur_);
+    if (full() && r_.sum.termination != T::LineSearchFailed) r_.sum.end_matrix = s_.end_matrix(cur_, held_);
+    obj_.set_horizon(t_end_);
   }
-  Point cur;
-  if (!s.evaluate(x, cur, false)) return fail_start();
-  r.record(0, cur.J, x.array().exp(), cur.g);
-  s.start(cur);
-  double radius = r.opt.trust_radius;
-  int k = 0;
-  MatrixXd held;  // the point before's matrix, when the run ends on the step from it
-  r.sum.termination = T::MaxIterations;
-  // On a short horizon a termination test lengthens the horizon instead; true if it did.
-  auto extend = [&](double T_new) {
-    if (full() || !(T_new > obj.horizon())) return false;
-    obj.set_horizon(T_new);
-    if (!s.evaluate(x, cur, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+
+private:
+  enum class Next { Go, Stop };
+  bool full() const { return obj_.horizon() >= t_end_; }
+  double doubled() const { return std::min(t_end_, obj_.horizon() + (obj_.horizon() - t0_)); }  // horizons from t0
+
+  // The first horizon (the whole record, or with continuation as far as the start's misfit
+  // allows) and the starting point; false if it cannot be evaluated.
+  bool begin() {
+    obj_.set_horizon(t_end_);
+    if (r_.opt.continuation) {
+      try {
+        obj_.set_horizon(r_.horizon_from(obj_.misfit_profile(x_.array().exp()), t0_));
+      } catch (const std::exception& e) {
+        if (!point_failure(e)) throw;
+        return false;
+      }
+    }
+    if (!s_.evaluate(x_, cur_, false)) return false;
+    r_.record(0, cur_.J, x_.array().exp(), cur_.g);
+    s_.start(cur_);
+    radius_ = r_.opt.trust_radius;
+    r_.sum.termination = T::MaxIterations;
     return true;
-  };
-  try {
-    while (true) {
-      if (cur.J <= r.opt.cost_floor || r.small_gradient(cur.g, cur.J)) {
-        if (extend(doubled())) continue;
-        r.sum.termination = cur.J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
-        break;
-      }
-      if (k >= r.opt.max_iterations) break;
-      const TrustRegionStep st = s.step(x, cur, radius, full() ? 0.0 : r.opt.short_horizon_floor * cur.J);
-      // On the whole record the undamped step's predicted decrease is the most the Gauss–Newton
-      // model can gain. A gain of J/N (the stall threshold) is a move of about one standard
-      // deviation (δᵀFδ ≈ N ΔJ / J with F ≈ H N / 2J), so below a thousandth of it the step left
-      // is within 0.03 std of the minimum: end the run without paying for the trial's solve.
-      if (full() && !st.on_boundary && st.predicted <= 1e-3 * r.gauss_newton_stall() * cur.J) {
-        if (cur.matrix_kept) {  // (a kept matrix's prediction: the point's own decides)
-          cur.H.resize(0, 0);
-          cur.matrix_kept = false;
-          if (!s.complete(x, cur)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at the current point");
-          continue;
-        }
-        r.sum.termination = T::CostStalled;
-        r.sum.message = "the Gauss-Newton step left predicts a decrease below 1e-3 of the stall threshold: at the minimum";
-        break;
-      }
-      Point trial;
-      const bool profile = continuation && !full();
-      bool ok = s.evaluate_trial(x + st.delta, trial, profile) && trial.J < cur.J;
-      const double rho = ok && st.predicted > 0 ? (cur.J - trial.J) / st.predicted : -1.0;
-      // A kept matrix that fails — a step it shaped is rejected, or gains less than the stall
-      // threshold — is replaced by the point's own before anything is concluded from it: the
-      // trial is dropped and the step taken again.
-      if (cur.matrix_kept && (!ok || cur.J - trial.J <= r.gauss_newton_stall() * cur.J)) {
-        cur.H.resize(0, 0);
-        cur.matrix_kept = false;
-        if (!s.complete(x, cur)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at the current point");
-        continue;
-      }
-      radius = update_radius(radius, st, rho, r.opt.max_trust_radius);
-      VectorXd delta = st.delta;
-      if (ok && rho > r.opt.extrapolation_ratio) s.extrapolate(x, st, rho, profile, trial, delta, radius);
-      // A point whose cost alone was taken gets its gradient and matrix now, unless the run ends on
-      // it (a stalled or vanishing step on the whole record: nothing is taken from there; a run
-      // that goes on from it evaluates it then). One whose gradient or matrix cannot be evaluated
-      // is rejected like one whose cost cannot.
-      const double step = delta.cwiseAbs().maxCoeff();
-      const bool stalled = cur.J - trial.J <= r.gauss_newton_stall() * cur.J;
-      const bool ends_here = full() && (stalled || step < r.opt.step_tolerance);  // (the test below)
-      if (ok && !ends_here && !s.complete(x + delta, trial)) {
-        ok = false;
-        radius = update_radius(radius, st, -1.0, r.opt.max_trust_radius);
-      }
-      if (!ok) {
-        if (radius < r.opt.step_tolerance) {
-          if (extend(doubled())) {
-            radius = r.opt.trust_radius;
-            continue;
-          }
-          r.sum.termination = T::StepTolerance;
-          r.sum.message = s.no_decrease();
-          break;
-        }
-        continue;
-      }
-      x += delta;
-      // A run ending on this step moved less than the stall threshold's worth (about one standard
-      // deviation, §7.4) or less than the step tolerance: the matrix it was taken with holds at its
-      // end (end_matrix).
-      if (ends_here) held = std::move(cur.H);
-      cur = std::move(trial);
-      ++k;
-      // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
-      // with its cost on the horizon the next step is taken on.
-      const bool extended = profile && extend(r.horizon_from(s.accepted_profile(x), obj.horizon()));
-      r.record(k, cur.J, x.array().exp(), cur.g);
-      if (extended) continue;
-      if (step < r.opt.step_tolerance || stalled) {
-        if (extend(doubled())) continue;
-        r.sum.termination = step < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
-        break;
-      }
-    }
-  } catch (const std::exception& e) {
-    if (!point_failure(e)) throw;
-    r.failed(e.what());
   }
-  r.conclude(k, x, cur.J);
-  r.sum.prior_cost = s.prior_cost(x, cur);
-  if (full() && r.sum.termination != T::LineSearchFailed) r.sum.end_matrix = s.end_matrix(cur, held);
-  obj.set_horizon(t_end);
-}
+
+  // On a short horizon a termination test lengthens the horizon instead; true if it did.
+  bool extend(double T_new) {
+    if (full() || !(T_new > obj_.horizon())) return false;
+    obj_.set_horizon(T_new);
+    if (!s_.evaluate(x_, cur_, false)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    return true;
+  }
+
+  // A kept matrix is replaced by the point's own, and the step taken again.
+  Next renew_matrix() {
+    cur_.H.resize(0, 0);
+    cur_.matrix_kept = false;
+    if (!s_.complete(x_, cur_)) throw std::runtime_error("the Gauss-Newton matrix cannot be evaluated at the current point");
+    return Next::Go;
+  }
+
+  Next iterate() {
+    if (cur_.J <= r_.opt.cost_floor || r_.small_gradient(cur_.g, cur_.J)) {
+      if (extend(doubled())) return Next::Go;
+      r_.sum.termination = cur_.J <= r_.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+      return Next::Stop;
+    }
+    if (k_ >= r_.opt.max_iterations) return Next::Stop;
+    const TrustRegionStep st = s_.step(x_, cur_, radius_, full() ? 0.0 : r_.opt.short_horizon_floor * cur_.J);
+    // On the whole record the undamped step's predicted decrease is the most the Gauss–Newton
+    // model can gain. A gain of J/N (the stall threshold) is a move of about one standard
+    // deviation (δᵀFδ ≈ N ΔJ / J with F ≈ H N / 2J), so below a thousandth of it the step left
+    // is within 0.03 std of the minimum: end the run without paying for the trial's solve.
+    if (full() && !st.on_boundary && st.predicted <= 1e-3 * r_.gauss_newton_stall() * cur_.J) {
+      if (cur_.matrix_kept) return renew_matrix();  // (a kept matrix's prediction: the point's own decides)
+      r_.sum.termination = T::CostStalled;
+      r_.sum.message = "the Gauss-Newton step left predicts a decrease below 1e-3 of the stall threshold: at the minimum";
+      return Next::Stop;
+    }
+    Point trial;
+    const bool profile = r_.opt.continuation && !full();
+    bool ok = s_.evaluate_trial(x_ + st.delta, trial, profile) && trial.J < cur_.J;
+    const double rho = ok && st.predicted > 0 ? (cur_.J - trial.J) / st.predicted : -1.0;
+    // A kept matrix that fails — a step it shaped is rejected, or gains less than the stall
+    // threshold — is replaced by the point's own before anything is concluded from it: the
+    // trial is dropped and the step taken again.
+    if (cur_.matrix_kept && (!ok || cur_.J - trial.J <= r_.gauss_newton_stall() * cur_.J)) return renew_matrix();
+    radius_ = update_radius(radius_, st, rho, r_.opt.max_trust_radius);
+    VectorXd delta = st.delta;
+    if (ok && rho > r_.opt.extrapolation_ratio) s_.extrapolate(x_, st, rho, profile, trial, delta, radius_);
+    // A point whose cost alone was taken gets its gradient and matrix now, unless the run ends on
+    // it (a stalled or vanishing step on the whole record: nothing is taken from there; a run
+    // that goes on from it evaluates it then). One whose gradient or matrix cannot be evaluated
+    // is rejected like one whose cost cannot.
+    const double step = delta.cwiseAbs().maxCoeff();
+    const bool stalled = cur_.J - trial.J <= r_.gauss_newton_stall() * cur_.J;
+    const bool ends_here = full() && (stalled || step < r_.opt.step_tolerance);  // (the test in accept)
+    if (ok && !ends_here && !s_.complete(x_ + delta, trial)) {
+      ok = false;
+      radius_ = update_radius(radius_, st, -1.0, r_.opt.max_trust_radius);
+    }
+    if (!ok) return rejected();
+    return accept(std::move(trial), delta, step, stalled, ends_here, profile);
+  }
+
+  // A rejected trial: a smaller radius next, until it falls below the step tolerance.
+  Next rejected() {
+    if (!(radius_ < r_.opt.step_tolerance)) return Next::Go;
+    if (extend(doubled())) {
+      radius_ = r_.opt.trust_radius;
+      return Next::Go;
+    }
+    r_.sum.termination = T::StepTolerance;
+    r_.sum.message = s_.no_decrease();
+    return Next::Stop;
+  }
+
+  Next accept(Point trial, const VectorXd& delta, double step, bool stalled, bool ends_here, bool profile) {
+    x_ += delta;
+    // A run ending on this step moved less than the stall threshold's worth (about one standard
+    // deviation, §7.4) or less than the step tolerance: the matrix it was taken with holds at its
+    // end (end_matrix).
+    if (ends_here) held_ = std::move(cur_.H);
+    cur_ = std::move(trial);
+    ++k_;
+    // Lengthen the horizon as far as the new iterate's misfit allows; the iterate is recorded
+    // with its cost on the horizon the next step is taken on.
+    const bool extended = profile && extend(r_.horizon_from(s_.accepted_profile(x_), obj_.horizon()));
+    r_.record(k_, cur_.J, x_.array().exp(), cur_.g);
+    if (extended) return Next::Go;
+    if (step < r_.opt.step_tolerance || stalled) {
+      if (extend(doubled())) return Next::Go;
+      r_.sum.termination = step < r_.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+      return Next::Stop;
+    }
+    return Next::Go;
+  }
+
+  Run& r_;
+  Misfit& obj_;
+  StepStrategy& s_;
+  VectorXd x_;
+  const double t0_, t_end_;
+  Point cur_;
+  double radius_ = 0.0;
+  int k_ = 0;
+  MatrixXd held_;  // the point before's matrix, when the run ends on the step from it
+};
+
+void trust_region(Run& r, VectorXd x, StepStrategy& s) { TrustRegionLoop(r, std::move(x), s).run(); }
 
 // Explicit Gauss–Newton: J, g and H from forward sensitivities at every trial point (the misfit
 // profile comes with the state solve); the Levenberg step of gauss_newton_step.h. With a
@@ -497,114 +528,138 @@ VectorXd lbfgs_direction(const VectorXd& x, const VectorXd& gx, std::deque<std::
   return d;
 }
 
-void lbfgs(Run& r, VectorXd x, bool steepest) {
-  Misfit& obj = r.obj;
-  const double t0 = obj.response_start(), t_end = obj.data_end();  // horizons measured from t0
-  // Horizon continuation as for Gauss–Newton (header, Run::horizon_from), from the misfit profile
-  // of one extra state solve per accepted step while the horizon is short of the record.
-  // The paper's update with fixed weights is reproduced as it is: on the whole record.
-  const bool continuation = r.opt.continuation && !(steepest && !r.opt.steepest_weights.empty());
-  auto full = [&]() { return obj.horizon() >= t_end; };
-  auto choose_horizon = [&](const VectorXd& xx, double current) {
-    return r.horizon_from(obj.misfit_profile(xx.array().exp()), current);
-  };
-  double J;
-  VectorXd gx;
-  std::deque<std::pair<VectorXd, VectorXd>> mem;  // (s, y)
-  // A new horizon is a new cost: its gradient, and the curvature pairs of the old one dropped.
-  auto extend = [&](double T_new) {
-    if (full() || !(T_new > obj.horizon())) return false;
-    obj.set_horizon(T_new);
-    if (!r.eval_grad(x, J, gx)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
-    mem.clear();
-    return true;
-  };
-  auto doubled = [&]() { return std::min(t_end, obj.horizon() + (obj.horizon() - t0)); };
-  obj.set_horizon(t_end);
-  bool start_ok = true;
-  if (continuation) {
+// L-BFGS or steepest descent with a backtracking line search; the loop's state between iterations.
+class LineSearchLoop {
+public:
+  LineSearchLoop(Run& r, VectorXd x, bool steepest)
+      : r_(r), obj_(r.obj), x_(std::move(x)), steepest_(steepest), fixed_weights_(steepest && !r.opt.steepest_weights.empty()),
+        // Horizon continuation as for Gauss–Newton (header, Run::horizon_from), from the misfit
+        // profile of one extra state solve per accepted step while the horizon is short of the
+        // record. The paper's update with fixed weights is reproduced as it is: on the whole record.
+        continuation_(r.opt.continuation && !fixed_weights_), t0_(obj_.response_start()), t_end_(obj_.data_end()) {}
+
+  void run() {
+    if (!begin()) {
+      r_.failed("cost cannot be evaluated at the starting point");
+      r_.sum.cost = NAN;  // (no cost: not a zero one)
+      r_.sum.q = x_.array().exp();
+      obj_.set_horizon(t_end_);
+      return;
+    }
+    r_.record(0, J_, x_.array().exp(), gx_);
+    if (fixed_weights_) {
+      w_ = Eigen::Map<const VectorXd>(r_.opt.steepest_weights.data(), static_cast<Eigen::Index>(r_.opt.steepest_weights.size()));
+      if (w_.size() != x_.size()) {
+        obj_.set_horizon(t_end_);
+        throw std::invalid_argument("steepest_weights: one weight per parameter");
+      }
+    }
+    r_.sum.termination = T::MaxIterations;
     try {
-      obj.set_horizon(choose_horizon(x, t0));
+      while (iterate() == Next::Go) {
+      }
     } catch (const std::exception& e) {
       if (!point_failure(e)) throw;
-      start_ok = false;
+      r_.failed(e.what());
     }
+    r_.conclude(k_, x_, J_);
+    r_.sum.prior_cost = r_.prior.value(x_);
+    obj_.set_horizon(t_end_);
   }
-  if (!start_ok || !r.eval_grad(x, J, gx)) {
-    r.failed("cost cannot be evaluated at the starting point");
-    r.sum.cost = NAN;  // (no cost: not a zero one)
-    r.sum.q = x.array().exp();
-    obj.set_horizon(t_end);
-    return;
-  }
-  r.record(0, J, x.array().exp(), gx);
-  const int m = 8;
-  double alpha0 = 1.0;
-  const bool fixed_weights = steepest && !r.opt.steepest_weights.empty();
-  VectorXd w;
-  if (fixed_weights) {
-    w = Eigen::Map<const VectorXd>(r.opt.steepest_weights.data(), static_cast<Eigen::Index>(r.opt.steepest_weights.size()));
-    if (w.size() != x.size()) {
-      obj.set_horizon(t_end);
-      throw std::invalid_argument("steepest_weights: one weight per parameter");
-    }
-  }
-  int k = 0;
-  r.sum.termination = T::MaxIterations;
-  try {
-    while (true) {
-      if (J <= r.opt.cost_floor || r.small_gradient(gx, J)) {
-        if (extend(doubled())) continue;
-        r.sum.termination = J <= r.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
-        break;
-      }
-      if (k >= r.opt.max_iterations) break;
-      VectorXd d = lbfgs_direction(x, gx, mem, steepest, fixed_weights ? &w : nullptr, alpha0);
-      const double mx = d.cwiseAbs().maxCoeff();
-      if (mx > 1.0) d *= 1.0 / mx;
-      double a = 1.0, Jn = 0.0;
-      VectorXd gn;
-      bool ok = false;
-      for (int ls = 0; ls < 40; ++ls) {
-        if (r.eval_grad(x + a * d, Jn, gn) && Jn <= J + 1e-4 * a * gx.dot(d) && Jn <= J) {
-          ok = true;
-          break;
-        }
-        a *= 0.5;
-      }
-      if (!ok) {
-        if (extend(doubled())) continue;
-        r.failed("no decrease along the search direction");
-        break;
-      }
-      const VectorXd s = a * d, y = gn - gx;
-      const bool stalled = J - Jn <= (r.opt.cost_stall > 0 ? r.opt.cost_stall : 1e-5) * J;
-      x += s;
-      J = Jn;
-      gx = gn;
-      if (!steepest && y.dot(s) > 1e-300) {
-        mem.emplace_back(s, y);
-        if (static_cast<int>(mem.size()) > m) mem.pop_front();
-      }
-      if (steepest && !fixed_weights) alpha0 = std::min(1e3, a * 2.0 * alpha0);
-      ++k;
-      const bool extended = continuation && !full() && extend(choose_horizon(x, obj.horizon()));
-      r.record(k, J, x.array().exp(), gx);
-      if (extended) continue;
-      if (s.cwiseAbs().maxCoeff() < r.opt.step_tolerance || (stalled && !steepest)) {
-        if (extend(doubled())) continue;
-        r.sum.termination = s.cwiseAbs().maxCoeff() < r.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
-        break;
+
+private:
+  enum class Next { Go, Stop };
+  static constexpr int kPairs = 8;  // curvature pairs kept
+  bool full() const { return obj_.horizon() >= t_end_; }
+  double doubled() const { return std::min(t_end_, obj_.horizon() + (obj_.horizon() - t0_)); }  // horizons from t0
+  double choose_horizon(double current) const { return r_.horizon_from(obj_.misfit_profile(x_.array().exp()), current); }
+
+  bool begin() {
+    obj_.set_horizon(t_end_);
+    if (continuation_) {
+      try {
+        obj_.set_horizon(choose_horizon(t0_));
+      } catch (const std::exception& e) {
+        if (!point_failure(e)) throw;
+        return false;
       }
     }
-  } catch (const std::exception& e) {
-    if (!point_failure(e)) throw;
-    r.failed(e.what());
+    return r_.eval_grad(x_, J_, gx_);
   }
-  r.conclude(k, x, J);
-  r.sum.prior_cost = r.prior.value(x);
-  obj.set_horizon(t_end);
-}
+
+  // A new horizon is a new cost: its gradient, and the curvature pairs of the old one dropped.
+  bool extend(double T_new) {
+    if (full() || !(T_new > obj_.horizon())) return false;
+    obj_.set_horizon(T_new);
+    if (!r_.eval_grad(x_, J_, gx_)) throw std::runtime_error("cost cannot be evaluated on the longer horizon");
+    mem_.clear();
+    return true;
+  }
+
+  Next iterate() {
+    if (J_ <= r_.opt.cost_floor || r_.small_gradient(gx_, J_)) {
+      if (extend(doubled())) return Next::Go;
+      r_.sum.termination = J_ <= r_.opt.cost_floor ? T::CostFloor : T::GradientTolerance;
+      return Next::Stop;
+    }
+    if (k_ >= r_.opt.max_iterations) return Next::Stop;
+    VectorXd d = lbfgs_direction(x_, gx_, mem_, steepest_, fixed_weights_ ? &w_ : nullptr, alpha0_);
+    const double mx = d.cwiseAbs().maxCoeff();
+    if (mx > 1.0) d *= 1.0 / mx;
+    // Backtracking to the Armijo condition.
+    double a = 1.0, Jn = 0.0;
+    VectorXd gn;
+    bool ok = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      if (r_.eval_grad(x_ + a * d, Jn, gn) && Jn <= J_ + 1e-4 * a * gx_.dot(d) && Jn <= J_) {
+        ok = true;
+        break;
+      }
+      a *= 0.5;
+    }
+    if (!ok) {
+      if (extend(doubled())) return Next::Go;
+      r_.failed("no decrease along the search direction");
+      return Next::Stop;
+    }
+    return accept(a, d, Jn, gn);
+  }
+
+  Next accept(double a, const VectorXd& d, double Jn, const VectorXd& gn) {
+    const VectorXd s = a * d, y = gn - gx_;
+    const bool stalled = J_ - Jn <= (r_.opt.cost_stall > 0 ? r_.opt.cost_stall : 1e-5) * J_;
+    x_ += s;
+    J_ = Jn;
+    gx_ = gn;
+    if (!steepest_ && y.dot(s) > 1e-300) {
+      mem_.emplace_back(s, y);
+      if (static_cast<int>(mem_.size()) > kPairs) mem_.pop_front();
+    }
+    if (steepest_ && !fixed_weights_) alpha0_ = std::min(1e3, a * 2.0 * alpha0_);
+    ++k_;
+    const bool extended = continuation_ && !full() && extend(choose_horizon(obj_.horizon()));
+    r_.record(k_, J_, x_.array().exp(), gx_);
+    if (extended) return Next::Go;
+    if (s.cwiseAbs().maxCoeff() < r_.opt.step_tolerance || (stalled && !steepest_)) {
+      if (extend(doubled())) return Next::Go;
+      r_.sum.termination = s.cwiseAbs().maxCoeff() < r_.opt.step_tolerance ? T::StepTolerance : T::CostStalled;
+      return Next::Stop;
+    }
+    return Next::Go;
+  }
+
+  Run& r_;
+  Misfit& obj_;
+  VectorXd x_;
+  const bool steepest_, fixed_weights_, continuation_;
+  const double t0_, t_end_;
+  double J_ = 0.0, alpha0_ = 1.0;
+  VectorXd gx_, w_;
+  std::deque<std::pair<VectorXd, VectorXd>> mem_;  // (s, y)
+  int k_ = 0;
+};
+
+void lbfgs(Run& r, VectorXd x, bool steepest) { LineSearchLoop(r, std::move(x), steepest).run(); }
 
 // Inexact Gauss–Newton–Krylov (docs/theory.md §7.7): the trust-region step from truncated
 // conjugate gradients on matrix-free products (Steihaug), stopped at ‖H δ + g‖ <= η ‖g‖ with the

@@ -37,13 +37,10 @@ void PhysicalParameterization::refuse(std::string field, std::string what, std::
   refusal_ = ParameterRefusal{std::move(field), std::move(what), std::move(value)};
 }
 
-void PhysicalParameterization::resolve(const io::IdentificationSpec& id) {
-  names_ = id.estimate;
-  if (names_.empty()) return refuse("identification.estimate", "must name at least one parameter", "none");
-  if (paper_ && !space_.paper_requirement.empty())
-    return refuse("identification.parameterization", space_.paper_requirement, "paper");
-  std::vector<std::string> allowed, paper_names{"q1", "q2"};
-  if (space_.has_q3) paper_names.push_back("q3");
+// The names identification.estimate may hold: q1, q2 (, q3) and what they do not stand for in the
+// paper form (ζ, ρI_ψ, the masses, ...); every group and quantity in the physical one.
+std::vector<std::string> PhysicalParameterization::allowed_names(const std::vector<std::string>& paper_names) const {
+  std::vector<std::string> allowed;
   if (paper_) {
     // q1, q2 (, q3) and any quantity or group they do not stand for (ζ, ρI_ψ, the masses, ...).
     allowed = paper_names;
@@ -63,6 +60,35 @@ void PhysicalParameterization::resolve(const io::IdentificationSpec& id) {
     for (const auto& g : space_.groups) allowed.push_back(g.name);
     allowed.insert(allowed.end(), space_.quantities.begin(), space_.quantities.end());
   }
+  return allowed;
+}
+
+// Starting φ: the scenario's values, overridden by identification.initial — groups first, then
+// single quantities, then the paper's q2 (ρA), q1 (EI = q1 ρA) and q3 (X = q3 ρA).
+std::vector<double> PhysicalParameterization::starting_values(const std::map<std::string, double>& ini) const {
+  std::vector<double> start = space_.value;
+  for (const auto& g : space_.groups)
+    if (ini.count(g.name))
+      for (int m : g.members) start[static_cast<std::size_t>(m)] = ini.at(g.name);
+  for (std::size_t k = 0; k < space_.quantities.size(); ++k)
+    if (ini.count(space_.quantities[k])) start[k] = ini.at(space_.quantities[k]);
+  const auto* ei = group(space_.EI_group);
+  if (space_.rho_A >= 0 && ini.count("q2")) start[static_cast<std::size_t>(space_.rho_A)] = 1.0 / ini.at("q2");
+  if (ei && space_.rho_A >= 0 && ini.count("q1"))
+    for (int m : ei->members) start[static_cast<std::size_t>(m)] = ini.at("q1") * start[static_cast<std::size_t>(space_.rho_A)];
+  if (space_.rho_A >= 0 && space_.q3_quantity >= 0 && ini.count("q3"))
+    start[static_cast<std::size_t>(space_.q3_quantity)] = ini.at("q3") * start[static_cast<std::size_t>(space_.rho_A)];
+  return start;
+}
+
+void PhysicalParameterization::resolve(const io::IdentificationSpec& id) {
+  names_ = id.estimate;
+  if (names_.empty()) return refuse("identification.estimate", "must name at least one parameter", "none");
+  if (paper_ && !space_.paper_requirement.empty())
+    return refuse("identification.parameterization", space_.paper_requirement, "paper");
+  std::vector<std::string> paper_names{"q1", "q2"};
+  if (space_.has_q3) paper_names.push_back("q3");
+  const std::vector<std::string> allowed = allowed_names(paper_names);
   for (std::size_t i = 0; i < names_.size(); ++i) {
     const std::string f = "identification.estimate[" + std::to_string(i) + "]";
     if (std::find(allowed.begin(), allowed.end(), names_[i]) == allowed.end())
@@ -87,22 +113,8 @@ void PhysicalParameterization::resolve(const io::IdentificationSpec& id) {
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       return refuse("identification.initial." + key, "is not a parameter of this " + space_.structure, format_value(v));
 
-  // Starting φ: the scenario's values, overridden by identification.initial — groups first, then
-  // single quantities, then the paper's q2 (ρA), q1 (EI = q1 ρA) and q3 (X = q3 ρA).
-  start_ = space_.value;
+  start_ = starting_values(id.initial);
   const auto& ini = id.initial;
-  for (const auto& g : space_.groups)
-    if (ini.count(g.name))
-      for (int m : g.members) start_[static_cast<std::size_t>(m)] = ini.at(g.name);
-  for (std::size_t k = 0; k < space_.quantities.size(); ++k)
-    if (ini.count(space_.quantities[k])) start_[k] = ini.at(space_.quantities[k]);
-  const auto* ei = group(space_.EI_group);
-  if (space_.rho_A >= 0 && ini.count("q2")) start_[static_cast<std::size_t>(space_.rho_A)] = 1.0 / ini.at("q2");
-  if (ei && space_.rho_A >= 0 && ini.count("q1"))
-    for (int m : ei->members) start_[static_cast<std::size_t>(m)] = ini.at("q1") * start_[static_cast<std::size_t>(space_.rho_A)];
-  if (space_.rho_A >= 0 && space_.q3_quantity >= 0 && ini.count("q3"))
-    start_[static_cast<std::size_t>(space_.q3_quantity)] = ini.at("q3") * start_[static_cast<std::size_t>(space_.rho_A)];
-
   // A group estimated as one value must start as one value.
   for (const auto& n : names_) {
     const auto* g = group(n == "q1" ? space_.EI_group : n);

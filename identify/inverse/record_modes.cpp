@@ -29,7 +29,7 @@ RecordModes record_modes(Objective& obj, const StructuralModel& model, const Par
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(q, c, dcdq);
-  const ModalModel mm = modal_model(model, c);
+  const ModalModel mm = modal_model(model, c, o.max_modes);
   // The elastic modes (rigid-body ones have ζ = NaN), numbered as modal_estimates numbers them.
   std::vector<Objective::RankOneDirection> dirs;
   int elastic = 0;

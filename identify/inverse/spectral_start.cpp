@@ -22,7 +22,7 @@ VectorXd log_frequencies(const StructuralModel& model, const Parameterization& p
   VectorXd c;
   MatrixXd dcdq;
   params.coefficients(q, c, dcdq);
-  const ModalModel mm = modal_model(model, c);
+  const ModalModel mm = modal_model(model, c, static_cast<int>(n));
   std::vector<double> f;
   for (Eigen::Index k = 0; k < mm.omega.size() && static_cast<Eigen::Index>(f.size()) < n; ++k)
     if (std::isfinite(mm.zeta[k]) && mm.omega[k] > 0) f.push_back(std::log(mm.omega[k]));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include "scoleid/identify/door/run_door.h"
@@ -112,6 +113,56 @@ void modal_interval(ExperimentsResult& r, const ExperimentsProblem& ep) {
 
 }  // namespace
 
+// The optimiser's callback: a signal ends the run; with `verbose` a table row per iteration (the
+// header printed now).
+static std::function<void(const IterationRecord&)> progress_printer(const std::vector<std::string>& names, bool verbose) {
+  if (verbose) {
+    io::progress("%5s", "iter");
+    for (std::size_t i = 0; i < names.size() && i < 6; ++i) io::progress(" %13s", names[i].c_str());
+    io::progress(" %13s %8s\n", "cost", "horizon");
+  }
+  return [verbose](const IterationRecord& rec) {
+    io::check_interrupt();
+    if (!verbose) return;
+    io::progress("%5d", rec.k);
+    for (Eigen::Index i = 0; i < rec.q.size() && i < 6; ++i) io::progress(" %13.6g", rec.q[i]);
+    io::progress(" %13.6e %8.4g\n", rec.cost, rec.horizon);
+    std::fflush(stdout);
+  };
+}
+
+// Each experiment's cost, share and (with compute_std) its own and the joint Fisher information.
+static void assess_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo, JointMisfit& joint,
+                        const std::vector<std::unique_ptr<Objective>>& objs, ModalMisfit* modal, int P, double J,
+                        ExperimentsResult& r) {
+  FisherInformation total;
+  for (int e = 0; e < joint.components(); ++e) {
+    ExperimentsResult::Experiment x;
+    x.name = joint.name(e);
+    x.cost = joint.last_costs()[static_cast<std::size_t>(e)];
+    x.share = J > 0 ? x.cost / J : 0.0;
+    const auto u = static_cast<std::size_t>(e);
+    const FisherInformation fi =
+        e < static_cast<int>(ep.runs.size())
+            ? time_experiment(*ep.runs[u], *objs[u], r.estimate, eo.compute_std, x)
+            : modal_experiment(*modal, *ep.modes, *ep.spec.modes_file, joint.components(), P, r.estimate,
+                               eo.compute_std, x);
+    if (eo.compute_std) {
+      x.alone = identifiability_from(fi, r.estimate);
+      if (x.kind == "modal") x.alone.noise_source = "the modal data file's stds";
+      total += fi;
+    }
+    r.experiments.push_back(std::move(x));
+  }
+  if (eo.compute_std) {
+    r.ident = identifiability_from(total, r.estimate);
+    if (r.weighting == "relative")
+      r.std_note = "some noise levels are not stated: the runs are weighed by their relative misfit, not by the likelihood, "
+                   "so the std (the Cramér-Rao bound with noise levels from the residual) may be optimistic";
+    if (ep.runs.empty() && ep.modes) modal_interval(r, ep);
+  }
+}
+
 ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo) {
   check_experiments_run(ep, eo);
   const auto t_start = std::chrono::steady_clock::now();
@@ -153,19 +204,7 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   if (r.method == io::Method::GaussNewtonKrylov && !joint.has_matrix_free_products())
     throw std::logic_error("run_experiments: gauss-newton-krylov without matrix-free products (check_experiments_run refuses it)");
   const OptimizerOptions oo = optimizer_options(lead.identification, r.method, params.size(), eo.max_iterations);
-  if (eo.verbose) {
-    io::progress("%5s", "iter");
-    for (std::size_t i = 0; i < r.names.size() && i < 6; ++i) io::progress(" %13s", r.names[i].c_str());
-    io::progress(" %13s %8s\n", "cost", "horizon");
-  }
-  auto progress = [&](const IterationRecord& rec) {
-    io::check_interrupt();
-    if (!eo.verbose) return;
-    io::progress("%5d", rec.k);
-    for (Eigen::Index i = 0; i < rec.q.size() && i < 6; ++i) io::progress(" %13.6g", rec.q[i]);
-    io::progress(" %13.6e %8.4g\n", rec.cost, rec.horizon);
-    std::fflush(stdout);
-  };
+  const auto progress = progress_printer(r.names, eo.verbose);
   r.summary = minimize(joint, r.initial, oo, progress);
   r.estimate = r.summary.q;
   joint.set_horizon(1.0);
@@ -178,34 +217,32 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   }
   r.summary.cost = J;
 
-  FisherInformation total;
-  for (int e = 0; e < joint.components(); ++e) {
-    ExperimentsResult::Experiment x;
-    x.name = joint.name(e);
-    x.cost = joint.last_costs()[static_cast<std::size_t>(e)];
-    x.share = J > 0 ? x.cost / J : 0.0;
-    const auto u = static_cast<std::size_t>(e);
-    const FisherInformation fi =
-        e < static_cast<int>(ep.runs.size())
-            ? time_experiment(*ep.runs[u], *objs[u], r.estimate, eo.compute_std, x)
-            : modal_experiment(*modal, *ep.modes, *ep.spec.modes_file, joint.components(), params.size(), r.estimate,
-                               eo.compute_std, x);
-    if (eo.compute_std) {
-      x.alone = identifiability_from(fi, r.estimate);
-      if (x.kind == "modal") x.alone.noise_source = "the modal data file's stds";
-      total += fi;
-    }
-    r.experiments.push_back(std::move(x));
-  }
-  if (eo.compute_std) {
-    r.ident = identifiability_from(total, r.estimate);
-    if (r.weighting == "relative")
-      r.std_note = "some noise levels are not stated: the runs are weighed by their relative misfit, not by the likelihood, "
-                   "so the std (the Cramér-Rao bound with noise levels from the residual) may be optimistic";
-    if (ep.runs.empty() && ep.modes) modal_interval(r, ep);
-  }
+  assess_experiments(ep, eo, joint, objs, modal.get(), params.size(), J, r);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
+}
+
+// The joint run's interval per parameter (the interval of a modal-data run), or why there is none.
+static nlohmann::json interval_json(const ExperimentsResult& r) {
+  using nlohmann::json;
+  if (r.interval.half_width.size() != r.estimate.size())
+    return "not assessed in a joint run with time records (no half-record refit, no consider terms): std and resolution "
+           "are the Fisher information's of all experiments together";
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  json iv = json::object();
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    const double w = r.interval.half_width[e];
+    json x{{"half_width", finite(w)},
+           {"low", std::isfinite(w) ? json(r.estimate[e] - w) : json(nullptr)},
+           {"high", std::isfinite(w) ? json(r.estimate[e] + w) : json(nullptr)},
+           {"noise_2std", finite(r.interval.noise[e])},
+           {"residual_2resolution", finite(r.interval.residual[e])}};
+    if (const auto t = r.truth.find(r.names[i]); t != r.truth.end() && std::isfinite(w))
+      x["covers_truth"] = std::abs(r.estimate[e] - t->second) <= w;
+    iv[r.names[i]] = x;
+  }
+  return iv;
 }
 
 nlohmann::json ExperimentsResult::to_json() const {
@@ -244,27 +281,8 @@ nlohmann::json ExperimentsResult::to_json() const {
   out["identifiability"] = ident_json(ident);
   if (!ident.identifiable.empty()) {
     out["identifiability"]["std_note"] = std_note;
-    if (interval.half_width.size() == estimate.size()) {
-      json iv = json::object();
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        const auto e = static_cast<Eigen::Index>(i);
-        const double w = interval.half_width[e];
-        json x{{"half_width", finite(w)},
-               {"low", std::isfinite(w) ? json(estimate[e] - w) : json(nullptr)},
-               {"high", std::isfinite(w) ? json(estimate[e] + w) : json(nullptr)},
-               {"noise_2std", finite(interval.noise[e])},
-               {"residual_2resolution", finite(interval.residual[e])}};
-        if (const auto t = truth.find(names[i]); t != truth.end() && std::isfinite(w))
-          x["covers_truth"] = std::abs(estimate[e] - t->second) <= w;
-        iv[names[i]] = x;
-      }
-      out["identifiability"]["interval"] = iv;
-      out["identifiability"]["interval_note"] = interval.note;
-    } else {
-      out["identifiability"]["interval"] =
-          "not assessed in a joint run with time records (no half-record refit, no consider terms): std and resolution "
-          "are the Fisher information's of all experiments together";
-    }
+    out["identifiability"]["interval"] = interval_json(*this);
+    if (interval.half_width.size() == estimate.size()) out["identifiability"]["interval_note"] = interval.note;
   }
   json ex = json::array();
   for (const auto& e : experiments) {

@@ -2,6 +2,8 @@
 // attempts (run/attempts.h), assessment (run/assessment.h); the outputs: run/run_report.cpp.
 #include "scoleid/identify/run/identify_run.h"
 
+#include "scoleid/identify/fe/lowest_modes.h"
+
 #include "scoleid/identify/door/run_door.h"
 #include "scoleid/identify/point_failure.h"
 #include "scoleid/io/progress.h"
@@ -121,7 +123,7 @@ bool better_attempt(const RunResult::Attempt& a, const RunResult::Attempt& b, lo
 
 void estimate_modes(const Problem& p, RunResult& r, bool verbose) {
   if (!r.estimate.allFinite()) return;
-  if (verbose && p.model().ndof >= 1000)
+  if (verbose && p.model().ndof >= kSparseModesFrom && !sparse_modes_pay(p.model().ndof, ModalUncertaintyOptions{}.max_modes + 7))
     io::progress("modes of the identified model: %ld dense eigen-solutions of the %d-degree-of-freedom model (each about %.2g s, "
                  "O(n^3); fewer elements are faster)\n",
                  1L + (r.ident.std.size() == r.estimate.size() ? 2L * static_cast<long>(r.estimate.size()) : 0L), p.model().ndof,

@@ -11,12 +11,14 @@
 
 #include <stdexcept>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <filesystem>
 #include <optional>
 #include <random>
 
+#include "scoleid/identify/fe/lowest_modes.h"
 #include "scoleid/identify/fe/modal.h"
 #include "scoleid/identify/inverse/band_filter.h"
 #include "scoleid/identify/inverse/spectral_start.h"
@@ -71,24 +73,68 @@ StartModes::StartModes(const StructuralModel& model, const Parameterization& par
   ops_ = assemble(model, c);
 }
 
-const std::vector<double>& StartModes::frequencies() {
-  if (!frequencies_) {
-    if (verbose_ && model_.ndof >= 1000)
+bool StartModes::sparse(double up_to) {
+  if (model_.ndof < kSparseModesFrom || !(up_to > 0)) return false;
+  if (!below_count_ || counted_at_ != up_to) {
+    below_count_ = modes_below(ops_.M, ops_.K, up_to);
+    counted_at_ = up_to;
+  }
+  return *below_count_ >= 0 && sparse_modes_pay(model_.ndof, *below_count_) && !sparse_failed_;
+}
+
+const std::vector<double>& StartModes::frequencies(double up_to) {
+  if (sparse(up_to)) {
+    const NaturalModes& m = modes(up_to);
+    if (!sparse_failed_) {
+      frequencies_ = std::vector<double>(m.omega.data(), m.omega.data() + m.omega.size());
+      frequencies_all_ = false;
+      return *frequencies_;
+    }
+  }
+  if (!frequencies_all_) {
+    if (verbose_ && model_.ndof >= kSparseModesFrom)
       io::progress("the starting model's frequencies: a dense eigen-solution of %d degrees of freedom, about %.2g s (O(n^3); fewer "
                    "elements are faster)\n",
                    model_.ndof, dense_eigen_seconds(model_.ndof, false));
     frequencies_ = natural_frequencies(ops_.M, ops_.K);
+    frequencies_all_ = true;
+    rigid_below_ = rigid_floor(ops_.M, ops_.K);
   }
   return *frequencies_;
 }
 
-const NaturalModes& StartModes::modes() {
-  if (!modes_) {
-    if (verbose_ && model_.ndof >= 1000)
+const NaturalModes& StartModes::modes(double up_to) {
+  if (sparse(up_to)) {
+    if (!modes_ || modes_all_ || solved_up_to_ < up_to) {
+      LowestModesOptions o;
+      o.below_omega = up_to;
+      LowestModesSummary s;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        modes_ = lowest_modes(ops_.M, ops_.K, o, &s);
+      } catch (const LowestModesFailure& e) {
+        if (verbose_) io::progress("the starting model's modes: %s; solving densely\n", e.what());
+        sparse_failed_ = true;
+        return modes(up_to);
+      }
+      solved_up_to_ = up_to;
+      modes_all_ = false;
+      rigid_below_ = modes_->floor;
+      if (verbose_)
+        io::progress("the starting model's %d modes below %.4g Hz: sparse subspace iteration on %d degrees of freedom, %d "
+                     "iterations, %.2g s\n",
+                     s.wanted, up_to / (2.0 * M_PI), model_.ndof, s.iterations,
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return *modes_;
+  }
+  if (!modes_all_) {
+    if (verbose_ && model_.ndof >= kSparseModesFrom)
       io::progress("the starting model's modes: a dense eigen-solution of %d degrees of freedom, about %.2g s (O(n^3); fewer "
                    "elements are faster)\n",
                    model_.ndof, dense_eigen_seconds(model_.ndof, true));
     modes_ = natural_modes(ops_.M, ops_.K);
+    modes_all_ = true;
   }
   return *modes_;
 }
@@ -107,13 +153,12 @@ DataContent data_content(StartModes& start, const std::vector<io::Signal>& signa
   const AssembledModel& ops = start.ops();
   DataContent d;
   d.nyquist = M_PI / sample_interval;
-  // K and ω_K from the frequencies alone (modes with ω <= 1e-6 ω_max count as rigid).
+  // K and ω_K from the frequencies alone (modes below start.rigid_below() count as rigid).
   {
-    const std::vector<double>& w = start.frequencies();
-    const double wmax = w.empty() ? 0.0 : w.back();
+    const std::vector<double>& w = start.frequencies(d.nyquist);
     std::vector<double> below;
     for (double x : w)
-      if (x > 1e-6 * wmax && x <= d.nyquist) below.push_back(x);
+      if (x > start.rigid_below() && x <= d.nyquist) below.push_back(x);
     d.modes_below_nyquist = static_cast<int>(below.size());
     if (below.empty()) return d;
     d.omega_first = below.front();
@@ -121,7 +166,7 @@ DataContent data_content(StartModes& start, const std::vector<io::Signal>& signa
     d.omega = below[static_cast<std::size_t>(d.mode - 1)];
   }
   // The visible content K_data (reported): from the mode shapes.
-  const NaturalModes& m = start.modes();
+  const NaturalModes& m = start.modes(d.nyquist);
   std::vector<Eigen::Index> flexible;
   for (Eigen::Index k = 0; k < m.omega.size(); ++k)
     if (m.omega[k] > m.floor && m.omega[k] <= d.nyquist) flexible.push_back(k);
@@ -206,9 +251,9 @@ bool estimates_damping(const StructuralModel& model, const Parameterization& par
 }
 
 // The smallest positive modal damping ratio φᵀDφ / (2ω) (M-orthonormal φ) over the flexible
-// modes 1 … count at the starting parameters; 0 if none is damped.
-double smallest_modal_damping(StartModes& start, int count) {
-  const NaturalModes& m = start.modes();
+// modes 1 … count (all below up_to) at the starting parameters; 0 if none is damped.
+double smallest_modal_damping(StartModes& start, int count, double up_to) {
+  const NaturalModes& m = start.modes(up_to);
   const MatrixXd D(start.ops().D);
   double smallest = 0.0;
   int counted = 0;
@@ -263,7 +308,7 @@ IdentifierStep identifier_integration(const io::Scenario& sc, StartModes& start,
   // there (docs/theory.md §5.2), or the fit absorbs the integrator's damping into the estimate.
   IdentifierStep out{h, -1, h};
   if (w > 0 && estimates_damping(start.model(), start.params())) {
-    const double target = 0.01 * smallest_modal_damping(start, content.mode);
+    const double target = 0.01 * smallest_modal_damping(start, content.mode, content.nyquist);
     if (target > 0.0) {
       const ButcherTable third = ButcherTable::arkode_dirk(-1), fourth = ButcherTable::arkode_dirk(ButcherTable::esdirk436_id());
       const double h3 = damping_bounded_step(third, w, h, target), h4 = damping_bounded_step(fourth, w, h, target);

@@ -345,6 +345,68 @@ nlohmann::json frf_json(const Problem& p, const RunResult& r) {
           {"note", p.frf_note}, {"start", r.frf_start_note}, {"passes", r.frf_passes}, {"factorisations", r.frf_factorisations},
           {"sensors", sensors}};
 }
+
+json band_json(const Problem& p) {
+  const auto& band = p.scenario.identification.band;
+  if (band.empty()) return p.band_note.empty() ? json(nullptr) : json{{"chosen", "auto"}, {"note", p.band_note}};
+  return {{"f_lo_hz", band[0]},
+          {"f_hi_hz", band[1]},
+          {"noise_gain", p.band_gain},
+          {"chosen", p.band_note.empty() ? "stated" : "auto"},
+          {"note", p.band_note.empty() ? "the scenario's identification.band" : p.band_note}};
+}
+
+json initial_state_json(const Problem& p, const RunResult& r) {
+  if (p.scenario.identification.initial_state != io::InitialState::Estimate)
+    return {{"estimated", false}, {"note", "the structure at rest at the first sample"}};
+  const auto m = static_cast<Eigen::Index>(r.initial_state_hz.size());
+  std::vector<double> a, b;
+  if (r.initial_state_coefficients.size() == 2 * m)
+    for (Eigen::Index j = 0; j < m; ++j) {
+      a.push_back(r.initial_state_coefficients[j]);
+      b.push_back(r.initial_state_coefficients[m + j]);
+    }
+  return {{"estimated", true},
+          {"modes", m},
+          {"basis_hz", r.initial_state_hz},
+          {"displacement", a},
+          {"velocity", b},
+          {"note", "x(t0) = sum of displacement[j] phi_j, x'(t0) = sum of velocity[j] phi_j, phi_j the basis "
+                   "model's M-orthonormal modes at basis_hz; profiled out of the fit, its unknowns counted in "
+                   "every interval"}};
+}
+
+json start_check_json(const StartCheck& c) {
+  json sensors = json::array();
+  for (const auto& s : c.sensors)
+    sensors.push_back({{"name", s.name},
+                       {"correlation", std::isfinite(s.correlation) ? json(s.correlation) : json(nullptr)},
+                       {"scale", std::isfinite(s.scale) ? json(s.scale) : json(nullptr)}});
+  json out = {{"from", c.from}, {"to", c.to}, {"sensors", sensors}, {"warnings", c.warnings}};
+  json frf = json::array();
+  auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  for (const auto& r : c.frf) {
+    json lines = json::array();
+    for (const auto& l : r.lines)
+      lines.push_back({{"hz", l.hz}, {"measured", number(l.measured)}, {"model", number(l.model)}, {"ratio", number(l.ratio)},
+                       {"phase_deg", number(l.phase_deg)}});
+    frf.push_back({{"input", r.input}, {"sensor", r.sensor}, {"median_ratio", number(r.median_ratio)},
+                   {"median_abs_phase_deg", number(r.median_phase_deg)}, {"lines", lines}});
+  }
+  out["frf"] = frf;
+  if (!c.frf_note.empty()) out["frf_note"] = c.frf_note;
+  return out;
+}
+
+json residual_bands_json(const Problem& p, const ResidualBands& rb) {
+  json bands = json::array();
+  for (const auto& b : rb.bands) {
+    json rms = json::object();
+    for (std::size_t j = 0; j < b.rms.size() && j < p.data.names.size(); ++j) rms[p.data.names[j]] = b.rms[j];
+    bands.push_back({{"from_hz", b.from_hz}, {"to_hz", b.to_hz}, {"holds", b.holds}, {"mode", b.mode}, {"share", b.share}, {"rms", rms}});
+  }
+  return {{"bands", bands}, {"at_modes", rb.at_modes}, {"summary", rb.summary}, {"note", rb.note}};
+}
 }  // namespace
 
 nlohmann::json RunResult::to_json(const Problem& p) const {
@@ -379,68 +441,16 @@ nlohmann::json RunResult::to_json(const Problem& p) const {
            {"settings", io::to_json(p.scenario)},
            {"identifiability", identifiability_json(*this)},
            {"modes", modes_json(*this)},
-           {"band", p.scenario.identification.band.empty()
-                        ? (p.band_note.empty() ? json(nullptr) : json{{"chosen", "auto"}, {"note", p.band_note}})
-                        : json{{"f_lo_hz", p.scenario.identification.band[0]},
-                               {"f_hi_hz", p.scenario.identification.band[1]},
-                               {"noise_gain", p.band_gain},
-                               {"chosen", p.band_note.empty() ? "stated" : "auto"},
-                               {"note", p.band_note.empty() ? "the scenario's identification.band" : p.band_note}}}};
-  if (p.scenario.identification.initial_state == io::InitialState::Estimate) {
-    const auto m = static_cast<Eigen::Index>(initial_state_hz.size());
-    std::vector<double> a, b;
-    if (initial_state_coefficients.size() == 2 * m)
-      for (Eigen::Index j = 0; j < m; ++j) {
-        a.push_back(initial_state_coefficients[j]);
-        b.push_back(initial_state_coefficients[m + j]);
-      }
-    out["initial_state"] = {{"estimated", true},
-                            {"modes", m},
-                            {"basis_hz", initial_state_hz},
-                            {"displacement", a},
-                            {"velocity", b},
-                            {"note", "x(t0) = sum of displacement[j] phi_j, x'(t0) = sum of velocity[j] phi_j, phi_j the basis "
-                                     "model's M-orthonormal modes at basis_hz; profiled out of the fit, its unknowns counted in "
-                                     "every interval"}};
-  } else {
-    out["initial_state"] = {{"estimated", false}, {"note", "the structure at rest at the first sample"}};
-  }
+           {"band", band_json(p)}};
+  out["initial_state"] = initial_state_json(p, *this);
   counts_json(*this, out);
   if (p.origin != Problem::DataOrigin::Synthesis) out["data_columns"] = data_columns_json(p.columns);
-  if (!start_check.sensors.empty()) {
-    json sensors = json::array();
-    for (const auto& s : start_check.sensors)
-      sensors.push_back({{"name", s.name},
-                         {"correlation", std::isfinite(s.correlation) ? json(s.correlation) : json(nullptr)},
-                         {"scale", std::isfinite(s.scale) ? json(s.scale) : json(nullptr)}});
-    out["start_check"] = {{"from", start_check.from}, {"to", start_check.to}, {"sensors", sensors}, {"warnings", start_check.warnings}};
-    json frf = json::array();
-    auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-    for (const auto& r : start_check.frf) {
-      json lines = json::array();
-      for (const auto& l : r.lines)
-        lines.push_back({{"hz", l.hz}, {"measured", number(l.measured)}, {"model", number(l.model)}, {"ratio", number(l.ratio)},
-                         {"phase_deg", number(l.phase_deg)}});
-      frf.push_back({{"input", r.input}, {"sensor", r.sensor}, {"median_ratio", number(r.median_ratio)},
-                     {"median_abs_phase_deg", number(r.median_phase_deg)}, {"lines", lines}});
-    }
-    out["start_check"]["frf"] = frf;
-    if (!start_check.frf_note.empty()) out["start_check"]["frf_note"] = start_check.frf_note;
-  }
+  if (!start_check.sensors.empty()) out["start_check"] = start_check_json(start_check);
   if (!p.warnings.empty()) out["data_warnings"] = p.warnings;
   if (interrupted_by != 0)
     out["interrupted"] = {{"signal", interrupted_by == SIGALRM ? "wall-time limit" : interrupted_by == SIGINT ? "SIGINT" : interrupted_by == SIGTERM ? "SIGTERM" : std::to_string(interrupted_by)},
                           {"note", interrupted_note}};
-  if (!residual_bands.bands.empty() || !residual_bands.note.empty()) {
-    json bands = json::array();
-    for (const auto& b : residual_bands.bands) {
-      json rms = json::object();
-      for (std::size_t j = 0; j < b.rms.size() && j < p.data.names.size(); ++j) rms[p.data.names[j]] = b.rms[j];
-      bands.push_back({{"from_hz", b.from_hz}, {"to_hz", b.to_hz}, {"holds", b.holds}, {"mode", b.mode}, {"share", b.share}, {"rms", rms}});
-    }
-    out["residual_bands"] = {{"bands", bands}, {"at_modes", residual_bands.at_modes}, {"summary", residual_bands.summary},
-                             {"note", residual_bands.note}};
-  }
+  if (!residual_bands.bands.empty() || !residual_bands.note.empty()) out["residual_bands"] = residual_bands_json(p, residual_bands);
   return out;
 }
 
@@ -636,6 +646,71 @@ std::string frf_plot_script(const Problem& p, const RunResult& r) {
 }
 }  // namespace
 
+// spectrum.csv / spectrum.gp: measured and predicted power spectral densities (false: none).
+static bool write_spectrum(io::RunDirectory& dir, const Problem& p, const RunResult& r, const MatrixXd& predicted, const std::string& title) {
+  const Spectrum sm = power_spectrum(p.data.t, p.data.z), sp = power_spectrum(p.data.t, predicted);
+  if (sm.f.empty() || sm.psd.rows() != sp.psd.rows()) return false;
+  io::DataTable spec;
+  spec.t = sm.f;
+  spec.time_name = "frequency_hz";
+  for (int k = 0; k < p.data.sensors(); ++k) {
+    const std::string& n = p.data.names[static_cast<std::size_t>(k)];
+    spec.names.insert(spec.names.end(), {n + "_measured_psd", n + "_predicted_psd"});
+    const VectorXd a = sm.psd.col(k), b = sp.psd.col(k);
+    spec.columns.push_back(std::vector<double>(a.data(), a.data() + a.size()));
+    spec.columns.push_back(std::vector<double>(b.data(), b.data() + b.size()));
+  }
+  io::write_csv(dir.path("spectrum.csv"), spec);
+  std::vector<double> modes_hz;
+  for (const auto& m : r.modes) modes_hz.push_back(m.frequency_hz);
+  io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, title,
+                                                                      spectrum_view(sm.f, sm.psd, sp.psd, p.scenario.identification.band)));
+  return true;
+}
+
+// start_frf.csv / start_frf.gp: the record's and the model's frequency responses at the start,
+// per sensor (start_check.h; false: none).
+static bool write_start_frf(io::RunDirectory& dir, const Problem& p, const RunResult& r) {
+  if (r.start_check.frf.empty()) return false;
+  const auto& first = r.start_check.frf.front();
+  io::DataTable frf;
+  frf.t = first.f;
+  frf.time_name = "frequency_hz";
+  std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * r.start_check.frf.size() + 40) +
+                   " noenhanced\nset output 'start_frf.png'\nset datafile separator ','\nset multiplot layout " +
+                   std::to_string(r.start_check.frf.size()) + ",2 title " +
+                   gnuplot_quote(p.scenario.name + ": the record against the model at the start (H1 = response / input '" + first.input + "')") +
+                   "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\n" +
+                   (first.f.size() > 1 ? "set xrange [" + io::format_value(first.f.front()) + ":" + io::format_value(first.f.back()) + "]\n"
+                                       : std::string());
+  int col = 2;
+  for (const auto& pair : r.start_check.frf) {
+    if (pair.f.size() != frf.t.size()) continue;
+    std::vector<double> mm, pm, mp, pp;
+    for (std::size_t b = 0; b < pair.f.size(); ++b) {
+      mm.push_back(std::abs(pair.measured[b]));
+      pm.push_back(std::abs(pair.model[b]));
+      mp.push_back(std::arg(pair.measured[b]) * 180.0 / M_PI);
+      pp.push_back(std::arg(pair.model[b]) * 180.0 / M_PI);
+    }
+    const std::string& n = pair.sensor;
+    frf.names.insert(frf.names.end(), {n + "_measured_magnitude", n + "_model_magnitude", n + "_measured_phase_deg", n + "_model_phase_deg"});
+    frf.columns.insert(frf.columns.end(), {mm, pm, mp, pp});
+    const std::string c = std::to_string(col);
+    gp += "set logscale y\nset format y '%g'\nset yrange [*:*]\nset title " + gnuplot_quote(n + ": magnitude") +
+          "\nplot 'start_frf.csv' every ::1 using 1:" + c + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
+          std::to_string(col + 1) + " with lines dt 2 lw 2 title 'model at the start'\n";
+    gp += "unset logscale y\nset yrange [-180:180]\nset ytics 90\nset title " + gnuplot_quote(n + ": phase [deg]") +
+          "\nplot 'start_frf.csv' every ::1 using 1:" + std::to_string(col + 2) + " with points pt 7 ps 0.3 title 'measured', '' every ::1 using 1:" +
+          std::to_string(col + 3) + " with points pt 6 ps 0.3 title 'model at the start'\nset ytics autofreq\n";
+    col += 4;
+  }
+  gp += "unset multiplot\n";
+  io::write_csv(dir.path("start_frf.csv"), frf);
+  io::write_text_atomic(dir.path("start_frf.gp"), gp);
+  return true;
+}
+
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   if (p.frf) {
     io::write_csv(dir.path("fit.csv"), frf_table(p, r));
@@ -657,67 +732,8 @@ void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   std::tie(notes.zoom_from, notes.zoom_to) = zoom_window(p.data);
   io::write_text_atomic(dir.path("fit.gp"), fit_plot_script(p.data.names, cost, "fit.csv", "fit.png", notes));
   std::vector<std::string> scripts;
-  // spectrum.csv / spectrum.gp / spectrum.png: measured and predicted power spectral densities.
-  const Spectrum sm = power_spectrum(p.data.t, p.data.z), sp = power_spectrum(p.data.t, predicted);
-  if (!sm.f.empty() && sm.psd.rows() == sp.psd.rows()) {
-    io::DataTable spec;
-    spec.t = sm.f;
-    spec.time_name = "frequency_hz";
-    for (int k = 0; k < p.data.sensors(); ++k) {
-      const std::string& n = p.data.names[static_cast<std::size_t>(k)];
-      spec.names.insert(spec.names.end(), {n + "_measured_psd", n + "_predicted_psd"});
-      const VectorXd a = sm.psd.col(k), b = sp.psd.col(k);
-      spec.columns.push_back(std::vector<double>(a.data(), a.data() + a.size()));
-      spec.columns.push_back(std::vector<double>(b.data(), b.data() + b.size()));
-    }
-    io::write_csv(dir.path("spectrum.csv"), spec);
-    std::vector<double> modes_hz;
-    for (const auto& m : r.modes) modes_hz.push_back(m.frequency_hz);
-    io::write_text_atomic(dir.path("spectrum.gp"), spectrum_plot_script(p.data.names, sensor_units(p), modes_hz, notes.title,
-                                                                        spectrum_view(sm.f, sm.psd, sp.psd, p.scenario.identification.band)));
-    scripts.push_back("spectrum.gp");
-  }
-  // start_frf.csv / start_frf.gp / start_frf.png: the record's and the model's frequency responses
-  // at the start, per sensor (start_check.h).
-  if (!r.start_check.frf.empty()) {
-    const auto& first = r.start_check.frf.front();
-    io::DataTable frf;
-    frf.t = first.f;
-    frf.time_name = "frequency_hz";
-    std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * r.start_check.frf.size() + 40) +
-                     " noenhanced\nset output 'start_frf.png'\nset datafile separator ','\nset multiplot layout " +
-                     std::to_string(r.start_check.frf.size()) + ",2 title " +
-                     gnuplot_quote(p.scenario.name + ": the record against the model at the start (H1 = response / input '" + first.input + "')") +
-                     "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\n" +
-                     (first.f.size() > 1 ? "set xrange [" + io::format_value(first.f.front()) + ":" + io::format_value(first.f.back()) + "]\n"
-                                         : std::string());
-    int col = 2;
-    for (const auto& pair : r.start_check.frf) {
-      if (pair.f.size() != frf.t.size()) continue;
-      std::vector<double> mm, pm, mp, pp;
-      for (std::size_t b = 0; b < pair.f.size(); ++b) {
-        mm.push_back(std::abs(pair.measured[b]));
-        pm.push_back(std::abs(pair.model[b]));
-        mp.push_back(std::arg(pair.measured[b]) * 180.0 / M_PI);
-        pp.push_back(std::arg(pair.model[b]) * 180.0 / M_PI);
-      }
-      const std::string& n = pair.sensor;
-      frf.names.insert(frf.names.end(), {n + "_measured_magnitude", n + "_model_magnitude", n + "_measured_phase_deg", n + "_model_phase_deg"});
-      frf.columns.insert(frf.columns.end(), {mm, pm, mp, pp});
-      const std::string c = std::to_string(col);
-      gp += "set logscale y\nset format y '%g'\nset yrange [*:*]\nset title " + gnuplot_quote(n + ": magnitude") +
-            "\nplot 'start_frf.csv' every ::1 using 1:" + c + " with lines lw 2 title 'measured', '' every ::1 using 1:" +
-            std::to_string(col + 1) + " with lines dt 2 lw 2 title 'model at the start'\n";
-      gp += "unset logscale y\nset yrange [-180:180]\nset ytics 90\nset title " + gnuplot_quote(n + ": phase [deg]") +
-            "\nplot 'start_frf.csv' every ::1 using 1:" + std::to_string(col + 2) + " with points pt 7 ps 0.3 title 'measured', '' every ::1 using 1:" +
-            std::to_string(col + 3) + " with points pt 6 ps 0.3 title 'model at the start'\nset ytics autofreq\n";
-      col += 4;
-    }
-    gp += "unset multiplot\n";
-    io::write_csv(dir.path("start_frf.csv"), frf);
-    io::write_text_atomic(dir.path("start_frf.gp"), gp);
-    scripts.push_back("start_frf.gp");
-  }
+  if (write_spectrum(dir, p, r, predicted, notes.title)) scripts.push_back("spectrum.gp");
+  if (write_start_frf(dir, p, r)) scripts.push_back("start_frf.gp");
   // fit.png (from a raw float64 copy of fit.csv: the same numbers, no text to parse) and
   // spectrum.png rendered side by side.
   const std::vector<RenderStatus> rendered =

@@ -19,6 +19,70 @@ std::string num(double v, const char* fmt = "%.3g") {
   return b;
 }
 
+// The input's spectrum and the bins it carries (start_frf).
+struct InputSpectrum {
+  std::string input;
+  const std::vector<std::complex<double>>& F;
+  const std::vector<std::size_t>& bins;
+  double fmax, T;
+};
+
+// One sensor's H1 against the input, its lines at the peaks, and the medians.
+StartFrf sensor_frf(const Problem& p, const MatrixXd& y, Eigen::Index j, const InputSpectrum& in, const std::vector<SpectralPeak>& peaks) {
+  const auto& z = p.data.z;
+  const std::size_t N = p.data.t.size();
+  const auto& F = in.F;
+  const auto& bins = in.bins;
+  const double fmax = in.fmax, T = in.T;
+  Eigen::FFT<double> fft;
+  std::vector<double> x(N);
+  std::vector<std::complex<double>> Z, Y;
+  const std::string& input = in.input;
+  StartFrf r;
+  r.input = input;
+  r.sensor = p.scenario.sensors[static_cast<std::size_t>(j)].name;
+  for (std::size_t k = 0; k < N; ++k) x[k] = z(static_cast<Eigen::Index>(k), j);
+  fft.fwd(Z, x);
+  for (std::size_t k = 0; k < N; ++k) x[k] = y(static_cast<Eigen::Index>(k), j);
+  fft.fwd(Y, x);
+  for (std::size_t b : bins) {
+    r.f.push_back(static_cast<double>(b) / T);
+    r.measured.push_back(Z[b] / F[b]);
+    r.model.push_back(Y[b] / F[b]);
+  }
+  for (const auto& pk : peaks) {
+    const auto at = std::lower_bound(r.f.begin(), r.f.end(), pk.f);
+    if (at == r.f.end() || (at == r.f.begin() && *at > pk.f * 1.001)) continue;
+    std::size_t b = static_cast<std::size_t>(at - r.f.begin());
+    if (b > 0 && std::abs(r.f[b - 1] - pk.f) < std::abs(r.f[b] - pk.f)) --b;
+    if (std::abs(r.f[b] - pk.f) > 1.5 / T) continue;  // the peak's bin is not among those the input carries
+    StartFrf::Line l;
+    l.hz = r.f[b];
+    l.measured = std::abs(r.measured[b]);
+    l.model = std::abs(r.model[b]);
+    l.ratio = l.model > 0 ? l.measured / l.model : NAN;
+    l.phase_deg = l.model > 0 && l.measured > 0 ? std::arg(r.measured[b] / r.model[b]) * 180.0 / M_PI : NAN;
+    r.lines.push_back(l);
+  }
+  std::sort(r.lines.begin(), r.lines.end(), [](const auto& a, const auto& b) { return a.hz < b.hz; });
+  // The medians over the bins where the input carries at least a tenth of its largest amplitude
+  // (below that, a chirp's or a tap's leakage: the ratio of two small numbers).
+  std::vector<double> ratios, phases;
+  for (std::size_t b = 0; b < r.f.size(); ++b)
+    if (std::abs(F[bins[b]]) >= 0.1 * fmax && std::abs(r.model[b]) > 0 && std::abs(r.measured[b]) > 0) {
+      ratios.push_back(std::abs(r.measured[b]) / std::abs(r.model[b]));
+      phases.push_back(std::abs(std::arg(r.measured[b] / r.model[b])) * 180.0 / M_PI);
+    }
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return std::nan("");
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  r.median_ratio = median(ratios);
+  r.median_phase_deg = median(phases);
+  return r;
+}
+
 // H1 of each sensor against the one data input (StartFrf), at the record's peaks `peaks`.
 void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPeak>& peaks, StartCheck& out) {
   const auto& t = p.data.t;
@@ -41,7 +105,7 @@ void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPe
     }
   Eigen::FFT<double> fft;
   std::vector<double> x(N);
-  std::vector<std::complex<double>> F, Z, Y;
+  std::vector<std::complex<double>> F;
   double lo = INFINITY, hi = -INFINITY;
   for (std::size_t k = 0; k < N; ++k) {
     x[k] = p.signals[i](t[k]);
@@ -69,50 +133,44 @@ void start_frf(const Problem& p, const MatrixXd& y, const std::vector<SpectralPe
     out.frf_note = "input '" + input + "' carries nothing in the band";
     return;
   }
-  for (Eigen::Index j = 0; j < z.cols(); ++j) {
-    StartFrf r;
-    r.input = input;
-    r.sensor = p.scenario.sensors[static_cast<std::size_t>(j)].name;
-    for (std::size_t k = 0; k < N; ++k) x[k] = z(static_cast<Eigen::Index>(k), j);
-    fft.fwd(Z, x);
-    for (std::size_t k = 0; k < N; ++k) x[k] = y(static_cast<Eigen::Index>(k), j);
-    fft.fwd(Y, x);
-    for (std::size_t b : bins) {
-      r.f.push_back(static_cast<double>(b) / T);
-      r.measured.push_back(Z[b] / F[b]);
-      r.model.push_back(Y[b] / F[b]);
-    }
-    for (const auto& pk : peaks) {
-      const auto at = std::lower_bound(r.f.begin(), r.f.end(), pk.f);
-      if (at == r.f.end() || (at == r.f.begin() && *at > pk.f * 1.001)) continue;
-      std::size_t b = static_cast<std::size_t>(at - r.f.begin());
-      if (b > 0 && std::abs(r.f[b - 1] - pk.f) < std::abs(r.f[b] - pk.f)) --b;
-      if (std::abs(r.f[b] - pk.f) > 1.5 / T) continue;  // the peak's bin is not among those the input carries
-      StartFrf::Line l;
-      l.hz = r.f[b];
-      l.measured = std::abs(r.measured[b]);
-      l.model = std::abs(r.model[b]);
-      l.ratio = l.model > 0 ? l.measured / l.model : NAN;
-      l.phase_deg = l.model > 0 && l.measured > 0 ? std::arg(r.measured[b] / r.model[b]) * 180.0 / M_PI : NAN;
-      r.lines.push_back(l);
-    }
-    std::sort(r.lines.begin(), r.lines.end(), [](const auto& a, const auto& b) { return a.hz < b.hz; });
-    // The medians over the bins where the input carries at least a tenth of its largest amplitude
-    // (below that, a chirp's or a tap's leakage: the ratio of two small numbers).
-    std::vector<double> ratios, phases;
-    for (std::size_t b = 0; b < r.f.size(); ++b)
-      if (std::abs(F[bins[b]]) >= 0.1 * fmax && std::abs(r.model[b]) > 0 && std::abs(r.measured[b]) > 0) {
-        ratios.push_back(std::abs(r.measured[b]) / std::abs(r.model[b]));
-        phases.push_back(std::abs(std::arg(r.measured[b] / r.model[b])) * 180.0 / M_PI);
-      }
-    auto median = [](std::vector<double> v) {
-      if (v.empty()) return std::nan("");
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-      return v[v.size() / 2];
-    };
-    r.median_ratio = median(ratios);
-    r.median_phase_deg = median(phases);
-    out.frf.push_back(std::move(r));
+  for (Eigen::Index j = 0; j < z.cols(); ++j)
+    out.frf.push_back(sensor_frf(p, y, j, {input, F, bins, fmax, T}, peaks));
+}
+
+// How the sensors read the model at the start (check_start's tallies).
+struct Tally {
+  int inverted, scaled, assessed;
+  double a_lo, a_hi;  // the smallest and largest |scale| of a correlated sensor
+};
+
+// The warnings: one for the input where every sensor agrees, else one per sensor.
+void add_warnings(const Problem& p, const std::string& set_aside, const Tally& c, StartCheck& out) {
+  const int inverted = c.inverted, scaled = c.scaled, assessed = c.assessed;
+  const double a_lo = c.a_lo, a_hi = c.a_hi;
+  // The one input read from the data, if there is exactly one: where every sensor agrees, it is the suspect.
+  const std::string input = p.columns.inputs_from_data.size() == 1 ? p.columns.inputs_from_data.front() : std::string();
+  const std::string span = "over " + num(out.from, "%.4g") + " .. " + num(out.to, "%.4g") + " s at the start" +
+                           (set_aside.empty() ? "" : ", the static offset of input " + set_aside + " set aside");
+  const std::string window = " (" + span + ")";
+  if (assessed > 1 && inverted == assessed && !input.empty()) {
+    out.warnings.push_back("every sensor reads the model's response inverted" + window + ": input '" + input +
+                           "' is likely of the other sign (a load cell mounted or wired the other way round); "
+                           "conditioning: {sign: -1} on it states that");
+  } else {
+    for (const auto& s : out.sensors)
+      if (std::isfinite(s.correlation) && s.correlation < -0.5)
+        out.warnings.push_back("sensor '" + s.name + "' reads the model's response inverted (correlation " + num(s.correlation, "%.2f") + " " +
+                               span + "): mounted or wired the other way round? conditioning: {sign: -1} on it states that");
+  }
+  if (assessed > 1 && scaled == assessed && !input.empty() && a_hi <= 2.0 * a_lo) {
+    out.warnings.push_back("every sensor reads about " + num(std::sqrt(a_lo * a_hi)) + " times the model's response" + window +
+                           ": input '" + input + "' is likely in another unit or calibration (state its column's unit, or "
+                           "conditioning: {scale: ...} on it)");
+  } else {
+    for (const auto& s : out.sensors)
+      if (std::isfinite(s.correlation) && std::abs(s.correlation) >= 0.5 && (std::abs(s.scale) > 3.0 || std::abs(s.scale) < 1.0 / 3.0))
+        out.warnings.push_back("sensor '" + s.name + "' reads " + num(std::abs(s.scale)) + " times the model's response" + window +
+                               ": another unit or calibration than stated? (its column's unit, or conditioning: {scale: ...})");
   }
 }
 
@@ -178,31 +236,7 @@ StartCheck check_start(const Problem& p, Objective& obj, const VectorXd& q) {
       if (a > 3.0 || a < 1.0 / 3.0) ++scaled;
     }
   }
-  // The one input read from the data, if there is exactly one: where every sensor agrees, it is the suspect.
-  const std::string input = p.columns.inputs_from_data.size() == 1 ? p.columns.inputs_from_data.front() : std::string();
-  const std::string span = "over " + num(out.from, "%.4g") + " .. " + num(out.to, "%.4g") + " s at the start" +
-                           (set_aside.empty() ? "" : ", the static offset of input " + set_aside + " set aside");
-  const std::string window = " (" + span + ")";
-  if (assessed > 1 && inverted == assessed && !input.empty()) {
-    out.warnings.push_back("every sensor reads the model's response inverted" + window + ": input '" + input +
-                           "' is likely of the other sign (a load cell mounted or wired the other way round); "
-                           "conditioning: {sign: -1} on it states that");
-  } else {
-    for (const auto& s : out.sensors)
-      if (std::isfinite(s.correlation) && s.correlation < -0.5)
-        out.warnings.push_back("sensor '" + s.name + "' reads the model's response inverted (correlation " + num(s.correlation, "%.2f") + " " +
-                               span + "): mounted or wired the other way round? conditioning: {sign: -1} on it states that");
-  }
-  if (assessed > 1 && scaled == assessed && !input.empty() && a_hi <= 2.0 * a_lo) {
-    out.warnings.push_back("every sensor reads about " + num(std::sqrt(a_lo * a_hi)) + " times the model's response" + window +
-                           ": input '" + input + "' is likely in another unit or calibration (state its column's unit, or "
-                           "conditioning: {scale: ...} on it)");
-  } else {
-    for (const auto& s : out.sensors)
-      if (std::isfinite(s.correlation) && std::abs(s.correlation) >= 0.5 && (std::abs(s.scale) > 3.0 || std::abs(s.scale) < 1.0 / 3.0))
-        out.warnings.push_back("sensor '" + s.name + "' reads " + num(std::abs(s.scale)) + " times the model's response" + window +
-                               ": another unit or calibration than stated? (its column's unit, or conditioning: {scale: ...})");
-  }
+  add_warnings(p, set_aside, {inverted, scaled, assessed, a_lo, a_hi}, out);
   return out;
 }
 

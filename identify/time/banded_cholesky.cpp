@@ -285,6 +285,61 @@ void with_bandwidth(int b, F&& f) {
 
 }  // namespace
 
+namespace {
+
+// The scalar loops' rows (BandedCholesky::solve_in_place): columns [0, blocked) four at a time,
+// the rest one at a time, every column the same operations in the same order.
+// L y = r, row i of the band (entries k ∈ [k0, i)) or of the border (k ∈ [0, i)) at Li[k].
+void scalar_forward_row(double* X, int columns, std::ptrdiff_t ld, const double* inv, int i, int k0, const double* Li) {
+  const int blocked = columns - columns % 4;
+  auto col = [X, ld](int j) { return X + static_cast<std::ptrdiff_t>(j) * ld; };
+  for (int j = 0; j < blocked; j += 4) {
+    double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
+    double s0 = x0[i], s1 = x1[i], s2 = x2[i], s3 = x3[i];
+    for (int k = k0; k < i; ++k) {
+      const double l = Li[k];
+      s0 -= l * x0[k];
+      s1 -= l * x1[k];
+      s2 -= l * x2[k];
+      s3 -= l * x3[k];
+    }
+    x0[i] = s0 * inv[i];
+    x1[i] = s1 * inv[i];
+    x2[i] = s2 * inv[i];
+    x3[i] = s3 * inv[i];
+  }
+  for (int j = blocked; j < columns; ++j) {
+    double* x = col(j);
+    double s = x[i];
+    for (int k = k0; k < i; ++k) s -= Li[k] * x[k];
+    x[i] = s * inv[i];
+  }
+}
+
+// Lᵀ x = y, row i's entries k ∈ [k0, i) at Li[k] taken out of the rows above it.
+void scalar_backward_row(double* X, int columns, std::ptrdiff_t ld, const double* inv, int i, int k0, const double* Li) {
+  const int blocked = columns - columns % 4;
+  auto col = [X, ld](int j) { return X + static_cast<std::ptrdiff_t>(j) * ld; };
+  for (int j = 0; j < blocked; j += 4) {
+    double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
+    const double y0 = (x0[i] *= inv[i]), y1 = (x1[i] *= inv[i]), y2 = (x2[i] *= inv[i]), y3 = (x3[i] *= inv[i]);
+    for (int k = k0; k < i; ++k) {
+      const double l = Li[k];
+      x0[k] -= l * y0;
+      x1[k] -= l * y1;
+      x2[k] -= l * y2;
+      x3[k] -= l * y3;
+    }
+  }
+  for (int j = blocked; j < columns; ++j) {
+    double* x = col(j);
+    const double xi = (x[i] *= inv[i]);
+    for (int k = k0; k < i; ++k) x[k] -= Li[k] * xi;
+  }
+}
+
+}  // namespace
+
 void BandedCholesky::solve_in_place(double* x) const { solve_in_place(x, 1, n_); }
 
 void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld, Kernel kernel) const {
@@ -335,51 +390,8 @@ void BandedCholesky::solve_in_place(double* X, int columns, std::ptrdiff_t ld, K
   const int w = b_ + 1;
   const double* L = data_.data();
   const double* inv = inv_diag_.data();
-  const int blocked = columns - columns % 4;  // columns [0, blocked) go four at a time
-  auto col = [X, ld](int j) { return X + static_cast<std::ptrdiff_t>(j) * ld; };
-  // L y = r, row i of the band (entries k ∈ [k0, i)) or of the border (k ∈ [0, i)) at Li[k].
-  auto forward_row = [&](int i, int k0, const double* Li) {
-    for (int j = 0; j < blocked; j += 4) {
-      double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
-      double s0 = x0[i], s1 = x1[i], s2 = x2[i], s3 = x3[i];
-      for (int k = k0; k < i; ++k) {
-        const double l = Li[k];
-        s0 -= l * x0[k];
-        s1 -= l * x1[k];
-        s2 -= l * x2[k];
-        s3 -= l * x3[k];
-      }
-      x0[i] = s0 * inv[i];
-      x1[i] = s1 * inv[i];
-      x2[i] = s2 * inv[i];
-      x3[i] = s3 * inv[i];
-    }
-    for (int j = blocked; j < columns; ++j) {
-      double* x = col(j);
-      double s = x[i];
-      for (int k = k0; k < i; ++k) s -= Li[k] * x[k];
-      x[i] = s * inv[i];
-    }
-  };
-  // Lᵀ x = y, row i's entries k ∈ [k0, i) at Li[k] taken out of the rows above it.
-  auto backward_row = [&](int i, int k0, const double* Li) {
-    for (int j = 0; j < blocked; j += 4) {
-      double *x0 = col(j), *x1 = x0 + ld, *x2 = x1 + ld, *x3 = x2 + ld;
-      const double y0 = (x0[i] *= inv[i]), y1 = (x1[i] *= inv[i]), y2 = (x2[i] *= inv[i]), y3 = (x3[i] *= inv[i]);
-      for (int k = k0; k < i; ++k) {
-        const double l = Li[k];
-        x0[k] -= l * y0;
-        x1[k] -= l * y1;
-        x2[k] -= l * y2;
-        x3[k] -= l * y3;
-      }
-    }
-    for (int j = blocked; j < columns; ++j) {
-      double* x = col(j);
-      const double xi = (x[i] *= inv[i]);
-      for (int k = k0; k < i; ++k) x[k] -= Li[k] * xi;
-    }
-  };
+  auto forward_row = [&](int i, int k0, const double* Li) { scalar_forward_row(X, columns, ld, inv, i, k0, Li); };
+  auto backward_row = [&](int i, int k0, const double* Li) { scalar_backward_row(X, columns, ld, inv, i, k0, Li); };
   auto band_row = [&](int i, int k0) { return L + static_cast<std::size_t>(i) * w + (k0 - i + b_) - k0; };
   // The band's first b rows (shorter than b) and, for a bandwidth without a kernel of its own, all.
   const int full_from = b_ >= 1 && b_ <= kMaxUnrolledBand ? std::min(b_, nb_) : nb_;

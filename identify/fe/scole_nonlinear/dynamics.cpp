@@ -38,62 +38,7 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   d.Mconst_.block(6, 0, ne_, 3) = d.Mconst_.block(0, 6, 3, ne_).transpose();
   d.Mconst_.block(6, 3, ne_, 3) = d.Mconst_.block(3, 6, 3, ne_).transpose();
   for (const auto& in : inputs_) d.input_scale_.push_back(in.coefficient >= 0 ? c[in.coefficient] : 1.0);
-  {
-    std::vector<Eigen::Triplet<double>> t;
-    for (Eigen::Index j = 0; j < ne_; ++j)
-      for (Eigen::Index i = 0; i < ne_; ++i)
-        if (d.Mconst_(6 + i, 6 + j) != 0.0) t.emplace_back(i, j, d.Mconst_(6 + i, 6 + j));
-    for (const auto& r : rotors_)  // a turned rotor couples all of its columns
-      for (int a : r.th.cols)
-        for (int b : r.th.cols) t.emplace_back(a, b, 0.0);
-    for (const auto& p : points_)  // the nonlinear points' local pattern, explicitly
-      for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
-        for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
-          if (p.kin.local[a] && p.kin.local[b]) t.emplace_back(p.kin.cols[a], p.kin.cols[b], 0.0);
-    d.Cbase_.resize(ne_, ne_);
-    d.Cbase_.setFromTriplets(t.begin(), t.end());
-    d.Cbase_.makeCompressed();
-    auto slot = [&](int i, int j) {
-      const int* first = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j];
-      const int* last = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j + 1];
-      const int* it = std::lower_bound(first, last, i);
-      if (it == last || *it != i) throw std::logic_error("ScoleNonlinear: an entry outside the mass pattern");
-      return static_cast<int>(it - d.Cbase_.innerIndexPtr());
-    };
-    for (const auto& r : rotors_) {
-      std::vector<int> sl;
-      for (int a : r.th.cols)
-        for (int b : r.th.cols) sl.push_back(slot(a, b));
-      d.rotor_slots_.push_back(std::move(sl));
-    }
-    for (const auto& p : points_) {
-      std::vector<int> sl;
-      for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
-        for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
-          sl.push_back(p.kin.local[a] && p.kin.local[b] ? slot(p.kin.cols[a], p.kin.cols[b]) : -1);
-      d.point_slots_.push_back(std::move(sl));
-    }
-    auto C = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>();
-    if (d.e_dependent_) {
-      // Checked positive definite at e = 0 here; per e, solve_mass factorises and reports failure.
-      SparseMatrix C0 = d.Cbase_;
-      for (std::size_t i = 0; i < points_.size(); ++i) {
-        const auto& q = points_[i].kin;
-        if (!q.active()) continue;
-        const MatrixXd Mi = d.mass_[i] * q.N.transpose() * q.N;  // N(0) = N: local columns only
-        for (std::size_t a = 0; a < q.cols.size(); ++a)
-          for (std::size_t b = 0; b < q.cols.size(); ++b)
-            if (q.local[a] && q.local[b])
-              C0.coeffRef(q.cols[a], q.cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
-      }
-      C->compute(C0);
-    } else {
-      C->compute(d.Cbase_);
-    }
-    if (C->info() != Eigen::Success)
-      throw std::domain_error("ScoleNonlinear::at: the elastic mass block is not positive definite");
-    d.C_ = C;
-  }
+  elastic_mass(d);
   d.K_ = MatrixXd::Zero(ne_, ne_);
   d.D_ = MatrixXd::Zero(ne_, ne_);
   for (const auto& t : stiffness_) d.K_ += scale(t.coefficient) * MatrixXd(t.matrix);
@@ -102,6 +47,65 @@ ScoleNonlinear::Dynamics ScoleNonlinear::at(const VectorXd& c, double constants)
   d.k_pitch_ = scale(ScoleFE::kEIPitch);
   d.k_twist_ = scale(ScoleFE::kGJ);
   return d;
+}
+
+// The elastic mass block's pattern (with every slot a turned rotor or a nonlinear point fills),
+// each rotor's and point's slots in it, and its factor at e = 0 (checked positive definite).
+void ScoleNonlinear::elastic_mass(Dynamics& d) const {
+  std::vector<Eigen::Triplet<double>> t;
+  for (Eigen::Index j = 0; j < ne_; ++j)
+    for (Eigen::Index i = 0; i < ne_; ++i)
+      if (d.Mconst_(6 + i, 6 + j) != 0.0) t.emplace_back(i, j, d.Mconst_(6 + i, 6 + j));
+  for (const auto& r : rotors_)  // a turned rotor couples all of its columns
+    for (int a : r.th.cols)
+      for (int b : r.th.cols) t.emplace_back(a, b, 0.0);
+  for (const auto& p : points_)  // the nonlinear points' local pattern, explicitly
+    for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
+      for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
+        if (p.kin.local[a] && p.kin.local[b]) t.emplace_back(p.kin.cols[a], p.kin.cols[b], 0.0);
+  d.Cbase_.resize(ne_, ne_);
+  d.Cbase_.setFromTriplets(t.begin(), t.end());
+  d.Cbase_.makeCompressed();
+  auto slot = [&](int i, int j) {
+    const int* first = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j];
+    const int* last = d.Cbase_.innerIndexPtr() + d.Cbase_.outerIndexPtr()[j + 1];
+    const int* it = std::lower_bound(first, last, i);
+    if (it == last || *it != i) throw std::logic_error("ScoleNonlinear: an entry outside the mass pattern");
+    return static_cast<int>(it - d.Cbase_.innerIndexPtr());
+  };
+  for (const auto& r : rotors_) {
+    std::vector<int> sl;
+    for (int a : r.th.cols)
+      for (int b : r.th.cols) sl.push_back(slot(a, b));
+    d.rotor_slots_.push_back(std::move(sl));
+  }
+  for (const auto& p : points_) {
+    std::vector<int> sl;
+    for (std::size_t a = 0; a < p.kin.cols.size(); ++a)
+      for (std::size_t b = 0; b < p.kin.cols.size(); ++b)
+        sl.push_back(p.kin.local[a] && p.kin.local[b] ? slot(p.kin.cols[a], p.kin.cols[b]) : -1);
+    d.point_slots_.push_back(std::move(sl));
+  }
+  auto C = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>();
+  if (d.e_dependent_) {
+    // Checked positive definite at e = 0 here; per e, solve_mass factorises and reports failure.
+    SparseMatrix C0 = d.Cbase_;
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const auto& q = points_[i].kin;
+      if (!q.active()) continue;
+      const MatrixXd Mi = d.mass_[i] * q.N.transpose() * q.N;  // N(0) = N: local columns only
+      for (std::size_t a = 0; a < q.cols.size(); ++a)
+        for (std::size_t b = 0; b < q.cols.size(); ++b)
+          if (q.local[a] && q.local[b])
+            C0.coeffRef(q.cols[a], q.cols[b]) += Mi(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    }
+    C->compute(C0);
+  } else {
+    C->compute(d.Cbase_);
+  }
+  if (C->info() != Eigen::Success)
+    throw std::domain_error("ScoleNonlinear::at: the elastic mass block is not positive definite");
+  d.C_ = C;
 }
 
 namespace {

@@ -15,10 +15,12 @@ constexpr double kMaxRecordValues = 1.0e8;
 // Segments of a Simbody chain. The truth linearises the chain (a dense Jacobian of its
 // 2 x (mobilities) states and its eigenvalues) to choose the integrator and its step.
 constexpr int kMaxSegments = 1000;
-// Finite elements of the identifier's mesh and of the mesh that synthesises data: what a run
-// finishes in minutes. The modal analyses (the step rule, the modes table, the spectral start) are
-// dense eigenproblems, O(N³): paper-beam-1 on 256, 512, 1024 elements takes 2.3, 11, 117 s on two
-// cores (its data on twice the elements); 4096 would take hours.
+// Finite elements of the identifier's mesh and of the mesh that synthesises data. Above 1000
+// degrees of freedom the modal analyses (the step rule, the modes table, the spectral start) take
+// the few modes they need from a sparse solver (identify/fe/lowest_modes.h): paper-beam-1 on 1024
+// elements (its data on 2048) takes about 6 s, where dense eigenproblems took 160 s. The bound is
+// accuracy now: any eigen solver's relative error in a beam's lowest frequency grows as N⁴
+// (docs/theory.md §4.4), 10⁻⁵ at 1024 elements.
 constexpr int kMaxElements = 1024;
 constexpr int kMaxDataElements = 4096;
 // Time steps of one trajectory (identifier or truth).

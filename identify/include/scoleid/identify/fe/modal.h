@@ -24,6 +24,13 @@ struct NaturalModes {
 };
 NaturalModes natural_modes(const SparseMatrix& M, const SparseMatrix& K);
 
+// natural_modes' floor, 1e-4 √σ: below it a mode is a rigid-body mode. It scales with the
+// model's highest frequencies (√σ ≈ 1e-3 ω_max) but lies five decades under them and four above
+// where a solver puts a rigid-body mode (≈ √ε ω_max unshifted, √(ε σ) shifted); "10⁻⁶ of the
+// highest frequency" instead would count a fine mesh's lowest elastic modes as rigid (a pinned
+// beam's fundamental on 500 elements lies there, its two lowest on 1000).
+double rigid_floor(const SparseMatrix& M, const SparseMatrix& K);
+
 // Roughly how long natural_frequencies (vectors false) or natural_modes (true) takes on an
 // n-degree-of-freedom model on this machine [s]: the solve's cost grows as n³, so one of 256
 // degrees of freedom (a chain's stiffness, best of two) is timed once per process and scaled by

@@ -242,6 +242,7 @@ public:
   const MatrixXd& linear_map() const { return G_; }
 
 private:
+  void elastic_mass(Dynamics& d) const;  // at()'s elastic mass pattern, slots and factor
   // Three rows on e with few nonzero columns (a point's or a section's rows touch one element's
   // DOFs): the products the equations evaluate at every f cost O(columns), not O(ne).
   struct Rows3 {

@@ -15,7 +15,7 @@
 // with the damping ratio ζ = φᵀ D φ / (2 ω) of the modal coordinate (exact for damping that the
 // modes diagonalise, such as the square-root and Kelvin–Voigt laws of a uniform beam), and its
 // shapes at the outputs (C₀ φ, C₁ φ, C₂ φ by sensor order) and at the inputs (B₀ᵀ φ, the modal
-// participation of each input). Rigid-body modes (ω below 1e-6 of the highest) have ζ = NaN.
+// participation of each input). Rigid-body modes (ω below rigid_floor, fe/modal.h) have ζ = NaN.
 #include <string>
 #include <vector>
 
@@ -42,6 +42,9 @@ struct ModalModel {
 
 // The model at coefficients c (Parameterization::coefficients of an estimate).
 StateSpace state_space(const StructuralModel& model, const VectorXd& c);
-ModalModel modal_model(const StructuralModel& model, const VectorXd& c);
+// Every mode (a dense solution); or, given `elastic` > 0 on a model large enough for the sparse
+// solver to pay (fe/lowest_modes.h), the rigid-body modes and the lowest `elastic` elastic ones
+// only. A rigid-body mode is one below rigid_floor (fe/modal.h) either way.
+ModalModel modal_model(const StructuralModel& model, const VectorXd& c, int elastic = 0);
 
 }  // namespace scoleid::identify

@@ -60,7 +60,7 @@ struct ModalUncertaintyOptions {
   double model_form_threshold = 3.0;    // in the record's std: a larger difference is the model's form
 };
 
-// The elastic modes (rigid-body modes, ω below 10⁻⁶ of the highest, left out) of the model at q̂,
+// The elastic modes (rigid-body modes, ω below rigid_floor of fe/modal.h, left out) of the model at q̂,
 // lowest first, with their uncertainty from `ident` and `interval` (both may be empty: then only the
 // values, and the note says why).
 std::vector<ModalEstimate> modal_estimates(const StructuralModel& model, const Parameterization& params, const VectorXd& q,

@@ -319,6 +319,20 @@ private:
   double gauss_newton_streamed(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
                                MatrixXd& H, MisfitProfile* profile, MatrixXd* sample_rows = nullptr,
                                const std::vector<Derivative>* derivs = nullptr);
+  // gauss_newton_solve with the initial state estimated (its coefficients profiled out of g and
+  // H), and without a tangent stepper (the tangents in blocks, each with the state re-solved).
+  double gauss_newton_with_start(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
+                                 MatrixXd& H, MisfitProfile* profile);
+  double gauss_newton_blocked(const Setup& s, const SecondOrderSolver& solver, double state_end, VectorXd& gradient,
+                              MatrixXd& H, MisfitProfile* profile);
+  // Its two passes, each adding every interval between recorded points to the running sums: on the
+  // outputs (no acceleration sensors; stream_outputs, and the sample rows), or on the states.
+  struct StreamPass;
+  void stream_output_pass(const Setup& s, const SecondOrderSolver& solver, double state_end, const std::vector<Derivative>& d,
+                          const SecondOrderSolver::Sink& state_visit, MatrixXd* sample_rows, StreamPass& pass,
+                          SolverSummary& sum) const;
+  void stream_state_pass(const Setup& s, const SecondOrderSolver& solver, double state_end, const std::vector<Derivative>& d,
+                         WindowedSink* profile_sink, StreamPass& pass, SolverSummary& sum) const;
   // cost_and_gradient's two ways into gc (the coefficient gradient): the state checkpointed every
   // L points, or stored whole, each with its backward pass.
   double gradient_checkpointed(const Setup& s, const SecondOrderSolver& solver, std::size_t L, VectorXd& gc);

@@ -69,6 +69,8 @@ public:
 
 private:
   void resolve(const io::IdentificationSpec& id);
+  std::vector<std::string> allowed_names(const std::vector<std::string>& paper_names) const;
+  std::vector<double> starting_values(const std::map<std::string, double>& initial) const;
   void refuse(std::string field, std::string what, std::string value);
   const ParameterSpace::Group* group(const std::string& name) const;
   int quantity(const std::string& name) const;

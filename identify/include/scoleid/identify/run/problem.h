@@ -176,25 +176,39 @@ Measurements synthesize_series(const io::Scenario& scenario, int terms = 4000);
 Measurements synthesize_nonlinear(const io::Scenario& scenario, int elements, double step, bool add_noise);
 // The starting model (the parameters' initial values) assembled, its natural frequencies and its
 // modes, each computed once, when first asked: a problem's build asks for them several times (the
-// data's content, the step's damping bound, a stated step's check), and each is a dense
-// eigen-solution, O(n³) in the degrees of freedom. `verbose` says so on stdout (io::progress)
-// before each on a model of 1000 degrees of freedom or more.
+// data's content, the step's damping bound, a stated step's check). On a model of fewer than
+// kSparseModesFrom degrees of freedom each is a dense eigen-solution of every mode (fe/modal.h);
+// on a larger one, when the modes below `up_to` are few (sparse_modes_pay), just those, by the
+// sparse solver of fe/lowest_modes.h — milliseconds where a dense solution takes minutes. `verbose`
+// says on stdout (io::progress) what is solved on a model of kSparseModesFrom degrees of freedom or more.
 class StartModes {
 public:
   StartModes(const StructuralModel& model, const Parameterization& params, bool verbose = false);
   const StructuralModel& model() const { return model_; }
   const Parameterization& params() const { return params_; }
   const AssembledModel& ops() const { return ops_; }
-  const std::vector<double>& frequencies();  // natural_frequencies(M, K), ascending [rad/s]
-  const NaturalModes& modes();               // natural_modes(M, K)
+  // Ascending [rad/s]: every mode's (natural_frequencies(M, K)), or on a large model at least
+  // those below up_to.
+  const std::vector<double>& frequencies(double up_to);
+  // natural_modes(M, K), or on a large model at least the modes below up_to.
+  const NaturalModes& modes(double up_to);
+  // Below this a frequency is a rigid-body mode's (rigid_floor, fe/modal.h; after frequencies()).
+  double rigid_below() const { return rigid_below_; }
 
 private:
+  bool sparse(double up_to);
   const StructuralModel& model_;
   const Parameterization& params_;
   bool verbose_;
   AssembledModel ops_;
   std::optional<std::vector<double>> frequencies_;
   std::optional<NaturalModes> modes_;
+  bool frequencies_all_ = false, modes_all_ = false;  // from a dense solution of every mode
+  bool sparse_failed_ = false;                        // the sparse solver gave up: dense from then on
+  double solved_up_to_ = 0.0;                         // the sparse modes' band
+  double rigid_below_ = 0.0;
+  std::optional<int> below_count_;  // the Sturm count at counted_at_
+  double counted_at_ = 0.0;
 };
 
 // from_data (identification.step_rule: data): K = K_data instead of min(P + 2, K_nyq).
