@@ -247,8 +247,9 @@ int main(int argc, char** argv) {
       "iterate reached is written, marked \"interrupted\" and not converged, before the first iterate nothing. The\n"
       "outputs of a run appear together or not at all: they are written beside --out and moved into place as one\n"
       "directory at the end.\n\n"
-      "With --experiments FILE, several runs (each its own scenario: inputs, sensors, data) and/or measured\n"
-      "modes (frequencies, damping ratios, shapes; CSV) are fitted with one parameter vector, the runs solved\n"
+      "With --experiments FILE, several runs (each its own scenario: inputs, sensors, data; in the time domain,\n"
+      "or as FRFs when the scenario says identification.domain: frequency) and/or measured modes (frequencies,\n"
+      "damping ratios, shapes; CSV) are fitted with one parameter vector, the runs solved\n"
       "concurrently (README \"Several experiments and modal data\"). Writes identify.json (joint estimate, joint\n"
       "and per-experiment std, misfit share and residual RMS per experiment), fit-<run>.csv/.gp/.png per run and\n"
       "modes-fit.csv (measured against matched model modes)."};

@@ -195,20 +195,26 @@ static void check_joint_run_scenario(const ExperimentsSpec& spec, std::size_t i,
         spec.runs[i].scenario);
 }
 
-// Likelihood weights (header): with modal data beside time runs every run needs stated noise.
+// Likelihood weights (header): with modal data or frequency-domain runs beside time runs every time
+// run needs stated noise (their misfits are ½χ² of stated variances).
 static void set_likelihood_weights(const ExperimentsSpec& spec, ExperimentsProblem& ep) {
-  bool all_stated = !ep.runs.empty();
-  for (std::size_t i = 0; i < ep.runs.size(); ++i)
+  bool all_stated = true, any_time = false, any_frf = false;
+  for (const auto& p : ep.runs) (p->frf ? any_frf : any_time) = true;
+  const char* beside = spec.modes_file ? "the modal data" : "the frequency-domain runs' FRFs";
+  for (std::size_t i = 0; i < ep.runs.size(); ++i) {
+    if (ep.runs[i]->frf) continue;
     for (std::size_t k = 0; k < ep.runs[i]->noise_std.size(); ++k)
       if (!(ep.runs[i]->noise_std[k] > 0)) {
         all_stated = false;
-        if (spec.modes_file)
+        if (spec.modes_file || any_frf)
           bad(spec.source, "runs[" + std::to_string(i) + "] (" + spec.runs[i].name + ")",
-              "sensor has no stated noise level (noise_std), needed to weigh its data against the modal data",
+              std::string("sensor has no stated noise level (noise_std), needed to weigh its data against ") + beside,
               ep.runs[i]->data.names[k]);
       }
-  if (all_stated)
+  }
+  if (all_stated && any_time)
     for (auto& p : ep.runs) {
+      if (p->frf) continue;
       const double W = p->data.white_noise_integral(p->data.t.front(), p->data.t.back());
       const auto n = static_cast<double>(p->data.t.size());
       p->objective_options.weights.clear();

@@ -68,7 +68,6 @@ void keep_band(const Problem& p, io::FrfData& d) {
 // Checks shared by both sources, and the variance's F-law scaling (frf_run.h).
 void finish_frf(Problem& p, io::FrfData d, double dof) {
   const auto& sc = p.scenario;
-  if (!sc.identification.uncertain.empty()) throw std::logic_error("finish_frf: declared uncertainties (identify::check_scenario refuses them)");
   keep_band(p, d);
   if (dof > 0.0 && !(dof > 4.0))
     fail_field(sc.source, "identification.frf.segment",

@@ -68,10 +68,6 @@ void check_scenario(const io::Scenario& sc) {
       io::fail_field(sc.source, "inputs",
                      "must hold exactly one input with identification.domain: frequency (FRFs are per unit of one input)",
                      std::to_string(sc.inputs.size()) + " inputs");
-    if (!id.uncertain.empty())
-      io::fail_field(sc.source, "identification.uncertain",
-                     "is not propagated by a frequency-domain run (declared uncertainties need the time-domain path, domain: time)",
-                     id.uncertain.front().field);
   }
   if (sc.sensors.empty()) io::fail_field(sc.source, "sensors", "must list at least one sensor", "none");
   if (sc.inputs.empty() && sc.identification.initial_state != io::InitialState::Estimate)

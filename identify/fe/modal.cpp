@@ -55,6 +55,7 @@ std::vector<DampedMode> damped_modes_now(const MatrixXd& M, const MatrixXd& D, c
   };
   MatrixXd A = MatrixXd::Zero(2 * n, 2 * n);
   double omega_max = 0.0;
+  double floor = -1.0;  // below it a root is a rigid-body root (header)
   bool modal = false;
   if (symmetric(M) && symmetric(K)) {
     // Undamped modes from the shifted problem M φ = μ (K + σM) φ, μ = 1/(ω² + σ), as in
@@ -79,6 +80,7 @@ std::vector<DampedMode> damped_modes_now(const MatrixXd& M, const MatrixXd& D, c
         }
         A.bottomRightCorner(n, n) = -Dq;
         modal = true;
+        floor = 1e-4 * std::sqrt(sigma);  // natural_modes' floor, rigid_floor
       }
     }
   }
@@ -92,7 +94,7 @@ std::vector<DampedMode> damped_modes_now(const MatrixXd& M, const MatrixXd& D, c
     omega_max = std::sqrt(ek.eigenvalues().cwiseAbs().maxCoeff());
   }
   const Eigen::EigenSolver<MatrixXd> es(A, false);
-  const double floor = 1e-6 * omega_max;
+  if (!modal) floor = 1e-6 * omega_max;
   for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) {
     const std::complex<double> l = es.eigenvalues()[i];
     const double r = std::abs(l);

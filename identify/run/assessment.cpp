@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -16,6 +17,55 @@
 #include "scoleid/io/scenario_fields.h"
 
 namespace scoleid::identify {
+
+std::vector<ConsiderTerm> declared_consider_terms(const io::Scenario& sc, int P, const VectorXd& y0,
+                                                  const std::function<VectorXd(const io::Scenario&)>& outputs,
+                                                  const std::function<VectorXd(const VectorXd&)>& shift) {
+  std::vector<ConsiderTerm> terms;
+  for (const auto& u : sc.identification.uncertain) {
+    ConsiderTerm t;
+    t.field = u.field;
+    io::Scenario hi = sc, lo = sc;
+    VectorXd d;
+    if (u.is_switch) {
+      *io::bool_field(hi, u.field) = u.alternative;
+      t.value = *io::bool_field(lo, u.field) ? 1.0 : 0.0;
+      t.delta = 1.0;
+      d = outputs(hi) - y0;
+    } else {
+      double* vh = io::numeric_field(hi, u.field);
+      double* vl = io::numeric_field(lo, u.field);
+      t.value = *vh;
+      t.delta = u.tolerance;
+      *vh += u.tolerance;
+      *vl -= u.tolerance;
+      // Central where both sides are valid scenarios; one-sided at the edge of the valid range (a
+      // sensor at the tip of the mast cannot move beyond it); the door refused a tolerance with
+      // neither (check_scenario).
+      const UncertainSides sides = uncertain_sides(sc, u);
+      if (sides.high && sides.low) d = 0.5 * (outputs(hi) - outputs(lo));
+      else if (sides.high) d = outputs(hi) - y0;
+      else if (sides.low) d = y0 - outputs(lo);
+      else throw std::logic_error("consider_terms: '" + u.field + "' has no valid side (identify::check_scenario refuses it)");
+    }
+    // Found only at q̂, after the fit: a quantity the outputs do not depend on has no consider term
+    // (0, said), one whose move leaves no finite response no interval (NaN, said). The door refused
+    // an estimated one (io::validate_scenario).
+    const std::string moved = "identification.uncertain." + u.field + " (" +
+                              (u.is_switch ? std::string(u.alternative ? "true" : "false") : io::format_value(u.tolerance)) + ")";
+    if (!d.allFinite()) {
+      t.shift = VectorXd::Constant(P, std::nan(""));
+      t.note = moved + " makes the model's response non-finite: no consider term, no interval";
+    } else if (!(d.squaredNorm() > 0)) {
+      t.shift = VectorXd::Zero(P);
+      t.note = moved + " does not change the model's outputs at the estimate: its consider term is 0";
+    } else {
+      t.shift = shift(d);
+    }
+    terms.push_back(t);
+  }
+  return terms;
+}
 
 namespace {
 
@@ -73,54 +123,13 @@ std::vector<ConsiderTerm> consider_terms(const Problem& p, const Identifiability
     for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
     if (t.shift.allFinite()) terms.push_back(t);
   }
-  for (const auto& u : uncertain) {
-    ConsiderTerm t;
-    t.field = u.field;
-    io::Scenario hi = p.scenario, lo = p.scenario;
-    VectorXd d;
-    if (u.is_switch) {
-      *io::bool_field(hi, u.field) = u.alternative;
-      t.value = *io::bool_field(lo, u.field) ? 1.0 : 0.0;
-      t.delta = 1.0;
-      d = outputs(hi) - flat(Y0);
-    } else {
-      double* vh = io::numeric_field(hi, u.field);
-      double* vl = io::numeric_field(lo, u.field);
-      t.value = *vh;
-      t.delta = u.tolerance;
-      *vh += u.tolerance;
-      *vl -= u.tolerance;
-      // Central where both sides are valid scenarios; one-sided at the edge of the valid range (a
-      // sensor at the tip of the mast cannot move beyond it); the door refused a tolerance with
-      // neither (check_scenario).
-      const UncertainSides sides = uncertain_sides(p.scenario, u);
-      if (sides.high && sides.low) d = 0.5 * (outputs(hi) - outputs(lo));
-      else if (sides.high) d = outputs(hi) - flat(Y0);
-      else if (sides.low) d = flat(Y0) - outputs(lo);
-      else throw std::logic_error("consider_terms: '" + u.field + "' has no valid side (identify::check_scenario refuses it)");
-    }
-    // Found only at q̂, after the fit: a quantity the outputs do not depend on has no consider term
-    // (0, said), one whose move leaves no finite response no interval (NaN, said). The door refused
-    // an estimated one (io::validate_scenario).
-    const std::string moved = "identification.uncertain." + u.field + " (" +
-                              (u.is_switch ? std::string(u.alternative ? "true" : "false") : io::format_value(u.tolerance)) + ")";
-    if (!d.allFinite()) {
-      t.shift = VectorXd::Constant(P, std::nan(""));
-      t.note = moved + " makes the model's response non-finite: no consider term, no interval";
-      terms.push_back(t);
-      continue;
-    }
-    if (!(d.squaredNorm() > 0)) {
-      t.shift = VectorXd::Zero(P);
-      t.note = moved + " does not change the model's outputs at the estimate: its consider term is 0";
-      terms.push_back(t);
-      continue;
-    }
+  const auto shift = [&](const VectorXd& d) {
     const VectorXd sk = ldlt.solve(Gk.transpose() * (w.asDiagonal() * d));
-    t.shift = VectorXd::Zero(P);
-    for (Eigen::Index a = 0; a < K; ++a) t.shift[keep[static_cast<std::size_t>(a)]] = sk[a];
-    terms.push_back(t);
-  }
+    VectorXd out = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) out[keep[static_cast<std::size_t>(a)]] = sk[a];
+    return out;
+  };
+  for (auto& t : declared_consider_terms(p.scenario, P, flat(Y0), outputs, shift)) terms.push_back(std::move(t));
   return terms;
 }
 

@@ -9,11 +9,13 @@
 #include <stdexcept>
 
 #include "scoleid/identify/door/run_door.h"
+#include "scoleid/identify/inverse/frf_misfit.h"
 #include "scoleid/identify/inverse/joint_misfit.h"
 #include "scoleid/identify/inverse/modal_misfit.h"
 #include "scoleid/identify/point_failure.h"
 #include "scoleid/identify/run/assessment.h"
 #include "scoleid/identify/run/fit_plot.h"
+#include "scoleid/identify/run/frf_run.h"
 #include "scoleid/identify/run/identify_run.h"
 #include "scoleid/identify/run/strategy.h"
 #include "scoleid/io/error.h"
@@ -33,6 +35,16 @@ bool ExperimentsResult::converged() const {
 
 namespace {
 
+// A run's fit test in its experiment's entry: the verdict, its message, each channel's residual RMS.
+void take_fit(const FitTest& f, ExperimentsResult::Experiment& x) {
+  x.explains_data = f.explains_data;
+  x.fit_message = f.message;
+  for (const auto& s : f.sensors) {
+    x.channels.push_back(s.name);
+    x.residual_rms.push_back(s.rms_residual);
+  }
+}
+
 // A time run's part of the joint result at the estimate: its fit test, residual RMS per sensor and,
 // with compute_std, its own Fisher information.
 FisherInformation time_experiment(Problem& p, Objective& obj, const VectorXd& estimate, bool compute_std,
@@ -41,17 +53,25 @@ FisherInformation time_experiment(Problem& p, Objective& obj, const VectorXd& es
   x.kind = "time";
   x.data_source = p.data_source;
   x.data_values = static_cast<long>(p.data.t.size()) * p.data.sensors();
-  const FitTest f = test_fit(p, obj, estimate);
-  x.explains_data = f.explains_data;
-  x.fit_message = f.message;
-  for (const auto& s : f.sensors) {
-    x.channels.push_back(s.name);
-    x.residual_rms.push_back(s.rms_residual);
-  }
+  take_fit(test_fit(p, obj, estimate), x);
   if (compute_std) {
     fi = fisher_information(obj, sensors_with_noise(p), estimate);
   }
   x.counters = obj.counters();
+  return fi;
+}
+
+// A frequency-domain run's part at the estimate: its fit test (frf_run.h), residual RMS per channel
+// (in the FRF's unit) and, with compute_std, its Fisher information.
+FisherInformation frf_experiment(Problem& p, FrfMisfit& m, const VectorXd& estimate, bool compute_std,
+                                 ExperimentsResult::Experiment& x) {
+  FisherInformation fi;
+  x.kind = "frf";
+  x.data_source = p.data_source;
+  x.data_values = 2L * p.frf->lines() * static_cast<long>(p.frf->channels.size());
+  take_fit(frf_fit_test(p, m, estimate), x);
+  if (compute_std) fi = frf_fisher(m, estimate);
+  x.factorisations = m.counters().factorisations;
   return fi;
 }
 
@@ -133,8 +153,9 @@ static std::function<void(const IterationRecord&)> progress_printer(const std::v
 
 // Each experiment's cost, share and (with compute_std) its own and the joint Fisher information.
 static void assess_experiments(ExperimentsProblem& ep, const ExperimentsOptions& eo, JointMisfit& joint,
-                        const std::vector<std::unique_ptr<Objective>>& objs, ModalMisfit* modal, int P, double J,
-                        ExperimentsResult& r) {
+                               const std::vector<std::unique_ptr<Objective>>& objs,
+                               const std::vector<std::unique_ptr<FrfMisfit>>& frfs, ModalMisfit* modal, int P, double J,
+                               ExperimentsResult& r) {
   FisherInformation total;
   for (int e = 0; e < joint.components(); ++e) {
     ExperimentsResult::Experiment x;
@@ -143,13 +164,14 @@ static void assess_experiments(ExperimentsProblem& ep, const ExperimentsOptions&
     x.share = J > 0 ? x.cost / J : 0.0;
     const auto u = static_cast<std::size_t>(e);
     const FisherInformation fi =
-        e < static_cast<int>(ep.runs.size())
-            ? time_experiment(*ep.runs[u], *objs[u], r.estimate, eo.compute_std, x)
-            : modal_experiment(*modal, *ep.modes, *ep.spec.modes_file, joint.components(), P, r.estimate,
-                               eo.compute_std, x);
+        e >= static_cast<int>(ep.runs.size())
+            ? modal_experiment(*modal, *ep.modes, *ep.spec.modes_file, joint.components(), P, r.estimate, eo.compute_std, x)
+        : frfs[u] ? frf_experiment(*ep.runs[u], *frfs[u], r.estimate, eo.compute_std, x)
+                  : time_experiment(*ep.runs[u], *objs[u], r.estimate, eo.compute_std, x);
     if (eo.compute_std) {
       x.alone = identifiability_from(fi, r.estimate);
       if (x.kind == "modal") x.alone.noise_source = "the modal data file's stds";
+      if (x.kind == "frf") x.alone.noise_source = "frf";
       total += fi;
     }
     r.experiments.push_back(std::move(x));
@@ -175,17 +197,32 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   // The true values where the data's origin states them (synthetic runs, truth.json beside a data
   // file); measured modes carry none.
   if (!ep.runs.empty()) r.truth = ep.runs.front()->true_values;
-  r.weighting = !ep.runs.empty() && !ep.runs.front()->objective_options.weights.empty() ? "likelihood" : "relative";
-  if (ep.runs.empty()) r.weighting = "likelihood";
+  // Likelihood weights where the door set them (every time run's noise stated, experiments_door.cpp);
+  // frequency-domain runs and modal data are ½χ² of stated variances anyway.
+  r.weighting = "likelihood";
+  for (const auto& p : ep.runs)
+    if (!p->frf && p->objective_options.weights.empty()) r.weighting = "relative";
 
+  // One misfit per run: a time-domain Objective or a frequency-domain FrfMisfit (the other slot null).
   std::vector<std::unique_ptr<Objective>> objs;
+  std::vector<std::unique_ptr<FrfMisfit>> frfs;
   std::vector<JointMisfit::Component> parts;
+  // Several parts are already solved side by side: one thread per sweep or pass over the lines.
+  const bool several = ep.runs.size() + (ep.modes ? 1 : 0) > 1;
   for (std::size_t i = 0; i < ep.runs.size(); ++i) {
     Problem& p = *ep.runs[i];
+    if (p.frf) {
+      FrfMisfitOptions fo;
+      if (several) fo.threads = 1;
+      objs.emplace_back();
+      frfs.push_back(std::make_unique<FrfMisfit>(p.model(), *p.params, *p.frf, p.frf_sensors, p.frf_input, fo));
+      parts.push_back({ep.spec.runs[i].name, frfs.back().get()});
+      continue;
+    }
     ObjectiveOptions oo = p.objective_options;
-    // Several parts are already solved side by side: one thread per sweep.
-    if (ep.runs.size() + (ep.modes ? 1 : 0) > 1) oo.sweep_threads = 1;
+    if (several) oo.sweep_threads = 1;
     objs.push_back(std::make_unique<Objective>(p.model(), *p.params, p.signals, p.data, oo));
+    frfs.emplace_back();
     parts.push_back({ep.spec.runs[i].name, objs.back().get()});
   }
   std::unique_ptr<ModalMisfit> modal;
@@ -217,7 +254,7 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
   }
   r.summary.cost = J;
 
-  assess_experiments(ep, eo, joint, objs, modal.get(), params.size(), J, r);
+  assess_experiments(ep, eo, joint, objs, frfs, modal.get(), params.size(), J, r);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }
@@ -226,8 +263,8 @@ ExperimentsResult run_experiments(ExperimentsProblem& ep, const ExperimentsOptio
 static nlohmann::json interval_json(const ExperimentsResult& r) {
   using nlohmann::json;
   if (r.interval.half_width.size() != r.estimate.size())
-    return "not assessed in a joint run with time records (no half-record refit, no consider terms): std and resolution "
-           "are the Fisher information's of all experiments together";
+    return "not assessed in a joint run with records (no half-record or half-band refit, no consider terms): std and "
+           "resolution are the Fisher information's of all experiments together";
   auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   json iv = json::object();
   for (std::size_t i = 0; i < r.names.size(); ++i) {
@@ -298,9 +335,10 @@ nlohmann::json ExperimentsResult::to_json() const {
                   {"explains_data", e.explains_data},
                   {"fit_message", e.fit_message},
                   {"alone_at_joint_estimate", ident_json(e.alone)},
-                  {"solves", {{"forward", e.counters.forward_solves},
-                              {"costate", e.counters.costate_solves},
-                              {"sensitivity", e.counters.sensitivity_solves}}}});
+                  {"solves", e.kind == "frf" ? json{{"factorisations", e.factorisations}}
+                                             : json{{"forward", e.counters.forward_solves},
+                                                    {"costate", e.counters.costate_solves},
+                                                    {"sensitivity", e.counters.sensitivity_solves}}}});
   }
   out["per_experiment"] = ex;
   json hist = json::array();
@@ -323,20 +361,31 @@ void write_experiments_outputs(io::RunDirectory& dir, ExperimentsProblem& ep, co
   for (const auto& it : r.summary.iterations) cost.emplace_back(it.k, it.cost);
   std::vector<io::DataTable> tables(ep.runs.size());
   std::vector<FitPlot> plots;
+  std::vector<std::string> frf_scripts;
   for (std::size_t i = 0; i < ep.runs.size(); ++i) {
     Problem& p = *ep.runs[i];
     const std::string base = "fit-" + ep.spec.runs[i].name;
+    if (p.frf) {
+      FrfMisfit m(p.model(), *p.params, *p.frf, p.frf_sensors, p.frf_input, FrfMisfitOptions{1});
+      io::write_csv(dir.path(base + ".csv"), frf_fit_table(*p.frf, r.estimate.allFinite() ? m.predict(r.estimate) : Eigen::MatrixXcd()));
+      io::write_text_atomic(dir.path(base + ".gp"),
+                            frf_plot_script(*p.frf, p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name,
+                                            r.name + ": " + ep.spec.runs[i].name, base + ".csv", base + ".png"));
+      frf_scripts.push_back(base + ".gp");
+      continue;
+    }
     Objective obj(p.model(), *p.params, p.signals, p.data, p.objective_options);
     tables[i] = fit_table(p.data, obj.predict(r.estimate));
     io::write_csv(dir.path(base + ".csv"), tables[i]);
     io::write_text_atomic(dir.path(base + ".gp"), fit_plot_script(p.data.names, cost, base + ".csv", base + ".png"));
     plots.push_back(FitPlot{&tables[i], p.data.names, cost, base + ".png", {}});
   }
-  // Every run's plot side by side, each from a raw float64 copy of its table.
-  const std::vector<RenderStatus> rendered = render_fit_plots(dir.staging(), plots);
+  // Every run's plot side by side, a time run's from a raw float64 copy of its table.
+  const std::vector<RenderStatus> rendered = render_fit_plots(dir.staging(), plots, frf_scripts);
   for (std::size_t i = 0; i < rendered.size(); ++i)
     if (rendered[i] == RenderStatus::Failed)
-      std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s\n", plots[i].png.c_str());
+      std::fprintf(stderr, "scole-identify: note: gnuplot could not render %s\n",
+                   i < plots.size() ? plots[i].png.c_str() : frf_scripts[i - plots.size()].c_str());
   if (ep.modes) {
     ModalMisfit modal(ep.modes_structure->model(), *ep.modes_params, *ep.modes);
     const auto matches = modal.matches(r.estimate);

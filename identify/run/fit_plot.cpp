@@ -1,6 +1,7 @@
 #include "scoleid/identify/run/fit_plot.h"
 
 #include <algorithm>
+#include <complex>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -169,6 +170,53 @@ std::vector<RenderStatus> render_fit_plots(const std::string& dir, const std::ve
   }
   all.insert(all.end(), scripts.begin(), scripts.end());
   return render_gnuplot(dir, all);
+}
+
+io::DataTable frf_fit_table(const io::FrfData& d, const Eigen::MatrixXcd& model) {
+  io::DataTable tab;
+  tab.t = d.f_hz;
+  tab.time_name = "frequency_hz";
+  const bool have_model = model.rows() == d.lines() && model.cols() == static_cast<Eigen::Index>(d.channels.size());
+  for (std::size_t s = 0; s < d.channels.size(); ++s) {
+    const auto& ch = d.channels[s];
+    const std::string& n = ch.sensor;
+    tab.names.insert(tab.names.end(), {n + "_measured_re", n + "_measured_im", n + "_model_re", n + "_model_im", n + "_measured_magnitude",
+                                       n + "_model_magnitude", n + "_measured_phase_deg", n + "_model_phase_deg", n + "_std"});
+    std::vector<std::vector<double>> c(9);
+    for (std::size_t k = 0; k < d.f_hz.size(); ++k) {
+      const std::complex<double> hm = ch.H[k];
+      const std::complex<double> hp = have_model ? model(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(s))
+                                                 : std::complex<double>(std::nan(""), std::nan(""));
+      const double vals[9] = {hm.real(), hm.imag(), hp.real(), hp.imag(), std::abs(hm), std::abs(hp),
+                              std::arg(hm) * 180.0 / M_PI, std::arg(hp) * 180.0 / M_PI, std::sqrt(ch.variance[k])};
+      for (int j = 0; j < 9; ++j) c[static_cast<std::size_t>(j)].push_back(vals[j]);
+    }
+    for (auto& col : c) tab.columns.push_back(std::move(col));
+  }
+  return tab;
+}
+
+std::string frf_plot_script(const io::FrfData& d, const std::string& input, const std::string& title, const std::string& csv,
+                            const std::string& png) {
+  const auto S = d.channels.size();
+  const std::string file = gnuplot_quote(csv);
+  std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * S + 60) + " noenhanced\nset output " + gnuplot_quote(png) +
+                   "\nset datafile separator ','\nset multiplot layout " + std::to_string(S) + ",2 title " +
+                   gnuplot_quote(title + " (FRFs per unit of '" + input + "'" +
+                                 (d.decay > 0 ? ", at s = " + io::format_value(std::round(d.decay * 1e3) / 1e3) + "/s + i omega: windowed" : std::string()) + ")") +
+                   "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\nset xrange [" +
+                   io::format_value(d.f_hz.front()) + ":" + io::format_value(d.f_hz.back()) + "]\n";
+  for (std::size_t s = 0; s < S; ++s) {
+    const std::string& n = d.channels[s].sensor;
+    const int base = 2 + 9 * static_cast<int>(s);
+    gp += "set logscale y\nset format y '%g'\nset yrange [*:*]\nset title " + gnuplot_quote(n + ": |H|") + "\nplot " + file + " every ::1 using 1:" +
+          std::to_string(base + 4) + " with points pt 7 ps 0.4 title 'measured', '' every ::1 using 1:" + std::to_string(base + 5) +
+          " with lines lw 2 title 'model at the estimate'\n";
+    gp += "unset logscale y\nset yrange [-180:180]\nset ytics 90\nset title " + gnuplot_quote(n + ": phase [deg]") +
+          "\nplot " + file + " every ::1 using 1:" + std::to_string(base + 6) + " with points pt 7 ps 0.4 title 'measured', '' every ::1 using 1:" +
+          std::to_string(base + 7) + " with lines lw 2 title 'model'\nset ytics autofreq\n";
+  }
+  return gp + "unset multiplot\n";
 }
 
 }  // namespace scoleid::identify

@@ -112,8 +112,9 @@ void print_iteration(const Problem& p, const IterationRecord& r) {
   for (int i = 0; i < P; ++i) io::progress(" %13.6g", r.q[i]);
   io::progress(" %13.6e %10.4g\n", r.cost, r.horizon);
 }
+}  // namespace
 
-// Fisher information of the weighted residuals (all lines) at q.
+// Fisher information of the weighted residuals (all lines) at q (frf_run.h).
 FisherInformation frf_fisher(FrfMisfit& m, const VectorXd& q) {
   m.set_horizon(m.data_end());
   VectorXd r;
@@ -133,7 +134,6 @@ FisherInformation frf_fisher(FrfMisfit& m, const VectorXd& q) {
   fi.stated_noise = true;
   return fi;
 }
-}  // namespace
 
 namespace {
 // The measured FRFs' resonance peaks: local maxima of P_k = Σ_s |Ĥ_ks|² / Σ_k' |Ĥ_k's|² that are the
@@ -261,6 +261,40 @@ void half_band_refit(const Problem& p, FrfMisfit& m, const OptimizerOptions& o, 
 }
 }  // namespace
 
+// The declared tolerances' consider terms (frf_run.h; assessment.h): the outputs are the weighted
+// residuals of every line at q̂, so an output change d is the weighted change of the model's FRFs,
+// and the estimate's response to it (JₖᵀJₖ)⁻¹Jₖᵀ d over the parameters with a finite std.
+std::vector<ConsiderTerm> frf_consider_terms(const Problem& p, FrfMisfit& m, const Identifiability& id, const VectorXd& q) {
+  if (p.scenario.identification.uncertain.empty()) return {};
+  m.set_horizon(m.data_end());
+  VectorXd r0;
+  MatrixXd J;
+  m.residuals(q, r0, &J);
+  const int P = static_cast<int>(q.size());
+  std::vector<int> keep;
+  for (int i = 0; i < P; ++i)
+    if (std::isfinite(id.std[i])) keep.push_back(i);
+  const auto K = static_cast<Eigen::Index>(keep.size());
+  MatrixXd Jk(J.rows(), K);
+  for (Eigen::Index a = 0; a < K; ++a) Jk.col(a) = J.col(keep[static_cast<std::size_t>(a)]);
+  const Eigen::LDLT<MatrixXd> ldlt(Jk.transpose() * Jk);
+  const auto outputs = [&](const io::Scenario& sc) {
+    const auto st = make_structure(sc, sc.identification.elements);
+    const auto params = st->parameterize(sc);
+    FrfMisfit moved(st->model(), *params, *p.frf, p.frf_sensors, p.frf_input, FrfMisfitOptions{1});
+    VectorXd r;
+    moved.residuals(q, r);
+    return r;
+  };
+  const auto shift = [&](const VectorXd& d) {
+    const VectorXd sk = ldlt.solve(Jk.transpose() * d);
+    VectorXd out = VectorXd::Zero(P);
+    for (Eigen::Index a = 0; a < K; ++a) out[keep[static_cast<std::size_t>(a)]] = sk[a];
+    return out;
+  };
+  return declared_consider_terms(p.scenario, P, r0, outputs, shift);
+}
+
 RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto& id = p.scenario.identification;
@@ -304,6 +338,7 @@ RunResult run_frf_identification(Problem& p, const RunOptions& ro) {
       IntervalInputs in;
       in.estimate = r.estimate;
       half_band_refit(p, m, o, r, in);
+      in.consider = frf_consider_terms(p, m, r.ident, r.estimate);
       r.interval = uncertainty_interval(r.ident, in);
       flag_wide_intervals(r);
       r.identifiability_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ti).count();

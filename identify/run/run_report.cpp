@@ -594,57 +594,6 @@ MatrixXd predicted_outputs(Problem& p, const RunResult& r) {
   return obj.predict(r.estimate);
 }
 
-namespace {
-// A frequency-domain run's fit.csv: per line, per sensor the measured and model FRF (real and
-// imaginary parts, magnitude, phase in degrees) and the measured value's standard deviation.
-io::DataTable frf_table(const Problem& p, const RunResult& r) {
-  const io::FrfData& d = *p.frf;
-  io::DataTable tab;
-  tab.t = d.f_hz;
-  tab.time_name = "frequency_hz";
-  for (std::size_t s = 0; s < d.channels.size(); ++s) {
-    const auto& ch = d.channels[s];
-    const std::string& n = ch.sensor;
-    tab.names.insert(tab.names.end(), {n + "_measured_re", n + "_measured_im", n + "_model_re", n + "_model_im", n + "_measured_magnitude",
-                                       n + "_model_magnitude", n + "_measured_phase_deg", n + "_model_phase_deg", n + "_std"});
-    std::vector<std::vector<double>> c(9);
-    for (std::size_t k = 0; k < d.f_hz.size(); ++k) {
-      const std::complex<double> hm = ch.H[k];
-      const std::complex<double> hp = r.frf_model.rows() == d.lines() ? r.frf_model(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(s))
-                                                                        : std::complex<double>(std::nan(""), std::nan(""));
-      const double vals[9] = {hm.real(), hm.imag(), hp.real(), hp.imag(), std::abs(hm), std::abs(hp),
-                              std::arg(hm) * 180.0 / M_PI, std::arg(hp) * 180.0 / M_PI, std::sqrt(ch.variance[k])};
-      for (int j = 0; j < 9; ++j) c[static_cast<std::size_t>(j)].push_back(vals[j]);
-    }
-    for (auto& col : c) tab.columns.push_back(std::move(col));
-  }
-  return tab;
-}
-
-// fit.gp for a frequency-domain run: per sensor the magnitude (log-log) and the phase, measured
-// (points) and model at the estimate (line).
-std::string frf_plot_script(const Problem& p, const RunResult& r) {
-  const io::FrfData& d = *p.frf;
-  const auto S = d.channels.size();
-  std::string gp = "set terminal pngcairo size 1200," + std::to_string(300 * S + 60) +
-                   " noenhanced\nset output 'fit.png'\nset datafile separator ','\nset multiplot layout " + std::to_string(S) +
-                   ",2 title " + gnuplot_quote(plot_title(r) + " (FRFs per unit of '" + p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name + "'" +
-                                 (p.frf->decay > 0 ? ", at s = " + io::format_value(std::round(p.frf->decay * 1e3) / 1e3) + "/s + i omega: windowed" : std::string()) + ")") +
-                   "\nset grid\nset key top right\nset xlabel 'frequency [Hz]'\nset logscale x\nset xrange [" +
-                   io::format_value(d.f_hz.front()) + ":" + io::format_value(d.f_hz.back()) + "]\n";
-  for (std::size_t s = 0; s < S; ++s) {
-    const std::string& n = d.channels[s].sensor;
-    const int base = 2 + 9 * static_cast<int>(s);
-    gp += "set logscale y\nset format y '%g'\nset yrange [*:*]\nset title " + gnuplot_quote(n + ": |H|") + "\nplot 'fit.csv' every ::1 using 1:" +
-          std::to_string(base + 4) + " with points pt 7 ps 0.4 title 'measured', '' every ::1 using 1:" + std::to_string(base + 5) +
-          " with lines lw 2 title 'model at the estimate'\n";
-    gp += "unset logscale y\nset yrange [-180:180]\nset ytics 90\nset title " + gnuplot_quote(n + ": phase [deg]") +
-          "\nplot 'fit.csv' every ::1 using 1:" + std::to_string(base + 6) + " with points pt 7 ps 0.4 title 'measured', '' every ::1 using 1:" +
-          std::to_string(base + 7) + " with lines lw 2 title 'model'\nset ytics autofreq\n";
-  }
-  return gp + "unset multiplot\n";
-}
-}  // namespace
 
 // spectrum.csv / spectrum.gp: measured and predicted power spectral densities (false: none).
 static bool write_spectrum(io::RunDirectory& dir, const Problem& p, const RunResult& r, const MatrixXd& predicted, const std::string& title) {
@@ -713,8 +662,9 @@ static bool write_start_frf(io::RunDirectory& dir, const Problem& p, const RunRe
 
 void write_outputs(io::RunDirectory& dir, Problem& p, const RunResult& r) {
   if (p.frf) {
-    io::write_csv(dir.path("fit.csv"), frf_table(p, r));
-    io::write_text_atomic(dir.path("fit.gp"), frf_plot_script(p, r));
+    io::write_csv(dir.path("fit.csv"), frf_fit_table(*p.frf, r.frf_model));
+    io::write_text_atomic(dir.path("fit.gp"), frf_plot_script(*p.frf, p.scenario.inputs[static_cast<std::size_t>(p.frf_input)].name,
+                                                              plot_title(r), "fit.csv", "fit.png"));
     render("fit.png", render_gnuplot(dir.staging(), "fit.gp"));
     io::write_json_atomic(dir.path("identify.json"), r.to_json(p));
     return;

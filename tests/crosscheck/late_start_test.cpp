@@ -145,7 +145,7 @@ TEST(LateStart, ScoleRingingOnOrbit) {
       EXPECT_TRUE(r.ident.identifiable[i]) << r.names[i];
       EXPECT_LT(std::abs(r.estimate[e] / t - 1.0), 1e-3) << r.names[i];
     }
-    if (r.ident.identifiable[i]) EXPECT_LE(std::abs(r.estimate[e] - t), r.interval.half_width[e]) << r.names[i];
+    if (r.ident.identifiable[i]) { EXPECT_LE(std::abs(r.estimate[e] - t), r.interval.half_width[e]) << r.names[i]; }
   }
   // The basis holds the rigid-body modes (at 0 Hz) below the flexible ones.
   ASSERT_FALSE(r.initial_state_hz.empty());

@@ -251,7 +251,7 @@ truth: {segments: 80, anti_alias_hz: 800}
                   pair.median_ratio, pair.median_phase_deg, pair.lines.size());
       EXPECT_EQ(pair.input, "shaker");
       EXPECT_FALSE(pair.lines.empty());
-      if (id == &raw) EXPECT_GT(pair.median_phase_deg, 135.0) << pair.sensor;
+      if (id == &raw) { EXPECT_GT(pair.median_phase_deg, 135.0) << pair.sensor; }
       else EXPECT_LT(pair.median_phase_deg, 45.0) << pair.sensor;
       EXPECT_GT(pair.median_ratio, 1.0 / 3.0) << pair.sensor;
       EXPECT_LT(pair.median_ratio, 3.0) << pair.sensor;

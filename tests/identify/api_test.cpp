@@ -203,7 +203,7 @@ TEST(Api, ConditioningUndoesAnOffsetAFlippedSignAndAScale) {
     }
   }
   for (const auto& j : fixed.to_json()["data_columns"]["sources"])
-    if (j["name"] == "P") EXPECT_EQ(j["conditioning"]["offset_removed"].get<double>(), -23.0) << j.dump();
+    if (j["name"] == "P") { EXPECT_EQ(j["conditioning"]["offset_removed"].get<double>(), -23.0) << j.dump(); }
 }
 
 // offset: {mean_before: T} removes the mean of the samples before T (a pre-trigger), and a T with

@@ -119,6 +119,24 @@ TEST(BeamDamping, DampedModesHandleOverdampingAndRigidBodies) {
   EXPECT_NEAR(g[0].zeta, 0.0, 1e-12);
 }
 
+TEST(BeamDamping, DampedModesKeepALowElasticModeOfAStiffModel) {
+  // M = I, K = diag(0, 4, 1e14), D = diag(0, 0.2, 0.2): a rigid-body motion, an elastic mode at
+  // ω = 2 (ζ = 0.2/(2·2) = 0.05) and one at 1e7. The elastic mode lies under 1e-6 ω_max = 10, as a
+  // fine mesh's fundamental does; the rigid-body floor (rigid_floor, 1e-4 √(1e-6·1e14) = 1) keeps it
+  // and leaves out the rigid-body roots.
+  const MatrixXd M = MatrixXd::Identity(3, 3);
+  const MatrixXd K = VectorXd((VectorXd(3) << 0.0, 4.0, 1e14).finished()).asDiagonal();
+  const MatrixXd D = VectorXd((VectorXd(3) << 0.0, 0.2, 0.2).finished()).asDiagonal();
+  EXPECT_DOUBLE_EQ(rigid_floor(M.sparseView(), K.sparseView()), 1.0);
+  const auto r = damped_modes(M, D, K);
+  ASSERT_EQ(r.size(), 2u);
+  // The shifted problem gives ω² to ε σ ≈ 2e-8 absolute (modal.h): ω = 2 to about 5e-9.
+  EXPECT_NEAR(r[0].omega, 2.0, 1e-7);
+  EXPECT_NEAR(r[0].zeta, 0.05, 1e-7);
+  EXPECT_NEAR(r[0].omega_d, 2.0 * std::sqrt(1.0 - 0.05 * 0.05), 1e-7);
+  EXPECT_NEAR(r[1].omega / 1e7, 1.0, 1e-12);
+}
+
 // ------------------------------------------------------------------ 2. the slope-product matrix
 
 TEST(BeamDamping, SlopeProductElementMatrixHasItsClosedForm) {

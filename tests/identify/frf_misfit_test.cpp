@@ -103,7 +103,7 @@ TEST(FrfMisfit, TipReceptanceMatchesEulerBernoulliAndConvergesWithTheMesh) {
       worst = std::max(worst, std::abs(H(static_cast<Eigen::Index>(k), 0).real() / exact - 1.0));
     }
     std::printf("elements %2d: worst relative error %.3e\n", elements, worst);
-    if (previous > 0) EXPECT_LT(worst, previous / 8.0) << "cubic Hermite elements: frequencies converge as h^4";
+    if (previous > 0) { EXPECT_LT(worst, previous / 8.0) << "cubic Hermite elements: frequencies converge as h^4"; }
     previous = worst;
   }
   EXPECT_LT(previous, 1e-4);
@@ -127,7 +127,7 @@ TEST(FrfMisfit, AtADecayTheTipReceptanceIsEulerBernoullisAtTheComplexFrequency) 
       worst = std::max(worst, std::abs(H(static_cast<Eigen::Index>(k), 0) / exact - 1.0));
     }
     std::printf("elements %2d: worst relative error at s = %g + i omega %.3e\n", elements, a, worst);
-    if (previous > 0) EXPECT_LT(worst, previous / 8.0);
+    if (previous > 0) { EXPECT_LT(worst, previous / 8.0); }
     previous = worst;
   }
   EXPECT_LT(previous, 1e-4);

@@ -13,6 +13,9 @@
 #include "scoleid/identify/inverse/joint_misfit.h"
 #include "scoleid/identify/door/experiments_door.h"
 #include "scoleid/identify/door/run_door.h"
+#include "scoleid/identify/run/experiments.h"
+#include "scoleid/identify/run/identify_run.h"
+#include "scoleid/io/scenario.h"
 #include "scoleid/io/error.h"
 #include "test_support.h"
 
@@ -384,6 +387,129 @@ identification:
   EXPECT_NE(m6.find("identification.model"), std::string::npos) << m6;
   EXPECT_NE(m6.find("e6.yaml"), std::string::npos) << m6;
   for (const std::string& m : {m1, m2, m3, m4, m5, m6}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+// Frequency-domain runs in a joint run (identification.domain: frequency; docs/theory.md §6.5,
+// §6.10), on the clamped strip of tests/data/scenarios/frf_run_test/multisine.yaml (FE-synthetic,
+// 16 elements, the identifier 8):
+//   - one such run alone is the frequency-domain run: the same estimate to a hundredth of its std
+//     and the same std (the same misfit, ½χ² of the FRFs' variances, and Fisher information);
+//   - two runs (the multisine read at the tip and mid-span; a second multisine, another band and
+//     another accelerometer): every parameter within 1 % of the truth, at the two runs' estimates
+//     combined by their Fisher informations, each experiment explaining its data, each joint std
+//     below either run's alone;
+//   - a time run without stated noise beside a frequency-domain run is refused (no common scale).
+std::string strip_run(const std::string& name, const std::string& signal, const std::string& sensors, int seed) {
+  return "name: " + name + R"(
+structure: beam
+units: SI
+beam:
+  length: 0.5
+  left: clamped
+  right: free
+  rho_A: 0.58875
+  EI: 11.25
+  zeta: 0.05
+  attachments:
+    - {name: shaker, location: 0.40, mass: 0.060}
+inputs:
+  - {name: F, at: beam, kind: force, location: 0.40, unit: N, signal: )" + signal + R"(}
+sensors:
+)" + sensors + "simulation: {duration: 12, sample_interval: 0.0009765625, record_start: 4, seed: " + std::to_string(seed) + R"(}
+identification:
+  estimate: [EI, rho_A, zeta]
+  initial: {EI: 13.5, rho_A: 0.47, zeta: 0.06}
+  elements: 8
+  domain: frequency
+  frf: {estimator: auto, segment: 0, overlap: 0.5, window: hann}
+)";
+}
+
+TEST(Experiments, FrequencyDomainRunsJoinAsTheirOwnChiSquare) {
+  Scratch s;
+  const std::string a = s.write("a.yaml", strip_run("strip-a", "{type: multisine, amplitude: 0.5, period: 1, f0: 1, f1: 120}",
+                                                    "  - {name: acc_tip, at: beam, kind: acceleration, location: 0.45, unit: m/s^2, noise_std: 0.02}\n"
+                                                    "  - {name: acc_mid, at: beam, kind: acceleration, location: 0.25, unit: m/s^2, noise_std: 0.02}\n",
+                                                    2));
+  s.write("b.yaml", strip_run("strip-b", "{type: multisine, amplitude: 0.3, period: 1, f0: 2, f1: 90}",
+                              "  - {name: acc_35, at: beam, kind: acceleration, location: 0.35, unit: m/s^2, noise_std: 0.03}\n", 5));
+  ExperimentsOptions eo;
+  eo.verbose = false;
+
+  // One run alone: the frequency-domain run's estimate and std.
+  auto single = make_problem(io::load_scenario(a), std::nullopt);
+  RunOptions ro;
+  ro.verbose = false;
+  const RunResult rs = run_identification(*single, ro);
+  ASSERT_TRUE(rs.converged()) << rs.summary.message << " / " << rs.fit.message;
+  auto one = make_experiments(load_experiments(s.write("one.yaml", "experiments: one\nruns:\n  - {name: a, scenario: a.yaml}\n")));
+  const ExperimentsResult r1 = run_experiments(*one, eo);
+  ASSERT_TRUE(r1.converged()) << r1.summary.message;
+  EXPECT_EQ(r1.weighting, "likelihood");
+  ASSERT_EQ(r1.experiments.size(), 1u);
+  EXPECT_EQ(r1.experiments[0].kind, "frf");
+  EXPECT_GT(r1.experiments[0].factorisations, 0);
+  EXPECT_EQ(r1.experiments[0].explains_data, rs.fit.explains_data) << r1.experiments[0].fit_message;
+  for (std::size_t i = 0; i < r1.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    std::printf("%-6s joint of one %.9g  frequency-domain run %.9g  std %.3g / %.3g\n", r1.names[i].c_str(), r1.estimate[e],
+                rs.estimate[e], r1.ident.std[e], rs.ident.std[e]);
+    EXPECT_LE(std::abs(r1.estimate[e] - rs.estimate[e]), 0.01 * rs.ident.std[e]) << r1.names[i];
+    EXPECT_NEAR(r1.ident.std[e] / rs.ident.std[e], 1.0, 1e-3) << r1.names[i];
+  }
+
+  // Two runs together.
+  auto two = make_experiments(load_experiments(
+      s.write("two.yaml", "experiments: two\nruns:\n  - {name: a, scenario: a.yaml}\n  - {name: b, scenario: b.yaml}\n")));
+  const ExperimentsResult r2 = run_experiments(*two, eo);
+  for (const auto& x : r2.experiments)
+    std::printf("%-3s %s, share %.3f, %ld values: %s\n", x.name.c_str(), x.kind.c_str(), x.share, x.data_values, x.fit_message.c_str());
+  ASSERT_TRUE(r2.converged()) << r2.summary.message;
+  ASSERT_EQ(r2.experiments.size(), 2u);
+  for (const auto& x : r2.experiments) {
+    EXPECT_EQ(x.kind, "frf");
+    EXPECT_TRUE(x.explains_data) << x.name << ": " << x.fit_message;
+  }
+  // The sum of the two ½χ²: its minimum is, to the misfits' quadratic approximation, the two runs'
+  // estimates combined with their Fisher informations as weights. Each run's estimate carries its
+  // own discretisation bias (8 elements against data made on 16: 5e-4 to 1e-3, beyond the noise's
+  // std), which the combination weighs as the joint fit does.
+  auto b_alone = make_problem(io::load_scenario((s.dir / "b.yaml").string()), std::nullopt);
+  const RunResult rb = run_identification(*b_alone, ro);
+  ASSERT_TRUE(rb.converged()) << rb.summary.message << " / " << rb.fit.message;
+  const Eigen::MatrixXd Fa = rs.ident.covariance.inverse(), Fb = rb.ident.covariance.inverse();
+  const Eigen::VectorXd combined = (Fa + Fb).ldlt().solve(Fa * rs.estimate + Fb * rb.estimate);
+  for (std::size_t i = 0; i < r2.names.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    const double truth = r2.truth.at(r2.names[i]);
+    std::printf("%-6s joint %.7g (%+.2e)  a %.7g  b %.7g  combined %.7g  std joint %.3g, a alone %.3g, b alone %.3g\n", r2.names[i].c_str(),
+                r2.estimate[e], r2.estimate[e] / truth - 1.0, rs.estimate[e], rb.estimate[e], combined[e], r2.ident.std[e],
+                r2.experiments[0].alone.std[e], r2.experiments[1].alone.std[e]);
+    EXPECT_TRUE(r2.ident.identifiable[i]) << r2.names[i];
+    EXPECT_LT(std::abs(r2.estimate[e] / truth - 1.0), 1e-2) << r2.names[i];
+    EXPECT_LE(std::abs(r2.estimate[e] - combined[e]), 0.1 * std::abs(rs.estimate[e] - rb.estimate[e]) + r2.ident.std[e]) << r2.names[i];
+    EXPECT_LT(r2.ident.std[e], r2.experiments[0].alone.std[e]) << r2.names[i];
+    EXPECT_LT(r2.ident.std[e], r2.experiments[1].alone.std[e]) << r2.names[i];
+  }
+  const nlohmann::json j = r2.to_json();
+  EXPECT_EQ(j["per_experiment"][0]["kind"], "frf");
+  EXPECT_TRUE(j["per_experiment"][0]["solves"].contains("factorisations"));
+  EXPECT_TRUE(j["identifiability"]["interval"].is_string());
+
+  // A time run whose noise is not stated beside them: refused, naming the run and its sensor.
+  std::string time_run = strip_run("strip-t", "{type: multisine, amplitude: 0.5, period: 1, f0: 1, f1: 120}",
+                                   "  - {name: acc_t, at: beam, kind: acceleration, location: 0.45, unit: m/s^2}\n", 7);
+  time_run.replace(time_run.find("  domain: frequency\n"), 20, "");
+  time_run.replace(time_run.find("  frf: {"), time_run.find("\n", time_run.find("  frf: {")) + 1 - time_run.find("  frf: {"), "");
+  s.write("t.yaml", time_run);
+  const std::string m = input_error([&] {
+    make_experiments(load_experiments(s.write("mixed.yaml", "experiments: mixed\nruns:\n  - {name: a, scenario: a.yaml}\n  - {name: t, scenario: t.yaml}\n")));
+  });
+  std::printf("%s\n", m.c_str());
+  EXPECT_NE(m.find("runs[1] (t)"), std::string::npos) << m;
+  EXPECT_NE(m.find("frequency-domain"), std::string::npos) << m;
+  EXPECT_NE(m.find("acc_t"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
 
 // The joint run's method at its door: gauss-newton-krylov needs every run's matrix-free products,

@@ -324,7 +324,7 @@ TEST(PointElements, ALumpedAttachmentConvergesAtFourthOrder) {
     SCOPED_TRACE("mode " + std::to_string(k + 1));
     for (const auto& e : err) EXPECT_GT(e[static_cast<std::size_t>(k)], -5e-9);
     EXPECT_LT(std::abs(err.back()[static_cast<std::size_t>(k)]), 5e-6);
-    if (err[1][static_cast<std::size_t>(k)] > 1e-6) EXPECT_NEAR(std::log2(err[1][static_cast<std::size_t>(k)] / err[2][static_cast<std::size_t>(k)]), 4.0, 0.3);
+    if (err[1][static_cast<std::size_t>(k)] > 1e-6) { EXPECT_NEAR(std::log2(err[1][static_cast<std::size_t>(k)] / err[2][static_cast<std::size_t>(k)]), 4.0, 0.3); }
   }
   // Its four quantities are named, estimable parameters.
   const auto values = io::structure_parameters(sc);

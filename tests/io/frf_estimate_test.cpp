@@ -486,7 +486,7 @@ TEST(ImpactFrf, TheWindowedRatioIsTheTransferFunctionAtAComplexFrequency) {
     // The response left at the record's end, r^(n−200) e^{−aT}: 0.15 of its start unwindowed (the
     // transform's wrap-around spoils the ratio), 3e-10 under e^{−5t}.
     std::printf("a = %g 1/s: largest relative error %.2e\n", a, worst);
-    if (a > 0) EXPECT_LT(worst, 1e-6);
+    if (a > 0) { EXPECT_LT(worst, 1e-6); }
     else EXPECT_GT(worst, 1e-2);
   }
 }

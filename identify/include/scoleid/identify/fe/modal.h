@@ -45,9 +45,12 @@ double dense_eigen_seconds(int n, bool vectors);
 //   omega_d = Im λ, the damped frequency
 // One entry per complex-conjugate pair (Im λ > 0). A real root is an entry of its own with
 // omega = |λ|, zeta = ±1 (sign of −λ), omega_d = 0: an overdamped mode shows as two such entries,
-// a damped rigid-body motion as one. Roots with |λ| < 1e-6 ω_max, ω_max the largest undamped
-// frequency (√ of the largest |eigenvalue| of M⁻¹K), are rigid-body roots and are left out (the
-// solvers place an exact zero at about √ε ω_max ≈ 1.5e-8 ω_max). Ascending in omega.
+// a damped rigid-body motion as one. Roots below a floor are rigid-body roots and are left out:
+// on the symmetric path below, rigid_floor (natural_modes' floor, about 1e-7 ω_max: the shifted
+// problem puts an exact zero at √(ε σ), and a fine mesh's lowest elastic modes lie above it); on
+// the general path 1e-6 ω_max, ω_max the largest undamped frequency (√ of the largest |eigenvalue|
+// of M⁻¹K), where the unshifted solver puts an exact zero at about √ε ω_max ≈ 1.5e-8 ω_max.
+// Ascending in omega.
 //
 // Method. When M and K are symmetric and K + σM is positive definite (FE models; σ = 1e-6
 // max_i K_ii/M_ii as in natural_modes), the undamped modes Φ (M-orthonormal, Φᵀ K Φ = Λ) come from

@@ -4,6 +4,9 @@
 // mirror test of sectional profiles, the other-minimum test of the attempts, the half-record refit, the smoothing shift of a prior, the
 // consider terms of the declared uncertainties and of the identifier's own discretisation, and from
 // them the uncertainty interval (interval.h); a parameter whose interval is too wide is flagged.
+#include <functional>
+#include <vector>
+
 #include "scoleid/identify/run/identify_run.h"
 
 namespace scoleid::identify {
@@ -21,6 +24,17 @@ void assess_estimate(const Problem& problem, Objective& objective, const Optimiz
 // record's ObjectiveOptions::sweep_threads (the numbers do not depend on it).
 IntervalInputs assessment_refits(const Problem& problem, Objective& objective, const OptimizerOptions& options,
                                  const VectorXd& estimate, int sweep_threads = 0);
+
+// The consider terms of the scenario's declared tolerances (identification.uncertain; interval.h)
+// at an estimate, whatever the data: for each, the scenario moved by its tolerance on both sides
+// (one side at the edge of its valid range; a switch to its alternative), `outputs` of the model
+// built from the moved scenario (a flat vector as `y0`, the outputs at the scenario's own values),
+// their change d, and `shift(d)` the estimate's least-squares response to it (F⁻¹ Gᵀ W d over the
+// parameters the Fisher test kept). A change that is zero or not finite gets a shift of 0 or NaN
+// and a note saying so.
+std::vector<ConsiderTerm> declared_consider_terms(const io::Scenario& scenario, int parameters, const VectorXd& y0,
+                                                  const std::function<VectorXd(const io::Scenario&)>& outputs,
+                                                  const std::function<VectorXd(const VectorXd&)>& shift);
 
 // The Fisher information of data filtered to identification.band (band_filter.h): scaled by the
 // filter's noise gain g, and the systematic residual counted beyond the noise's χ² band for g N

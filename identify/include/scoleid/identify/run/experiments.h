@@ -1,13 +1,14 @@
 #pragma once
 // Several experiments identified together (docs/theory.md §6.5): one parameter vector fitted to
-// several time-domain runs — each with its own inputs, sensors and data — and optionally to
-// measured modes, the cost the sum of theirs (inverse/joint_misfit.h).
+// several runs — each with its own inputs, sensors and data, in the time domain or, when its
+// scenario says identification.domain: frequency, as FRFs (frf_run.h, inverse/frf_misfit.h) — and
+// optionally to measured modes, the cost the sum of theirs (inverse/joint_misfit.h).
 //
 // The experiments file (YAML; paths relative to the file):
 //   experiments: NAME                 # names the run
 //   description: "..."
 //   threads: 0                        # concurrent experiment solves; 0 = the machine's threads
-//   runs:                             # time-domain runs (may be empty with modes)
+//   runs:                             # time- or frequency-domain runs (may be empty with modes)
 //     - {name: pulse, scenario: pulse.yaml | built-in name, data: pulse/truth.csv}   # data optional
 //   modes: {file: modes.csv, scenario: model.yaml}   # optional; scenario default: the first run's
 // Every run estimates the same parameters from the same starting values (checked); the first
@@ -20,17 +21,20 @@
 // weights are those of the likelihood instead: R_kk = n / (σ_k² W), n the run's samples and
 // W = E∫ñ² the integral of the data interpolant of unit white noise over the record
 // (Measurements::white_noise_integral), so white noise of the stated level adds ½ per sample to J
-// in expectation, as it does to ½χ²: the runs and the modal ½χ² are on one scale. Modal data
-// combined with a run whose noise level is not stated is refused. With relative weights the
+// in expectation, as it does to ½χ²: the runs and the modal ½χ² are on one scale. A
+// frequency-domain run's misfit is ½χ² of its FRFs' variances already. Modal data or a
+// frequency-domain run combined with a time run whose noise level is not stated is refused. With relative weights the
 // reported std, the Cramér–Rao bound, may be optimistic (identify.json says so). Every setting of
 // the fit (method, tolerances, continuation) is the first run's (or the modes scenario's).
 //
 // Convergence: the optimiser stopped on a convergence test AND every experiment explains its data
-// (a time run by its fit test, fit_test.h; modal data when their χ² lies within ν + 3√(2ν), ν the
+// (a time run by its fit test, fit_test.h; a frequency-domain run by frf_fit_test, frf_run.h;
+// modal data when their χ² lies within ν + 3√(2ν), ν the
 // residuals less one per unit-normalised shape, less P when the modes are the only data).
 // Identifiability: the Fisher informations add (independent noise), so the joint std comes from
 // Σ_e F_e; each experiment's own F_e at the joint estimate tells what it determines alone. No
-// half-record refit and no consider terms are run (the single-run interval, interval.h).
+// half-record (or half-band) refit and no consider terms are run (the single-run interval,
+// interval.h): identify.json says so in place of an interval.
 #include <memory>
 #include <optional>
 #include <string>
@@ -83,7 +87,7 @@ struct ExperimentsResult {
   int threads = 1;
   std::string weighting;  // "relative" | "likelihood"
   struct Experiment {
-    std::string name, kind, data_source;  // kind: "time" | "modal"
+    std::string name, kind, data_source;  // kind: "time" | "frf" | "modal"
     double cost = 0;                      // J_e at the estimate
     double share = 0;                     // J_e / J
     long data_values = 0;
@@ -92,7 +96,8 @@ struct ExperimentsResult {
     bool explains_data = false;
     std::string fit_message;
     Identifiability alone;                // this experiment's Fisher information alone, at the joint estimate
-    ObjectiveCounters counters;
+    ObjectiveCounters counters;           // a time run's solves
+    long factorisations = 0;              // a frequency-domain run's: complex LU factorisations, one per line and pass
   };
   std::vector<Experiment> experiments;
   Identifiability ident;  // joint

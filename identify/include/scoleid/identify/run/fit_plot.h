@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "scoleid/io/data_files.h"
+#include "scoleid/io/frf_data.h"
 
 namespace scoleid::identify {
 
@@ -36,6 +37,16 @@ struct FitPlotAnnotations {
 std::string fit_plot_script(const std::vector<std::string>& sensors, const std::vector<std::pair<int, double>>& cost,
                             const std::string& csv = "fit.csv", const std::string& png = "fit.png",
                             const FitPlotAnnotations& notes = {}, int binary_columns = 0);
+
+// A frequency-domain fit's table: per line, per channel the measured and model FRF (real and
+// imaginary parts, magnitude, phase in degrees) and the measured value's standard deviation; the
+// model columns NaN when `model` (lines × channels) is empty.
+io::DataTable frf_fit_table(const io::FrfData& data, const Eigen::MatrixXcd& model);
+// Its script: reads `csv` (frf_fit_table's columns) and writes `png`, per channel the magnitude
+// (log-log) and the phase, measured (points) and model at the estimate (line); `input` names what
+// the FRFs are per unit of.
+std::string frf_plot_script(const io::FrfData& data, const std::string& input, const std::string& title, const std::string& csv,
+                            const std::string& png);
 
 // The table as raw float64 rows (t, then every column; machine byte order), which gnuplot reads
 // several times faster than CSV: parsing the text was most of a long record's rendering time. The

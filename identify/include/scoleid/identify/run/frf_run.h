@@ -10,7 +10,9 @@
 // half of the band (the lines up to the middle one, from q̂): a model error that grows with
 // frequency — a frequency error growing with mode number, as a lumped or coarse model's does —
 // moves the estimate between the band and its lower half, as a time-domain model error moves it
-// between the record and its first half. Declared uncertainties are refused at the door. Outputs: identify.json as the time-domain run's (with an "frf" block), fit.csv
+// between the record and its first half. Declared uncertainties (identification.uncertain) add their
+// consider terms (interval.h): the model rebuilt with each moved by its tolerance, the change of the
+// weighted residuals of every line, and the estimate's least-squares response to it. Outputs: identify.json as the time-domain run's (with an "frf" block), fit.csv
 // (per line and sensor: measured and model real, imaginary, magnitude and phase, the value's std),
 // fit.png (magnitude and phase, measured and model).
 //
@@ -27,5 +29,10 @@ namespace scoleid::identify {
 
 RunResult run_frf_identification(Problem& p, const RunOptions& options);
 FitTest frf_fit_test(const Problem& p, FrfMisfit& misfit, const VectorXd& q);
+// The Fisher information JᵀJ of the weighted residuals of every line at q (the noise the FRFs'
+// variances, so stated): the run's, and a frequency-domain experiment's in a joint run.
+FisherInformation frf_fisher(FrfMisfit& misfit, const VectorXd& q);
+// The consider terms of the scenario's declared tolerances at q (above; none without them).
+std::vector<ConsiderTerm> frf_consider_terms(const Problem& p, FrfMisfit& misfit, const Identifiability& ident, const VectorXd& q);
 
 }  // namespace scoleid::identify
