@@ -24,6 +24,7 @@
 #include "scoleid/io/structure_parameters.h"
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/truth.h"
+#include "common/truth_support.h"
 
 using namespace scoleid;
 
@@ -78,7 +79,7 @@ truth: {segments: 40}
 
 TEST(Bench, OneShakerRecordGivesTheStripTheClampAndTheFixture) {
   const io::Scenario sc = io::load_scenario("bench-cantilever");
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   const auto exact = identify::analytic::point_element_omegas(sc.beam, 3);
   const std::string opposite =
       "{EI: 7.875, rho_A: 0.765, zeta: 0.0035, supports.left.k_theta: 1060, attachments.shaker.mass: 0.042}";
@@ -251,7 +252,7 @@ TEST(Bench, ALumpedAttachmentOnTheChainMeetsTheExactFrequencies) {
 
 TEST(Bench, OneRecordGivesTheStripAndTheArmatureOnItsStinger) {
   const io::Scenario sc = io::parse_scenario(kArmature, "armature");
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   const auto wall0 = std::chrono::steady_clock::now();
   const Identification id = identify_parameters(sc, DataSource::in_memory(truth.table, "armature truth", truth.meta), {});
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -285,7 +286,7 @@ TEST(Bench, ADriveOnTheArmatureGivesTheStripThroughTheStinger) {
   yaml.replace(at, yaml.find('}', yaml.find("lumped_c", at)) + 1 - at, "initial: {EI: 13.5, rho_A: 0.471, zeta: 0.006}");
   const io::Scenario sc = io::parse_scenario(yaml, "armature drive");
   ASSERT_EQ(sc.inputs[0].attachment, "shaker");
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   const Identification id = identify_parameters(sc, DataSource::in_memory(truth.table, "armature-drive truth", truth.meta), {});
   std::printf("%s", id.FullReport().c_str());
   ASSERT_TRUE(id.converged()) << id.verdict();

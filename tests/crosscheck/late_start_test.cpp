@@ -13,13 +13,14 @@
 #include "scoleid/identify.h"
 #include "scoleid/identify/fe/analytic_beam.h"
 #include "scoleid/truth.h"
+#include "common/truth_support.h"
 
 using namespace scoleid;
 
 TEST(LateStart, TheInitialStateEstimatedGivesTheStripFromARingingRecord) {
   const io::Scenario sc = io::load_scenario("tap-late-start");
   ASSERT_EQ(sc.identification.initial_state, io::InitialState::Estimate);
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   ASSERT_FALSE(truth.table.t.empty());
   EXPECT_NEAR(truth.table.t.front(), sc.simulation.record_start, 1e-9);
 
@@ -63,7 +64,7 @@ TEST(LateStart, TheInitialStateEstimatedGivesTheStripFromARingingRecord) {
 TEST(LateStart, APluckGivesWhatAFreeDecayCan) {
   const io::Scenario sc = io::load_scenario("pluck");
   ASSERT_GT(sc.beam.tip_mass, 0.0);
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   const Identification id = identify_parameters(sc, DataSource::in_memory(truth.table, "pluck truth", truth.meta), {});
   std::printf("%s", id.FullReport().c_str());
   ASSERT_TRUE(id.converged()) << id.verdict();
@@ -95,7 +96,7 @@ TEST(LateStart, APluckGivesWhatAFreeDecayCan) {
   // Without the tip mass.
   io::Scenario bare = sc;
   bare.beam.tip_mass = 0.0;
-  const Truth bare_truth = simulate_truth(bare);
+  const Truth bare_truth = test::identification_truth(bare);
   const Identification b = identify_parameters(bare, DataSource::in_memory(bare_truth.table, "bare pluck truth", bare_truth.meta), {});
   std::printf("%s", b.FullReport().c_str());
   const auto& r = b.result();

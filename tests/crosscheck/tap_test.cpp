@@ -24,6 +24,7 @@
 #include "scoleid/crosscheck/modes.h"
 #include "scoleid/identify.h"
 #include "scoleid/truth.h"
+#include "common/truth_support.h"
 
 using namespace scoleid;
 
@@ -51,7 +52,7 @@ truth: {segments: 80, anti_alias_hz: 800}
 
 TEST(TapTest, FromHandbookAndFarStartsTheStripsParametersAndModesAreFound) {
   const io::Scenario sc = io::parse_scenario(tap_scenario("{EI: 27, rho_A: 0.44, zeta: 0.02}"), "tap test");
-  const Truth truth = simulate_truth(sc);
+  const Truth truth = test::identification_truth(sc);
   crosscheck::ModesOptions mo;
   mo.count = 3;
   mo.levels = 1;
@@ -125,7 +126,7 @@ simulation: {duration: 1.0, sample_interval: 0.0005, seed: 3}
 identification: {estimate: [EI, rho_A, zeta], initial: {EI: 27, rho_A: 0.44, zeta: 0.02}, elements: 16}
 truth: {segments: 80, anti_alias_hz: 800}
 )";
-  const Truth truth = simulate_truth(io::parse_scenario(truth_yaml, "truth.yaml"));
+  const Truth truth = test::identification_truth(io::parse_scenario(truth_yaml, "truth.yaml"));
   std::string lab_yaml = truth_yaml;
   for (std::size_t at; (at = lab_yaml.find(", noise_std: 0.05")) != std::string::npos;) lab_yaml.erase(at, 17);
   const io::Scenario lab = io::parse_scenario(lab_yaml, "lab.yaml");
@@ -195,7 +196,7 @@ simulation: {duration: 1.5, sample_interval: 0.0005, seed: 5}
 identification: {estimate: [EI, rho_A, zeta], initial: {EI: 27, rho_A: 0.44, zeta: 0.02}, elements: 16}
 truth: {segments: 80, anti_alias_hz: 800}
 )";
-  const Truth truth = simulate_truth(io::parse_scenario(yaml, "truth.yaml"));
+  const Truth truth = test::identification_truth(io::parse_scenario(yaml, "truth.yaml"));
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("scoleid-shaker-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   auto write = [&](const std::string& name, double sign, double offset) {

@@ -25,11 +25,6 @@ IDENTIFY = os.path.join(BUILD, "identify", "scole-identify")
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-@pytest.fixture(scope="module")
-def beam_record():
-    return scoleid.truth("paper-beam-1")
-
-
 def test_version_is_the_projects():
     with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
         version = re.search(r"project\(scoleid VERSION ([0-9.]+)", f.read()).group(1)
