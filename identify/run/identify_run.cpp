@@ -22,7 +22,6 @@
 #include "scoleid/identify/run/attempts.h"
 #include "scoleid/identify/run/frf_run.h"
 #include "scoleid/identify/run/strategy.h"
-#include "scoleid/io/error.h"
 #include "scoleid/io/interrupt.h"
 #include "scoleid/io/limits.h"
 
@@ -77,12 +76,10 @@ FitTest test_fit(const Problem& p, Objective& obj, const VectorXd& q, const Matr
           Objective fo(fine->model(), *params, p.signals, p.data, o);
           Yfine = fo.predict(q);
         }
-      } catch (const io::Interrupted&) {
-        fine_error = std::current_exception();
-      } catch (const io::InputError&) {
-        // A model that cannot be refined (its finer mesh): no discretisation estimate.
       } catch (const std::exception& e) {
-        if (point_failure(e)) return;  // nor where the finer model cannot be evaluated
+        // Where the finer model cannot be evaluated at q: no discretisation estimate. Anything
+        // else (an interrupt; an input the door let through, a defect) reaches the caller.
+        if (point_failure(e)) return;
         fine_error = std::current_exception();
       }
     });
