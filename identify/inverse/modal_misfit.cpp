@@ -1,9 +1,11 @@
 #include "scoleid/identify/inverse/modal_misfit.h"
 
 #include <Eigen/SVD>
+#include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -98,6 +100,7 @@ ModalMisfit::ModalMisfit(const StructuralModel& model, const Parameterization& p
   };
   if (!(options_.extra_candidates >= 0)) unchecked("extra_candidates < 0");
   if (!(options_.cluster_tolerance >= 0) || !std::isfinite(options_.cluster_tolerance)) unchecked("cluster_tolerance not >= 0");
+  if (!(options_.sparse_from >= 0)) unchecked("sparse_from < 0");
   // Stations: sensors acting on u.
   Cs_ = MatrixXd::Zero(static_cast<Eigen::Index>(data_.stations.size()), model_.ndof);
   for (std::size_t k = 0; k < data_.stations.size(); ++k) {
@@ -133,7 +136,7 @@ struct Cluster {
 };
 
 struct Spectrum {
-  const MatrixXd& Phi;  // all n modes, M-orthonormal
+  const MatrixXd& Phi;  // the modes computed (all n, or the few of the sparse path), M-orthonormal
   VectorXd lambda;      // ω²
   std::vector<int> flex;        // mode index of flexible mode f
   std::vector<int> cluster_of;  // cluster of flexible mode f
@@ -147,8 +150,7 @@ Spectrum cluster_spectrum(const NaturalModes& nm, const SparseMatrix& D, const M
                           const ModalMisfitOptions& options) {
   Spectrum s{nm.vectors, nm.omega.array().square(), {}, {}, {}, {}, 0};
   const MatrixXd& Phi = s.Phi;
-  const int n = static_cast<int>(Phi.rows());
-  for (int k = 0; k < n; ++k)
+  for (int k = 0; k < nm.omega.size(); ++k)  // every mode, or the few the sparse solver gave
     if (nm.omega[k] > nm.floor) s.flex.push_back(k);
   const int nflex = static_cast<int>(s.flex.size());
   if (nflex < nmeas)
@@ -303,6 +305,67 @@ ClusterDerivative cluster_derivative(const Spectrum& s, const Cluster& C, const 
   return d;
 }
 
+// What Nelson's method needs of one matched mode, once per evaluation: the regularised K − λM
+// (row and column r replaced by the identity's) factorised, M φ and D φ.
+struct NelsonMode {
+  int r = 0;
+  VectorXd Mphi, Dphi;
+  std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu;
+};
+
+NelsonMode nelson_mode(const VectorXd& phi, double lambda, const SparseMatrix& M, const SparseMatrix& K, const SparseMatrix& D,
+                       bool damping) {
+  NelsonMode nmode;
+  phi.cwiseAbs().maxCoeff(&nmode.r);
+  const SparseMatrix A = K - lambda * M;
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<std::size_t>(A.nonZeros()) + 1);
+  for (int j = 0; j < A.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+      if (it.row() != nmode.r && it.col() != nmode.r) t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+  t.emplace_back(nmode.r, nmode.r, 1.0);
+  SparseMatrix Ar(A.rows(), A.cols());
+  Ar.setFromTriplets(t.begin(), t.end());
+  nmode.lu = std::make_unique<Eigen::SparseLU<SparseMatrix>>();
+  nmode.lu->compute(Ar);
+  if (nmode.lu->info() != Eigen::Success)
+    throw std::domain_error("ModalMisfit: Nelson's matrix K - lambda M is singular at a matched mode (a repeated eigenvalue?)");
+  nmode.Mphi = M * phi;
+  if (damping) nmode.Dphi = D * phi;
+  return nmode;
+}
+
+// cluster_derivative's quantities from the cluster's own modes (the sparse path, header): the mean
+// eigenvalue's derivative for any cluster; for a single mode also dφ by Nelson's method, and from
+// it the damping ratio's and the station shape's.
+ClusterDerivative nelson_derivative(const Spectrum& s, const Cluster& C, const NelsonMode* nmode, const MatrixXd& Cs,
+                                    const SparseMatrix& dM, const SparseMatrix& dK, const SparseMatrix& dD, bool damping,
+                                    bool shapes) {
+  ClusterDerivative d;
+  const int m = static_cast<int>(C.modes.size());
+  for (int k : C.modes) {
+    const VectorXd phi = s.Phi.col(k);
+    d.dlambda += phi.dot(dK * phi - s.lambda[k] * (dM * phi)) / m;
+  }
+  d.domega = d.dlambda / (2.0 * C.omega);
+  d.df = d.domega / kTwoPi;
+  if (!damping && !shapes) return d;
+  if (m != 1 || nmode == nullptr) throw std::logic_error("ModalMisfit: Nelson's method on a cluster (the dense path takes it)");
+  const int k = C.modes.front();
+  const VectorXd phi = s.Phi.col(k);
+  const VectorXd dMphi = dM * phi;
+  VectorXd F = -(dK * phi - s.lambda[k] * dMphi - d.dlambda * nmode->Mphi);
+  F[nmode->r] = 0.0;
+  const VectorXd v = nmode->lu->solve(F);
+  const VectorXd dphi = v + (-nmode->Mphi.dot(v) - 0.5 * phi.dot(dMphi)) * phi;
+  if (damping) {
+    const double tr_dD = phi.dot(dD * phi);
+    d.dzeta = (tr_dD + 2.0 * nmode->Dphi.dot(dphi)) / (2.0 * C.omega) - C.zeta * d.domega / C.omega;
+  }
+  if (shapes) d.dY = Cs * dphi;
+  return d;
+}
+
 // The weighted residuals of the matched modes (frequency, damping ratio, unit station shape with
 // its sign), the matches, and per measured mode what the shape derivatives need.
 VectorXd modal_residuals(const Spectrum& s, const io::ModalData& data, const std::vector<VectorXd>& measured_shape,
@@ -339,9 +402,11 @@ VectorXd modal_residuals(const Spectrum& s, const io::ModalData& data, const std
 
 // ∂r/∂q: per parameter direction, the derivative of every matched cluster (cluster_derivative),
 // then of each residual row.
-MatrixXd modal_jacobian(const StructuralModel& model, const Spectrum& s, const SparseMatrix& D, const MatrixXd& dcdq,
-                        const io::ModalData& data, int rows_per_mode, const std::vector<int>& partner,
-                        const std::vector<ShapeMatch>& shape) {
+// With `few` (the sparse path, header) the clusters' derivatives from their own modes
+// (nelson_derivative), otherwise from every mode (cluster_derivative).
+MatrixXd modal_jacobian(const StructuralModel& model, const Spectrum& s, const SparseMatrix& M, const SparseMatrix& K,
+                        const SparseMatrix& D, const MatrixXd& Cs, bool few, const MatrixXd& dcdq, const io::ModalData& data,
+                        int rows_per_mode, const std::vector<int>& partner, const std::vector<ShapeMatch>& shape) {
   const bool damping = data.has_damping(), shapes = data.has_shapes();
   const int nmeas = static_cast<int>(data.modes.size());
   const Eigen::Index ns = static_cast<Eigen::Index>(data.stations.size());
@@ -355,7 +420,13 @@ MatrixXd modal_jacobian(const StructuralModel& model, const Spectrum& s, const S
     if (std::find(used.begin(), used.end(), j) == used.end()) used.push_back(j);
   }
   std::vector<MatrixXd> W(used.size());  // Φᵀ D Φ_c, for tr(Φ_cᵀ D dΦ_c)
-  if (damping)
+  std::vector<NelsonMode> nelson(used.size());
+  if (few && (damping || shapes))
+    for (std::size_t u = 0; u < used.size(); ++u) {
+      const Cluster& C = s.cl[static_cast<std::size_t>(used[u])];
+      nelson[u] = nelson_mode(s.Phi.col(C.modes.front()), s.lambda[C.modes.front()], M, K, D, damping);
+    }
+  if (damping && !few)
     for (std::size_t u = 0; u < used.size(); ++u) {
       const Cluster& C = s.cl[static_cast<std::size_t>(used[u])];
       MatrixXd DPc(n, static_cast<Eigen::Index>(C.modes.size()));
@@ -369,8 +440,11 @@ MatrixXd modal_jacobian(const StructuralModel& model, const Spectrum& s, const S
     const SparseMatrix dM = along(model.mass, dc, n);
     const SparseMatrix dK = along(model.stiffness, dc, n);
     const SparseMatrix dD = damping ? along(model.damping, dc, n) : SparseMatrix(n, n);
-    for (std::size_t u = 0; u < used.size(); ++u)
-      cd[u] = cluster_derivative(s, s.cl[static_cast<std::size_t>(used[u])], W[u], dM, dK, dD, damping, shapes);
+    for (std::size_t u = 0; u < used.size(); ++u) {
+      const Cluster& C = s.cl[static_cast<std::size_t>(used[u])];
+      cd[u] = few ? nelson_derivative(s, C, nelson[u].lu ? &nelson[u] : nullptr, Cs, dM, dK, dD, damping, shapes)
+                  : cluster_derivative(s, C, W[u], dM, dK, dD, damping, shapes);
+    }
     for (int i = 0; i < nmeas; ++i) {
       const auto& md = data.modes[static_cast<std::size_t>(i)];
       const int j = s.cluster_of[static_cast<std::size_t>(partner[static_cast<std::size_t>(i)])];
@@ -409,24 +483,56 @@ const ModalMisfit::Evaluation& ModalMisfit::evaluate(const VectorXd& q, bool der
   const SparseMatrix M = model_.assemble(model_.mass, c);
   const SparseMatrix D = model_.assemble(model_.damping, c);
   const SparseMatrix K = model_.assemble(model_.stiffness, c);
-  const NaturalModes nm = natural_modes(M, K);
-  ++counters_.evaluations;
-  if (!nm.omega.allFinite() || !nm.vectors.allFinite())
-    throw std::domain_error("ModalMisfit: the eigenproblem has no finite solution at this q");
-  const Spectrum s = cluster_spectrum(nm, D, Cs_, nmeas, data_.has_shapes(), options_);
+  // The modes: the few the matching needs where that pays (header), else every one.
+  const bool derivative_of_shapes = data_.has_shapes() || data_.has_damping();
+  const int needed = nmeas + options_.extra_candidates + 1;  // the candidates and one above them
+  NaturalModes nm;
+  bool few = false;
+  if (model_.ndof >= options_.sparse_from && 8 * (needed + 6) <= model_.ndof) {
+    LowestModesOptions lo;
+    lo.flexible = needed;
+    lo.tolerance = options_.sparse_tolerance;
+    try {
+      nm = lowest_modes(M, K, lo);
+      few = nm.omega.size() < model_.ndof;
+    } catch (const LowestModesFailure&) {
+      few = false;  // the dense solution below
+    }
+  }
   std::vector<double> mac_of;
-  const std::vector<int> partner = pair_modes(s, data_, measured_shape_, mac_of);
+  std::vector<int> partner;
+  std::unique_ptr<Spectrum> s;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (!few) nm = natural_modes(M, K);
+    ++counters_.evaluations;
+    if (few) ++counters_.sparse_evaluations;
+    if (!nm.omega.allFinite() || !nm.vectors.allFinite())
+      throw std::domain_error("ModalMisfit: the eigenproblem has no finite solution at this q");
+    s = std::make_unique<Spectrum>(cluster_spectrum(nm, D, Cs_, nmeas, data_.has_shapes(), options_));
+    partner = pair_modes(*s, data_, measured_shape_, mac_of);
+    if (!few) break;
+    // The sparse path holds where every matched cluster is complete among the computed modes and,
+    // where shapes or damping are differentiated, a single mode (Nelson's method).
+    const int last_cluster = s->cluster_of.back();
+    bool holds = true;
+    for (int f : partner) {
+      const int j = s->cluster_of[static_cast<std::size_t>(f)];
+      if (j == last_cluster || (derivative_of_shapes && s->cl[static_cast<std::size_t>(j)].modes.size() > 1)) holds = false;
+    }
+    if (holds) break;
+    few = false;
+  }
 
   Evaluation& e = last_;
   e.q = q;
   std::vector<ShapeMatch> shape;
-  e.r = modal_residuals(s, data_, measured_shape_, rows_per_mode_, partner, mac_of, shape, e.matches);
+  e.r = modal_residuals(*s, data_, measured_shape_, rows_per_mode_, partner, mac_of, shape, e.matches);
   e.J = 0.5 * e.r.squaredNorm();
   e.has_jacobian = false;
   e.jacobian.resize(0, 0);
   if (!std::isfinite(e.J)) throw std::domain_error("ModalMisfit: the misfit is not finite at this q");
   if (derivatives) {
-    e.jacobian = modal_jacobian(model_, s, D, dcdq, data_, rows_per_mode_, partner, shape);
+    e.jacobian = modal_jacobian(model_, *s, M, K, D, Cs_, few, dcdq, data_, rows_per_mode_, partner, shape);
     e.has_jacobian = true;
     if (!e.jacobian.allFinite()) throw std::domain_error("ModalMisfit: the Jacobian is not finite at this q");
   }

@@ -65,10 +65,24 @@
 // shape components is then the Gauss–Newton approximation with a fixed. All of it costs one
 // dense eigensolve and O(n² P) per matched mode per evaluation.
 //
+// Large models (options.sparse_from degrees of freedom or more, when the modes the matching needs —
+// the candidates and one above them — are at most an eighth of them): those modes alone from the
+// sparse solver (fe/lowest_modes.h), and the modal expansion above, which needs every mode, replaced
+// by Nelson's method for each matched single mode k (φ M-orthonormal, λ = ω²):
+//   dλ = φᵀ (K' − λ M') φ,
+//   (K − λ M) v = −(K' − λ M' − dλ M) φ  with v_r = 0,  r the largest component of φ (the
+//          singular system made regular by taking out row and column r: one sparse LU per mode and
+//          evaluation, one solve per parameter direction),
+//   dφ = v + c φ,  c = −φᵀ M v − ½ φᵀ M' φ   (the normalisation φᵀ M φ = 1 kept),
+// which is the same derivative, exactly. Frequencies need no dφ. A matched cluster of repeated
+// eigenvalues with shapes or damping, or a cluster the computed modes may cut, takes the dense
+// solution of every mode instead (Nelson's method needs a distinct eigenvalue).
+//
 // No time record: the horizon is fixed at data_end() = 1 (misfit.h); the misfit profile is the one
 // point {t: 1, misfit: 2J/N}.
 #include <vector>
 
+#include "scoleid/identify/fe/lowest_modes.h"
 #include "scoleid/identify/fe/structural_model.h"
 #include "scoleid/identify/inverse/misfit.h"
 #include "scoleid/identify/inverse/parameterization.h"
@@ -79,10 +93,16 @@ namespace scoleid::identify {
 struct ModalMisfitOptions {
   int extra_candidates = 6;         // model modes beyond the number measured that may be matched
   double cluster_tolerance = 1e-6;  // relative eigenvalue difference below which modes are one cluster
+  int sparse_from = kSparseModesFrom;  // degrees of freedom from which the few modes needed may come from the sparse solver (above)
+  // The sparse solver's relative residual per mode (lowest_modes' tolerance). The misfit's rounding
+  // is what the optimiser's line search and a difference quotient see: the vectors' error, about
+  // this, enters the shape residuals divided by their std.
+  double sparse_tolerance = 1e-11;
 };
 
 struct ModalMisfitCounters {
-  int evaluations = 0;  // dense eigensolves
+  int evaluations = 0;         // eigensolves, dense or sparse
+  int sparse_evaluations = 0;  // of which the few modes needed, from the sparse solver
 };
 
 class ModalMisfit final : public Misfit {
